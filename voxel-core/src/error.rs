@@ -1,0 +1,50 @@
+//! The crate's error type.
+
+use crate::{BlockId, ChunkPos};
+
+/// Everything that can go wrong in `voxel-core`. Each variant names the input at fault.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A block id that the registry does not hold.
+    #[error("unknown block id {0} (the registry holds ids 0..{1})")]
+    UnknownBlock(BlockId, usize),
+    /// A block name that the registry does not hold; `known` lists the names it does hold.
+    #[error("unknown block name {name:?}; known blocks: {known}")]
+    UnknownBlockName {
+        /// The name asked for.
+        name: String,
+        /// Comma-separated list of the registered names.
+        known: String,
+    },
+    /// A local chunk coordinate outside `0..CHUNK_SIZE`.
+    #[error("local coordinate ({x}, {y}, {z}) is outside the chunk (0..32 on each axis)")]
+    LocalOutOfRange {
+        /// x as given
+        x: usize,
+        /// y as given
+        y: usize,
+        /// z as given
+        z: usize,
+    },
+    /// A chunk position whose blocks would lie outside the `i32` world coordinate range.
+    #[error("chunk {0:?} lies outside the i32 world (chunk coordinates must be in -2^26..2^26)")]
+    ChunkOutOfRange(ChunkPos),
+    /// A block definition that breaks a rule of the registry.
+    #[error("invalid block definition {name:?}: {reason}")]
+    InvalidBlockDef {
+        /// The block's name.
+        name: String,
+        /// Which rule it breaks.
+        reason: &'static str,
+    },
+    /// Two blocks with the same name.
+    #[error("a block named {0:?} is already registered")]
+    DuplicateBlockName(String),
+    /// More blocks than a 16-bit id can name.
+    #[error("the registry is full (65536 blocks)")]
+    TooManyBlocks,
+}
+
+/// `Result` with this crate's [`Error`] as the default error.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

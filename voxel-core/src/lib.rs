@@ -1,0 +1,18 @@
+//! Blocks, chunks and worlds of the voxel OIT renderer, and a deterministic noise terrain.
+//!
+//! Nothing here knows about the GPU: `voxel-mesh` and `voxel-render` build on these types.
+//! Coordinates: `y` is up; a chunk is [`CHUNK_SIZE`]³ blocks; world block coordinates are `i32`.
+
+mod block;
+mod chunk;
+mod error;
+mod terrain;
+mod world;
+
+pub use block::{BlockDef, BlockId, BlockRegistry, RenderClass, blocks};
+pub use chunk::{
+    CHUNK_AREA, CHUNK_SIZE, CHUNK_VOLUME, Chunk, ColumnMask, Occupancy, column_index, row_index,
+};
+pub use error::{Error, Result};
+pub use terrain::{Site, SiteKind, TerrainConfig, TerrainGenerator};
+pub use world::{ChunkPos, Face, World, WorldPos};

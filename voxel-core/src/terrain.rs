@@ -1,0 +1,482 @@
+//! Deterministic terrain from a seed: a 2D fBm heightmap (hills), a sea, sand shores, trees
+//! with leaf canopies, and glass structures on the shore so that views through glass onto
+//! water exist. Only 2D noise: nothing here needs caves or overhangs.
+//!
+//! Every chunk is generated on its own (so chunks can be generated in parallel): trees and
+//! structures that straddle chunk borders are placed by hashing world positions, and each
+//! chunk writes the part that falls inside it.
+
+use std::sync::Arc;
+
+use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
+use rayon::prelude::*;
+
+use crate::blocks::*;
+use crate::{BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, World};
+
+/// Parameters of the generator. `Default` gives the world the demo and tests use.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TerrainConfig {
+    /// Seed of every noise and hash: the same seed gives the same world.
+    pub seed: u32,
+    /// World y of the sea surface: empty blocks at or below it are water. 24 puts the sea
+    /// inside the lowest chunk layer so that a 2-chunk-high world holds hills and sea.
+    pub sea_level: i32,
+    /// Mean ground height. 26: a little above the sea, so land and sea are both common.
+    pub base_height: i32,
+    /// Ground height varies by about ± this much. 18 keeps hills below y = 50, inside
+    /// two chunk layers.
+    pub amplitude: f64,
+    /// Horizontal size of a hill, in blocks. 110 gives coasts every hundred blocks or so.
+    pub hill_size: f64,
+    /// Fraction of 8×8 tree cells holding a tree (on dry land). 0.3: woods, not a forest.
+    pub tree_density: f64,
+    /// Whether to place glass structures (greenhouses, stained-glass pavilions) on shores.
+    pub structures: bool,
+}
+
+impl Default for TerrainConfig {
+    fn default() -> Self {
+        Self {
+            seed: 1,
+            sea_level: 24,
+            base_height: 26,
+            amplitude: 18.0,
+            hill_size: 110.0,
+            tree_density: 0.3,
+            structures: true,
+        }
+    }
+}
+
+/// What stands on a [`Site`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SiteKind {
+    /// An 11×9 clear-glass house with a wooden frame, a green-glass partition and bushes
+    /// (leaves) inside.
+    Greenhouse,
+    /// A 9×9 pavilion on a platform whose four walls are red, blue, green and clear glass.
+    Pavilion,
+}
+
+/// A structure placed on a shore.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Site {
+    /// Which structure.
+    pub kind: SiteKind,
+    /// World position of the centre of its floor (the first block above the floor slab).
+    pub center: [i64; 3],
+    /// Horizontal direction `(dx, dz)` from the centre in which the sea lies.
+    pub water_dir: [i32; 2],
+}
+
+impl Site {
+    /// Half extents `(x, z)` of the footprint.
+    pub fn half_extent(&self) -> [i64; 2] {
+        match self.kind {
+            SiteKind::Greenhouse => [5, 4],
+            SiteKind::Pavilion => [4, 4],
+        }
+    }
+}
+
+/// Side of the square regions that hold at most one structure each.
+const REGION: i64 = 96;
+/// Side of the square cells that hold at most one tree each.
+const TREE_CELL: i64 = 8;
+/// How far leaves reach from a trunk.
+const CANOPY: i64 = 2;
+
+/// The terrain generator. Cheap to share between threads.
+#[derive(Debug, Clone)]
+pub struct TerrainGenerator {
+    config: TerrainConfig,
+    height: Fbm<Perlin>,
+}
+
+/// splitmix64 over the seed, a position and a salt: the one source of randomness.
+fn hash(seed: u32, x: i64, z: i64, salt: u64) -> u64 {
+    let mut h = u64::from(seed)
+        ^ (x as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ (z as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f)
+        ^ salt.wrapping_mul(0x1656_67b1_9e37_79f9);
+    h = (h ^ (h >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    h = (h ^ (h >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    h ^ (h >> 31)
+}
+
+/// A box of one block in world coordinates, inclusive.
+struct WorldBox {
+    min: [i64; 3],
+    max: [i64; 3],
+    id: BlockId,
+}
+
+fn bx(min: [i64; 3], max: [i64; 3], id: BlockId) -> WorldBox {
+    WorldBox { min, max, id }
+}
+
+impl TerrainGenerator {
+    /// A generator for `config`.
+    pub fn new(config: TerrainConfig) -> Self {
+        let height = Fbm::<Perlin>::new(config.seed)
+            .set_octaves(4)
+            .set_frequency(1.0 / config.hill_size);
+        Self { config, height }
+    }
+
+    /// The configuration this generator was made with.
+    pub fn config(&self) -> &TerrainConfig {
+        &self.config
+    }
+
+    /// World y of the top ground block of column `(x, z)`.
+    pub fn height_at(&self, x: i64, z: i64) -> i64 {
+        let n = self.height.get([x as f64, z as f64]).clamp(-1.0, 1.0);
+        i64::from(self.config.base_height) + (n * self.config.amplitude).round() as i64
+    }
+
+    fn sea(&self) -> i64 {
+        i64::from(self.config.sea_level)
+    }
+
+    /// The structure of region `(rx, rz)`, if its shore has room for one: the first of eight
+    /// hashed spots whose ground is within a few blocks of sea level and that has open water
+    /// 12 blocks away.
+    pub fn site_in_region(&self, rx: i64, rz: i64) -> Option<Site> {
+        if !self.config.structures {
+            return None;
+        }
+        let sea = self.sea();
+        let dirs = [
+            [1, 0],
+            [-1, 0],
+            [0, 1],
+            [0, -1],
+            [1, 1],
+            [-1, 1],
+            [1, -1],
+            [-1, -1],
+        ];
+        (0..8u64).find_map(|k| {
+            let r = hash(self.config.seed, rx, rz, 100 + k);
+            let x = rx * REGION + 16 + (r % (REGION as u64 - 32)) as i64;
+            let z = rz * REGION + 16 + ((r >> 20) % (REGION as u64 - 32)) as i64;
+            let h = self.height_at(x, z);
+            if !(sea - 1..=sea + 3).contains(&h) {
+                return None;
+            }
+            let water_dir = dirs.into_iter().find(|[dx, dz]| {
+                self.height_at(x + 12 * i64::from(*dx), z + 12 * i64::from(*dz)) < sea - 1
+            })?;
+            let kind = if (r >> 40) & 1 == 0 {
+                SiteKind::Greenhouse
+            } else {
+                SiteKind::Pavilion
+            };
+            Some(Site {
+                kind,
+                center: [x, h.max(sea) + 1, z],
+                water_dir,
+            })
+        })
+    }
+
+    /// Every structure whose region overlaps the square `[x0, x1) × [z0, z1)`.
+    pub fn sites_in(&self, x0: i64, z0: i64, x1: i64, z1: i64) -> Vec<Site> {
+        let r = |v: i64| v.div_euclid(REGION);
+        let mut out = Vec::new();
+        for rx in r(x0)..=r(x1 - 1) {
+            for rz in r(z0)..=r(z1 - 1) {
+                out.extend(self.site_in_region(rx, rz));
+            }
+        }
+        out
+    }
+
+    /// Generates the chunk at `pos`. Never panics: positions near the `i32` limits work.
+    pub fn generate_chunk(&self, pos: ChunkPos) -> Chunk {
+        let [ox, oy, oz] = pos.origin();
+        let n = CHUNK_SIZE as i64;
+        let mut chunk = Chunk::default();
+        let sea = self.sea();
+        let local = |y: i64| (y - oy).clamp(0, n) as usize;
+
+        // Ground and sea, a column run at a time.
+        for x in 0..CHUNK_SIZE {
+            for z in 0..CHUNK_SIZE {
+                let h = self.height_at(ox + x as i64, oz + z as i64);
+                let shore = h <= sea + 1;
+                let top = if shore { SAND } else { GRASS };
+                let soil = if shore { SAND } else { DIRT };
+                for (y0, y1, id) in [
+                    (i64::MIN, h - 3, STONE),
+                    (h - 3, h, soil),
+                    (h, h + 1, top),
+                    (h + 1, sea + 1, WATER),
+                ] {
+                    let (a, b) = (local(y0.max(oy)), local(y1));
+                    if a < b {
+                        // In range by construction: a < b <= 32.
+                        let _ = chunk.fill_column(x, z, a..b, id);
+                    }
+                }
+            }
+        }
+
+        let sites = self.sites_in(ox - 16, oz - 16, ox + n + 16, oz + n + 16);
+        let mut boxes = Vec::new();
+        self.trees(ox, oz, &sites, &mut boxes);
+        for site in &sites {
+            structure(site, &mut boxes);
+        }
+        for b in &boxes {
+            let min = [b.min[0] - ox, b.min[1] - oy, b.min[2] - oz].map(|v| v.max(0));
+            let max = [b.max[0] - ox, b.max[1] - oy, b.max[2] - oz].map(|v| v.min(n - 1));
+            if min.iter().zip(&max).all(|(a, b)| a <= b) {
+                // Clipped to the chunk above, so always in range.
+                let _ = chunk.fill_box(min.map(|v| v as usize), max.map(|v| v as usize), b.id);
+            }
+        }
+        chunk
+    }
+
+    /// Trees whose canopy may reach into the chunk at `(ox, oz)`, as boxes (leaves first, so
+    /// the trunk wins where they overlap).
+    fn trees(&self, ox: i64, oz: i64, sites: &[Site], out: &mut Vec<WorldBox>) {
+        let sea = self.sea();
+        let n = CHUNK_SIZE as i64;
+        let cell = |v: i64| v.div_euclid(TREE_CELL);
+        for cx in cell(ox - CANOPY)..=cell(ox + n + CANOPY) {
+            for cz in cell(oz - CANOPY)..=cell(oz + n + CANOPY) {
+                let r = hash(self.config.seed, cx, cz, 1);
+                if (r % 10_000) as f64 >= self.config.tree_density * 10_000.0 {
+                    continue;
+                }
+                let tx = cx * TREE_CELL + 1 + ((r >> 16) % (TREE_CELL as u64 - 2)) as i64;
+                let tz = cz * TREE_CELL + 1 + ((r >> 24) % (TREE_CELL as u64 - 2)) as i64;
+                let near_site = sites.iter().any(|s| {
+                    let [hx, hz] = s.half_extent();
+                    (tx - s.center[0]).abs() <= hx + 4 && (tz - s.center[2]).abs() <= hz + 4
+                });
+                let h = self.height_at(tx, tz);
+                if near_site || h <= sea + 1 {
+                    continue;
+                }
+                let top = h + 4 + ((r >> 32) % 3) as i64;
+                out.push(bx(
+                    [tx - 2, top - 2, tz - 2],
+                    [tx + 2, top - 1, tz + 2],
+                    LEAVES,
+                ));
+                out.push(bx([tx - 1, top, tz - 1], [tx + 1, top, tz + 1], LEAVES));
+                out.push(bx([tx - 1, top + 1, tz], [tx + 1, top + 1, tz], LEAVES));
+                out.push(bx([tx, top + 1, tz - 1], [tx, top + 1, tz + 1], LEAVES));
+                // Corners of the wide layers are cut at random, as trees look less boxy so.
+                for (i, (dx, dz)) in [(-2, -2), (2, -2), (-2, 2), (2, 2)].into_iter().enumerate() {
+                    let y = top - 1 - ((r >> (40 + i)) & 1) as i64;
+                    out.push(bx([tx + dx, y, tz + dz], [tx + dx, top - 1, tz + dz], AIR));
+                }
+                out.push(bx([tx, h + 1, tz], [tx, top, tz], WOOD));
+            }
+        }
+    }
+
+    /// Generates every chunk of the box `min..=max` (chunk coordinates) in parallel into a
+    /// new world over `registry`, which must hold the default blocks' ids.
+    pub fn generate_world(
+        &self,
+        registry: Arc<BlockRegistry>,
+        min: ChunkPos,
+        max: ChunkPos,
+    ) -> crate::Result<World> {
+        let mut positions = Vec::new();
+        for x in min.x..=max.x {
+            for y in min.y..=max.y {
+                for z in min.z..=max.z {
+                    positions.push(ChunkPos::new(x, y, z));
+                }
+            }
+        }
+        let chunks: Vec<_> = positions
+            .into_par_iter()
+            .map(|p| (p, self.generate_chunk(p)))
+            .collect();
+        let mut world = World::new(registry);
+        for (p, c) in chunks {
+            world.insert_chunk(p, c)?;
+        }
+        Ok(world)
+    }
+}
+
+/// The boxes of a structure, in the order they are written.
+fn structure(site: &Site, out: &mut Vec<WorldBox>) {
+    let [cx, fy, cz] = site.center;
+    let [hx, hz] = site.half_extent();
+    let (x0, x1, z0, z1) = (cx - hx, cx + hx, cz - hz, cz + hz);
+    // Clear the volume (terrain, stray leaves), then a plinth so nothing floats.
+    out.push(bx([x0 - 1, fy, z0 - 1], [x1 + 1, fy + 9, z1 + 1], AIR));
+    match site.kind {
+        SiteKind::Greenhouse => {
+            let top = fy + 5;
+            out.push(bx([x0, fy - 4, z0], [x1, fy - 1, z1], STONE));
+            // Glass shell, then the wooden frame on its edges.
+            out.push(bx([x0, fy, z0], [x1, top, z1], GLASS));
+            out.push(bx([x0 + 1, fy, z0 + 1], [x1 - 1, top - 1, z1 - 1], AIR));
+            for (x, z) in [(x0, z0), (x1, z0), (x0, z1), (x1, z1)] {
+                out.push(bx([x, fy, z], [x, top, z], WOOD));
+            }
+            out.push(bx([x0, top, z0], [x1, top, z0], WOOD));
+            out.push(bx([x0, top, z1], [x1, top, z1], WOOD));
+            out.push(bx([x0, top, z0], [x0, top, z1], WOOD));
+            out.push(bx([x1, top, z0], [x1, top, z1], WOOD));
+            // A green glass partition across the middle and bushes on both sides of it.
+            out.push(bx([cx, fy, z0 + 1], [cx, fy + 3, z1 - 1], GREEN_GLASS));
+            out.push(bx([cx - 3, fy, z0 + 1], [cx - 2, fy + 1, z0 + 2], LEAVES));
+            out.push(bx([cx + 2, fy, z1 - 2], [cx + 3, fy + 1, z1 - 1], LEAVES));
+            // Door on the side away from the sea (or -z when the sea lies along x).
+            let dz = if site.water_dir[1] > 0 { z0 } else { z1 };
+            out.push(bx([cx - 2, fy, dz], [cx - 2, fy + 1, dz], AIR));
+        }
+        SiteKind::Pavilion => {
+            let top = fy + 4;
+            out.push(bx([x0, fy - 1, z0], [x1, fy - 1, z1], WOOD));
+            for (x, z) in [(x0, z0), (x1, z0), (x0, z1), (x1, z1)] {
+                out.push(bx([x, fy - 12, z], [x, top, z], WOOD));
+            }
+            out.push(bx([x1, fy, z0 + 1], [x1, top - 1, z1 - 1], RED_GLASS));
+            out.push(bx([x0, fy, z0 + 1], [x0, top - 1, z1 - 1], BLUE_GLASS));
+            out.push(bx([x0 + 1, fy, z1], [x1 - 1, top - 1, z1], GREEN_GLASS));
+            out.push(bx([x0 + 1, fy, z0], [x1 - 1, top - 1, z0], GLASS));
+            out.push(bx([x0, top, z0], [x1, top, z1], STONE));
+            out.push(bx([cx - 1, top, cz - 1], [cx + 1, top, cz + 1], GLASS));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn generator() -> TerrainGenerator {
+        TerrainGenerator::new(TerrainConfig::default())
+    }
+
+    #[test]
+    fn same_seed_same_chunk_other_seed_other_chunk() {
+        let g = generator();
+        let p = ChunkPos::new(3, 0, -2);
+        let a = g.generate_chunk(p).to_dense();
+        assert_eq!(a, g.generate_chunk(p).to_dense());
+        let other = TerrainGenerator::new(TerrainConfig {
+            seed: 2,
+            ..TerrainConfig::default()
+        });
+        assert_ne!(a, other.generate_chunk(p).to_dense());
+    }
+
+    #[test]
+    fn columns_are_stone_soil_top_then_water_or_air() {
+        let g = generator();
+        let sea = i64::from(g.config().sea_level);
+        let c = g.generate_chunk(ChunkPos::new(0, 0, 0));
+        c.check_invariants().unwrap();
+        let mut saw_water = false;
+        let mut saw_grass = false;
+        for x in 0..32 {
+            for z in 0..32 {
+                let h = g.height_at(x as i64, z as i64);
+                // Skip columns a tree or a structure changed.
+                let col: Vec<_> = (0..32).map(|y| c.get(x, y, z).unwrap()).collect();
+                if col.iter().any(|b| [WOOD, LEAVES, GLASS].contains(b)) {
+                    continue;
+                }
+                for (y, b) in col.iter().enumerate() {
+                    let y = y as i64;
+                    let want = if y < h - 3 {
+                        STONE
+                    } else if y < h {
+                        if h <= sea + 1 { SAND } else { DIRT }
+                    } else if y == h {
+                        if h <= sea + 1 { SAND } else { GRASS }
+                    } else if y <= sea {
+                        WATER
+                    } else {
+                        AIR
+                    };
+                    if want != *b && !(y > h && *b == AIR) {
+                        panic!("column ({x},{z}) y {y}: {b} but expected {want} (h {h})");
+                    }
+                }
+                saw_water |= col.contains(&WATER);
+                saw_grass |= col.contains(&GRASS);
+            }
+        }
+        assert!(saw_grass || saw_water);
+    }
+
+    #[test]
+    fn default_world_has_sea_trees_and_both_structures_near_spawn() {
+        let g = generator();
+        let sites = g.sites_in(-384, -384, 384, 384);
+        assert!(
+            sites.iter().any(|s| s.kind == SiteKind::Greenhouse),
+            "{sites:?}"
+        );
+        assert!(
+            sites.iter().any(|s| s.kind == SiteKind::Pavilion),
+            "{sites:?}"
+        );
+        for s in &sites {
+            // Open water lies in the recorded direction: a view through glass onto water.
+            let [dx, dz] = s.water_dir.map(i64::from);
+            assert!(g.height_at(s.center[0] + 12 * dx, s.center[2] + 12 * dz) < 23);
+            // The structure's glass is there in the generated chunk.
+            let pos = ChunkPos::new(
+                (s.center[0].div_euclid(32)) as i32,
+                (s.center[1].div_euclid(32)) as i32,
+                (s.center[2].div_euclid(32)) as i32,
+            );
+            let c = g.generate_chunk(pos);
+            let glass = [GLASS, RED_GLASS, GREEN_GLASS, BLUE_GLASS];
+            assert!(glass.iter().any(|&id| c.count(id) > 0), "{s:?}");
+        }
+        let c = g.generate_chunk(ChunkPos::new(1, 1, 1));
+        let world_leaves: usize = (-3..3)
+            .flat_map(|x| (-3..3).map(move |z| (x, z)))
+            .map(|(x, z)| {
+                (0..2)
+                    .map(|y| g.generate_chunk(ChunkPos::new(x, y, z)).count(LEAVES))
+                    .sum::<usize>()
+            })
+            .sum();
+        assert!(world_leaves > 100, "{world_leaves} leaves");
+        c.check_invariants().unwrap();
+    }
+
+    #[test]
+    fn chunks_at_the_i32_limits_generate() {
+        let g = generator();
+        for p in [
+            ChunkPos::new(ChunkPos::MAX, 0, ChunkPos::MAX),
+            ChunkPos::new(ChunkPos::MIN, ChunkPos::MIN, ChunkPos::MIN),
+            ChunkPos::new(ChunkPos::MIN, ChunkPos::MAX, ChunkPos::MAX),
+        ] {
+            g.generate_chunk(p).check_invariants().unwrap();
+        }
+    }
+
+    #[test]
+    fn deep_and_high_chunks_are_uniform() {
+        let g = generator();
+        assert_eq!(
+            g.generate_chunk(ChunkPos::new(0, -2, 0)).as_uniform(),
+            Some(STONE)
+        );
+        assert_eq!(
+            g.generate_chunk(ChunkPos::new(0, 3, 0)).as_uniform(),
+            Some(AIR)
+        );
+    }
+}

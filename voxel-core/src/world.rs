@@ -1,0 +1,408 @@
+//! Chunks keyed by chunk coordinates, block access by world coordinate, and the dirty set
+//! that tells the mesher what to rebuild.
+
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
+
+use crate::{BlockId, BlockRegistry, CHUNK_SIZE, Chunk, Error, Result};
+
+/// The six face directions, in the order used everywhere (mesher, quads, neighbours).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Face {
+    /// +x
+    PosX = 0,
+    /// -x
+    NegX = 1,
+    /// +y (up)
+    PosY = 2,
+    /// -y (down)
+    NegY = 3,
+    /// +z
+    PosZ = 4,
+    /// -z
+    NegZ = 5,
+}
+
+impl Face {
+    /// All faces, indexed by their discriminant.
+    pub const ALL: [Face; 6] = [
+        Face::PosX,
+        Face::NegX,
+        Face::PosY,
+        Face::NegY,
+        Face::PosZ,
+        Face::NegZ,
+    ];
+
+    /// The face with discriminant `i` (taken modulo nothing: `i` must be below 6).
+    pub fn from_index(i: usize) -> Option<Face> {
+        Self::ALL.get(i).copied()
+    }
+
+    /// The axis of the normal: 0 = x, 1 = y, 2 = z.
+    pub fn axis(self) -> usize {
+        self as usize / 2
+    }
+
+    /// Whether the normal points along +axis.
+    pub fn is_positive(self) -> bool {
+        (self as usize).is_multiple_of(2)
+    }
+
+    /// The outward unit normal.
+    pub fn normal(self) -> [i32; 3] {
+        let mut n = [0; 3];
+        n[self.axis()] = if self.is_positive() { 1 } else { -1 };
+        n
+    }
+
+    /// The face pointing the other way.
+    pub fn opposite(self) -> Face {
+        Self::ALL[self as usize ^ 1]
+    }
+}
+
+/// A block position in the world.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct WorldPos {
+    /// x
+    pub x: i32,
+    /// y (up)
+    pub y: i32,
+    /// z
+    pub z: i32,
+}
+
+impl WorldPos {
+    /// A world position.
+    pub const fn new(x: i32, y: i32, z: i32) -> Self {
+        Self { x, y, z }
+    }
+
+    /// The chunk holding this block and the block's local coordinates in it.
+    /// Defined for every `i32` position (floor division, so -1 is in chunk -1 at local 31).
+    pub fn split(self) -> (ChunkPos, [usize; 3]) {
+        let s = CHUNK_SIZE as i32;
+        let c = ChunkPos::new(
+            self.x.div_euclid(s),
+            self.y.div_euclid(s),
+            self.z.div_euclid(s),
+        );
+        let l = [self.x, self.y, self.z].map(|v| v.rem_euclid(s) as usize);
+        (c, l)
+    }
+}
+
+/// A chunk's position in chunk units: chunk `(1, 0, 0)` holds world x `32..64`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ChunkPos {
+    /// x in chunks
+    pub x: i32,
+    /// y in chunks
+    pub y: i32,
+    /// z in chunks
+    pub z: i32,
+}
+
+impl ChunkPos {
+    /// Smallest chunk coordinate whose blocks fit the `i32` world: -2^26.
+    pub const MIN: i32 = i32::MIN / CHUNK_SIZE as i32;
+    /// Largest chunk coordinate whose blocks fit the `i32` world: 2^26 - 1.
+    pub const MAX: i32 = i32::MAX / CHUNK_SIZE as i32;
+
+    /// A chunk position (not checked: see [`ChunkPos::is_valid`]).
+    pub const fn new(x: i32, y: i32, z: i32) -> Self {
+        Self { x, y, z }
+    }
+
+    /// Whether all of the chunk's blocks have `i32` world coordinates.
+    pub fn is_valid(self) -> bool {
+        [self.x, self.y, self.z]
+            .iter()
+            .all(|v| (Self::MIN..=Self::MAX).contains(v))
+    }
+
+    /// World coordinates of the chunk's block `(0, 0, 0)`, as `i64` so that no chunk
+    /// position overflows.
+    pub fn origin(self) -> [i64; 3] {
+        [self.x, self.y, self.z].map(|v| i64::from(v) * CHUNK_SIZE as i64)
+    }
+
+    /// The adjacent chunk across `face`, or `None` past the edge of the `i32` world.
+    pub fn neighbour(self, face: Face) -> Option<ChunkPos> {
+        let n = face.normal();
+        let p = ChunkPos::new(
+            self.x.checked_add(n[0])?,
+            self.y.checked_add(n[1])?,
+            self.z.checked_add(n[2])?,
+        );
+        p.is_valid().then_some(p)
+    }
+}
+
+/// A sparse world of chunks over one block registry.
+#[derive(Debug, Clone)]
+pub struct World {
+    registry: Arc<BlockRegistry>,
+    chunks: HashMap<ChunkPos, Chunk>,
+    dirty: HashSet<ChunkPos>,
+}
+
+impl World {
+    /// An empty world. Missing chunks read as air.
+    pub fn new(registry: Arc<BlockRegistry>) -> Self {
+        Self {
+            registry,
+            chunks: HashMap::new(),
+            dirty: HashSet::new(),
+        }
+    }
+
+    /// The block registry every chunk's ids refer to.
+    pub fn registry(&self) -> &Arc<BlockRegistry> {
+        &self.registry
+    }
+
+    /// The block at `pos`; air where no chunk is loaded.
+    pub fn get_block(&self, pos: WorldPos) -> BlockId {
+        let (c, [x, y, z]) = pos.split();
+        self.chunks
+            .get(&c)
+            .and_then(|chunk| chunk.get(x, y, z).ok())
+            .unwrap_or(BlockId::AIR)
+    }
+
+    /// Sets the block at `pos` (creating an air chunk if needed) and returns the old one.
+    /// Marks the chunk dirty, and each loaded neighbour whose border the block touches.
+    pub fn set_block(&mut self, pos: WorldPos, id: BlockId) -> Result<BlockId> {
+        if !self.registry.contains(id) {
+            return Err(Error::UnknownBlock(id, self.registry.len()));
+        }
+        let (c, [x, y, z]) = pos.split();
+        if id == BlockId::AIR && !self.chunks.contains_key(&c) {
+            return Ok(BlockId::AIR);
+        }
+        let old = self.chunks.entry(c).or_default().set(x, y, z, id)?;
+        if old != id {
+            self.dirty.insert(c);
+            let last = CHUNK_SIZE - 1;
+            for (face, on_border) in [
+                (Face::PosX, x == last),
+                (Face::NegX, x == 0),
+                (Face::PosY, y == last),
+                (Face::NegY, y == 0),
+                (Face::PosZ, z == last),
+                (Face::NegZ, z == 0),
+            ] {
+                if let Some(n) = c
+                    .neighbour(face)
+                    .filter(|n| on_border && self.chunks.contains_key(n))
+                {
+                    self.dirty.insert(n);
+                }
+            }
+        }
+        Ok(old)
+    }
+
+    /// Puts a whole chunk in place (returning the one it replaces) and marks it and its
+    /// loaded neighbours dirty. Fails on a position outside the `i32` world or a block id the
+    /// registry does not hold.
+    pub fn insert_chunk(&mut self, pos: ChunkPos, chunk: Chunk) -> Result<Option<Chunk>> {
+        if !pos.is_valid() {
+            return Err(Error::ChunkOutOfRange(pos));
+        }
+        if let Some((id, _)) = chunk.palette().find(|(id, _)| !self.registry.contains(*id)) {
+            return Err(Error::UnknownBlock(id, self.registry.len()));
+        }
+        self.mark_with_neighbours(pos);
+        Ok(self.chunks.insert(pos, chunk))
+    }
+
+    /// Unloads a chunk; it and its loaded neighbours become dirty (the mesher then returns
+    /// empty meshes for it).
+    pub fn remove_chunk(&mut self, pos: ChunkPos) -> Option<Chunk> {
+        let old = self.chunks.remove(&pos);
+        if old.is_some() {
+            self.mark_with_neighbours(pos);
+        }
+        old
+    }
+
+    fn mark_with_neighbours(&mut self, pos: ChunkPos) {
+        self.dirty.insert(pos);
+        for face in Face::ALL {
+            if let Some(n) = pos.neighbour(face).filter(|n| self.chunks.contains_key(n)) {
+                self.dirty.insert(n);
+            }
+        }
+    }
+
+    /// The chunk at `pos`, if loaded.
+    pub fn chunk(&self, pos: ChunkPos) -> Option<&Chunk> {
+        self.chunks.get(&pos)
+    }
+
+    /// The six neighbours of `pos` in [`Face`] order; `None` where not loaded.
+    pub fn neighbours(&self, pos: ChunkPos) -> [Option<&Chunk>; 6] {
+        Face::ALL.map(|f| pos.neighbour(f).and_then(|n| self.chunks.get(&n)))
+    }
+
+    /// All loaded chunks, in no particular order.
+    pub fn iter(&self) -> impl Iterator<Item = (ChunkPos, &Chunk)> {
+        self.chunks.iter().map(|(p, c)| (*p, c))
+    }
+
+    /// Number of loaded chunks.
+    pub fn len(&self) -> usize {
+        self.chunks.len()
+    }
+
+    /// Whether no chunk is loaded.
+    pub fn is_empty(&self) -> bool {
+        self.chunks.is_empty()
+    }
+
+    /// Chunks waiting to be remeshed.
+    pub fn dirty(&self) -> &HashSet<ChunkPos> {
+        &self.dirty
+    }
+
+    /// Marks a chunk for remeshing.
+    pub fn mark_dirty(&mut self, pos: ChunkPos) {
+        self.dirty.insert(pos);
+    }
+
+    /// Empties the dirty set and returns it, sorted so that work is reproducible.
+    pub fn take_dirty(&mut self) -> Vec<ChunkPos> {
+        let mut v: Vec<_> = self.dirty.drain().collect();
+        v.sort_unstable();
+        v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::blocks::*;
+
+    fn world() -> World {
+        World::new(Arc::new(BlockRegistry::default()))
+    }
+
+    #[test]
+    fn split_floors_negative_coordinates() {
+        assert_eq!(
+            WorldPos::new(-1, 0, 33).split(),
+            (ChunkPos::new(-1, 0, 1), [31, 0, 1])
+        );
+        let (c, l) = WorldPos::new(i32::MIN, i32::MAX, 0).split();
+        assert_eq!(c, ChunkPos::new(ChunkPos::MIN, ChunkPos::MAX, 0));
+        assert_eq!(l, [0, 31, 0]);
+        assert!(c.is_valid());
+    }
+
+    #[test]
+    fn neighbours_stop_at_the_edge_of_the_i32_world() {
+        let edge = ChunkPos::new(ChunkPos::MAX, 0, ChunkPos::MIN);
+        assert_eq!(edge.neighbour(Face::PosX), None);
+        assert_eq!(edge.neighbour(Face::NegZ), None);
+        assert_eq!(
+            edge.neighbour(Face::NegX),
+            Some(ChunkPos::new(ChunkPos::MAX - 1, 0, ChunkPos::MIN))
+        );
+        assert_eq!(ChunkPos::new(i32::MAX, 0, 0).neighbour(Face::PosX), None);
+        assert_eq!(edge.origin()[0], i64::from(i32::MAX) - 31);
+    }
+
+    #[test]
+    fn set_get_at_the_i32_limits() {
+        let mut w = world();
+        for p in [
+            WorldPos::new(i32::MAX, i32::MAX, i32::MAX),
+            WorldPos::new(i32::MIN, i32::MIN, i32::MIN),
+        ] {
+            w.set_block(p, GLASS).unwrap();
+            assert_eq!(w.get_block(p), GLASS);
+        }
+        assert_eq!(w.len(), 2);
+    }
+
+    #[test]
+    fn unknown_block_is_rejected() {
+        let mut w = world();
+        assert_eq!(
+            w.set_block(WorldPos::new(0, 0, 0), BlockId(500)),
+            Err(Error::UnknownBlock(BlockId(500), 13))
+        );
+        let mut c = Chunk::default();
+        c.set(0, 0, 0, BlockId(77)).unwrap();
+        assert!(matches!(
+            w.insert_chunk(ChunkPos::new(0, 0, 0), c),
+            Err(Error::UnknownBlock(BlockId(77), _))
+        ));
+        assert!(matches!(
+            w.insert_chunk(ChunkPos::new(1 << 26, 0, 0), Chunk::default()),
+            Err(Error::ChunkOutOfRange(p)) if p == ChunkPos::new(1 << 26, 0, 0)
+        ));
+    }
+
+    #[test]
+    fn border_edits_dirty_the_neighbour() {
+        let mut w = world();
+        for x in -1..=1 {
+            w.insert_chunk(ChunkPos::new(x, 0, 0), Chunk::default())
+                .unwrap();
+        }
+        w.take_dirty();
+        // Interior edit: only the chunk itself.
+        w.set_block(WorldPos::new(5, 5, 5), STONE).unwrap();
+        assert_eq!(w.take_dirty(), vec![ChunkPos::new(0, 0, 0)]);
+        // Setting the same block again changes nothing.
+        w.set_block(WorldPos::new(5, 5, 5), STONE).unwrap();
+        assert!(w.take_dirty().is_empty());
+        // Edit on the -x border: the -x neighbour too; the +y neighbour is not loaded.
+        w.set_block(WorldPos::new(0, 31, 5), STONE).unwrap();
+        assert_eq!(
+            w.take_dirty(),
+            vec![ChunkPos::new(-1, 0, 0), ChunkPos::new(0, 0, 0)]
+        );
+        w.set_block(WorldPos::new(31, 3, 3), WATER).unwrap();
+        assert_eq!(
+            w.take_dirty(),
+            vec![ChunkPos::new(0, 0, 0), ChunkPos::new(1, 0, 0)]
+        );
+    }
+
+    #[test]
+    fn insert_and_remove_dirty_neighbours() {
+        let mut w = world();
+        w.insert_chunk(ChunkPos::new(0, 0, 0), Chunk::default())
+            .unwrap();
+        w.take_dirty();
+        w.insert_chunk(ChunkPos::new(0, 1, 0), Chunk::uniform(STONE))
+            .unwrap();
+        assert_eq!(
+            w.take_dirty(),
+            vec![ChunkPos::new(0, 0, 0), ChunkPos::new(0, 1, 0)]
+        );
+        assert!(w.remove_chunk(ChunkPos::new(0, 1, 0)).is_some());
+        assert_eq!(
+            w.take_dirty(),
+            vec![ChunkPos::new(0, 0, 0), ChunkPos::new(0, 1, 0)]
+        );
+        assert!(
+            w.neighbours(ChunkPos::new(0, 0, 0))
+                .iter()
+                .all(Option::is_none)
+        );
+    }
+
+    #[test]
+    fn setting_air_in_a_missing_chunk_loads_nothing() {
+        let mut w = world();
+        assert_eq!(w.set_block(WorldPos::new(1, 2, 3), AIR).unwrap(), AIR);
+        assert!(w.is_empty());
+        assert!(w.dirty().is_empty());
+    }
+}

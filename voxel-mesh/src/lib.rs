@@ -1,0 +1,32 @@
+//! Chunk mesher of the voxel OIT renderer: splits every chunk's visible faces into opaque,
+//! cutout and translucent meshes of 8-byte packed quads, culling against neighbour chunks.
+//!
+//! - [`Mesher`]: one chunk with its neighbours → [`ChunkMeshes`] (binary greedy meshing).
+//! - [`PackedQuad`]: the 8-byte quad format the renderer expands in its vertex shader.
+//! - [`mesh_dirty`]: remesh a world's dirty chunks in parallel with rayon.
+//! - [`sort`]: back-to-front ordering of translucent quads and chunks for a camera.
+
+mod bits;
+mod mesher;
+mod quad;
+pub mod sort;
+mod world;
+
+pub use bits::greedy_rects;
+pub use mesher::{ChunkMeshes, Mesher, Neighbours};
+pub use quad::{PackedQuad, Quad, UV_AXES};
+pub use world::{mesh_chunks, mesh_dirty};
+
+use voxel_core::BlockId;
+
+/// What can go wrong while meshing.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A chunk (or a neighbour) holds a block id that the registry does not know.
+    #[error("a chunk holds block id {0}, which the registry does not know")]
+    UnknownBlock(BlockId),
+}
+
+/// `Result` with this crate's [`Error`] as the default error.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
