@@ -1,1 +1,193 @@
-//! tests
+//! Helpers of the integration tests: a GPU that is never silently missing under CI, small
+//! hand-built scenes, rendering to images, and comparisons that leave pictures behind.
+
+#![allow(clippy::unwrap_used, clippy::missing_panics_doc)] // test support: panics are failures
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use glam::DVec3;
+use voxel_core::{BlockId, BlockRegistry, World, WorldPos};
+use voxel_render::{Camera, GpuContext, Image, Renderer, RendererConfig, Technique, readback};
+
+pub use demo::headless::{Offscreen, renderer_for};
+pub use demo::scene::Scene;
+
+/// A headless Vulkan context (lavapipe on machines without a GPU). Without an adapter, a
+/// test skips with a loud message, unless `CI` is set: then a missing adapter fails.
+pub fn gpu() -> Option<GpuContext> {
+    match GpuContext::headless(wgpu::Backends::VULKAN) {
+        Ok(ctx) => Some(ctx),
+        Err(e) if std::env::var_os("CI").is_some() => {
+            panic!("CI is set but no Vulkan adapter was found ({e}); install mesa-vulkan-drivers")
+        }
+        Err(e) => {
+            eprintln!(
+                "\n!!!! SKIPPING GPU TEST: no Vulkan adapter ({e}). Install mesa-vulkan-drivers. !!!!\n"
+            );
+            None
+        }
+    }
+}
+
+/// `target/test-output/<name>/`, created. Pictures of every test land here.
+pub fn out_dir(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../target/test-output")
+        .join(name);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A world of boxes of blocks (inclusive corners) over the default registry.
+pub fn box_world(boxes: &[([i32; 3], [i32; 3], BlockId)]) -> World {
+    let mut world = World::new(Arc::new(BlockRegistry::default()));
+    for &(min, max, id) in boxes {
+        for x in min[0]..=max[0] {
+            for y in min[1]..=max[1] {
+                for z in min[2]..=max[2] {
+                    world.set_block(WorldPos::new(x, y, z), id).unwrap();
+                }
+            }
+        }
+    }
+    world
+}
+
+/// A scene of `world` seen by one camera at `eye` looking at `target` (fov 60°).
+pub fn scene(name: &str, world: World, eye: [f64; 3], target: [f64; 3]) -> Scene {
+    let camera = Camera::look_at(DVec3::from(eye), DVec3::from(target), 60.0, 0.1, 500.0).unwrap();
+    Scene {
+        name: name.to_owned(),
+        world,
+        cameras: vec![camera],
+    }
+}
+
+/// Renders `scene`'s first camera with `technique` at `width`×`height`.
+pub fn render(
+    ctx: &GpuContext,
+    scene: &Scene,
+    technique: Technique,
+    width: u32,
+    height: u32,
+) -> Image {
+    let mut config = RendererConfig {
+        width,
+        height,
+        ..RendererConfig::default()
+    };
+    config.oit.technique = technique;
+    render_with(ctx, scene, config)
+}
+
+/// Renders `scene`'s first camera with `config`.
+pub fn render_with(ctx: &GpuContext, scene: &Scene, config: RendererConfig) -> Image {
+    let (w, h) = (config.width, config.height);
+    let mut r = renderer_for(ctx, scene, config).unwrap();
+    let target = Offscreen::new(ctx, w, h);
+    demo::headless::render_image(ctx, &mut r, &target, &scene.cameras[0]).unwrap()
+}
+
+/// The renderer's HDR scene colour, as f32 RGBA.
+pub fn read_hdr(ctx: &GpuContext, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
+    let bytes = readback::read_texture(ctx, texture, 8).unwrap();
+    bytes
+        .chunks_exact(8)
+        .map(|p| {
+            let h = |i: usize| readback::f16_to_f32(u16::from_le_bytes([p[i], p[i + 1]]));
+            [h(0), h(2), h(4), h(6)]
+        })
+        .collect()
+}
+
+/// Renders with `renderer` into a fresh target and returns the picture.
+pub fn frame(ctx: &GpuContext, renderer: &mut Renderer, camera: &Camera) -> Image {
+    let (w, h) = renderer.size();
+    let target = Offscreen::new(ctx, w, h);
+    demo::headless::render_image(ctx, renderer, &target, camera).unwrap()
+}
+
+/// Per-channel comparison of two images of the same size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Diff {
+    /// Largest absolute difference of any channel, in 1/255 steps.
+    pub max: u8,
+    /// Pixels whose largest channel difference is above 1/255.
+    pub over_one: usize,
+    /// Pixels that differ at all.
+    pub differing: usize,
+}
+
+/// Compares RGB of `a` and `b`.
+pub fn diff(a: &Image, b: &Image) -> Diff {
+    assert_eq!(
+        (a.width, a.height),
+        (b.width, b.height),
+        "image sizes differ"
+    );
+    let mut d = Diff {
+        max: 0,
+        over_one: 0,
+        differing: 0,
+    };
+    for (p, q) in a.rgba.chunks_exact(4).zip(b.rgba.chunks_exact(4)) {
+        let m = (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap_or(0);
+        d.max = d.max.max(m);
+        d.over_one += usize::from(m > 1);
+        d.differing += usize::from(m > 0);
+    }
+    d
+}
+
+/// A heat map of the per-pixel difference: black where equal, brighter where larger
+/// (scaled so that 16/255 is full red).
+pub fn diff_image(a: &Image, b: &Image) -> Image {
+    let rgba = a
+        .rgba
+        .chunks_exact(4)
+        .zip(b.rgba.chunks_exact(4))
+        .flat_map(|(p, q)| {
+            let m = (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap_or(0);
+            let v = (u32::from(m) * 16).min(255) as u8;
+            [v, if m > 0 { 40 } else { 0 }, 0, 255]
+        })
+        .collect();
+    Image {
+        width: a.width,
+        height: a.height,
+        rgba,
+    }
+}
+
+/// Asserts that `actual` is within `tolerance`/255 of `expected` on every channel. Writes
+/// `actual.png`, `expected.png` and `diff.png` under [`out_dir`]`(name)` either way, so a
+/// person can look; the message says where.
+pub fn assert_close(name: &str, actual: &Image, expected: &Image, tolerance: u8) {
+    let dir = out_dir(name);
+    actual.save_png(&dir.join("actual.png")).unwrap();
+    expected.save_png(&dir.join("expected.png")).unwrap();
+    let d = diff(actual, expected);
+    diff_image(actual, expected)
+        .save_png(&dir.join("diff.png"))
+        .unwrap();
+    assert!(
+        d.max <= tolerance,
+        "{name}: differs by up to {}/255 (tolerance {tolerance}), {} pixels off by more than 1; see {}",
+        d.max,
+        d.over_one,
+        dir.display()
+    );
+}
+
+/// Number of distinct RGB colours: a blank or flat image has very few.
+pub fn distinct_colours(img: &Image) -> usize {
+    let mut v: Vec<[u8; 3]> = img
+        .rgba
+        .chunks_exact(4)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    v.sort_unstable();
+    v.dedup();
+    v.len()
+}

@@ -121,7 +121,7 @@ pub mod blocks {
     pub const WOOD: BlockId = BlockId(5);
     /// Tree canopies: alpha-tested (cutout).
     pub const LEAVES: BlockId = BlockId(6);
-    /// Sea and pools (opacity 0.45).
+    /// Sea and pools (opacity 0.7).
     pub const WATER: BlockId = BlockId(7);
     /// Clear glass (opacity 0.2).
     pub const GLASS: BlockId = BlockId(8);
@@ -235,7 +235,7 @@ impl Default for BlockRegistry {
             BlockDef::new("sand", [219, 205, 150], 1.0),
             BlockDef::new("wood", [110, 80, 45], 1.0),
             BlockDef::cutout("leaves", [60, 130, 45]),
-            BlockDef::new("water", [40, 95, 190], 0.45),
+            BlockDef::new("water", [25, 105, 165], 0.7),
             BlockDef::new("glass", [225, 240, 245], 0.2),
             BlockDef::new("ice", [170, 210, 245], 0.92),
             BlockDef::new("red_glass", [210, 40, 40], 0.5),

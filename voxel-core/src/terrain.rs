@@ -86,6 +86,9 @@ const REGION: i64 = 96;
 const TREE_CELL: i64 = 8;
 /// How far leaves reach from a trunk.
 const CANOPY: i64 = 2;
+/// No tree stands within this many blocks of a structure's footprint: a clearing, so that
+/// the structure can be seen from around it.
+const CLEARING: i64 = 22;
 
 /// The terrain generator. Cheap to share between threads.
 #[derive(Debug, Clone)]
@@ -224,7 +227,8 @@ impl TerrainGenerator {
             }
         }
 
-        let sites = self.sites_in(ox - 16, oz - 16, ox + n + 16, oz + n + 16);
+        let margin = CLEARING + 8;
+        let sites = self.sites_in(ox - margin, oz - margin, ox + n + margin, oz + n + margin);
         let mut boxes = Vec::new();
         self.trees(ox, oz, &sites, &mut boxes);
         for site in &sites {
@@ -257,7 +261,8 @@ impl TerrainGenerator {
                 let tz = cz * TREE_CELL + 1 + ((r >> 24) % (TREE_CELL as u64 - 2)) as i64;
                 let near_site = sites.iter().any(|s| {
                     let [hx, hz] = s.half_extent();
-                    (tx - s.center[0]).abs() <= hx + 4 && (tz - s.center[2]).abs() <= hz + 4
+                    (tx - s.center[0]).abs() <= hx + CLEARING
+                        && (tz - s.center[2]).abs() <= hz + CLEARING
                 });
                 let h = self.height_at(tx, tz);
                 if near_site || h <= sea + 1 {

@@ -1,0 +1,82 @@
+//! Rendering without a window: a headless GPU, an offscreen target, PNG output.
+
+use voxel_mesh::mesh_chunks;
+use voxel_render::{Camera, GpuContext, Image, Renderer, RendererConfig, readback};
+
+use crate::scene::Scene;
+
+/// A headless context on Vulkan (lavapipe on a machine without a GPU), or the backends
+/// named by `WGPU_BACKEND`.
+pub fn context() -> Result<GpuContext, String> {
+    let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
+    GpuContext::headless(backends).map_err(|e| e.to_string())
+}
+
+/// An RGBA8 sRGB texture to render into and read back.
+#[derive(Debug)]
+pub struct Offscreen {
+    /// The texture.
+    pub texture: wgpu::Texture,
+    /// Its view.
+    pub view: wgpu::TextureView,
+}
+
+impl Offscreen {
+    /// A `width` × `height` target.
+    pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Self {
+        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("offscreen_output"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Self { texture, view }
+    }
+
+    /// Reads the target back.
+    pub fn read(&self, ctx: &GpuContext) -> Result<Image, String> {
+        let rgba = readback::read_texture(ctx, &self.texture, 4).map_err(|e| e.to_string())?;
+        Ok(Image {
+            width: self.texture.width(),
+            height: self.texture.height(),
+            rgba,
+        })
+    }
+}
+
+/// A renderer with every chunk of `scene` meshed and uploaded.
+pub fn renderer_for(
+    ctx: &GpuContext,
+    scene: &Scene,
+    config: RendererConfig,
+) -> Result<Renderer, String> {
+    let mut renderer =
+        Renderer::new(ctx, scene.world.registry(), config).map_err(|e| e.to_string())?;
+    let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
+    for (pos, meshes) in mesh_chunks(&scene.world, &positions).map_err(|e| e.to_string())? {
+        renderer.upload_chunk(pos, &meshes);
+    }
+    Ok(renderer)
+}
+
+/// Renders `camera` into `target` and reads the picture back.
+pub fn render_image(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    target: &Offscreen,
+    camera: &Camera,
+) -> Result<Image, String> {
+    renderer
+        .render_and_submit(&target.view, camera)
+        .map_err(|e| e.to_string())?;
+    target.read(ctx)
+}

@@ -1,0 +1,141 @@
+//! The GPU a renderer draws with: the game's own device and queue, or a headless one for
+//! tests and tools, plus the capabilities the renderer adapts to.
+
+use crate::{Error, Result};
+
+/// What the adapter can do that changes how we render. Read once from the adapter.
+#[derive(Clone, Debug)]
+pub struct Capabilities {
+    /// The adapter's name and backend, for logs and reports.
+    pub adapter_name: String,
+    /// Backend in use.
+    pub backend: wgpu::Backend,
+    /// Device type (CPU for lavapipe).
+    pub device_type: wgpu::DeviceType,
+    /// Features enabled on the device.
+    pub features: wgpu::Features,
+    /// Downlevel flags of the adapter (independent blend, fragment storage writes, ...).
+    pub downlevel: wgpu::DownlevelFlags,
+    /// Whether `Rgba16Float` can be rendered to and blended (WBOIT accumulation).
+    pub rgba16f_blendable: bool,
+    /// Whether 4× MSAA works on the scene colour and depth formats.
+    pub msaa4: bool,
+    /// Device limits.
+    pub limits: wgpu::Limits,
+}
+
+impl Capabilities {
+    /// Reads the capabilities of `adapter` for a device created with `features`.
+    pub fn new(adapter: &wgpu::Adapter, features: wgpu::Features, limits: wgpu::Limits) -> Self {
+        let info = adapter.get_info();
+        let f16 = adapter.get_texture_format_features(wgpu::TextureFormat::Rgba16Float);
+        let depth = adapter.get_texture_format_features(crate::DEPTH_FORMAT);
+        let msaa4 = f16
+            .flags
+            .contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_X4)
+            && depth
+                .flags
+                .contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_X4)
+            && f16
+                .flags
+                .contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE);
+        Self {
+            adapter_name: format!("{} ({:?})", info.name, info.backend),
+            backend: info.backend,
+            device_type: info.device_type,
+            features,
+            downlevel: adapter.get_downlevel_capabilities().flags,
+            rgba16f_blendable: f16
+                .allowed_usages
+                .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+                && f16
+                    .flags
+                    .contains(wgpu::TextureFormatFeatureFlags::BLENDABLE),
+            msaa4,
+            limits,
+        }
+    }
+
+    /// Whether timestamp queries at pass boundaries are available.
+    pub fn timestamps(&self) -> bool {
+        self.features.contains(wgpu::Features::TIMESTAMP_QUERY)
+    }
+
+    /// Whether colour targets of one pass may use different blend states (MRT WBOIT).
+    pub fn independent_blend(&self) -> bool {
+        self.downlevel
+            .contains(wgpu::DownlevelFlags::INDEPENDENT_BLEND)
+    }
+
+    /// Whether fragment shaders may write storage buffers (the A-buffer reference).
+    pub fn fragment_storage(&self) -> bool {
+        self.downlevel
+            .contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE)
+    }
+}
+
+/// A device, its queue and its capabilities. Cheap to clone (wgpu handles are shared).
+#[derive(Clone, Debug)]
+pub struct GpuContext {
+    /// The device everything is created on.
+    pub device: wgpu::Device,
+    /// The queue everything is submitted to.
+    pub queue: wgpu::Queue,
+    /// What the adapter can do.
+    pub caps: Capabilities,
+}
+
+/// Optional features the renderer uses when the adapter has them.
+pub const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY;
+
+impl GpuContext {
+    /// Wraps a device the embedding game already owns. `adapter` is the one it came from
+    /// (for capability queries); `device.features()` says which optional features we may use.
+    pub fn from_device(adapter: &wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        let caps = Capabilities::new(adapter, device.features(), device.limits());
+        Self {
+            device,
+            queue,
+            caps,
+        }
+    }
+
+    /// A headless context on the first adapter of `backends` (tests use
+    /// `Backends::VULKAN`, which finds lavapipe on a machine without a GPU). Asks for
+    /// [`WANTED_FEATURES`] where the adapter has them.
+    pub fn headless(backends: wgpu::Backends) -> Result<Self> {
+        pollster::block_on(Self::headless_async(backends))
+    }
+
+    async fn headless_async(backends: wgpu::Backends) -> Result<Self> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = backends;
+        let instance = wgpu::Instance::new(desc);
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| Error::NoAdapter(format!("{backends:?}: {e}")))?;
+        let (device, queue) = request_device(&adapter).await?;
+        Ok(Self::from_device(&adapter, device, queue))
+    }
+}
+
+/// Requests a device with the optional features the adapter has and all of its limits.
+pub async fn request_device(adapter: &wgpu::Adapter) -> Result<(wgpu::Device, wgpu::Queue)> {
+    let features = adapter.features() & WANTED_FEATURES;
+    adapter
+        .request_device(&wgpu::DeviceDescriptor {
+            label: Some("voxel_render_device"),
+            required_features: features,
+            // The adapter's own limits: the A-buffer reference wants large storage buffers.
+            required_limits: adapter.limits(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        })
+        .await
+        .map_err(|e| Error::Device(e.to_string()))
+}

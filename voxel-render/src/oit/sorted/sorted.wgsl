@@ -1,0 +1,7 @@
+// Sorted alpha blending (appended to common.wgsl): seed 003's forward pass. Meshes arrive
+// farthest first; blending is SrcAlpha, OneMinusSrcAlpha into the HDR scene colour.
+
+@fragment
+fn fs_sorted(in: VsOut) -> @location(0) vec4<f32> {
+    return translucent_color(in);
+}
