@@ -1,8 +1,9 @@
 //! The demo and headless tools of the voxel OIT renderer.
 //!
 //! - `demo stats [--seed N] [--chunks N]`: generate and mesh a world, print statistics.
-//! - `demo render [--technique NAME] [--weight NAME] [--size WxH] [--seed N] [--msaa]
-//!   [--frames N] --out FILE.png`: render the default scene headlessly.
+//! - `demo render [--technique NAME] [--weight NAME] [--bayer 2|4|8|16] [--layers N]
+//!   [--size WxH] [--seed N] [--msaa] [--frames N] --out FILE.png`: render the default
+//!   scene headlessly.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -111,6 +112,8 @@ fn render(argv: &[String]) -> Result<(), String> {
     a.reject_unknown(&[
         "technique",
         "weight",
+        "bayer",
+        "layers",
         "size",
         "seed",
         "msaa",
@@ -135,6 +138,19 @@ fn render(argv: &[String]) -> Result<(), String> {
     config.oit.technique = technique;
     if let Some(w) = a.get("weight") {
         config.oit.weight = WeightFunction::from_name(w).map_err(|e| e.to_string())?;
+    }
+    if let Some(b) = a.get("bayer") {
+        let side = b
+            .parse()
+            .map_err(|_| format!("--bayer {b:?}: expected 2, 4, 8 or 16"))?;
+        config.oit.bayer = voxel_render::BayerSize::from_side(side).map_err(|e| e.to_string())?;
+    }
+    config.oit.peel_layers = a.parse_or("layers", config.oit.peel_layers)?;
+    if config.oit.peel_layers < 2 || !config.oit.peel_layers.is_multiple_of(2) {
+        return Err(format!(
+            "--layers {}: dual depth peeling takes an even number of layers, at least 2",
+            config.oit.peel_layers
+        ));
     }
     let t = Instant::now();
     let scene = demo::scene::default_scene(seed)?;
@@ -180,6 +196,12 @@ fn render(argv: &[String]) -> Result<(), String> {
         stats.meshes_drawn[2],
         stats.translucent_quads
     );
+    if let Some(layers) = stats.technique.layers {
+        println!("layers peeled: {layers}");
+    }
+    if let Some(overflow) = stats.technique.overflow {
+        println!("reference overflow: {overflow} fragments");
+    }
     if per_pass.is_empty() {
         println!("GPU times: unavailable (no timestamp queries on this adapter)");
     } else {

@@ -21,7 +21,8 @@ pub use chunks::{ChunkStore, Frustum, GpuChunk, GpuMesh, MeshKind, Visible};
 pub use context::{Capabilities, GpuContext, WANTED_FEATURES, request_device};
 pub use gpu_types::{ChunkUniforms, FrameUniforms};
 pub use oit::{
-    OitConfig, OitManager, Technique, TranslucentFrame, TranslucentTechnique, WeightFunction,
+    BayerSize, OitConfig, OitManager, Technique, TechniqueReport, TranslucentFrame,
+    TranslucentTechnique, WeightFunction,
 };
 pub use pipelines::SharedLayouts;
 pub use readback::Image;

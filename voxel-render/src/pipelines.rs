@@ -11,7 +11,7 @@ pub const FULLSCREEN_WGSL: &str = include_str!("shaders/fullscreen.wgsl");
 /// Layouts every chunk pipeline is built against.
 #[derive(Debug, Clone)]
 pub struct SharedLayouts {
-    /// Group 0: frame uniforms, block textures, sampler.
+    /// Group 0: frame uniforms, block textures, sampler, Bayer levels.
     pub scene: wgpu::BindGroupLayout,
     /// Group 1: a chunk mesh's quads and the chunk uniform.
     pub chunk: wgpu::BindGroupLayout,
@@ -49,8 +49,19 @@ impl SharedLayouts {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
             ],
         });
+
         Self {
             scene,
             chunk: crate::chunks::chunk_layout(device),
@@ -76,6 +87,8 @@ pub enum DepthMode {
     /// Reverse-Z test, nearer or equal, no write: the sorted baseline (seed 003's LessEqual
     /// in a standard depth range).
     ReadOnlyOrEqual,
+    /// Keep the farthest fragment and write it: back-layer peeling.
+    WriteFarthest,
 }
 
 /// A pipeline drawing chunk quads from `module` (which includes `common.wgsl`'s `vs_main`).
@@ -99,6 +112,7 @@ pub fn chunk_pipeline(
         DepthMode::Write => (true, wgpu::CompareFunction::Greater),
         DepthMode::ReadOnly => (false, wgpu::CompareFunction::Greater),
         DepthMode::ReadOnlyOrEqual => (false, wgpu::CompareFunction::GreaterEqual),
+        DepthMode::WriteFarthest => (true, wgpu::CompareFunction::Less),
     };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
@@ -253,4 +267,86 @@ pub fn read_only_depth(
         depth_ops: None,
         stencil_ops: None,
     })
+}
+
+/// A colour attachment cleared to transparent black.
+pub fn clear_transparent(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    clear_attachment(view, wgpu::Color::TRANSPARENT)
+}
+
+/// A 2D texture of `format` and `usage` at `width` × `height`, with its default view.
+pub fn target(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    width: u32,
+    height: u32,
+) -> (wgpu::Texture, wgpu::TextureView) {
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    (texture, view)
+}
+
+/// A bind group of texture views at bindings 0, 1, ...
+pub fn texture_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    views: &[&wgpu::TextureView],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = views
+        .iter()
+        .enumerate()
+        .map(|(i, v)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: wgpu::BindingResource::TextureView(v),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// A layout of `count` fragment textures at bindings 0, 1, ... of `sample_type`.
+pub fn textures_layout(
+    device: &wgpu::Device,
+    label: &str,
+    sample_type: wgpu::TextureSampleType,
+    count: u32,
+) -> wgpu::BindGroupLayout {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> =
+        (0..count).map(|i| texture_entry(i, sample_type)).collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    })
+}
+
+/// Submits what `encoder` holds and replaces it with a fresh one, so that a technique can
+/// wait for GPU results in the middle of a frame (the exact methods do; real-time ones
+/// never do). Commands keep their order: the rest of the frame follows in the new encoder.
+pub fn flush(ctx: &crate::GpuContext, encoder: &mut wgpu::CommandEncoder) {
+    let fresh = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame_continued"),
+        });
+    let done = std::mem::replace(encoder, fresh);
+    ctx.queue.submit([done.finish()]);
 }

@@ -42,6 +42,10 @@ pub struct RendererConfig {
     pub ambient: f32,
     /// Sky colour (linear). Default a light blue.
     pub sky: [f32; 3],
+    /// Frames over which a newly uploaded chunk fades in (screen-door dissolve of its
+    /// opaque and cutout faces, alpha ramp of its translucent ones). Default 0: off, so
+    /// that a picture depends only on the scene; the interactive demo turns it on.
+    pub fade_in_frames: u32,
 }
 
 impl Default for RendererConfig {
@@ -55,6 +59,7 @@ impl Default for RendererConfig {
             sun_dir: [0.35, 0.85, 0.4],
             ambient: 0.45,
             sky: [0.45, 0.65, 0.9],
+            fade_in_frames: 0,
         }
     }
 }
@@ -66,8 +71,14 @@ pub struct FrameStats {
     pub meshes_drawn: [usize; 3],
     /// Translucent quads drawn.
     pub translucent_quads: usize,
-    /// CPU time spent recording the frame, milliseconds.
+    /// CPU time spent recording the frame, milliseconds (sorting included).
     pub cpu_ms: f64,
+    /// CPU time spent sorting translucent quads (sorted-quads), milliseconds.
+    pub sort_ms: f64,
+    /// Chunks whose translucent quads were re-sorted this frame.
+    pub chunks_resorted: usize,
+    /// Technique-specific facts (peeled layers, reference overflow).
+    pub technique: crate::oit::TechniqueReport,
 }
 
 #[derive(Debug)]
@@ -103,6 +114,10 @@ pub struct Renderer {
     oit: OitManager,
     timer: Option<GpuTimer>,
     frame_index: u32,
+    /// Chunks fading in, with the frame they appeared.
+    fading: HashMap<ChunkPos, u32>,
+    /// Sorted-quads: the eye each chunk's translucent quads were last sorted for.
+    sorted_for: HashMap<ChunkPos, glam::DVec3>,
 }
 
 /// Most timed passes in a frame: peeling to convergence can take many.
@@ -130,6 +145,11 @@ impl Renderer {
             contents: bytemuck::bytes_of(&FrameUniforms::default()),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
+        let bayer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("bayer_levels"),
+            contents: bytemuck::cast_slice(&crate::oit::stipple::bayer::bayer_levels()),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
         let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layouts.scene,
@@ -146,8 +166,13 @@ impl Renderer {
                     binding: 2,
                     resource: wgpu::BindingResource::Sampler(&textures.sampler),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: bayer.as_entire_binding(),
+                },
             ],
         });
+
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
         let tonemap_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("tonemap_layout"),
@@ -212,6 +237,8 @@ impl Renderer {
             oit,
             timer: GpuTimer::new(ctx, MAX_TIMED_PASSES),
             frame_index: 0,
+            fading: HashMap::new(),
+            sorted_for: HashMap::new(),
             config,
         })
     }
@@ -224,8 +251,13 @@ impl Renderer {
         let module = pipelines::shader(
             &ctx.device,
             "opaque",
-            &[COMMON_WGSL, include_str!("shaders/opaque.wgsl")],
+            &[
+                COMMON_WGSL,
+                crate::oit::stipple::DITHER_WGSL,
+                include_str!("shaders/opaque.wgsl"),
+            ],
         );
+
         let samples = if msaa { MSAA_SAMPLES } else { 1 };
         let groups = [Some(&layouts.scene), Some(&layouts.chunk)];
         let make = |label, entry| {
@@ -272,7 +304,7 @@ impl Renderer {
             "scene_color",
             SCENE_FORMAT,
             1,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST,
         );
         let depth = texture(
             "scene_depth",
@@ -346,19 +378,45 @@ impl Renderer {
         (self.targets.width, self.targets.height)
     }
 
-    /// Uploads or replaces a chunk's meshes; empty meshes remove it.
+    /// Uploads or replaces a chunk's meshes; empty meshes remove it. A chunk that was not
+    /// on the GPU fades in when [`RendererConfig::fade_in_frames`] is set.
     pub fn upload_chunk(&mut self, pos: ChunkPos, meshes: &ChunkMeshes) {
+        let new = self.chunks.get(pos).is_none();
         self.chunks.upload(&self.ctx, pos, meshes);
+        self.sorted_for.remove(&pos);
+        if new && self.config.fade_in_frames > 0 && self.chunks.get(pos).is_some() {
+            self.fading.insert(pos, self.frame_index);
+            self.chunks.set_alpha(&self.ctx, pos, 0.0);
+        }
     }
 
     /// Removes a chunk from the GPU.
     pub fn remove_chunk(&mut self, pos: ChunkPos) {
         self.chunks.remove(pos);
+        self.fading.remove(&pos);
+        self.sorted_for.remove(&pos);
     }
 
     /// Removes every chunk.
     pub fn clear_chunks(&mut self) {
         self.chunks.clear();
+        self.fading.clear();
+        self.sorted_for.clear();
+    }
+
+    /// Changes the transparency settings (technique, weight, Bayer size, peel layers, ...).
+    pub fn set_oit_config(&mut self, config: OitConfig) {
+        self.oit.set_config(config);
+    }
+
+    /// Changes how many frames new chunks take to fade in (0: no fade).
+    pub fn set_fade_in_frames(&mut self, frames: u32) {
+        self.config.fade_in_frames = frames;
+        if frames == 0 {
+            for (pos, _) in self.fading.drain() {
+                self.chunks.set_alpha(&self.ctx, pos, 1.0);
+            }
+        }
     }
 
     /// The chunks on the GPU.
@@ -435,11 +493,58 @@ impl Renderer {
             .unwrap_or_default()
     }
 
-    /// Call after submitting a frame's encoder: starts reading its GPU timings back.
+    /// Call after submitting a frame's encoder: starts reading its GPU timings (and the
+    /// technique's own counters) back.
     pub fn after_submit(&mut self) {
         if let Some(t) = &mut self.timer {
             t.after_submit();
         }
+        self.oit.after_submit();
+    }
+
+    /// Advances chunk fade-ins by one frame.
+    fn update_fades(&mut self) {
+        let frames = self.config.fade_in_frames.max(1);
+        let now = self.frame_index;
+        let mut done = Vec::new();
+        for (&pos, &start) in &self.fading {
+            let t = now.wrapping_sub(start) as f32 / frames as f32;
+            self.chunks.set_alpha(&self.ctx, pos, t.min(1.0));
+            if t >= 1.0 {
+                done.push(pos);
+            }
+        }
+        for pos in done {
+            self.fading.remove(&pos);
+        }
+    }
+
+    /// Sorted-quads: re-sorts the translucent quads of the visible chunks whose last sort
+    /// was for an eye farther than [`OitConfig::resort_distance`] away. Returns (ms, chunks).
+    fn sort_quads(&mut self, positions: &[ChunkPos], eye: glam::DVec3) -> (f64, usize) {
+        let start = Instant::now();
+        let threshold = self.oit.config().resort_distance;
+        let mut n = 0;
+        for &pos in positions {
+            if self
+                .sorted_for
+                .get(&pos)
+                .is_some_and(|e| e.distance(eye) <= threshold)
+            {
+                continue;
+            }
+            let Some(chunk) = self.chunks.get(pos) else {
+                continue;
+            };
+            let mut quads = chunk.translucent_quads().to_vec();
+            let o = pos.origin();
+            let local = eye - glam::DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
+            voxel_mesh::sort::quads_back_to_front(&mut quads, local.as_vec3().to_array());
+            self.chunks.reorder_translucent(&self.ctx, pos, quads);
+            self.sorted_for.insert(pos, eye);
+            n += 1;
+        }
+        (start.elapsed().as_secs_f64() * 1e3, n)
     }
 
     /// The HDR scene colour (after the composite, before tonemapping).
@@ -491,9 +596,21 @@ impl Renderer {
         let start = Instant::now();
         let format = self.config.output_format;
         self.tonemap_pipeline(format);
+        self.update_fades();
         let (w, h) = self.size();
         let view_proj = camera.view_proj(f64::from(w) / f64::from(h));
         let frustum = Frustum::new(view_proj, camera.eye);
+        let (sort_ms, chunks_resorted) = if self.oit.technique() == Technique::SortedQuads {
+            let positions: Vec<ChunkPos> = self
+                .chunks
+                .visible(MeshKind::Translucent, &frustum)
+                .iter()
+                .map(|v| v.pos)
+                .collect();
+            self.sort_quads(&positions, camera.eye)
+        } else {
+            (0.0, 0)
+        };
         let opaque = self.chunks.visible(MeshKind::Opaque, &frustum);
         let cutout = self.chunks.visible(MeshKind::Cutout, &frustum);
         let mut translucent = self.chunks.visible(MeshKind::Translucent, &frustum);
@@ -501,7 +618,9 @@ impl Renderer {
         let stats = FrameStats {
             meshes_drawn: [opaque.len(), cutout.len(), translucent.len()],
             translucent_quads: translucent.iter().map(|v| v.mesh.quads() as usize).sum(),
-            cpu_ms: 0.0,
+            sort_ms,
+            chunks_resorted,
+            ..FrameStats::default()
         };
 
         let (eye_int, eye_frac) = camera.eye_split();
@@ -521,7 +640,7 @@ impl Renderer {
             viewport: [w as f32, h as f32],
             weight_fn: oit_config.weight as u32,
             accum_scale: self.oit.accum_scale(),
-            shading_state: 0,
+            shading_state: oit_config.shading_state().pack(),
             frame_index: self.frame_index,
             depth_range: [near_t, far_t],
         };
@@ -617,7 +736,9 @@ impl Renderer {
 
         let mut frame = TranslucentFrame {
             target: &t.color_view,
+            target_texture: &t.color,
             depth: &t.depth_view,
+            depth_texture: &t.depth,
             scene: &self.scene_group,
             chunks: &translucent,
             timer: self.timer.as_mut(),
@@ -642,6 +763,7 @@ impl Renderer {
         }
         Ok(FrameStats {
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
+            technique: self.oit.report(),
             ..stats
         })
     }

@@ -2,7 +2,10 @@
 //! Rust form) records the translucent pass and its composite for the selected
 //! [`Technique`]. One folder per technique; each implements [`TranslucentTechnique`].
 
+pub mod peeling;
+pub mod reference;
 pub mod sorted;
+pub mod stipple;
 pub mod wboit;
 
 use crate::chunks::Visible;
@@ -10,6 +13,7 @@ use crate::pipelines::SharedLayouts;
 use crate::timing::GpuTimer;
 use crate::{Error, GpuContext, Result};
 
+pub use stipple::{BayerSize, ShadingState, TransparencyMode};
 pub use wboit::weights::WeightFunction;
 
 /// A way to draw the translucent meshes.
@@ -22,17 +26,33 @@ pub enum Technique {
     /// Weighted blended OIT, two passes (seed 002): one per target. For adapters without
     /// independent blend.
     WboitTwoPass,
+    /// Screen-door transparency with a Bayer pattern (seed 001): the low-end mode.
+    Stipple,
     /// Alpha blending of chunks sorted back to front (seed 003): the baseline.
     Sorted,
+    /// Like `Sorted`, with the quads inside each chunk sorted back to front too.
+    SortedQuads,
+    /// Dual depth peeling of [`OitConfig::peel_layers`] layers (seed 004).
+    DepthPeeling,
+    /// The exact reference: per-pixel sorted fragment lists (A-buffer). Stalls the GPU.
+    Reference,
+    /// The second exact method: front-to-back depth peeling until a pass writes nothing.
+    /// Stalls the GPU once per layer.
+    PeelReference,
 }
 
 impl Technique {
     /// Every technique, in the order menus and reports list them.
-    pub const ALL: [Technique; 4] = [
+    pub const ALL: [Technique; 9] = [
         Technique::OpaqueOnly,
         Technique::WboitMrt,
         Technique::WboitTwoPass,
+        Technique::Stipple,
         Technique::Sorted,
+        Technique::SortedQuads,
+        Technique::DepthPeeling,
+        Technique::Reference,
+        Technique::PeelReference,
     ];
 
     /// The command-line name.
@@ -41,8 +61,18 @@ impl Technique {
             Technique::OpaqueOnly => "opaque-only",
             Technique::WboitMrt => "wboit-mrt",
             Technique::WboitTwoPass => "wboit-two-pass",
+            Technique::Stipple => "stipple",
             Technique::Sorted => "sorted",
+            Technique::SortedQuads => "sorted-quads",
+            Technique::DepthPeeling => "depth-peeling",
+            Technique::Reference => "reference",
+            Technique::PeelReference => "peel-reference",
         }
+    }
+
+    /// Whether the technique computes the exact blend (up to rounding).
+    pub fn is_exact(self) -> bool {
+        matches!(self, Technique::Reference | Technique::PeelReference)
     }
 
     /// Parses a command-line name; the error lists the known names.
@@ -69,7 +99,7 @@ impl std::fmt::Display for Technique {
 #[derive(Clone, Debug, PartialEq)]
 pub struct OitConfig {
     /// The technique to draw translucent meshes with. Default: WBOIT in one MRT pass, the
-    /// fastest exact-enough method on any adapter with independent blend.
+    /// fastest method that looks right on any adapter with independent blend.
     pub technique: Technique,
     /// Render target width in pixels.
     pub width: u32,
@@ -85,6 +115,21 @@ pub struct OitConfig {
     /// the maximum weight (without it, 22 such layers reach 65504). Default true; turn off
     /// only to test the composite's guard against non-finite sums.
     pub wboit_headroom: bool,
+    /// Stipple pattern. Default 4×4, seed 001's default ("era-authentic").
+    pub bayer: BayerSize,
+    /// Whether kept stipple pixels write depth. Default true, seed 001's behaviour ("writes
+    /// to depth buffer normally"): nearer kept pixels then hide what is behind them.
+    pub stipple_depth_write: bool,
+    /// Uniform alpha of the stipple shading state, multiplying every translucent alpha.
+    /// Default 255 (1.0): surfaces keep their own opacity.
+    pub stipple_alpha: u8,
+    /// Layers dual depth peeling captures at most (even; presets 4, 6, 8). Default 8: the
+    /// depth complexity of glass-over-water views in our terrain stays below it.
+    pub peel_layers: u32,
+    /// Sorted-quads: how far (blocks) the eye may move before a chunk's quads are
+    /// re-sorted. Default 0.25: a quarter block changes the order of few quads, and a
+    /// sort of a chunk's translucent quads takes microseconds.
+    pub resort_distance: f64,
 }
 
 impl Default for OitConfig {
@@ -96,8 +141,38 @@ impl Default for OitConfig {
             weight: WeightFunction::McGuire10,
             force_rgba8_accum: false,
             wboit_headroom: true,
+            bayer: BayerSize::B4,
+            stipple_depth_write: true,
+            stipple_alpha: 255,
+            peel_layers: 8,
+            resort_distance: 0.25,
         }
     }
+}
+
+impl OitConfig {
+    /// Seed 001's packed shading state for the frame uniforms (stipple mode, pattern, alpha).
+    pub fn shading_state(&self) -> ShadingState {
+        ShadingState {
+            alpha: self.stipple_alpha,
+            mode: TransparencyMode::Stipple,
+            pattern: self.bayer,
+        }
+    }
+}
+
+/// Technique-specific facts about the last frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TechniqueReport {
+    /// Layers found (depth peeling).
+    pub layers: Option<u32>,
+    /// Peeling iterations run this frame (each a front and, in dual mode, a back peel).
+    pub iterations: Option<u32>,
+
+    /// Fragments that did not fit (reference): should be zero; never hidden.
+    pub overflow: Option<u64>,
+    /// Attempts the reference needed this frame (more than 1 after growing its pool).
+    pub attempts: Option<u32>,
 }
 
 /// What a technique draws with and into, for one frame.
@@ -105,8 +180,12 @@ impl Default for OitConfig {
 pub struct TranslucentFrame<'a> {
     /// The HDR scene colour holding the opaque image; the composite blends into it.
     pub target: &'a wgpu::TextureView,
+    /// The texture of `target` (for copies).
+    pub target_texture: &'a wgpu::Texture,
     /// The opaque depth (single-sample): read-only attachment, or sampled by peeling.
     pub depth: &'a wgpu::TextureView,
+    /// The texture of `depth` (for copies).
+    pub depth_texture: &'a wgpu::Texture,
     /// Group 0: frame uniforms and block textures.
     pub scene: &'a wgpu::BindGroup,
     /// The visible translucent meshes, farthest first.
@@ -145,6 +224,12 @@ pub trait TranslucentTechnique: std::fmt::Debug {
         encoder: &mut wgpu::CommandEncoder,
         frame: &mut TranslucentFrame<'_>,
     );
+    /// Called after the frame's commands were submitted (to start reading results back).
+    fn after_submit(&mut self) {}
+    /// Technique-specific facts about the last frame.
+    fn report(&self) -> TechniqueReport {
+        TechniqueReport::default()
+    }
     /// The WBOIT accumulation target, for techniques that have one.
     fn accumulation(&self) -> Option<&wgpu::Texture> {
         None
@@ -186,9 +271,16 @@ impl OitManager {
 
     /// `technique`, or what replaces it on this adapter.
     fn supported(&self, technique: Technique) -> Technique {
-        if technique == Technique::WboitMrt && !self.ctx.caps.independent_blend() {
+        let caps = &self.ctx.caps;
+        if technique == Technique::WboitMrt && !caps.independent_blend() {
             log::warn!("adapter lacks independent blend: using two-pass WBOIT instead of MRT");
             return Technique::WboitTwoPass;
+        }
+        if technique == Technique::Reference && !caps.fragment_storage() {
+            log::warn!(
+                "adapter lacks fragment storage writes: using peel-to-convergence as the reference"
+            );
+            return Technique::PeelReference;
         }
         technique
     }
@@ -215,6 +307,37 @@ impl OitManager {
     /// Changes the WBOIT weight function (a uniform: no pipeline is rebuilt).
     pub fn set_weight(&mut self, weight: WeightFunction) {
         self.config.weight = weight;
+    }
+
+    /// Changes settings other than the size; resources are rebuilt only if a setting the
+    /// active technique's pipelines or targets depend on changed.
+    pub fn set_config(&mut self, config: OitConfig) {
+        let old = &self.config;
+        let rebuild = config.technique != old.technique
+            || config.force_rgba8_accum != old.force_rgba8_accum
+            || config.stipple_depth_write != old.stipple_depth_write
+            || config.peel_layers != old.peel_layers;
+        self.config = OitConfig {
+            width: old.width,
+            height: old.height,
+            ..config
+        };
+        self.config.technique = self.supported(self.config.technique);
+        if rebuild {
+            self.active = None;
+        }
+    }
+
+    /// Technique-specific facts about the last frame.
+    pub fn report(&self) -> TechniqueReport {
+        self.active.as_ref().map(|t| t.report()).unwrap_or_default()
+    }
+
+    /// Call after the frame's commands were submitted.
+    pub fn after_submit(&mut self) {
+        if let Some(t) = &mut self.active {
+            t.after_submit();
+        }
     }
 
     /// Resizes the targets. Same size: nothing happens. Zero width or height (a minimised
@@ -257,7 +380,31 @@ impl OitManager {
             Technique::WboitMrt | Technique::WboitTwoPass => {
                 Some(Box::new(wboit::Wboit::new(&self.ctx, &self.layouts, c)))
             }
-            Technique::Sorted => Some(Box::new(sorted::Sorted::new(&self.ctx, &self.layouts))),
+            Technique::Sorted | Technique::SortedQuads => {
+                Some(Box::new(sorted::Sorted::new(&self.ctx, &self.layouts)))
+            }
+            Technique::Stipple => {
+                Some(Box::new(stipple::Stipple::new(&self.ctx, &self.layouts, c)))
+            }
+            Technique::DepthPeeling => Some(Box::new(peeling::Peeling::new(
+                &self.ctx,
+                &self.layouts,
+                c,
+                peeling::PeelMode::Dual {
+                    layers: c.peel_layers,
+                },
+            ))),
+            Technique::PeelReference => Some(Box::new(peeling::Peeling::new(
+                &self.ctx,
+                &self.layouts,
+                c,
+                peeling::PeelMode::Converge,
+            ))),
+            Technique::Reference => Some(Box::new(reference::Reference::new(
+                &self.ctx,
+                &self.layouts,
+                c,
+            ))),
         }
     }
 

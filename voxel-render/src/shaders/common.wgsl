@@ -33,7 +33,9 @@ struct ChunkInfo {
 @group(1) @binding(1) var<uniform> chunk: ChunkInfo;
 
 struct VsOut {
-    @builtin(position) clip: vec4<f32>,
+    // Invariant: the same quad gets bit-identical depths in every pipeline, which depth
+    // peeling relies on to tell a peeled layer from the next one without an epsilon.
+    @builtin(position) @invariant clip: vec4<f32>,
     // Texture coordinates in blocks: the texture repeats once per block.
     @location(0) uv: vec2<f32>,
     @location(1) @interpolate(flat) block: u32,

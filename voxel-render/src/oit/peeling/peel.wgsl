@@ -1,0 +1,24 @@
+// Depth peeling (appended to common.wgsl): a fragment is a candidate only strictly between
+// the two layers already peeled at its pixel. The pass's depth test then keeps the nearest
+// candidate (front peel, compare greater in reverse-Z) or the farthest (back peel), and its
+// colour replaces the layer target's: after the pass the target holds that one layer.
+//
+// Depth epsilon: none. Positions are @invariant, so the same fragment has the same depth
+// bits in every pass, and strict comparisons exclude exactly the layer peeled before. (An
+// epsilon, like seed 004's 0.0001, would merge distinct layers closer than it: in
+// reverse-Z a window-depth difference of 1e-4 is many blocks at a distance of 100.)
+
+@group(2) @binding(0) var front_limit: texture_depth_2d;
+@group(2) @binding(1) var back_limit: texture_depth_2d;
+
+@fragment
+fn fs_peel(in: VsOut) -> @location(0) vec4<f32> {
+    // Sample first: derivatives need uniform control flow.
+    let c = translucent_color(in);
+    let p = vec2<i32>(in.clip.xy);
+    let d = in.clip.z;
+    if !(d < textureLoad(front_limit, p, 0) && d > textureLoad(back_limit, p, 0)) {
+        discard;
+    }
+    return c;
+}

@@ -1,0 +1,47 @@
+// Exact reference, pass 1 (appended to common.wgsl): every translucent fragment in front of
+// the opaque surfaces is appended to its pixel's linked list (an A-buffer).
+
+struct Node {
+    // Colour and alpha as four halves (pack2x16float): exact enough for a reference that
+    // blends in f32 and is compared after 8-bit output.
+    color: vec2<u32>,
+    depth: f32,
+    // Index + 1 of the next node of the pixel; 0 ends the list.
+    next: u32,
+};
+
+struct Counters {
+    // Nodes asked for, including those that did not fit.
+    nodes: atomic<u32>,
+    // Pixels whose list was longer than the resolve can sort (MAX_LAYERS).
+    truncated: atomic<u32>,
+};
+
+struct Params {
+    width: u32,
+    capacity: u32,
+};
+
+@group(2) @binding(0) var<storage, read_write> heads: array<atomic<u32>>;
+@group(2) @binding(1) var<storage, read_write> nodes: array<Node>;
+@group(2) @binding(2) var<storage, read_write> counters: Counters;
+@group(2) @binding(3) var<uniform> params: Params;
+@group(2) @binding(4) var opaque_depth: texture_depth_2d;
+
+@fragment
+fn fs_abuffer(in: VsOut) {
+    let c = translucent_color(in);
+    let p = vec2<u32>(in.clip.xy);
+    // The depth test, in the shader: a fragment with storage writes may run them before a
+    // late depth test would have dropped it.
+    if in.clip.z <= textureLoad(opaque_depth, vec2<i32>(p), 0) || c.a <= 0.0 {
+        return;
+    }
+    let index = atomicAdd(&counters.nodes, 1u);
+    if index >= params.capacity {
+        return;
+    }
+    nodes[index].color = vec2<u32>(pack2x16float(c.rg), pack2x16float(c.ba));
+    nodes[index].depth = in.clip.z;
+    nodes[index].next = atomicExchange(&heads[p.y * params.width + p.x], index + 1u);
+}
