@@ -1,22 +1,83 @@
-//! Scenes: a world and the cameras to look at it with. The default scene is generated
-//! terrain around the greenhouse nearest the origin, seen from the land side so that the
-//! view goes through glass onto the sea.
+//! Scenes: a world and the cameras to look at it with, from generated terrain, from a
+//! hand-written TOML file, or built in code.
+//!
+//! The file format (every key but `name` and one camera is optional):
+//!
+//! ```toml
+//! name = "Stained-glass corridor"
+//! description = "many layers of different colours"
+//! size = [640, 360]                 # output size when the command gives none
+//!
+//! [terrain]                         # generated terrain, chunk coordinates inclusive
+//! seed = 1
+//! min_chunk = [-2, 0, -2]
+//! max_chunk = [1, 1, 1]
+//!
+//! [[blocks]]                        # extra block types, usable by name below
+//! name = "smoky_glass"
+//! color = [90, 90, 100]             # sRGB
+//! opacity = 0.5                     # below 1: translucent
+//!
+//! [[boxes]]                         # filled boxes, corners inclusive, in order
+//! block = "red_glass"
+//! min = [0, 0, 0]
+//! max = [3, 5, 0]
+//!
+//! [[cameras]]
+//! eye = [0.5, 3.5, 12.0]
+//! target = [0.5, 3.5, 0.0]
+//! fov = 60.0                        # vertical, degrees
+//! near = 0.1
+//! far = 1000.0
+//! path_to = [6.5, 3.5, 12.0]        # the flicker test moves the eye here in 60 frames
+//! ```
 
+use std::path::Path;
 use std::sync::Arc;
 
 use glam::DVec3;
-use voxel_core::{BlockRegistry, ChunkPos, SiteKind, TerrainConfig, TerrainGenerator, World};
+use serde::Deserialize;
+use toml::Spanned;
+use voxel_core::{
+    BlockDef, BlockRegistry, ChunkPos, SiteKind, TerrainConfig, TerrainGenerator, World, WorldPos,
+};
 use voxel_render::Camera;
 
-/// A world with named cameras.
+/// A world with cameras.
 #[derive(Debug, Clone)]
 pub struct Scene {
     /// Name, for reports.
     pub name: String,
+    /// What the scene is for.
+    pub description: String,
     /// The blocks.
     pub world: World,
     /// Cameras, at least one.
     pub cameras: Vec<Camera>,
+    /// Per camera: where its eye moves in the flicker test, if anywhere.
+    pub paths: Vec<Option<DVec3>>,
+    /// Output size the scene asks for.
+    pub size: Option<(u32, u32)>,
+}
+
+impl Scene {
+    /// A scene of `world` with one camera and nothing else.
+    pub fn new(name: &str, world: World, camera: Camera) -> Self {
+        Self {
+            name: name.to_owned(),
+            description: String::new(),
+            world,
+            cameras: vec![camera],
+            paths: vec![None],
+            size: None,
+        }
+    }
+
+    /// Reads a scene file. Errors name the file, the line and the field.
+    pub fn load(path: &Path) -> Result<Self, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        parse(&text).map_err(|e| format!("{}:{}", path.display(), e))
+    }
 }
 
 /// Chunks generated around the default scene's structure, in each horizontal direction.
@@ -64,9 +125,333 @@ pub fn default_scene(seed: u32) -> Result<Scene, String> {
     eye.y = eye.y.max(ground + 3.5);
     let target = center + dir * 12.0 + DVec3::Y * (sea - center.y + 1.0);
     let camera = Camera::look_at(eye, target, 70.0, 0.1, 600.0).map_err(|e| e.to_string())?;
+    // The flicker path slides sideways, keeping the greenhouse in view.
+    let side = DVec3::new(-dir.z, 0.0, dir.x);
     Ok(Scene {
         name: format!("default (seed {seed})"),
+        description: "generated terrain: a greenhouse on the shore, the sea seen through its glass"
+            .into(),
         world,
         cameras: vec![camera],
+        paths: vec![Some(eye + side * 6.0)],
+        size: None,
     })
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    name: String,
+    #[serde(default)]
+    description: String,
+    size: Option<Spanned<[u32; 2]>>,
+    terrain: Option<Spanned<TerrainDef>>,
+    #[serde(default)]
+    blocks: Vec<Spanned<BlockDefFile>>,
+    #[serde(default)]
+    boxes: Vec<Spanned<BoxDef>>,
+    cameras: Vec<Spanned<CameraDef>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TerrainDef {
+    #[serde(default = "default_seed")]
+    seed: u32,
+    min_chunk: [i32; 3],
+    max_chunk: [i32; 3],
+}
+
+fn default_seed() -> u32 {
+    1
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BlockDefFile {
+    name: String,
+    color: [u8; 3],
+    opacity: f32,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BoxDef {
+    block: Spanned<String>,
+    min: [i32; 3],
+    max: [i32; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraDef {
+    eye: [f64; 3],
+    target: [f64; 3],
+    #[serde(default = "default_fov")]
+    fov: f64,
+    #[serde(default = "default_near")]
+    near: f64,
+    #[serde(default = "default_far")]
+    far: f64,
+    path_to: Option<[f64; 3]>,
+}
+
+fn default_fov() -> f64 {
+    60.0
+}
+fn default_near() -> f64 {
+    0.1
+}
+fn default_far() -> f64 {
+    1000.0
+}
+
+/// Most chunks a scene's terrain may generate (64 × 8 × 64 = 32768 chunks would not fit in
+/// memory: this keeps a typo from taking the machine down).
+const MAX_TERRAIN_CHUNKS: i64 = 4096;
+/// Most blocks all boxes together may fill.
+const MAX_BOX_BLOCKS: i64 = 20_000_000;
+
+/// `line N: message` for the byte offset `at` of `text`.
+fn at_line(text: &str, at: usize, message: impl std::fmt::Display) -> String {
+    let line = text[..at.min(text.len())].matches('\n').count() + 1;
+    format!("{line}: {message}")
+}
+
+/// The `table.key` written on the line holding byte `at` (the key before `=`, the table
+/// from the nearest header above), for error messages.
+fn field_at(text: &str, at: usize) -> String {
+    let at = at.min(text.len());
+    let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
+    let line = text[start..].lines().next().unwrap_or("");
+    let key = line.split_once('=').map(|(k, _)| k.trim()).unwrap_or("");
+    let table = text[..start]
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find(|l| l.starts_with('['))
+        .map(|l| l.trim_matches(|c| c == '[' || c == ']'))
+        .unwrap_or("");
+    match (table, key) {
+        ("", k) | (k, "") => k.to_owned(),
+        (t, k) => format!("{t}.{k}"),
+    }
+}
+
+/// Parses the text of a scene file; errors read `LINE: field: message`.
+pub fn parse(text: &str) -> Result<Scene, String> {
+    let file: SceneFile = toml::from_str(text).map_err(|e| match e.span() {
+        Some(s) => {
+            let field = field_at(text, s.start);
+            let message = e.message().trim();
+            if field.is_empty() {
+                at_line(text, s.start, message)
+            } else {
+                at_line(text, s.start, format!("{field}: {message}"))
+            }
+        }
+        None => format!("?: {}", e.message().trim()),
+    })?;
+
+    let mut registry = BlockRegistry::default();
+    for b in &file.blocks {
+        let (span, def) = (b.span(), b.get_ref());
+        registry
+            .register(BlockDef::new(def.name.clone(), def.color, def.opacity))
+            .map_err(|e| at_line(text, span.start, format!("blocks: {e}")))?;
+    }
+    let registry = Arc::new(registry);
+    let mut world = match &file.terrain {
+        Some(t) => {
+            let (span, t) = (t.span(), t.get_ref());
+            let count: i64 = (0..3)
+                .map(|i| i64::from(t.max_chunk[i]) - i64::from(t.min_chunk[i]) + 1)
+                .product();
+            if (0..3).any(|i| t.min_chunk[i] > t.max_chunk[i]) || count > MAX_TERRAIN_CHUNKS {
+                return Err(at_line(
+                    text,
+                    span.start,
+                    format!(
+                        "terrain: min_chunk..max_chunk must be a non-empty box of at most {MAX_TERRAIN_CHUNKS} chunks"
+                    ),
+                ));
+            }
+            let generator = TerrainGenerator::new(TerrainConfig {
+                seed: t.seed,
+                ..TerrainConfig::default()
+            });
+            let min = ChunkPos::new(t.min_chunk[0], t.min_chunk[1], t.min_chunk[2]);
+            let max = ChunkPos::new(t.max_chunk[0], t.max_chunk[1], t.max_chunk[2]);
+            generator
+                .generate_world(registry.clone(), min, max)
+                .map_err(|e| at_line(text, span.start, format!("terrain: {e}")))?
+        }
+        None => World::new(registry.clone()),
+    };
+    let mut filled: i64 = 0;
+    for b in &file.boxes {
+        let (span, def) = (b.span(), b.get_ref());
+        let id = registry
+            .id(def.block.get_ref())
+            .map_err(|e| at_line(text, def.block.span().start, format!("boxes.block: {e}")))?;
+        if (0..3).any(|i| def.min[i] > def.max[i]) {
+            return Err(at_line(
+                text,
+                span.start,
+                "boxes: min must not exceed max on any axis",
+            ));
+        }
+        filled += (0..3)
+            .map(|i| i64::from(def.max[i]) - i64::from(def.min[i]) + 1)
+            .product::<i64>();
+        if filled > MAX_BOX_BLOCKS {
+            return Err(at_line(
+                text,
+                span.start,
+                format!("boxes: more than {MAX_BOX_BLOCKS} blocks in all"),
+            ));
+        }
+        fill_box(&mut world, def.min, def.max, id)
+            .map_err(|e| at_line(text, span.start, format!("boxes: {e}")))?;
+    }
+    if file.cameras.is_empty() {
+        return Err("1: cameras: a scene needs at least one [[cameras]] entry".into());
+    }
+    let mut cameras = Vec::new();
+    let mut paths = Vec::new();
+    for c in &file.cameras {
+        let (span, d) = (c.span(), c.get_ref());
+        let camera = Camera::look_at(
+            DVec3::from(d.eye),
+            DVec3::from(d.target),
+            d.fov,
+            d.near,
+            d.far,
+        )
+        .map_err(|e| at_line(text, span.start, format!("cameras: {e}")))?;
+        cameras.push(camera);
+        paths.push(d.path_to.map(DVec3::from));
+    }
+    let size = match &file.size {
+        Some(s) if s.get_ref().iter().any(|v| !(1..=16384).contains(v)) => {
+            return Err(at_line(
+                text,
+                s.span().start,
+                "size: both sides must be in 1..=16384",
+            ));
+        }
+        s => s.as_ref().map(|s| (s.get_ref()[0], s.get_ref()[1])),
+    };
+    Ok(Scene {
+        name: file.name,
+        description: file.description,
+        world,
+        cameras,
+        paths,
+        size,
+    })
+}
+
+/// Fills a box of blocks (corners inclusive).
+pub fn fill_box(
+    world: &mut World,
+    min: [i32; 3],
+    max: [i32; 3],
+    id: voxel_core::BlockId,
+) -> Result<(), String> {
+    world
+        .fill_box(
+            WorldPos::new(min[0], min[1], min[2]),
+            WorldPos::new(max[0], max[1], max[2]),
+            id,
+        )
+        .map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+name = "test"
+size = [64, 32]
+
+[[blocks]]
+name = "smoky_glass"
+color = [90, 90, 100]
+opacity = 0.5
+
+[[boxes]]
+block = "smoky_glass"
+min = [0, 0, 0]
+max = [3, 2, 0]
+
+[[cameras]]
+eye = [0.5, 1.0, 10.0]
+target = [0.5, 1.0, 0.0]
+path_to = [3.0, 1.0, 10.0]
+"#;
+
+    #[test]
+    fn a_good_file_parses() {
+        let s = parse(GOOD).unwrap();
+        assert_eq!(s.name, "test");
+        assert_eq!(s.size, Some((64, 32)));
+        assert_eq!(s.cameras.len(), 1);
+        assert_eq!(s.paths[0], Some(DVec3::new(3.0, 1.0, 10.0)));
+        let smoky = s.world.registry().id("smoky_glass").unwrap();
+        assert_eq!(s.world.get_block(WorldPos::new(3, 2, 0)), smoky);
+        assert_eq!(
+            s.world.get_block(WorldPos::new(4, 2, 0)),
+            voxel_core::BlockId::AIR
+        );
+    }
+
+    #[test]
+    fn an_unknown_block_names_the_line_and_lists_the_known_ones() {
+        let bad = GOOD.replace("block = \"smoky_glass\"", "block = \"lava\"");
+        let e = parse(&bad).unwrap_err();
+        assert!(
+            e.starts_with("11: boxes.block: unknown block name \"lava\""),
+            "{e}"
+        );
+
+        assert!(e.contains("water") && e.contains("smoky_glass"), "{e}");
+    }
+
+    #[test]
+    fn syntax_and_type_errors_name_line_and_field() {
+        let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [3, 2]")).unwrap_err();
+        assert!(
+            e.starts_with("13: boxes.max:") && e.contains("length 3"),
+            "{e}"
+        );
+
+        let e = parse(&GOOD.replace("fov", "x").replace("path_to", "pathto")).unwrap_err();
+        assert!(e.contains("pathto"), "unknown keys are named: {e}");
+        let e = parse("name = \"x\"\n[[cameras]]\neye = [0, 0, 0]\n").unwrap_err();
+        assert!(e.contains("target"), "missing keys are named: {e}");
+        let e = parse("name = \"x\"\nsize = [64, 32\n").unwrap_err();
+        assert!(e.starts_with("2:") || e.starts_with("3:"), "{e}");
+    }
+
+    #[test]
+    fn bad_values_are_errors_not_panics() {
+        let e = parse(&GOOD.replace("target = [0.5, 1.0, 0.0]", "target = [0.5, 1.0, 10.0]"))
+            .unwrap_err();
+        assert!(e.contains("cameras") && e.contains("zero"), "{e}");
+        let e = parse(&GOOD.replace("opacity = 0.5", "opacity = 1.5")).unwrap_err();
+        assert!(e.starts_with("5: blocks:"), "{e}");
+        let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [-3, 2, 0]")).unwrap_err();
+        assert!(e.contains("min must not exceed max"), "{e}");
+        let e = parse(&GOOD.replace("size = [64, 32]", "size = [0, 32]")).unwrap_err();
+        assert!(e.starts_with("3: size"), "{e}");
+        let e = parse(&format!(
+            "{GOOD}\n[terrain]\nmin_chunk = [0, 0, 0]\nmax_chunk = [100, 8, 100]\n"
+        ))
+        .unwrap_err();
+        assert!(e.contains("at most 4096 chunks"), "{e}");
+        let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [3000, 3000, 3000]")).unwrap_err();
+        assert!(e.contains("blocks in all"), "{e}");
+    }
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::DVec3;
-use voxel_core::{BlockId, BlockRegistry, World, WorldPos};
+use voxel_core::{BlockId, BlockRegistry, World};
 use voxel_render::{Camera, GpuContext, Image, Renderer, RendererConfig, Technique, readback};
 
 pub use demo::headless::{Offscreen, renderer_for};
@@ -43,13 +43,7 @@ pub fn out_dir(name: &str) -> PathBuf {
 pub fn box_world(boxes: &[([i32; 3], [i32; 3], BlockId)]) -> World {
     let mut world = World::new(Arc::new(BlockRegistry::default()));
     for &(min, max, id) in boxes {
-        for x in min[0]..=max[0] {
-            for y in min[1]..=max[1] {
-                for z in min[2]..=max[2] {
-                    world.set_block(WorldPos::new(x, y, z), id).unwrap();
-                }
-            }
-        }
+        demo::scene::fill_box(&mut world, min, max, id).unwrap();
     }
     world
 }
@@ -57,11 +51,7 @@ pub fn box_world(boxes: &[([i32; 3], [i32; 3], BlockId)]) -> World {
 /// A scene of `world` seen by one camera at `eye` looking at `target` (fov 60°).
 pub fn scene(name: &str, world: World, eye: [f64; 3], target: [f64; 3]) -> Scene {
     let camera = Camera::look_at(DVec3::from(eye), DVec3::from(target), 60.0, 0.1, 500.0).unwrap();
-    Scene {
-        name: name.to_owned(),
-        world,
-        cameras: vec![camera],
-    }
+    Scene::new(name, world, camera)
 }
 
 /// Renders `scene`'s first camera with `technique` at `width`×`height`.

@@ -261,7 +261,13 @@ fn techniques_create_resources_only_when_translucency_is_on_screen() {
 fn shader_weights_match_the_rust_formulas() {
     let Some(ctx) = gpu() else { return };
     let distance = 12.5;
-    let world = box_world(&[([-20, -20, -20], [20, 20, -20], WATER)]);
+    // A small glass sheet nearer, off to the side (not over the centre pixel), so that
+    // the translucent depth range of the fitted weight has the water sheet inside it.
+    let world = box_world(&[
+        ([-20, -20, -20], [20, 20, -20], WATER),
+        ([-6, -6, -12], [-4, -4, -12], GLASS),
+    ]);
+
     // The sheet's front face is the plane z = -19; the eye sits `distance` in front of it.
     let scene = scene(
         "weights",
@@ -282,10 +288,19 @@ fn shader_weights_match_the_rust_formulas() {
         };
         config.oit.weight = weight;
         let mut r = renderer_for(&ctx, &scene, config).unwrap();
-        frame(&ctx, &mut r, &cam);
+        let stats = r
+            .render_and_submit(&Offscreen::new(&ctx, 33, 33).view, &cam)
+            .unwrap();
         let accum = read_hdr(&ctx, r.oit().accumulation_target().unwrap());
+
         let got = accum[16 * 33 + 16][3];
-        let want = alpha * weight.weight(z, d as f32, alpha) * HEADROOM_SCALE;
+        let range = stats.translucent_depth_range;
+        assert!(
+            range[0] < 9.0 && range[1] > 12.5,
+            "the range spans the sheets: {range:?}"
+        );
+        let want = alpha * weight.weight(z, d as f32, alpha, range) * HEADROOM_SCALE;
+
         // fp16 stores 11 significant bits: 1e-3 relative, with margin.
         assert!(
             (got - want).abs() <= 2e-3 * want,

@@ -205,6 +205,49 @@ impl World {
         Ok(old)
     }
 
+    /// Sets every block of the box `min..=max` to `id`, a chunk at a time. Marks the
+    /// touched chunks and their loaded neighbours dirty. Chunks are created only to hold a
+    /// block that is not air.
+    pub fn fill_box(&mut self, min: WorldPos, max: WorldPos, id: BlockId) -> Result<()> {
+        if !self.registry.contains(id) {
+            return Err(Error::UnknownBlock(id, self.registry.len()));
+        }
+        if min.x > max.x || min.y > max.y || min.z > max.z {
+            return Ok(());
+        }
+        let (c0, _) = min.split();
+        let (c1, _) = max.split();
+        let last = CHUNK_SIZE as i64 - 1;
+        for cx in c0.x..=c1.x {
+            for cy in c0.y..=c1.y {
+                for cz in c0.z..=c1.z {
+                    let pos = ChunkPos::new(cx, cy, cz);
+                    let o = pos.origin();
+                    let lo = [min.x, min.y, min.z]
+                        .iter()
+                        .zip(o)
+                        .map(|(&m, o)| (i64::from(m) - o).clamp(0, last) as usize)
+                        .collect::<Vec<_>>();
+                    let hi = [max.x, max.y, max.z]
+                        .iter()
+                        .zip(o)
+                        .map(|(&m, o)| (i64::from(m) - o).clamp(0, last) as usize)
+                        .collect::<Vec<_>>();
+                    if id == BlockId::AIR && !self.chunks.contains_key(&pos) {
+                        continue;
+                    }
+                    self.chunks.entry(pos).or_default().fill_box(
+                        [lo[0], lo[1], lo[2]],
+                        [hi[0], hi[1], hi[2]],
+                        id,
+                    )?;
+                    self.mark_with_neighbours(pos);
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Puts a whole chunk in place (returning the one it replaces) and marks it and its
     /// loaded neighbours dirty. Fails on a position outside the `i32` world or a block id the
     /// registry does not hold.
@@ -395,6 +438,39 @@ mod tests {
             w.neighbours(ChunkPos::new(0, 0, 0))
                 .iter()
                 .all(Option::is_none)
+        );
+    }
+
+    #[test]
+    fn fill_box_matches_setting_each_block() {
+        let mut a = world();
+        let mut b = world();
+        let (min, max) = (WorldPos::new(-40, -3, 5), WorldPos::new(70, 33, 6));
+        a.fill_box(min, max, GLASS).unwrap();
+        for x in min.x..=max.x {
+            for y in min.y..=max.y {
+                for z in min.z..=max.z {
+                    b.set_block(WorldPos::new(x, y, z), GLASS).unwrap();
+                }
+            }
+        }
+        assert_eq!(a.len(), b.len());
+        for (pos, chunk) in a.iter() {
+            assert_eq!(
+                chunk.to_dense(),
+                b.chunk(pos).unwrap().to_dense(),
+                "{pos:?}"
+            );
+        }
+        assert!(a.fill_box(min, max, BlockId(99)).is_err());
+        a.fill_box(WorldPos::new(0, 0, 0), WorldPos::new(-1, 0, 0), STONE)
+            .unwrap();
+        a.fill_box(WorldPos::new(500, 0, 0), WorldPos::new(600, 0, 0), AIR)
+            .unwrap();
+        assert_eq!(
+            a.len(),
+            b.len(),
+            "empty boxes and air in missing chunks load nothing"
         );
     }
 

@@ -28,6 +28,30 @@ pub struct GpuMesh {
     buffer: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     quads: u32,
+    /// World-space box around every quad (min, max), for depth ranges.
+    bounds: (glam::DVec3, glam::DVec3),
+}
+
+/// The box around `quads` of the chunk at `pos`, in world coordinates.
+fn quad_bounds(pos: ChunkPos, quads: &[PackedQuad]) -> (DVec3, DVec3) {
+    let o = pos.origin();
+    let origin = DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for q in quads {
+        let Some(u) = q.unpack() else { continue };
+        let axis = u.face.axis();
+        let [ua, va] = voxel_mesh::UV_AXES[axis];
+        let mut min = u.pos.map(f64::from);
+        if u.face.is_positive() {
+            min[axis] += 1.0;
+        }
+        let mut max = min;
+        max[ua] += f64::from(u.size[0]);
+        max[va] += f64::from(u.size[1]);
+        lo = lo.min(DVec3::from(min));
+        hi = hi.max(DVec3::from(max));
+    }
+    (origin + lo, origin + hi)
 }
 
 impl GpuMesh {
@@ -39,6 +63,14 @@ impl GpuMesh {
     /// Number of quads (6 vertices each).
     pub fn quads(&self) -> u32 {
         self.quads
+    }
+
+    /// Nearest and farthest distance from `eye` to the box around the mesh's quads.
+    pub fn distance_range(&self, eye: DVec3) -> (f64, f64) {
+        let (lo, hi) = self.bounds;
+        let nearest = eye.clamp(lo, hi).distance(eye);
+        let farthest = (eye - lo).abs().max((eye - hi).abs()).length();
+        (nearest, farthest)
     }
 
     /// Records the draw of this mesh (pipeline and group 0 already set).
@@ -180,6 +212,7 @@ impl ChunkStore {
                     buffer,
                     bind_group,
                     quads: quads.len() as u32,
+                    bounds: quad_bounds(pos, quads),
                 }
             })
         };

@@ -79,6 +79,9 @@ pub struct FrameStats {
     pub chunks_resorted: usize,
     /// Technique-specific facts (peeled layers, reference overflow).
     pub technique: crate::oit::TechniqueReport,
+    /// Nearest and farthest view distance the visible translucent chunks span (the fitted
+    /// WBOIT weight's range).
+    pub translucent_depth_range: [f32; 2],
 }
 
 #[derive(Debug)]
@@ -615,17 +618,19 @@ impl Renderer {
         let cutout = self.chunks.visible(MeshKind::Cutout, &frustum);
         let mut translucent = self.chunks.visible(MeshKind::Translucent, &frustum);
         translucent.reverse();
+        let (near_t, far_t) = depth_range(&translucent, camera);
         let stats = FrameStats {
             meshes_drawn: [opaque.len(), cutout.len(), translucent.len()],
             translucent_quads: translucent.iter().map(|v| v.mesh.quads() as usize).sum(),
             sort_ms,
             chunks_resorted,
+            translucent_depth_range: [near_t, far_t],
             ..FrameStats::default()
         };
 
         let (eye_int, eye_frac) = camera.eye_split();
         let sun = glam::Vec3::from(self.config.sun_dir).normalize_or(glam::Vec3::Y);
-        let (near_t, far_t) = depth_range(&translucent, camera);
+
         let oit_config = self.oit.config();
         let uniforms = FrameUniforms {
             view_proj: view_proj.to_cols_array_2d(),
@@ -787,21 +792,19 @@ impl Renderer {
     }
 }
 
-/// Nearest and farthest view distance the visible translucent chunks can span.
+/// Nearest and farthest distance from the eye the visible translucent meshes span, from
+/// the boxes around their quads (kept with each mesh: no per-frame work but a distance).
 fn depth_range(chunks: &[Visible<'_>], camera: &Camera) -> (f32, f32) {
-    // Half the diagonal of a chunk: every block of a chunk is this close to its centre.
-    const RADIUS: f64 = 27.8;
-    let near = chunks
-        .iter()
-        .map(|c| c.distance - RADIUS)
-        .fold(f64::INFINITY, f64::min);
-    let far = chunks
-        .iter()
-        .map(|c| c.distance + RADIUS)
-        .fold(0.0, f64::max);
     if chunks.is_empty() {
         return (camera.near as f32, camera.far as f32);
     }
+    let (near, far) = chunks
+        .iter()
+        .map(|c| c.mesh.distance_range(camera.eye))
+        .fold((f64::INFINITY, 0.0f64), |(n, f), (a, b)| {
+            (n.min(a), f.max(b))
+        });
+
     (
         near.max(camera.near) as f32,
         far.min(camera.far).max(camera.near) as f32,

@@ -30,11 +30,23 @@ fn weight(z: f32, depth: f32, a: f32) -> f32 {
         case 4u: {
             return a * clamp(0.03 / (1e-5 + pow(d / 200.0, 4.0)), 1e-2, 3e3);
         }
-        default: {
+        case 5u: {
             return a * max(1e-2, 3e3 * cube(1.0 - z));
+        }
+        default: {
+            // Fitted: log-uniform over the translucent depth range in view.
+            let n = max(frame.depth_range.x, 1e-4);
+            let f = max(frame.depth_range.y, n * 1.001);
+            let t = clamp(log(d / n) / log(f / n), 0.0, 1.0);
+            return a * a * 3e3 * exp(-FITTED_K * t);
         }
     }
 }
+
+// As in weights.rs.
+const FITTED_K: f32 = 9.0;
+
+
 
 fn accumulation(in: VsOut) -> vec4<f32> {
     let c = translucent_color(in);

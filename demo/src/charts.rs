@@ -1,0 +1,402 @@
+//! Charts of the lab (plotters): speed against accuracy with its Pareto front, error
+//! against a swept parameter, and bars. PNG (bitmap) and SVG from the same drawing code.
+//! Text uses the Ubuntu font that egui ships, so no system font is needed.
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// A named set of points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// Legend text.
+    pub name: String,
+    /// (x, y) points.
+    pub points: Vec<(f64, f64)>,
+}
+
+const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// The colour of the `i`-th series.
+pub fn color(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+fn fonts() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        );
+    });
+}
+
+fn err(e: impl std::fmt::Debug) -> String {
+    format!("chart: {e:?}")
+}
+
+/// Axis range covering `values` with a margin; on a log axis the range stays positive.
+fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let v: Vec<f64> = values
+        .filter(|v| v.is_finite() && (!log || *v > 0.0))
+        .collect();
+    let (lo, hi) = v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    if !lo.is_finite() {
+        return if log { (0.01, 1.0) } else { (0.0, 1.0) };
+    }
+    if log {
+        (lo / 1.6, hi * 1.6)
+    } else {
+        let pad = ((hi - lo) * 0.08).max(1e-3);
+        (
+            (lo - pad)
+                .min(0.0)
+                .max(if lo >= 0.0 { 0.0 } else { lo - pad }),
+            hi + pad,
+        )
+    }
+}
+
+/// The points not dominated by another (smaller x and smaller y are better), by x.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut p: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .collect();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut front = Vec::new();
+    let mut best = f64::INFINITY;
+    for (x, y) in p {
+        if y < best {
+            front.push((x, y));
+            best = y;
+        }
+    }
+    front
+}
+
+/// Speed against accuracy: small markers per scene, large ones for the suite means, the
+/// Pareto front through the means. Writes `path.png` and `path.svg`.
+pub fn speed_vs_accuracy(
+    path: &Path,
+    title: &str,
+    per_scene: &[Series],
+    means: &[Series],
+) -> Result<(), String> {
+    fonts();
+    let draw = |root: DrawingArea<_, Shift>| -> Result<(), String> {
+        scatter(root, title, per_scene, means)
+    };
+    draw(BitMapBackend::new(&path.with_extension("png"), (1000, 640)).into_drawing_area())?;
+    draw_svg(&path.with_extension("svg"), (1000, 640), |root| {
+        scatter(root, title, per_scene, means)
+    })
+}
+
+fn draw_svg(
+    path: &Path,
+    size: (u32, u32),
+    f: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<(), String> {
+    f(SVGBackend::new(path, size).into_drawing_area())
+}
+
+fn scatter<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    per_scene: &[Series],
+    means: &[Series],
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let all = || {
+        per_scene
+            .iter()
+            .chain(means)
+            .flat_map(|s| s.points.iter().copied())
+    };
+    let (x0, x1) = range(all().map(|p| p.0), true);
+    let (_, y1) = range(all().map(|p| p.1), false);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d((x0..x1).log_scale(), 0.0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("GPU ms per frame for the translucent work (log scale)")
+        .y_desc("mean FLIP against the exact reference")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    for (i, s) in per_scene.iter().enumerate() {
+        let c = color(i);
+        chart
+            .draw_series(
+                s.points
+                    .iter()
+                    .map(move |&p| Circle::new(p, 3, c.mix(0.55).filled())),
+            )
+            .map_err(err)?;
+    }
+    for (i, s) in means.iter().enumerate() {
+        let c = color(i);
+        chart
+            .draw_series(s.points.iter().map(move |&p| Circle::new(p, 8, c.filled())))
+            .map_err(err)?
+            .label(s.name.clone())
+            .legend(move |(x, y)| Circle::new((x, y), 6, c.filled()));
+    }
+    let front = pareto_front(
+        &means
+            .iter()
+            .flat_map(|s| s.points.iter().copied())
+            .collect::<Vec<_>>(),
+    );
+    chart
+        .draw_series(LineSeries::new(front, BLACK.stroke_width(2)))
+        .map_err(err)?
+        .label("Pareto front (suite means)")
+        .legend(|(x, y)| PathElement::new(vec![(x - 10, y), (x + 10, y)], BLACK.stroke_width(2)));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)
+}
+
+/// Error against a swept parameter, one line per technique. Writes `path.png` and `.svg`.
+pub fn sweep(
+    path: &Path,
+    title: &str,
+    x_desc: &str,
+    log_x: bool,
+    series: &[Series],
+) -> Result<(), String> {
+    fonts();
+    lines(
+        BitMapBackend::new(&path.with_extension("png"), (900, 560)).into_drawing_area(),
+        title,
+        x_desc,
+        log_x,
+        series,
+    )?;
+    draw_svg(&path.with_extension("svg"), (900, 560), |root| {
+        lines(root, title, x_desc, log_x, series)
+    })
+}
+
+fn lines<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    x_desc: &str,
+    log_x: bool,
+    series: &[Series],
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let all = || series.iter().flat_map(|s| s.points.iter().copied());
+    let (x0, x1) = range(all().map(|p| p.0), log_x);
+    let (_, y1) = range(all().map(|p| p.1), false);
+    macro_rules! builder {
+        () => {
+            ChartBuilder::on(&root)
+                .caption(title, ("sans-serif", 20))
+                .margin(14)
+                .x_label_area_size(44)
+                .y_label_area_size(64)
+        };
+    }
+    macro_rules! body {
+        ($chart:expr) => {{
+            let mut chart = $chart;
+            chart
+                .configure_mesh()
+                .x_desc(x_desc)
+                .y_desc("mean FLIP against the exact reference")
+                .label_style(("sans-serif", 14))
+                .draw()
+                .map_err(err)?;
+            for (i, s) in series.iter().enumerate() {
+                let c = color(i);
+                chart
+                    .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
+                    .map_err(err)?
+                    .label(s.name.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x - 10, y), (x + 10, y)], c.stroke_width(2))
+                    });
+                chart
+                    .draw_series(s.points.iter().map(move |&p| Circle::new(p, 3, c.filled())))
+                    .map_err(err)?;
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .label_font(("sans-serif", 13))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()
+                .map_err(err)?;
+        }};
+    }
+    if log_x {
+        body!(
+            builder!()
+                .build_cartesian_2d((x0..x1).log_scale(), 0.0..y1)
+                .map_err(err)?
+        );
+    } else {
+        body!(
+            builder!()
+                .build_cartesian_2d(x0..x1, 0.0..y1)
+                .map_err(err)?
+        );
+    }
+
+    root.present().map_err(err)
+}
+
+/// One bar per name. Writes `path.png` and `path.svg`.
+pub fn bars(
+    path: &Path,
+    title: &str,
+    y_desc: &str,
+    values: &[(String, f64)],
+) -> Result<(), String> {
+    fonts();
+    bar_body(
+        BitMapBackend::new(&path.with_extension("png"), (900, 520)).into_drawing_area(),
+        title,
+        y_desc,
+        values,
+    )?;
+    draw_svg(&path.with_extension("svg"), (900, 520), |root| {
+        bar_body(root, title, y_desc, values)
+    })
+}
+
+fn bar_body<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    y_desc: &str,
+    values: &[(String, f64)],
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let (_, y1) = range(values.iter().map(|v| v.1), false);
+    let n = values.len().max(1) as i32;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(14)
+        .x_label_area_size(70)
+        .y_label_area_size(64)
+        .build_cartesian_2d(0..n, 0.0..y1)
+        .map_err(err)?;
+    let names: Vec<String> = values.iter().map(|v| v.0.clone()).collect();
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(values.len().max(1))
+        .x_label_formatter(&|i| names.get(*i as usize).cloned().unwrap_or_default())
+        .x_label_style(
+            ("sans-serif", 12)
+                .into_font()
+                .transform(FontTransform::Rotate90),
+        )
+        .y_desc(y_desc)
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    chart
+        .draw_series(values.iter().enumerate().map(|(i, (_, v))| {
+            let i = i as i32;
+            Rectangle::new([(i, 0.0), (i + 1, *v)], color(i as usize).filled())
+        }))
+        .map_err(err)?;
+    root.present().map_err(err)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pareto_front_keeps_only_undominated_points() {
+        let p = [
+            (1.0, 0.5),
+            (2.0, 0.6),
+            (3.0, 0.1),
+            (0.5, 0.9),
+            (4.0, 0.0),
+            (5.0, 0.0),
+        ];
+        assert_eq!(
+            pareto_front(&p),
+            vec![(0.5, 0.9), (1.0, 0.5), (3.0, 0.1), (4.0, 0.0)]
+        );
+    }
+
+    #[test]
+    fn charts_are_written() {
+        let dir = std::env::temp_dir().join(format!("voxel_charts_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let s = vec![Series {
+            name: "a".into(),
+            points: vec![(0.5, 0.1), (2.0, 0.05)],
+        }];
+        speed_vs_accuracy(&dir.join("sva"), "t", &s, &s).unwrap();
+        sweep(&dir.join("sweep"), "t", "x", true, &s).unwrap();
+        bars(
+            &dir.join("bars"),
+            "t",
+            "y",
+            &[("a".into(), 1.0), ("b".into(), 2.0)],
+        )
+        .unwrap();
+        for f in [
+            "sva.png",
+            "sva.svg",
+            "sweep.png",
+            "sweep.svg",
+            "bars.png",
+            "bars.svg",
+        ] {
+            let len = std::fs::metadata(dir.join(f)).unwrap().len();
+            assert!(len > 1000, "{f}: {len} bytes");
+        }
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}

@@ -1,0 +1,203 @@
+//! Error of a picture against the exact reference: RMSE, PSNR, mean FLIP (NVIDIA's
+//! perceptual difference, through the nv-flip crate), largest channel error, share of
+//! pixels off by more than one level, and non-finite HDR pixels.
+
+use serde::Serialize;
+use voxel_render::Image;
+
+/// How far a picture is from the reference.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Metrics {
+    /// Root mean square error over RGB, in [0, 1] units of the 8-bit output.
+    pub rmse: f64,
+    /// Peak signal-to-noise ratio, dB; 100 stands for identical pictures.
+    pub psnr: f64,
+    /// Mean FLIP error in [0, 1] (0: identical), at nv-flip's default pixels per degree.
+    pub flip_mean: f64,
+    /// Largest absolute difference of any channel, in 1/255 steps.
+    pub max_abs_err: u32,
+    /// Share of pixels whose largest channel difference exceeds 1/255.
+    pub frac_bad_px: f64,
+}
+
+/// PSNR written for identical pictures (a finite stand-in for infinity, which JSON lacks).
+pub const PSNR_IDENTICAL: f64 = 100.0;
+
+fn rgb(img: &Image) -> Vec<u8> {
+    img.rgba
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect()
+}
+
+/// Compares `test` with `reference` (same size). Also returns the FLIP error map as a
+/// magma-coloured heat map.
+pub fn compare(reference: &Image, test: &Image) -> (Metrics, Image) {
+    assert_eq!(
+        (reference.width, reference.height),
+        (test.width, test.height),
+        "picture sizes differ"
+    );
+    let (w, h) = (reference.width, reference.height);
+    let mut sq = 0.0f64;
+    let mut max = 0u32;
+    let mut bad = 0usize;
+    for (p, q) in reference
+        .rgba
+        .chunks_exact(4)
+        .zip(test.rgba.chunks_exact(4))
+    {
+        let mut m = 0u32;
+        for c in 0..3 {
+            let d = u32::from(p[c].abs_diff(q[c]));
+            sq += f64::from(d * d);
+            m = m.max(d);
+        }
+        max = max.max(m);
+        bad += usize::from(m > 1);
+    }
+    let n = f64::from(w) * f64::from(h);
+    let rmse = (sq / (3.0 * n)).sqrt() / 255.0;
+    let psnr = if rmse == 0.0 {
+        PSNR_IDENTICAL
+    } else {
+        (20.0 * (1.0 / rmse).log10()).min(PSNR_IDENTICAL)
+    };
+    let error_map = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(w, h, &rgb(reference)),
+        nv_flip::FlipImageRgb8::with_data(w, h, &rgb(test)),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let flip_mean = f64::from(nv_flip::FlipPool::from_image(&error_map).mean());
+    let heat = error_map.apply_color_lut(&nv_flip::magma_lut()).to_vec();
+    let heat = Image {
+        width: w,
+        height: h,
+        rgba: heat
+            .chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect(),
+    };
+    (
+        Metrics {
+            rmse,
+            psnr,
+            flip_mean,
+            max_abs_err: max,
+            frac_bad_px: bad as f64 / n,
+        },
+        heat,
+    )
+}
+
+/// Pixels of an HDR readback holding NaN or an infinity in any channel.
+pub fn non_finite_pixels(hdr: &[[f32; 4]]) -> usize {
+    hdr.iter()
+        .filter(|p| p.iter().any(|c| !c.is_finite()))
+        .count()
+}
+
+/// Mean over pixels and RGB of |a − b|, in 1/255 steps.
+pub fn mean_abs_diff(a: &Image, b: &Image) -> f64 {
+    let total: u64 = a
+        .rgba
+        .chunks_exact(4)
+        .zip(b.rgba.chunks_exact(4))
+        .map(|(p, q)| (0..3).map(|c| u64::from(p[c].abs_diff(q[c]))).sum::<u64>())
+        .sum();
+    total as f64 / (3.0 * f64::from(a.width) * f64::from(a.height))
+}
+
+/// Temporal flicker of a technique beyond the reference's own change between two frames:
+/// per pixel and channel, how much more the technique's picture changed than the
+/// reference's did (never below zero), averaged, in 1/255 steps.
+pub fn excess_change(prev: &Image, cur: &Image, ref_prev: &Image, ref_cur: &Image) -> f64 {
+    let mut total = 0.0f64;
+    for (((p, q), r), s) in prev
+        .rgba
+        .chunks_exact(4)
+        .zip(cur.rgba.chunks_exact(4))
+        .zip(ref_prev.rgba.chunks_exact(4))
+        .zip(ref_cur.rgba.chunks_exact(4))
+    {
+        for c in 0..3 {
+            let own = f64::from(p[c].abs_diff(q[c]));
+            let truth = f64::from(r[c].abs_diff(s[c]));
+            total += (own - truth).max(0.0);
+        }
+    }
+    total / (3.0 * f64::from(cur.width) * f64::from(cur.height))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn img(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Image {
+        Image {
+            width: w,
+            height: h,
+            rgba: (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .flat_map(|(x, y)| f(x, y))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn identical_pictures_have_no_error() {
+        let a = img(16, 8, |x, y| [x as u8 * 10, y as u8 * 20, 7, 255]);
+        let (m, heat) = compare(&a, &a);
+        assert_eq!(m.rmse, 0.0);
+        assert_eq!(m.psnr, PSNR_IDENTICAL);
+        assert_eq!(m.max_abs_err, 0);
+        assert_eq!(m.frac_bad_px, 0.0);
+        assert!(m.flip_mean < 1e-6);
+        assert_eq!((heat.width, heat.height), (16, 8));
+    }
+
+    #[test]
+    fn worked_example() {
+        // Half the pixels differ by 30 in red only: mean square = 0.5 * 900 / 3 = 150,
+        // rmse = sqrt(150) / 255 = 0.04803, psnr = 20 log10(1 / 0.04803) = 26.37 dB.
+        let a = img(8, 8, |_, _| [100, 100, 100, 255]);
+        let b = img(8, 8, |x, _| {
+            if x < 4 {
+                [130, 100, 100, 255]
+            } else {
+                [100, 100, 100, 255]
+            }
+        });
+        let (m, _) = compare(&a, &b);
+        assert!((m.rmse - 0.048_03).abs() < 1e-4, "{m:?}");
+        assert!((m.psnr - 26.37).abs() < 0.01, "{m:?}");
+        assert_eq!(m.max_abs_err, 30);
+        assert_eq!(m.frac_bad_px, 0.5);
+        assert!(m.flip_mean > 0.01);
+    }
+
+    #[test]
+    fn non_finite_and_flicker() {
+        assert_eq!(
+            non_finite_pixels(&[
+                [0.0; 4],
+                [f32::NAN, 0.0, 0.0, 1.0],
+                [0.0, f32::INFINITY, 0.0, 0.0]
+            ]),
+            2
+        );
+        let a = img(2, 1, |_, _| [10, 10, 10, 255]);
+        let b = img(2, 1, |x, _| {
+            if x == 0 {
+                [20, 10, 10, 255]
+            } else {
+                [10, 10, 10, 255]
+            }
+        });
+        assert!((mean_abs_diff(&a, &b) - 10.0 / 6.0).abs() < 1e-12);
+        // The technique changes where the reference did not: all of it is excess.
+        assert!((excess_change(&a, &b, &a, &a) - 10.0 / 6.0).abs() < 1e-12);
+        // The same change as the reference: none of it is.
+        assert_eq!(excess_change(&a, &b, &a, &b), 0.0);
+    }
+}

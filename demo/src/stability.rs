@@ -1,0 +1,389 @@
+//! Stability where methods fail: sweeps that change one thing (opacity, number of layers,
+//! distance of the stack) and chart each technique's error against it, and a camera path
+//! that measures temporal flicker beyond the reference's own change.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use serde::Serialize;
+use voxel_core::{BlockDef, BlockId, BlockRegistry, World};
+
+use voxel_render::{Camera, GpuContext, Technique};
+
+use crate::charts::{self, Series};
+use crate::eval::{self, EvalOptions, Progress, make_renderer, measure, oit_config};
+use crate::headless::Offscreen;
+use crate::metrics;
+use crate::scene::Scene;
+
+/// One sweep: a parameter and each technique's mean FLIP at each of its values.
+#[derive(Clone, Debug, Serialize)]
+pub struct Sweep {
+    /// Short name (file stem of its chart).
+    pub name: String,
+    /// What is swept.
+    pub parameter: String,
+    /// The values, in order.
+    pub values: Vec<f64>,
+    /// Per technique: mean FLIP at each value.
+    pub flip: Vec<(String, Vec<f64>)>,
+}
+
+/// Temporal flicker along one scene's camera path.
+#[derive(Clone, Debug, Serialize)]
+pub struct Flicker {
+    /// Scene file stem.
+    pub scene: String,
+    /// Frames of the path.
+    pub frames: usize,
+    /// The reference's own mean absolute change between frames, in 1/255 steps.
+    pub reference_change: f64,
+    /// Per technique: mean change beyond the reference's, in 1/255 steps.
+    pub excess: Vec<(String, f64)>,
+}
+
+/// All stability results.
+#[derive(Clone, Debug, Serialize)]
+pub struct Stability {
+    /// The sweeps.
+    pub sweeps: Vec<Sweep>,
+    /// Flicker per path.
+    pub flicker: Vec<Flicker>,
+}
+
+/// Techniques the sweeps chart: all measured ones but the references and opaque-only.
+fn swept(opts: &EvalOptions) -> Vec<Technique> {
+    opts.techniques
+        .iter()
+        .copied()
+        .filter(|t| !t.is_exact() && *t != Technique::OpaqueOnly)
+        .collect()
+}
+
+/// `n` values spread over `all` (its first and last always included).
+fn pick(all: &[f64], n: usize) -> Vec<f64> {
+    if n >= all.len() || n < 2 {
+        return all.to_vec();
+    }
+    (0..n).map(|i| all[i * (all.len() - 1) / (n - 1)]).collect()
+}
+
+/// A registry with sweep blocks of `opacity` in the given colours, and their ids.
+fn sweep_registry(opacity: f32, colors: &[[u8; 3]]) -> (Arc<BlockRegistry>, Vec<BlockId>) {
+    let mut r = BlockRegistry::default();
+    let ids = colors
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| {
+            r.register(BlockDef::new(format!("sweep_{i}"), *c, opacity))
+                .ok()
+        })
+        .collect();
+    (Arc::new(r), ids)
+}
+
+/// Parallel sheets facing +z at the given z, over a stone and sand back wall.
+fn sheets(
+    registry: Arc<BlockRegistry>,
+    ids: &[BlockId],
+    zs: &[i32],
+    half: i32,
+    eye_z: f64,
+) -> Result<Scene, String> {
+    let mut world = World::new(registry);
+    let back = zs.iter().min().copied().unwrap_or(0) - 4;
+    let fill =
+        |w: &mut World, min: [i32; 3], max: [i32; 3], id| crate::scene::fill_box(w, min, max, id);
+    fill(
+        &mut world,
+        [-half - 4, -half - 4, back - 1],
+        [half + 4, half + 4, back],
+        voxel_core::blocks::STONE,
+    )?;
+    fill(
+        &mut world,
+        [-half - 4, -half - 4, back + 1],
+        [half + 4, -half / 3, back + 1],
+        voxel_core::blocks::SAND,
+    )?;
+    for (i, &z) in zs.iter().enumerate() {
+        fill(
+            &mut world,
+            [-half, -half, z],
+            [half, half, z],
+            ids[i % ids.len()],
+        )?;
+    }
+    let camera = Camera::look_at(
+        DVec3::new(0.5, 0.5, eye_z),
+        DVec3::new(0.5, 0.5, -1.0),
+        60.0,
+        0.1,
+        4000.0,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(Scene::new("sweep", world, camera))
+}
+
+/// Mean FLIP of each technique against the reference on `scene`.
+fn errors(
+    ctx: &GpuContext,
+    scene: &Scene,
+    opts: &EvalOptions,
+    size: (u32, u32),
+    techniques: &[Technique],
+) -> Result<Vec<f64>, String> {
+    let mut renderer = make_renderer(ctx, scene, size)?;
+    let target = Offscreen::new(ctx, size.0, size.1);
+    let cam = scene.cameras[0];
+    let weight = voxel_render::OitConfig::default().weight;
+    let reference = measure(
+        ctx,
+        &mut renderer,
+        &target,
+        &cam,
+        &oit_config(Technique::Reference, weight),
+        0,
+        1,
+    )?;
+    techniques
+        .iter()
+        .map(|t| {
+            let m = measure(
+                ctx,
+                &mut renderer,
+                &target,
+                &cam,
+                &oit_config(*t, weight),
+                opts.warmup,
+                1,
+            )?;
+            Ok(metrics::compare(&reference.image, &m.image).0.flip_mean)
+        })
+        .collect()
+}
+
+const COLORS: [[u8; 3]; 4] = [[210, 60, 40], [40, 90, 210], [60, 180, 70], [230, 200, 60]];
+
+/// Runs the sweeps and the flicker paths, writes `stability/` charts and JSON.
+pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability, String> {
+    let dir = opts.out.join("stability");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let techniques = swept(opts);
+    let size = opts
+        .size
+        .map(|(w, h)| (w.min(480), h.min(270)))
+        .unwrap_or((480, 270));
+    let n = opts.sweep_points.max(2);
+
+    let opacities = pick(&[0.05, 0.1, 0.2, 0.35, 0.5, 0.65, 0.8, 0.9, 0.99], n);
+    let layers = pick(&[1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0], n);
+    let distances = pick(&[1.0, 3.0, 10.0, 30.0, 100.0, 300.0, 1000.0], n);
+    let flicker_scenes = flicker_scenes(opts)?;
+    let mut progress =
+        Progress::new(opacities.len() + layers.len() + distances.len() + flicker_scenes.len());
+
+    let mut sweep = |name: &str,
+                     parameter: &str,
+                     values: &[f64],
+                     build: &dyn Fn(f64) -> Result<Scene, String>|
+     -> Result<Sweep, String> {
+        let mut flip = vec![Vec::new(); techniques.len()];
+        for &v in values {
+            progress.step(&format!("stability: {name} {v}"));
+            let scene = build(v)?;
+            for (i, e) in errors(ctx, &scene, opts, size, &techniques)?
+                .into_iter()
+                .enumerate()
+            {
+                flip[i].push(e);
+            }
+        }
+        Ok(Sweep {
+            name: name.to_owned(),
+            parameter: parameter.to_owned(),
+            values: values.to_vec(),
+            flip: techniques
+                .iter()
+                .map(|t| t.name().to_owned())
+                .zip(flip)
+                .collect(),
+        })
+    };
+    let opacity = sweep(
+        "opacity",
+        "opacity of every layer (6 layers)",
+        &opacities,
+        &|a| {
+            let (reg, ids) = sweep_registry(a as f32, &COLORS[..2]);
+            sheets(reg, &ids, &[0, -2, -4, -6, -8, -10], 12, 14.0)
+        },
+    )?;
+    let layer_count = sweep("layers", "number of layers (opacity 0.3)", &layers, &|n| {
+        let (reg, ids) = sweep_registry(0.3, &COLORS[..3]);
+        let zs: Vec<i32> = (0..n as i32).map(|i| -2 * i).collect();
+        sheets(reg, &ids, &zs, 14, 8.0)
+    })?;
+    let distance = sweep(
+        "distance",
+        "distance from the eye to the stack (blocks)",
+        &distances,
+        &|d| {
+            let (reg, ids) = sweep_registry(0.4, &COLORS);
+            // The stack grows with distance so that it covers the same part of the view.
+            let half = (0.7 * d).max(6.0) as i32;
+            sheets(reg, &ids, &[0, -2, -4, -6], half, d + 1.0)
+        },
+    )?;
+    let sweeps = vec![opacity, layer_count, distance];
+    for (s, log) in sweeps.iter().zip([false, true, true]) {
+        let series: Vec<Series> = s
+            .flip
+            .iter()
+            .map(|(t, f)| Series {
+                name: t.clone(),
+                points: s.values.iter().copied().zip(f.iter().copied()).collect(),
+            })
+            .collect();
+        charts::sweep(
+            &dir.join(&s.name),
+            &format!("Error against {}", s.parameter),
+            &s.parameter,
+            log,
+            &series,
+        )?;
+    }
+
+    let mut flicker = Vec::new();
+    for (stem, scene) in flicker_scenes {
+        progress.step(&format!("stability: flicker {stem}"));
+        let f = flicker_path(ctx, &stem, &scene, opts, size, &techniques)?;
+        charts::bars(
+            &dir.join(format!("flicker_{stem}")),
+            &format!("Flicker beyond the reference, {stem}, {} frames", f.frames),
+            "mean excess change per frame (1/255)",
+            &f.excess,
+        )?;
+        flicker.push(f);
+    }
+    let result = Stability { sweeps, flicker };
+    eval::write_json(&dir.join("stability.json"), &result)?;
+    Ok(result)
+}
+
+/// The scenes whose camera paths measure flicker: the greenhouse and the corridor when in
+/// the suite, else the first scene with a path.
+fn flicker_scenes(opts: &EvalOptions) -> Result<Vec<(String, Scene)>, String> {
+    let mut out = Vec::new();
+    let stem = |p: &std::path::PathBuf| {
+        p.file_stem()
+            .map_or(String::new(), |s| s.to_string_lossy().into_owned())
+    };
+    for want in ["terrain_greenhouse", "stained_glass_corridor"] {
+        if let Some(p) = opts.scenes.iter().find(|p| stem(p) == want) {
+            out.push((want.to_owned(), Scene::load(p)?));
+        }
+    }
+    if out.is_empty() {
+        for p in &opts.scenes {
+            let s = Scene::load(p)?;
+            if s.paths[0].is_some() {
+                out.push((stem(p), s));
+                break;
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn flicker_path(
+    ctx: &GpuContext,
+    stem: &str,
+    scene: &Scene,
+    opts: &EvalOptions,
+    size: (u32, u32),
+    techniques: &[Technique],
+) -> Result<Flicker, String> {
+    let start = scene.cameras[0];
+    let end = scene.paths[0].unwrap_or(start.eye + DVec3::X * 2.0);
+    let frames = opts.flicker_frames.max(2);
+    let cameras: Vec<Camera> = (0..frames)
+        .map(|i| Camera {
+            eye: start.eye.lerp(end, i as f64 / (frames - 1) as f64),
+            ..start
+        })
+        .collect();
+    let mut renderer = make_renderer(ctx, scene, size)?;
+    let target = Offscreen::new(ctx, size.0, size.1);
+    let weight = voxel_render::OitConfig::default().weight;
+    let path = |renderer: &mut voxel_render::Renderer,
+                t: Technique|
+     -> Result<Vec<voxel_render::Image>, String> {
+        // Settle at the start (pipelines, adaptive peeling), then walk the path.
+        measure(
+            ctx,
+            renderer,
+            &target,
+            &cameras[0],
+            &oit_config(t, weight),
+            opts.warmup,
+            0,
+        )?;
+        cameras
+            .iter()
+            .map(|c| {
+                renderer
+                    .render_and_submit(&target.view, c)
+                    .map_err(|e| e.to_string())?;
+                target.read(ctx)
+            })
+            .collect()
+    };
+    let reference = path(&mut renderer, Technique::Reference)?;
+    let change = |v: &[voxel_render::Image]| -> f64 {
+        v.windows(2)
+            .map(|w| metrics::mean_abs_diff(&w[0], &w[1]))
+            .sum::<f64>()
+            / (v.len() - 1) as f64
+    };
+    let mut excess = Vec::new();
+    for &t in techniques {
+        let imgs = path(&mut renderer, t)?;
+        let e = (1..imgs.len())
+            .map(|i| {
+                metrics::excess_change(&imgs[i - 1], &imgs[i], &reference[i - 1], &reference[i])
+            })
+            .sum::<f64>()
+            / (imgs.len() - 1) as f64;
+        excess.push((t.name().to_owned(), e));
+    }
+    Ok(Flicker {
+        scene: stem.to_owned(),
+        frames,
+        reference_change: change(&reference),
+        excess,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use voxel_core::WorldPos;
+
+    #[test]
+    fn pick_spreads_values_and_keeps_the_ends() {
+        let all = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0];
+        assert_eq!(pick(&all, 3), vec![1.0, 4.0, 7.0]);
+        assert_eq!(pick(&all, 2), vec![1.0, 7.0]);
+        assert_eq!(pick(&all, 10), all.to_vec());
+    }
+
+    #[test]
+    fn sweep_scenes_hold_the_sheets() {
+        let (reg, ids) = sweep_registry(0.3, &COLORS[..3]);
+        assert_eq!(ids.len(), 3);
+        let s = sheets(reg, &ids, &[0, -2, -4], 5, 8.0).unwrap();
+        assert_eq!(s.world.get_block(WorldPos::new(0, 0, -2)), ids[1]);
+        assert_eq!(s.world.get_block(WorldPos::new(0, 0, -1)), BlockId::AIR);
+    }
+}

@@ -1,0 +1,116 @@
+//! The lab in CI: a small, few-frame evaluation of the whole scene suite with every
+//! technique, checking that the two exact methods agree, that nothing overflows or turns
+//! NaN, and that every output file is written.
+
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use std::path::Path;
+
+use demo::eval::{EvalOptions, run, scene_files};
+use voxel_render::{Technique, WeightFunction};
+
+#[test]
+fn small_eval_of_the_suite() {
+    let Some(ctx) = tests::gpu() else { return };
+    let out = tests::out_dir("lab");
+    let _ = std::fs::remove_dir_all(&out);
+    let scenes = scene_files(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")).unwrap();
+    assert!(scenes.len() >= 10, "the suite has at least 10 scenes");
+    let opts = EvalOptions {
+        scenes: scenes.clone(),
+        techniques: Technique::ALL.to_vec(),
+        weights: WeightFunction::ALL.to_vec(),
+        size: Some((96, 54)),
+        frames: 1,
+        warmup: 1,
+        out: out.clone(),
+        stability: true,
+        flicker_frames: 3,
+        sweep_points: 2,
+        command: "cargo test -p tests --test lab".into(),
+        heatmap_width: Some(48),
+    };
+
+    let summary = run(&ctx, &opts).unwrap();
+
+    // The reference is right: the two exact methods agree on every scene, nothing lost.
+    assert_eq!(summary.reference_checks.len(), scenes.len());
+    for c in &summary.reference_checks {
+        assert!(
+            c.max_abs_err <= 1,
+            "{}: A-buffer and peeling differ by {}/255",
+            c.scene,
+            c.max_abs_err
+        );
+        assert_eq!(c.overflow, 0, "{}: A-buffer overflow", c.scene);
+    }
+    assert!(
+        summary
+            .reference_checks
+            .iter()
+            .any(|c| c.depth_complexity >= 32),
+        "the suite holds a scene of 32+ layers"
+    );
+    // One record per scene and technique (plus the weight runs), none with NaN or inf.
+    assert_eq!(
+        summary.records.len(),
+        scenes.len() * (Technique::ALL.len() + WeightFunction::ALL.len())
+    );
+    for r in &summary.records {
+        assert_eq!(r.nan_px, 0, "{} {}: NaN/inf pixels", r.scene, r.technique);
+        assert!(out.join(&r.heatmap).is_file(), "missing {}", r.heatmap);
+        if r.scene == "opaque_only" {
+            assert_eq!(
+                r.max_abs_err, 0,
+                "{}: no translucency, so no error",
+                r.technique
+            );
+        }
+        if r.technique == "reference" {
+            assert_eq!(r.max_abs_err, 0);
+        }
+    }
+
+    // summary.json: an array of records with the documented keys.
+    let json: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(json.len(), summary.records.len());
+    for key in [
+        "scene",
+        "technique",
+        "width",
+        "height",
+        "gpu_ms",
+        "cpu_ms",
+        "rmse",
+        "psnr",
+        "flip_mean",
+        "max_abs_err",
+        "frac_bad_px",
+        "nan_px",
+    ] {
+        assert!(
+            json.iter().all(|r| r.get(key).is_some()),
+            "summary.json lacks {key}"
+        );
+    }
+    for file in [
+        "speed_vs_accuracy.png",
+        "speed_vs_accuracy.svg",
+        "report.md",
+        "stability/opacity.png",
+        "stability/layers.png",
+        "stability/distance.png",
+        "stability/stability.json",
+        "stability/flicker_terrain_greenhouse.png",
+    ] {
+        let len = std::fs::metadata(out.join(file))
+            .map(|m| m.len())
+            .unwrap_or(0);
+        assert!(len > 500, "{file}: {len} bytes");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for c in &summary.reference_checks {
+        assert!(report.contains(&c.scene), "report.md lacks {}", c.scene);
+    }
+}
