@@ -95,6 +95,9 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     front
 }
 
+/// Smallest FLIP the speed/accuracy chart shows (its y axis is logarithmic; 0 is drawn here).
+pub const FLIP_FLOOR: f64 = 1e-4;
+
 /// Speed against accuracy: small markers per scene, large ones for the suite means, the
 /// Pareto front through the means. Writes `path.png` and `path.svg`.
 pub fn speed_vs_accuracy(
@@ -131,25 +134,27 @@ where
     DB::ErrorType: 'static,
 {
     root.fill(&WHITE).map_err(err)?;
+    let floor = |(x, y): (f64, f64)| (x, y.max(FLIP_FLOOR));
     let all = || {
         per_scene
             .iter()
             .chain(means)
             .flat_map(|s| s.points.iter().copied())
+            .map(floor)
     };
     let (x0, x1) = range(all().map(|p| p.0), true);
-    let (_, y1) = range(all().map(|p| p.1), false);
+    let (_, y1) = range(all().map(|p| p.1), true);
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
         .margin(14)
         .x_label_area_size(44)
         .y_label_area_size(64)
-        .build_cartesian_2d((x0..x1).log_scale(), 0.0..y1)
+        .build_cartesian_2d((x0..x1).log_scale(), (FLIP_FLOOR / 1.5..y1).log_scale())
         .map_err(err)?;
     chart
         .configure_mesh()
         .x_desc("GPU ms per frame for the translucent work (log scale)")
-        .y_desc("mean FLIP against the exact reference")
+        .y_desc("mean FLIP against the exact reference (log; 0 drawn at 1e-4)")
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(err)?;
@@ -159,24 +164,27 @@ where
             .draw_series(
                 s.points
                     .iter()
-                    .map(move |&p| Circle::new(p, 3, c.mix(0.55).filled())),
+                    .map(move |&p| Circle::new(floor(p), 3, c.mix(0.55).filled())),
             )
             .map_err(err)?;
     }
     for (i, s) in means.iter().enumerate() {
         let c = color(i);
         chart
-            .draw_series(s.points.iter().map(move |&p| Circle::new(p, 8, c.filled())))
+            .draw_series(
+                s.points
+                    .iter()
+                    .map(move |&p| Circle::new(floor(p), 8, c.filled())),
+            )
             .map_err(err)?
             .label(s.name.clone())
             .legend(move |(x, y)| Circle::new((x, y), 6, c.filled()));
     }
-    let front = pareto_front(
-        &means
-            .iter()
-            .flat_map(|s| s.points.iter().copied())
-            .collect::<Vec<_>>(),
-    );
+    let points: Vec<(f64, f64)> = means
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .collect();
+    let front: Vec<(f64, f64)> = pareto_front(&points).into_iter().map(floor).collect();
     chart
         .draw_series(LineSeries::new(front, BLACK.stroke_width(2)))
         .map_err(err)?

@@ -477,7 +477,8 @@ fn chart(out: &Path, summary: &Summary, opts: &EvalOptions) -> Result<(), String
         .into_iter()
         .filter(|n| n != "opaque-only")
         .collect();
-    // A technique with no GPU work measured (0 ms) would sit at -inf on the log axis.
+    // A scene where a technique drew nothing translucent (0 ms: nothing in view to
+    // compose) says nothing about it, and would sit at -inf on the log axis.
     let floor = 0.001;
     let per_scene: Vec<Series> = names
         .iter()
@@ -487,7 +488,7 @@ fn chart(out: &Path, summary: &Summary, opts: &EvalOptions) -> Result<(), String
                 .records
                 .iter()
                 .filter(|r| &r.technique == n)
-                .filter_map(|r| r.gpu_ms.map(|g| (g.max(floor), r.flip_mean)))
+                .filter_map(|r| r.gpu_ms.filter(|g| *g > 0.0).map(|g| (g, r.flip_mean)))
                 .collect(),
         })
         .collect();

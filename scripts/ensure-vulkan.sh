@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Makes sure a Vulkan driver is present (Mesa's software one, lavapipe, on machines without
+# a GPU), plus Xvfb and the X11 keyboard library winit loads at run time. Installs what is
+# missing with apt-get when running as root on Debian/Ubuntu; otherwise says what to
+# install and fails. Sourced by run.sh and test.sh.
+
+have_vulkan_driver() {
+    compgen -G "/usr/share/vulkan/icd.d/*.json" >/dev/null ||
+        compgen -G "/etc/vulkan/icd.d/*.json" >/dev/null
+}
+
+have_lib() {
+    ldconfig -p 2>/dev/null | grep -q "$1"
+}
+
+ensure_vulkan() {
+    local missing=()
+    have_vulkan_driver || missing+=(mesa-vulkan-drivers)
+    command -v Xvfb >/dev/null || missing+=(xvfb)
+    have_lib libxkbcommon-x11.so.0 || missing+=(libxkbcommon-x11-0)
+    if ((${#missing[@]})); then
+        if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+            echo "installing ${missing[*]} with apt-get" >&2
+            apt-get update -qq
+            DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+        else
+            echo "error: missing ${missing[*]}; install with: sudo apt-get install -y ${missing[*]}" >&2
+            return 1
+        fi
+    fi
+    # Mesa's Wayland probe complains without a runtime directory; give it one.
+    if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "${XDG_RUNTIME_DIR}" ]; then
+        export XDG_RUNTIME_DIR="${TMPDIR:-/tmp}/voxel-oit-runtime-$(id -u)"
+        mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
+    fi
+}
