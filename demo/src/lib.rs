@@ -1,5 +1,6 @@
 //! The demo's library: scenes, headless rendering, and the lab behind `demo eval`.
 
+pub mod app;
 pub mod args;
 pub mod charts;
 pub mod eval;

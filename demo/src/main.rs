@@ -1,5 +1,11 @@
 //! The demo and headless tools of the voxel OIT renderer.
 //!
+//! - `demo [window] [--seed N] [--size WxH] [--technique NAME] [--view-distance N]
+//!   [--heatmap] [--frames N] [--screenshot FILE] [--cycle DIR] [--edit] [--resize]`: the
+//!   interactive demo (a window); the last five script it for tests. Without a display,
+//!   `demo` runs the showcase instead.
+//! - `demo showcase [--out DIR] [--size WxH]`: every technique rendered for the default scene
+//!   into `DIR` (default `out/`), and a quick speed/accuracy evaluation with its chart.
 //! - `demo stats [--seed N] [--chunks N]`: generate and mesh a world, print statistics.
 //! - `demo render [--technique NAME] [--weight NAME] [--bayer 2|4|8|16] [--layers N]
 //!   [--scene FILE] [--size WxH] [--seed N] [--msaa] [--frames N] --out FILE.png`: render a
@@ -15,14 +21,23 @@ fn main() {
     let argv: Vec<String> = std::env::args().skip(1).collect();
     let (cmd, rest) = match argv.first().map(String::as_str) {
         Some(c) if !c.starts_with("--") => (c, &argv[1..]),
-        _ => ("stats", &argv[..]),
+        _ => ("", &argv[..]),
     };
     let result = match cmd {
+        "" if demo::app::have_display() => window(rest),
+        "" => {
+            eprintln!(
+                "no display (neither DISPLAY nor WAYLAND_DISPLAY is set): running the headless showcase instead"
+            );
+            showcase(rest)
+        }
+        "window" => window(rest),
+        "showcase" => showcase(rest),
         "stats" => stats(rest),
         "render" => render(rest),
         "eval" => eval(rest),
         other => Err(format!(
-            "unknown command {other:?}; commands: stats, render, eval"
+            "unknown command {other:?}; commands: window, showcase, stats, render, eval"
         )),
     };
     if let Err(e) = result {
@@ -349,5 +364,118 @@ fn eval(argv: &[String]) -> Result<(), String> {
         t.elapsed().as_secs_f64(),
         out.join("report.md").display()
     );
+    Ok(())
+}
+
+/// Opens the interactive demo.
+fn window(argv: &[String]) -> Result<(), String> {
+    let a = Args::parse(argv, &["heatmap", "edit", "resize"], &[])?;
+    a.reject_unknown(&[
+        "seed",
+        "size",
+        "technique",
+        "view-distance",
+        "heatmap",
+        "frames",
+        "screenshot",
+        "cycle",
+        "edit",
+        "resize",
+    ])?;
+    let defaults = demo::app::DemoOptions::default();
+    let opts = demo::app::DemoOptions {
+        seed: a.parse_or("seed", defaults.seed)?,
+        size: a
+            .get("size")
+            .map(args::parse_size)
+            .transpose()?
+            .unwrap_or(defaults.size),
+        technique: match a.get("technique") {
+            Some(t) => voxel_render::Technique::from_name(t).map_err(|e| e.to_string())?,
+            None => defaults.technique,
+        },
+        view_distance: a.parse_or("view-distance", defaults.view_distance)?,
+        frames: a
+            .get("frames")
+            .map(str::parse)
+            .transpose()
+            .map_err(|e| format!("--frames: {e}"))?,
+        screenshot: a.get("screenshot").map(std::path::PathBuf::from),
+        cycle: a.get("cycle").map(std::path::PathBuf::from),
+        heatmap: a.flag("heatmap"),
+        edit: a.flag("edit"),
+        resize: a.flag("resize"),
+    };
+    if !(1..=16).contains(&opts.view_distance) {
+        return Err(format!(
+            "--view-distance {}: must be in 1..=16 chunks",
+            opts.view_distance
+        ));
+    }
+    if (opts.screenshot.is_some() || opts.cycle.is_some() || opts.edit || opts.resize)
+        && opts.frames.is_none()
+    {
+        return Err(
+            "--screenshot, --cycle, --edit and --resize script a run: give --frames N too".into(),
+        );
+    }
+    demo::app::run(opts)
+}
+
+/// Without a display: every technique's picture of the default scene, and a quick
+/// evaluation of the suite with its speed/accuracy chart.
+fn showcase(argv: &[String]) -> Result<(), String> {
+    use voxel_render::{RendererConfig, Technique};
+    let a = Args::parse(argv, &[], &[])?;
+    a.reject_unknown(&["out", "size"])?;
+    let out = std::path::PathBuf::from(a.get("out").unwrap_or("out"));
+    let (w, h) = args::parse_size(a.get("size").unwrap_or("1280x720"))?;
+    let ctx = demo::headless::context()?;
+    println!("adapter: {}", ctx.caps.adapter_name);
+    let scene = demo::scene::default_scene(1)?;
+    let mut renderer = demo::headless::renderer_for(
+        &ctx,
+        &scene,
+        RendererConfig {
+            width: w,
+            height: h,
+            ..RendererConfig::default()
+        },
+    )?;
+    let target = demo::headless::Offscreen::new(&ctx, w, h);
+    for t in Technique::ALL {
+        renderer.set_technique(t);
+        // One frame to settle (adaptive peeling), one to keep.
+        renderer
+            .render_and_submit(&target.view, &scene.cameras[0])
+            .map_err(|e| e.to_string())?;
+        let img = demo::headless::render_image(&ctx, &mut renderer, &target, &scene.cameras[0])?;
+        let path = out.join(format!("{}.png", t.name()));
+        img.save_png(&path).map_err(|e| e.to_string())?;
+        println!("wrote {}", path.display());
+    }
+    let eval_out = out.join("eval");
+    let opts = demo::eval::EvalOptions {
+        scenes: scene_paths(&[])?,
+        techniques: Technique::ALL.to_vec(),
+        weights: Vec::new(),
+        size: Some((480, 270)),
+        frames: 3,
+        warmup: 1,
+        out: eval_out.clone(),
+        stability: false,
+        flicker_frames: 0,
+        sweep_points: 0,
+        command: "demo showcase".into(),
+        heatmap_width: Some(240),
+    };
+    let summary = demo::eval::run(&ctx, &opts)?;
+    println!(
+        "evaluated {} scenes x {} techniques: {}",
+        summary.reference_checks.len(),
+        opts.techniques.len(),
+        eval_out.join("speed_vs_accuracy.png").display()
+    );
+    println!("report: {}", eval_out.join("report.md").display());
     Ok(())
 }

@@ -86,6 +86,12 @@ pub const DEFAULT_RADIUS: i32 = 6;
 /// The default scene for `seed`: terrain `DEFAULT_RADIUS` chunks around the greenhouse
 /// nearest the origin, the camera on the land side looking through it at the sea.
 pub fn default_scene(seed: u32) -> Result<Scene, String> {
+    default_scene_with_radius(seed, DEFAULT_RADIUS)
+}
+
+/// [`default_scene`] with `radius` chunks of terrain each way (1 to 16).
+pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene, String> {
+    let radius = radius.clamp(1, 16);
     let config = TerrainConfig {
         seed,
         ..TerrainConfig::default()
@@ -108,8 +114,8 @@ pub fn default_scene(seed: u32) -> Result<Scene, String> {
     let world = generator
         .generate_world(
             Arc::new(BlockRegistry::default()),
-            ChunkPos::new(cx - DEFAULT_RADIUS, 0, cz - DEFAULT_RADIUS),
-            ChunkPos::new(cx + DEFAULT_RADIUS, 1, cz + DEFAULT_RADIUS),
+            ChunkPos::new(cx - radius, 0, cz - radius),
+            ChunkPos::new(cx + radius, 1, cz + radius),
         )
         .map_err(|e| e.to_string())?;
     let dir = DVec3::new(

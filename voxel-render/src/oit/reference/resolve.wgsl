@@ -23,6 +23,10 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> counters: Counters;
 @group(0) @binding(3) var<uniform> params: Params;
 
+fn tie_key(c: vec2<u32>) -> u32 {
+    return c.x ^ (c.y * 2654435761u);
+}
+
 // Most fragments one pixel can hold; a longer list is counted in `truncated`.
 const MAX_LAYERS: u32 = 128u;
 
@@ -37,10 +41,14 @@ fn fs_resolve(in: FullscreenOut) -> @location(0) vec4<f32> {
     var color: array<vec2<u32>, MAX_LAYERS>;
     var n = 0u;
     // Insertion sort while walking the list: nearest (largest reverse-Z depth) first.
+    // Fragments at exactly the same depth (two faces meeting on an edge that passes
+    // through the pixel centre) are ordered by their colour bits, so that the order does
+    // not depend on which fragment won the race to the list.
     while next != 0u && n < MAX_LAYERS {
         let node = nodes[next - 1u];
         var i = n;
-        while i > 0u && depth[i - 1u] < node.depth {
+        while i > 0u && (depth[i - 1u] < node.depth
+            || (depth[i - 1u] == node.depth && tie_key(color[i - 1u]) < tie_key(node.color))) {
             depth[i] = depth[i - 1u];
             color[i] = color[i - 1u];
             i -= 1u;

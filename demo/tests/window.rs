@@ -1,0 +1,225 @@
+//! The real demo window under Xvfb on lavapipe: the scripted demo steps through every
+//! technique, edits a block, resizes, and saves screenshots with its panel, which must not be
+//! blank and must differ between techniques where they should.
+//!
+//! Without Xvfb or a Vulkan adapter the test skips with a loud message, unless `CI` is set:
+//! then it fails.
+
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
+use voxel_render::{GpuContext, Image, Technique};
+
+fn skip_or_fail(why: &str) {
+    if std::env::var_os("CI").is_some() {
+        panic!("CI is set but {why}");
+    }
+    eprintln!("\n!!!! SKIPPING WINDOW TEST: {why} !!!!\n");
+}
+
+/// An Xvfb server on a display it picks itself (-displayfd), killed on drop.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    fn start() -> Option<Self> {
+        let mut child = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1280x800x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .ok()?;
+        let mut line = String::new();
+        BufReader::new(child.stdout.take()?)
+            .read_line(&mut line)
+            .ok()?;
+        let n: u32 = line.trim().parse().ok()?;
+        Some(Self {
+            child,
+            display: format!(":{n}"),
+        })
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn out_dir() -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/test-output/window");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn demo(display: &str, args: &[&str]) {
+    let runtime = std::env::temp_dir().join(format!("voxel-oit-xdg-{}", std::process::id()));
+    std::fs::create_dir_all(&runtime).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_demo"))
+        .args(args)
+        .env("DISPLAY", display)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("XDG_RUNTIME_DIR", &runtime)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "demo {args:?} failed: {}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// Where the panel ends: the first column whose mean brightness is that of the scene (sky,
+/// grass, water), not of the dark panel with its text.
+fn panel_edge(img: &Image) -> u32 {
+    let mean = |x: u32| {
+        (0..img.height)
+            .map(|y| {
+                let p = img.pixel(x, y);
+                (u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2])) / 3
+            })
+            .sum::<u32>()
+            / img.height
+    };
+    (0..img.width)
+        .find(|&x| mean(x) > 100)
+        .unwrap_or(img.width / 2)
+}
+
+/// The 3D view right of the panel.
+fn view(img: &Image) -> Vec<[u8; 3]> {
+    let mut v = Vec::new();
+    let edge = panel_edge(img) + 4;
+    assert!(
+        edge > 100 && edge < img.width / 2 + 60,
+        "panel edge at {edge}"
+    );
+    for y in 0..img.height {
+        for x in edge..img.width {
+            let p = img.pixel(x, y);
+            v.push([p[0], p[1], p[2]]);
+        }
+    }
+    v
+}
+
+fn max_diff(a: &[[u8; 3]], b: &[[u8; 3]]) -> u8 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])))
+        .max()
+        .unwrap_or(0)
+}
+
+fn distinct(v: &[[u8; 3]]) -> usize {
+    let mut v = v.to_vec();
+    v.sort_unstable();
+    v.dedup();
+    v.len()
+}
+
+#[test]
+fn the_window_runs_every_technique_under_xvfb() {
+    if GpuContext::headless(wgpu::Backends::VULKAN).is_err() {
+        return skip_or_fail("no Vulkan adapter (install mesa-vulkan-drivers)");
+    }
+    let Some(x) = Xvfb::start() else {
+        return skip_or_fail("Xvfb could not be started (install xvfb)");
+    };
+    let dir = out_dir();
+    demo(
+        &x.display,
+        &[
+            "--size",
+            "640x360",
+            "--frames",
+            "3",
+            "--cycle",
+            dir.to_str().unwrap(),
+        ],
+    );
+
+    let shots: Vec<(Technique, Image)> = Technique::ALL
+        .iter()
+        .map(|t| {
+            (
+                *t,
+                Image::load_png(&dir.join(format!("{}.png", t.name()))).unwrap(),
+            )
+        })
+        .collect();
+    for (t, img) in &shots {
+        assert_eq!((img.width, img.height), (640, 360), "{t}");
+        // Not blank: terrain, water, glass and the panel's text.
+        assert!(
+            distinct(&view(img)) > 200,
+            "{t}: {} colours",
+            distinct(&view(img))
+        );
+        // The egui panel is drawn on the left: its dark background.
+        let p = img.pixel(4, 300);
+        assert!(
+            p[0] < 60 && p[1] < 60 && p[2] < 60,
+            "{t}: no panel at the left edge ({p:?})"
+        );
+    }
+    let get = |t: Technique| view(&shots.iter().find(|s| s.0 == t).unwrap().1);
+    let reference = get(Technique::Reference);
+    // Same maths: the same picture up to rounding.
+    assert!(max_diff(&get(Technique::PeelReference), &reference) <= 1);
+    assert!(max_diff(&get(Technique::WboitTwoPass), &get(Technique::WboitMrt)) <= 1);
+    assert!(max_diff(&get(Technique::SortedQuads), &reference) <= 2);
+    // Different methods: visibly different pictures.
+    for t in [
+        Technique::OpaqueOnly,
+        Technique::WboitMrt,
+        Technique::Stipple,
+    ] {
+        assert!(
+            max_diff(&get(t), &reference) > 8,
+            "{t} should differ from the reference"
+        );
+    }
+
+    // Resizing, a zero size and back: the last picture has the window's size again. A
+    // block placed on frame 1 is remeshed in the background and shows in the last frame.
+    let resized = dir.join("resized.png");
+    demo(
+        &x.display,
+        &[
+            "--size",
+            "640x360",
+            "--frames",
+            "8",
+            "--resize",
+            "--edit",
+            "--screenshot",
+            resized.to_str().unwrap(),
+        ],
+    );
+    let img = Image::load_png(&resized).unwrap();
+    assert_eq!((img.width, img.height), (640, 360));
+    assert!(distinct(&view(&img)) > 200);
+    let before = &shots.iter().find(|s| s.0 == Technique::WboitMrt).unwrap().1;
+    assert!(
+        max_diff(&view(&img), &view(before)) > 8,
+        "the placed block shows"
+    );
+}
