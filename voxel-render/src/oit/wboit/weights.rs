@@ -34,7 +34,7 @@ pub enum WeightFunction {
     /// that hold translucent layers, in relative (log) depth so that near layers are as
     /// distinct as far ones. The α² favours dense layers, which hide what lies behind
     /// them whatever the order (seed 002's α³ idea, milder). K and the power of α were
-    /// chosen by a sweep over the scene suite (`results/README.md`).
+    /// chosen by a sweep over the scene suite (`results/weight_sweep.md`).
     Fitted = 6,
 }
 
