@@ -24,21 +24,15 @@ pub struct Offscreen {
 impl Offscreen {
     /// A `width` × `height` target.
     pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Self {
-        let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("offscreen_output"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba8UnormSrgb,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&Default::default());
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let (texture, view) = voxel_render::render_target(
+            &ctx.device,
+            "offscreen_output",
+            wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage,
+            width,
+            height,
+        );
         Self { texture, view }
     }
 

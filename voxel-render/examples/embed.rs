@@ -32,21 +32,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     config.oit.technique = Technique::WboitMrt;
     let mut renderer = Renderer::new(&ctx, &registry, config)?;
-    let output = ctx.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("game_output"),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8UnormSrgb,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
-    let view = output.create_view(&Default::default());
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let (output, view) =
+        voxel_render::render_target(&ctx.device, "game_output", format, usage, width, height);
 
     for frame in 0..60u32 {
         // Game logic: a glass pillar grows in front of the camera.

@@ -24,7 +24,7 @@ pub use oit::{
     BayerSize, OitConfig, OitManager, Technique, TechniqueReport, TranslucentFrame,
     TranslucentTechnique, WeightFunction,
 };
-pub use pipelines::SharedLayouts;
+pub use pipelines::{SharedLayouts, target as render_target};
 pub use readback::Image;
 pub use renderer::{FrameStats, Renderer, RendererConfig};
 pub use timing::GpuTimer;

@@ -153,19 +153,21 @@ pub fn chunk_pipeline(
     })
 }
 
-/// A fullscreen-triangle pipeline (`fullscreen.wgsl`'s `vs_fullscreen`) with no depth
-/// unless `depth_write` asks for a depth target that always passes and writes.
+/// A fullscreen-triangle pipeline: `source` (a technique's fragment shader) after
+/// `fullscreen.wgsl`, whose `vs_fullscreen` it uses. No depth unless `depth_write` asks for a
+/// depth target that always passes and writes.
 #[allow(clippy::too_many_arguments)]
 pub fn fullscreen_pipeline(
     device: &wgpu::Device,
     label: &str,
-    module: &wgpu::ShaderModule,
+    source: &str,
     fragment_entry: &str,
     bind_group_layouts: &[Option<&wgpu::BindGroupLayout>],
     targets: &[Option<wgpu::ColorTargetState>],
     depth_write: bool,
     constants: &[(&str, f64)],
 ) -> wgpu::RenderPipeline {
+    let module = &shader(device, label, &[FULLSCREEN_WGSL, source]);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts,
@@ -283,6 +285,19 @@ pub fn target(
     width: u32,
     height: u32,
 ) -> (wgpu::Texture, wgpu::TextureView) {
+    multisampled_target(device, label, format, usage, width, height, 1)
+}
+
+/// [`target`] with `samples` samples per pixel.
+pub fn multisampled_target(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    width: u32,
+    height: u32,
+    samples: u32,
+) -> (wgpu::Texture, wgpu::TextureView) {
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d {
@@ -291,7 +306,7 @@ pub fn target(
             depth_or_array_layers: 1,
         },
         mip_level_count: 1,
-        sample_count: 1,
+        sample_count: samples,
         dimension: wgpu::TextureDimension::D2,
         format,
         usage,

@@ -182,3 +182,121 @@ mod tests {
         let _ = std::fs::remove_file(path);
     }
 }
+
+const IDLE: u8 = 0;
+const MAPPING: u8 = 1;
+const MAPPED: u8 = 2;
+const FAILED: u8 = 3;
+
+/// A query set whose results are copied to the CPU without stalling: resolved and copied
+/// at the end of a frame's commands, mapped once those are submitted, read a frame or more
+/// later (or at once with [`QueryReadback::wait`]). While one copy is in flight, further
+/// copies are skipped rather than waited for.
+#[derive(Debug)]
+pub struct QueryReadback {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    readback: wgpu::Buffer,
+    state: std::sync::Arc<std::sync::atomic::AtomicU8>,
+    pending: u32,
+    copied: bool,
+}
+
+impl QueryReadback {
+    /// `count` queries of `ty`.
+    pub fn new(ctx: &GpuContext, label: &str, ty: wgpu::QueryType, count: u32) -> Self {
+        let size = u64::from(count) * 8;
+        let buffer = |suffix: &str, usage| {
+            ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&format!("{label}_{suffix}")),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Self {
+            set: ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some(label),
+                ty,
+                count,
+            }),
+            resolve: buffer(
+                "resolve",
+                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            ),
+            readback: buffer(
+                "readback",
+                wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            ),
+            state: std::sync::Arc::new(std::sync::atomic::AtomicU8::new(IDLE)),
+            pending: 0,
+            copied: false,
+        }
+    }
+
+    /// The query set passes write to.
+    pub fn set(&self) -> &wgpu::QuerySet {
+        &self.set
+    }
+
+    /// Records the copy of queries `range` (to be read as results `0..len`), unless a copy
+    /// is already in flight. Returns whether it was recorded.
+    pub fn copy(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        range: std::ops::Range<u32>,
+    ) -> bool {
+        let n = range.end.saturating_sub(range.start);
+        if n == 0 || self.copied || self.state.load(std::sync::atomic::Ordering::Acquire) != IDLE {
+            return false;
+        }
+        encoder.resolve_query_set(&self.set, range, &self.resolve, 0);
+        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, u64::from(n) * 8);
+        self.pending = n;
+        self.copied = true;
+        true
+    }
+
+    /// Starts mapping the recorded copy; call once its commands are submitted.
+    pub fn map(&mut self) {
+        if !std::mem::take(&mut self.copied) {
+            return;
+        }
+        use std::sync::atomic::Ordering;
+        self.state.store(MAPPING, Ordering::Release);
+        let state = self.state.clone();
+        self.readback
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |r| {
+                state.store(if r.is_ok() { MAPPED } else { FAILED }, Ordering::Release);
+            });
+    }
+
+    /// The results, once mapped (needs `device.poll` now and then); frees the buffer.
+    pub fn take(&mut self) -> Option<Vec<u64>> {
+        use std::sync::atomic::Ordering;
+        match self.state.load(Ordering::Acquire) {
+            MAPPED => {
+                let values = self.readback.slice(..).get_mapped_range().ok().map(|v| {
+                    bytemuck::cast_slice::<u8, u64>(&v[..self.pending as usize * 8]).to_vec()
+                });
+                self.readback.unmap();
+                self.state.store(IDLE, Ordering::Release);
+                values
+            }
+            FAILED => {
+                self.state.store(IDLE, Ordering::Release);
+                None
+            }
+            _ => None,
+        }
+    }
+
+    /// Waits for the GPU, then [`QueryReadback::take`].
+    pub fn wait(&mut self, ctx: &GpuContext) -> Option<Vec<u64>> {
+        if self.state.load(std::sync::atomic::Ordering::Acquire) == MAPPING {
+            let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+        }
+        self.take()
+    }
+}

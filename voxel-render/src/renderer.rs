@@ -14,7 +14,7 @@ use crate::chunks::{ChunkStore, Frustum, MeshKind, Visible};
 use crate::gpu_types::FrameUniforms;
 use crate::oit::{OitConfig, OitManager, Technique, TranslucentFrame, WeightFunction};
 use crate::pipelines::{
-    self, COMMON_WGSL, DepthMode, FULLSCREEN_WGSL, SharedLayouts, load_attachment, texture_entry,
+    self, COMMON_WGSL, DepthMode, SharedLayouts, load_attachment, texture_entry,
 };
 use crate::textures::BlockTextures;
 use crate::timing::GpuTimer;
@@ -198,15 +198,10 @@ impl Renderer {
                     count: None,
                 }],
             });
-        let depth_resolve_module = pipelines::shader(
-            device,
-            "depth_resolve",
-            &[FULLSCREEN_WGSL, include_str!("shaders/depth_resolve.wgsl")],
-        );
         let depth_resolve = pipelines::fullscreen_pipeline(
             device,
             "depth_resolve",
-            &depth_resolve_module,
+            include_str!("shaders/depth_resolve.wgsl"),
             "fs_depth_resolve",
             &[Some(&depth_resolve_layout)],
             &[],
@@ -286,54 +281,44 @@ impl Renderer {
         height: u32,
         msaa: bool,
     ) -> SceneTargets {
-        let texture = |label, format, samples, usage| {
-            ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: samples,
-                dimension: wgpu::TextureDimension::D2,
+        use wgpu::TextureUsages as U;
+        let target = |label, format, samples, usage| {
+            pipelines::multisampled_target(
+                &ctx.device,
+                label,
                 format,
                 usage,
-                view_formats: &[],
-            })
+                width,
+                height,
+                samples,
+            )
         };
-        use wgpu::TextureUsages as U;
-        let color = texture(
+        let (color, color_view) = target(
             "scene_color",
             SCENE_FORMAT,
             1,
             U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST,
         );
-        let depth = texture(
+        let (depth, depth_view) = target(
             "scene_depth",
             DEPTH_FORMAT,
             1,
             U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
         );
-        let color_view = color.create_view(&Default::default());
-        let depth_view = depth.create_view(&Default::default());
         let msaa_views = msaa.then(|| {
-            let c = texture(
+            let (_, c) = target(
                 "scene_color_msaa",
                 SCENE_FORMAT,
                 MSAA_SAMPLES,
                 U::RENDER_ATTACHMENT,
             );
-            let d = texture(
+            let (_, d) = target(
                 "scene_depth_msaa",
                 DEPTH_FORMAT,
                 MSAA_SAMPLES,
                 U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
             );
-            (
-                c.create_view(&Default::default()),
-                d.create_view(&Default::default()),
-            )
+            (c, d)
         });
         let tonemap_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("tonemap"),
@@ -563,16 +548,11 @@ impl Renderer {
     fn tonemap_pipeline(&mut self, format: wgpu::TextureFormat) -> &wgpu::RenderPipeline {
         let (ctx, layout) = (&self.ctx, &self.tonemap_layout);
         self.tonemap.entry(format).or_insert_with(|| {
-            let module = pipelines::shader(
-                &ctx.device,
-                "tonemap",
-                &[FULLSCREEN_WGSL, include_str!("shaders/tonemap.wgsl")],
-            );
             let encode = if format.is_srgb() { 0.0 } else { 1.0 };
             pipelines::fullscreen_pipeline(
                 &ctx.device,
                 "tonemap",
-                &module,
+                include_str!("shaders/tonemap.wgsl"),
                 "fs_tonemap",
                 &[Some(layout)],
                 &[Some(wgpu::ColorTargetState {

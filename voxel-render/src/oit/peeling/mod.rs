@@ -20,15 +20,12 @@
 //! Peel to convergence (exact): front peels only, each followed by reading its occlusion
 //! count (a stall per layer), until a pass writes nothing. For measurement, not games.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicU8, Ordering};
-
 use crate::oit::{OitConfig, TechniqueReport, TranslucentFrame, TranslucentTechnique};
 use crate::pipelines::{
-    self, COMMON_WGSL, DepthMode, FULLSCREEN_WGSL, SharedLayouts, clear_transparent,
-    load_attachment,
+    self, COMMON_WGSL, DepthMode, SharedLayouts, clear_transparent, load_attachment,
 };
-use crate::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT, readback};
+use crate::readback::QueryReadback;
+use crate::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
 
 /// Iterations peel-to-convergence runs at most (a safety net: 512 layers).
 pub const MAX_CONVERGE_ITERATIONS: u32 = 512;
@@ -63,95 +60,6 @@ struct Targets {
     front_acc_group: wgpu::BindGroup,
 }
 
-const IDLE: u8 = 0;
-const MAPPING: u8 = 1;
-const MAPPED: u8 = 2;
-
-/// Occlusion counts of the front peels, read back without stalling (or with, on demand).
-#[derive(Debug)]
-struct Counts {
-    set: wgpu::QuerySet,
-    resolve: wgpu::Buffer,
-    readback: wgpu::Buffer,
-    state: Arc<AtomicU8>,
-    pending: u32,
-    copied: bool,
-}
-
-impl Counts {
-    fn new(ctx: &GpuContext, count: u32) -> Self {
-        let size = u64::from(count) * 8;
-        let buffer = |label, usage| {
-            ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
-        Self {
-            set: ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("peel_counts"),
-                ty: wgpu::QueryType::Occlusion,
-                count,
-            }),
-            resolve: buffer(
-                "peel_counts_resolve",
-                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            ),
-            readback: buffer(
-                "peel_counts_readback",
-                wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            ),
-            state: Arc::new(AtomicU8::new(IDLE)),
-            pending: 0,
-            copied: false,
-        }
-    }
-
-    /// Records the copy of queries `0..n` if the readback buffer is free.
-    fn copy(&mut self, encoder: &mut wgpu::CommandEncoder, n: u32) {
-        if n == 0 || self.state.load(Ordering::Acquire) != IDLE {
-            return;
-        }
-        encoder.resolve_query_set(&self.set, 0..n, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, u64::from(n) * 8);
-        self.pending = n;
-        self.copied = true;
-    }
-
-    /// Starts mapping what [`Counts::copy`] recorded (call once it is submitted).
-    fn map(&mut self) {
-        if !self.copied {
-            return;
-        }
-        self.copied = false;
-        self.state.store(MAPPING, Ordering::Release);
-        let state = self.state.clone();
-        self.readback
-            .slice(..)
-            .map_async(wgpu::MapMode::Read, move |r| {
-                state.store(if r.is_ok() { MAPPED } else { IDLE }, Ordering::Release);
-            });
-    }
-
-    /// The counts, once mapped.
-    fn take(&mut self) -> Option<Vec<u64>> {
-        if self.state.load(Ordering::Acquire) != MAPPED {
-            return None;
-        }
-        let counts = self
-            .readback
-            .slice(..)
-            .get_mapped_range()
-            .ok()
-            .map(|v| bytemuck::cast_slice::<u8, u64>(&v[..self.pending as usize * 8]).to_vec());
-        self.readback.unmap();
-        self.state.store(IDLE, Ordering::Release);
-        counts
-    }
-}
-
 /// Depth peeling resources.
 #[derive(Debug)]
 pub struct Peeling {
@@ -164,7 +72,8 @@ pub struct Peeling {
     limits_layout: wgpu::BindGroupLayout,
     layer_layout: wgpu::BindGroupLayout,
     targets: Targets,
-    counts: Counts,
+    /// Samples each front peel wrote (occlusion queries).
+    counts: QueryReadback,
     /// Dual mode: iterations to run this frame (adaptive).
     iterations: u32,
     report: TechniqueReport,
@@ -224,16 +133,11 @@ impl Peeling {
         };
         let peel_front = peel("peel_front", DepthMode::Write);
         let peel_back = peel("peel_back", DepthMode::WriteFarthest);
-        let blend_module = pipelines::shader(
-            device,
-            "peel_blend",
-            &[FULLSCREEN_WGSL, include_str!("blend.wgsl")],
-        );
         let blend = |label, entry, state| {
             pipelines::fullscreen_pipeline(
                 device,
                 label,
-                &blend_module,
+                include_str!("blend.wgsl"),
                 entry,
                 &[Some(&layer_layout)],
                 &[pipelines::scene_target(Some(state))],
@@ -269,7 +173,12 @@ impl Peeling {
             limits_layout,
             layer_layout,
             targets,
-            counts: Counts::new(ctx, max_iterations),
+            counts: QueryReadback::new(
+                ctx,
+                "peel_counts",
+                wgpu::QueryType::Occlusion,
+                max_iterations,
+            ),
             iterations: max_iterations,
             report: TechniqueReport::default(),
         }
@@ -452,7 +361,7 @@ impl Peeling {
             &t.front[cur].1,
             wgpu::LoadOp::Load,
             limits,
-            Some((&self.counts.set, i)),
+            Some((self.counts.set(), i)),
         );
         Self::blend_pass(
             encoder,
@@ -514,7 +423,7 @@ impl Peeling {
             frame.target,
             &self.targets.front_acc_group,
         );
-        self.counts.copy(encoder, self.iterations);
+        self.counts.copy(encoder, 0..self.iterations);
     }
 
     fn render_converge(
@@ -529,12 +438,14 @@ impl Peeling {
             let cur = (i % 2) as usize;
             self.front_iteration(encoder, frame, i, &self.targets.converge_limits[cur]);
             // Wait for this pass's count: zero means every layer has been peeled.
-            encoder.resolve_query_set(&self.counts.set, i..i + 1, &self.counts.resolve, 0);
-            encoder.copy_buffer_to_buffer(&self.counts.resolve, 0, &self.counts.readback, 0, 8);
+            self.counts.copy(encoder, i..i + 1);
             pipelines::flush(ctx, encoder);
-            let written = readback::map_read(ctx, &self.counts.readback)
-                .ok()
-                .map_or(0, |b| bytemuck::cast_slice::<u8, u64>(&b[..8])[0]);
+            self.counts.map();
+            let written = self
+                .counts
+                .wait(ctx)
+                .and_then(|c| c.first().copied())
+                .unwrap_or(0);
             if written == 0 {
                 break;
             }

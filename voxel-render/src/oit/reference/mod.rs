@@ -17,10 +17,11 @@
 use wgpu::util::DeviceExt;
 
 use crate::oit::{OitConfig, TechniqueReport, TranslucentFrame, TranslucentTechnique};
-use crate::pipelines::{
-    self, COMMON_WGSL, DepthMode, FULLSCREEN_WGSL, SharedLayouts, load_attachment,
-};
+use crate::pipelines::{self, COMMON_WGSL, DepthMode, SharedLayouts, load_attachment};
 use crate::{GpuContext, readback};
+
+/// WGSL of the node, counter and parameter structs both passes share.
+const TYPES_WGSL: &str = include_str!("types.wgsl");
 
 /// Bytes per node: colour (4 halves), depth, next.
 pub const NODE_BYTES: u64 = 16;
@@ -107,7 +108,7 @@ impl Reference {
         let module = pipelines::shader(
             device,
             "abuffer_build",
-            &[COMMON_WGSL, include_str!("abuffer.wgsl")],
+            &[COMMON_WGSL, TYPES_WGSL, include_str!("abuffer.wgsl")],
         );
         let build = pipelines::chunk_pipeline(
             device,
@@ -123,15 +124,10 @@ impl Reference {
             DepthMode::ReadOnly,
             1,
         );
-        let resolve_module = pipelines::shader(
-            device,
-            "abuffer_resolve",
-            &[FULLSCREEN_WGSL, include_str!("resolve.wgsl")],
-        );
         let resolve = pipelines::fullscreen_pipeline(
             device,
             "abuffer_resolve",
-            &resolve_module,
+            &[TYPES_WGSL, include_str!("resolve.wgsl")].concat(),
             "fs_resolve",
             &[Some(&resolve_layout)],
             &[pipelines::scene_target(Some(

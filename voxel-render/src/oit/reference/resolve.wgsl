@@ -2,22 +2,6 @@
 // depth and blend them front to back; the result goes over the opaque image with
 // (One, OneMinusSrcAlpha): out = Σ layers (exact "over" order) + Π(1 − α) · opaque.
 
-struct Node {
-    color: vec2<u32>,
-    depth: f32,
-    next: u32,
-};
-
-struct Counters {
-    nodes: atomic<u32>,
-    truncated: atomic<u32>,
-};
-
-struct Params {
-    width: u32,
-    capacity: u32,
-};
-
 @group(0) @binding(0) var<storage, read> heads: array<u32>;
 @group(0) @binding(1) var<storage, read> nodes: array<Node>;
 @group(0) @binding(2) var<storage, read_write> counters: Counters;

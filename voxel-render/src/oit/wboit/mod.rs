@@ -28,8 +28,8 @@ pub mod weights;
 use crate::GpuContext;
 use crate::oit::{OitConfig, Technique, TranslucentFrame, TranslucentTechnique};
 use crate::pipelines::{
-    self, COMMON_WGSL, DepthMode, FULLSCREEN_WGSL, SharedLayouts, clear_attachment,
-    load_attachment, read_only_depth, texture_entry,
+    self, COMMON_WGSL, DepthMode, SharedLayouts, clear_attachment, load_attachment,
+    read_only_depth, texture_entry,
 };
 
 /// Revealage format (seed 000): one byte of Π(1 − α).
@@ -167,15 +167,10 @@ impl Wboit {
                 texture_entry(1, wgpu::TextureSampleType::Float { filterable: false }),
             ],
         });
-        let composite_module = pipelines::shader(
-            device,
-            "wboit_composite",
-            &[FULLSCREEN_WGSL, include_str!("composite.wgsl")],
-        );
         let composite = pipelines::fullscreen_pipeline(
             device,
             "wboit_composite",
-            &composite_module,
+            include_str!("composite.wgsl"),
             "fs_composite",
             &[Some(&composite_layout)],
             &[pipelines::scene_target(Some(
@@ -207,28 +202,12 @@ impl Wboit {
         width: u32,
         height: u32,
     ) -> Targets {
-        let make = |label, format| {
-            ctx.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
-        };
-        let accumulation = make("wboit_accumulation", accum_format);
-        let revealage = make("wboit_revealage", REVEALAGE_FORMAT);
-        let accumulation_view = accumulation.create_view(&Default::default());
-        let revealage_view = revealage.create_view(&Default::default());
+        use wgpu::TextureUsages as U;
+        let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC;
+        let make =
+            |label, format| pipelines::target(&ctx.device, label, format, usage, width, height);
+        let (accumulation, accumulation_view) = make("wboit_accumulation", accum_format);
+        let (revealage, revealage_view) = make("wboit_revealage", REVEALAGE_FORMAT);
         let composite_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("wboit_composite"),
             layout,
