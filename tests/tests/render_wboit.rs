@@ -261,11 +261,12 @@ fn techniques_create_resources_only_when_translucency_is_on_screen() {
 fn shader_weights_match_the_rust_formulas() {
     let Some(ctx) = gpu() else { return };
     let distance = 12.5;
-    // A small glass sheet nearer, off to the side (not over the centre pixel), so that
-    // the translucent depth range of the fitted weight has the water sheet inside it.
+    // A red glass sheet nearer, just right of the centre pixel: the fitted weight's depth
+    // range runs from it to the water, and the centre pixel's screen tile (pixels 16.5 to
+    // 20.6 of 33) has some of its optical depth in front of the water.
     let world = box_world(&[
         ([-20, -20, -20], [20, 20, -20], WATER),
-        ([-6, -6, -12], [-4, -4, -12], GLASS),
+        ([1, -3, -12], [6, 3, -12], RED_GLASS),
     ]);
 
     // The sheet's front face is the plane z = -19; the eye sits `distance` in front of it.
@@ -294,12 +295,18 @@ fn shader_weights_match_the_rust_formulas() {
         let accum = read_hdr(&ctx, r.oit().accumulation_target().unwrap());
 
         let got = accum[16 * 33 + 16][3];
-        let range = stats.translucent_depth_range;
+        let fit = stats.weight_fit;
+        let centre = [16.5 / 33.0; 2];
         assert!(
-            range[0] < 9.0 && range[1] > 12.5,
-            "the range spans the sheets: {range:?}"
+            fit.range[0] < 9.0 && fit.range[1] > 12.4,
+            "the range spans the sheets: {:?}",
+            fit.range
         );
-        let want = alpha * weight.weight(z, d as f32, alpha, range) * HEADROOM_SCALE;
+        assert!(
+            fit.optical_depth_at(centre, d as f32) > 0.05,
+            "the glass counts in the centre tile"
+        );
+        let want = alpha * weight.weight(z, d as f32, alpha, centre, &fit) * HEADROOM_SCALE;
 
         // fp16 stores 11 significant bits: 1e-3 relative, with margin.
         assert!(

@@ -10,6 +10,7 @@ use wgpu::util::DeviceExt;
 
 use crate::GpuContext;
 use crate::gpu_types::ChunkUniforms;
+use crate::layers::MeshLayers;
 
 /// Which of a chunk's three meshes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -28,30 +29,9 @@ pub struct GpuMesh {
     buffer: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     quads: u32,
-    /// World-space box around every quad (min, max), for depth ranges.
-    bounds: (glam::DVec3, glam::DVec3),
-}
-
-/// The box around `quads` of the chunk at `pos`, in world coordinates.
-fn quad_bounds(pos: ChunkPos, quads: &[PackedQuad]) -> (DVec3, DVec3) {
-    let o = pos.origin();
-    let origin = DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    for q in quads {
-        let Some(u) = q.unpack() else { continue };
-        let axis = u.face.axis();
-        let [ua, va] = voxel_mesh::UV_AXES[axis];
-        let mut min = u.pos.map(f64::from);
-        if u.face.is_positive() {
-            min[axis] += 1.0;
-        }
-        let mut max = min;
-        max[ua] += f64::from(u.size[0]);
-        max[va] += f64::from(u.size[1]);
-        lo = lo.min(DVec3::from(min));
-        hi = hi.max(DVec3::from(max));
-    }
-    (origin + lo, origin + hi)
+    /// The translucent layers the quads make (fitted WBOIT weight); empty for the
+    /// opaque and cutout meshes.
+    layers: MeshLayers,
 }
 
 impl GpuMesh {
@@ -65,12 +45,9 @@ impl GpuMesh {
         self.quads
     }
 
-    /// Nearest and farthest distance from `eye` to the box around the mesh's quads.
-    pub fn distance_range(&self, eye: DVec3) -> (f64, f64) {
-        let (lo, hi) = self.bounds;
-        let nearest = eye.clamp(lo, hi).distance(eye);
-        let farthest = (eye - lo).abs().max((eye - hi).abs()).length();
-        (nearest, farthest)
+    /// The translucent layers the mesh's quads make, per face direction.
+    pub fn layers(&self) -> &MeshLayers {
+        &self.layers
     }
 
     /// Records the draw of this mesh (pipeline and group 0 already set).
@@ -116,6 +93,8 @@ pub struct Visible<'a> {
 #[derive(Debug)]
 pub struct ChunkStore {
     layout: wgpu::BindGroupLayout,
+    /// Opacity by block id, for the translucent meshes' layers.
+    opacity: Vec<f32>,
     chunks: HashMap<ChunkPos, GpuChunk>,
 }
 
@@ -149,10 +128,12 @@ pub fn chunk_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 }
 
 impl ChunkStore {
-    /// An empty store whose bind groups use `layout` (from [`chunk_layout`]).
-    pub fn new(layout: wgpu::BindGroupLayout) -> Self {
+    /// An empty store whose bind groups use `layout` (from [`chunk_layout`]); `opacity`
+    /// by block id.
+    pub fn new(layout: wgpu::BindGroupLayout, opacity: Vec<f32>) -> Self {
         Self {
             layout,
+            opacity,
             chunks: HashMap::new(),
         }
     }
@@ -185,7 +166,7 @@ impl ChunkStore {
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 }),
         };
-        let make = |quads: &[PackedQuad], label| {
+        let make = |kind: MeshKind, quads: &[PackedQuad], label| {
             (!quads.is_empty()).then(|| {
                 let buffer = ctx
                     .device
@@ -212,15 +193,23 @@ impl ChunkStore {
                     buffer,
                     bind_group,
                     quads: quads.len() as u32,
-                    bounds: quad_bounds(pos, quads),
+                    layers: if kind == MeshKind::Translucent {
+                        MeshLayers::new(pos, quads, &self.opacity)
+                    } else {
+                        MeshLayers::default()
+                    },
                 }
             })
         };
         let chunk = GpuChunk {
             meshes: [
-                make(&meshes.opaque, "chunk_opaque_quads"),
-                make(&meshes.cutout, "chunk_cutout_quads"),
-                make(&meshes.translucent, "chunk_translucent_quads"),
+                make(MeshKind::Opaque, &meshes.opaque, "chunk_opaque_quads"),
+                make(MeshKind::Cutout, &meshes.cutout, "chunk_cutout_quads"),
+                make(
+                    MeshKind::Translucent,
+                    &meshes.translucent,
+                    "chunk_translucent_quads",
+                ),
             ],
             translucent: meshes.translucent.clone(),
             uniform,

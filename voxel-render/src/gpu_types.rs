@@ -2,9 +2,13 @@
 
 use bytemuck::{Pod, Zeroable};
 
+/// `vec4`s of the fitted weight's optical-depth table.
+pub const OPTICAL_DEPTH_VEC4S: usize =
+    crate::layers::TILES * crate::layers::TILES * crate::layers::PROFILE_LEN / 4;
+
 /// Per-frame uniforms: camera, lighting and transparency parameters (`Frame` in WGSL).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct FrameUniforms {
     /// Camera-relative view × reverse-Z projection.
     pub view_proj: [[f32; 4]; 4],
@@ -36,6 +40,9 @@ pub struct FrameUniforms {
     pub frame_index: u32,
     /// Nearest and farthest view depth of the visible translucent chunks (fitted weight).
     pub depth_range: [f32; 2],
+    /// Per screen tile, the expected optical depth in front of log-spaced depths across
+    /// `depth_range` (fitted weight; [`crate::layers`]).
+    pub optical_depth: [[f32; 4]; OPTICAL_DEPTH_VEC4S],
 }
 
 /// Per-chunk uniforms (`ChunkInfo` in WGSL).
@@ -55,7 +62,10 @@ mod tests {
     /// The WGSL structs' sizes under uniform layout rules (vec3 + scalar share 16 bytes).
     #[test]
     fn sizes_match_wgsl() {
-        assert_eq!(std::mem::size_of::<FrameUniforms>(), 64 + 16 * 4 + 16 + 16);
+        assert_eq!(
+            std::mem::size_of::<FrameUniforms>(),
+            64 + 16 * 4 + 16 + 16 + 16 * OPTICAL_DEPTH_VEC4S
+        );
         assert_eq!(std::mem::size_of::<ChunkUniforms>(), 16);
     }
 }

@@ -9,6 +9,7 @@ mod camera;
 mod chunks;
 mod context;
 mod gpu_types;
+pub mod layers;
 pub mod oit;
 mod pipelines;
 pub mod readback;
@@ -22,7 +23,7 @@ pub use context::{Capabilities, GpuContext, WANTED_FEATURES, request_device};
 pub use gpu_types::{ChunkUniforms, FrameUniforms};
 pub use oit::{
     BayerSize, OitConfig, OitManager, Technique, TechniqueReport, TranslucentFrame,
-    TranslucentTechnique, WeightFunction,
+    TranslucentTechnique, WeightFit, WeightFunction,
 };
 pub use pipelines::{SharedLayouts, target as render_target};
 pub use readback::Image;

@@ -10,9 +10,10 @@ use voxel_core::{BlockRegistry, ChunkPos};
 use voxel_mesh::ChunkMeshes;
 use wgpu::util::DeviceExt;
 
-use crate::chunks::{ChunkStore, Frustum, MeshKind, Visible};
-use crate::gpu_types::FrameUniforms;
-use crate::oit::{OitConfig, OitManager, Technique, TranslucentFrame, WeightFunction};
+use crate::chunks::{ChunkStore, Frustum, MeshKind};
+use crate::gpu_types::{FrameUniforms, OPTICAL_DEPTH_VEC4S};
+use crate::layers;
+use crate::oit::{OitConfig, OitManager, Technique, TranslucentFrame, WeightFit, WeightFunction};
 use crate::pipelines::{
     self, COMMON_WGSL, DepthMode, SharedLayouts, load_attachment, texture_entry,
 };
@@ -79,9 +80,9 @@ pub struct FrameStats {
     pub chunks_resorted: usize,
     /// Technique-specific facts (peeled layers, reference overflow).
     pub technique: crate::oit::TechniqueReport,
-    /// Nearest and farthest view distance the visible translucent chunks span (the fitted
-    /// WBOIT weight's range).
-    pub translucent_depth_range: [f32; 2],
+    /// What the fitted WBOIT weight was fitted to: the view distances the visible
+    /// translucent meshes span and the optical depth in front of distances across them.
+    pub weight_fit: WeightFit,
 }
 
 #[derive(Debug)]
@@ -145,7 +146,7 @@ impl Renderer {
         let textures = BlockTextures::new(ctx, registry)?;
         let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame_uniforms"),
-            contents: bytemuck::bytes_of(&FrameUniforms::default()),
+            contents: bytemuck::bytes_of(&<FrameUniforms as bytemuck::Zeroable>::zeroed()),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let bayer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -222,7 +223,10 @@ impl Renderer {
         );
         Ok(Self {
             ctx: ctx.clone(),
-            chunks: ChunkStore::new(layouts.chunk.clone()),
+            chunks: ChunkStore::new(
+                layouts.chunk.clone(),
+                registry.iter().map(|(_, def)| def.opacity).collect(),
+            ),
             layouts,
             frame_buffer,
             scene_group,
@@ -598,13 +602,24 @@ impl Renderer {
         let cutout = self.chunks.visible(MeshKind::Cutout, &frustum);
         let mut translucent = self.chunks.visible(MeshKind::Translucent, &frustum);
         translucent.reverse();
-        let (near_t, far_t) = depth_range(&translucent, camera);
+        let weight_fit = layers::fit(
+            translucent.iter().map(|v| v.mesh.layers()),
+            view_proj,
+            camera.eye,
+            camera.near as f32,
+            camera.far as f32,
+        );
+        let depth_range = weight_fit.range;
+        let mut optical_depth = [[0.0; 4]; OPTICAL_DEPTH_VEC4S];
+        let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut optical_depth);
+        let n = weight_fit.optical_depth.len().min(flat.len());
+        flat[..n].copy_from_slice(&weight_fit.optical_depth[..n]);
         let stats = FrameStats {
             meshes_drawn: [opaque.len(), cutout.len(), translucent.len()],
             translucent_quads: translucent.iter().map(|v| v.mesh.quads() as usize).sum(),
             sort_ms,
             chunks_resorted,
-            translucent_depth_range: [near_t, far_t],
+            weight_fit,
             ..FrameStats::default()
         };
 
@@ -627,7 +642,8 @@ impl Renderer {
             accum_scale: self.oit.accum_scale(),
             shading_state: oit_config.shading_state().pack(),
             frame_index: self.frame_index,
-            depth_range: [near_t, far_t],
+            depth_range,
+            optical_depth,
         };
         self.frame_index = self.frame_index.wrapping_add(1);
         self.ctx
@@ -770,23 +786,4 @@ impl Renderer {
         self.after_submit();
         Ok(stats)
     }
-}
-
-/// Nearest and farthest distance from the eye the visible translucent meshes span, from
-/// the boxes around their quads (kept with each mesh: no per-frame work but a distance).
-fn depth_range(chunks: &[Visible<'_>], camera: &Camera) -> (f32, f32) {
-    if chunks.is_empty() {
-        return (camera.near as f32, camera.far as f32);
-    }
-    let (near, far) = chunks
-        .iter()
-        .map(|c| c.mesh.distance_range(camera.eye))
-        .fold((f64::INFINITY, 0.0f64), |(n, f), (a, b)| {
-            (n.min(a), f.max(b))
-        });
-
-    (
-        near.max(camera.near) as f32,
-        far.min(camera.far).max(camera.near) as f32,
-    )
 }

@@ -14,7 +14,7 @@ use crate::timing::GpuTimer;
 use crate::{Error, GpuContext, Result};
 
 pub use stipple::{BayerSize, ShadingState, TransparencyMode};
-pub use wboit::weights::WeightFunction;
+pub use wboit::weights::{WeightFit, WeightFunction};
 
 /// A way to draw the translucent meshes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

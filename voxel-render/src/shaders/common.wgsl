@@ -18,6 +18,7 @@ struct Frame {
     shading_state: u32,
     frame_index: u32,
     depth_range: vec2<f32>,
+    optical_depth: array<vec4<f32>, 512>,
 };
 
 struct ChunkInfo {

@@ -10,7 +10,7 @@ fn cube(x: f32) -> f32 {
     return x * x * x;
 }
 
-fn weight(z: f32, depth: f32, a: f32) -> f32 {
+fn weight(pixel: vec2<f32>, z: f32, depth: f32, a: f32) -> f32 {
     let d = abs(depth);
     switch frame.weight_fn {
         case 0u: {
@@ -34,23 +34,37 @@ fn weight(z: f32, depth: f32, a: f32) -> f32 {
             return a * max(1e-2, 3e3 * cube(1.0 - z));
         }
         default: {
-            // Fitted: log-uniform over the translucent depth range in view.
-            let n = max(frame.depth_range.x, 1e-4);
-            let f = max(frame.depth_range.y, n * 1.001);
-            let t = clamp(log(d / n) / log(f / n), 0.0, 1.0);
-            return a * a * 3e3 * exp(-FITTED_K * t);
+            // Fitted: the estimated transmittance in front of the fragment.
+            return 3e3 * exp(-optical_depth_at(pixel, d));
         }
     }
 }
 
-// As in weights.rs.
-const FITTED_K: f32 = 9.0;
+// WeightFit::optical_depth_at in weights.rs: the table of the fragment's screen tile,
+// interpolated in log depth.
+const PROFILE_LEN: u32 = 32u;
+const TILES: u32 = 8u;
+const MAX_FITTED_DEPTH: f32 = 12.0;
 
+fn profile(first: u32, k: u32) -> f32 {
+    let i = first + k;
+    return frame.optical_depth[i / 4u][i % 4u];
+}
 
+fn optical_depth_at(pixel: vec2<f32>, d: f32) -> f32 {
+    let tile = min(vec2<u32>(pixel / frame.viewport * f32(TILES)), vec2<u32>(TILES - 1u));
+    let first = (tile.y * TILES + tile.x) * PROFILE_LEN;
+    let n = max(frame.depth_range.x, 1e-4);
+    let f = max(frame.depth_range.y, n * 1.001);
+    let x = clamp(log(d / n) / log(f / n), 0.0, 1.0) * f32(PROFILE_LEN - 1u);
+    let k = min(u32(floor(x)), PROFILE_LEN - 2u);
+    let t = x - f32(k);
+    return min(mix(profile(first, k), profile(first, k + 1u), t), MAX_FITTED_DEPTH);
+}
 
 fn accumulation(in: VsOut) -> vec4<f32> {
     let c = translucent_color(in);
-    let w = weight(standard_depth(in.clip.z), in.view_depth, c.a) * frame.accum_scale;
+    let w = weight(in.clip.xy, standard_depth(in.clip.z), in.view_depth, c.a) * frame.accum_scale;
     return vec4<f32>(c.rgb * c.a, c.a) * w;
 }
 

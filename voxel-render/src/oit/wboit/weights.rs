@@ -4,9 +4,11 @@
 //!
 //! Inputs: `z` is the standard window depth in [0, 1] (0 at the near plane: the seeds'
 //! `gl_FragCoord.z`), `depth` the view-space distance (McGuire & Bavoil's |z|), `alpha`
-//! the fragment's coverage, `range` the nearest and farthest view distance of the
-//! translucent chunks in view (from their bounds; only the fitted weight uses it).
+//! the fragment's coverage; only the fitted weight uses the last two: `screen`, the
+//! fragment's position on screen (0 to 1, y down), and `fit`, the frame's estimate of the
+//! translucent layers in view ([`WeightFit`]).
 
+use crate::layers::{PROFILE_LEN, TILES};
 use crate::{Error, Result};
 
 /// A weight function.
@@ -26,21 +28,52 @@ pub enum WeightFunction {
     McGuire9 = 4,
     /// McGuire & Bavoil 2013 eq. 10: `α · max(1e-2, 3e3 · (1 − z)³)`.
     McGuire10 = 5,
-    /// Ours, fitted to the translucent depth range in view `[n, f]` (from the boxes around
-    /// the visible translucent meshes): `α² · 3e3 · exp(−K·t)` with `t = ln(d/n) / ln(f/n)`
-    /// clamped to [0, 1] and `K = 9`. Eq. 7–10 fix the depths their weights fall over (a
-    /// few blocks to 200, or the window depth, which a near plane of 0.1 squeezes into
-    /// 1 − z < 0.01 beyond 10 blocks, where eq. 10 is flat); this one falls over the depths
-    /// that hold translucent layers, in relative (log) depth so that near layers are as
-    /// distinct as far ones. The α² favours dense layers, which hide what lies behind
-    /// them whatever the order (seed 002's α³ idea, milder). K and the power of α were
-    /// chosen by a sweep over the scene suite (`results/weight_sweep.md`).
+    /// Ours: `3000 · e^−τ`, where `τ` is the optical depth expected in front of the
+    /// fragment, estimated each frame from the visible translucent meshes for the
+    /// fragment's screen tile and interpolated in log depth ([`crate::layers`]). The ideal
+    /// weight of a layer is the transmittance in front of it (with it the weighted average
+    /// is exact), so this weight falls where translucent layers are and stays flat where
+    /// there are none: steep through a stack of dense sheets, flat between clear glass at
+    /// the eye and water far away, which no fixed curve of depth can be. Eq. 7–10 fix the
+    /// depths their weights fall over (a few blocks to 200, or the window depth, which a
+    /// near plane of 0.1 squeezes into 1 − z < 0.01 beyond 10 blocks). The power of α and
+    /// the tiles were chosen by runs over the scene suite (`results/weight_sweep.md`).
     Fitted = 6,
 }
 
-/// The fitted weight's fall over the translucent depth range: `e^−9` (1/8100) from its
-/// nearest to its farthest end.
-pub const FITTED_K: f32 = 9.0;
+/// What the fitted weight is fitted to in a frame (see [`crate::layers`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WeightFit {
+    /// Nearest and farthest view depth of the visible translucent meshes.
+    pub range: [f32; 2],
+    /// For each screen tile (row by row, [`TILES`] × [`TILES`]), the expected optical
+    /// depth in front of [`PROFILE_LEN`] depths spaced evenly in log depth across `range`.
+    /// Empty: none anywhere.
+    pub optical_depth: Vec<f32>,
+}
+
+/// The most optical depth the fitted weight falls by: `e^−12`, 6·10⁻⁶ (the weight must
+/// stay above fp16's smallest numbers once times α·3000).
+pub const MAX_FITTED_DEPTH: f32 = 12.0;
+
+impl WeightFit {
+    /// The optical depth in front of view depth `d` at `screen` (0 to 1, y down),
+    /// interpolated in log depth and clamped at the ends of the range and at
+    /// [`MAX_FITTED_DEPTH`].
+    pub fn optical_depth_at(&self, screen: [f32; 2], d: f32) -> f32 {
+        let tile = |v: f32| ((v * TILES as f32) as usize).min(TILES - 1);
+        let first = (tile(screen[1]) * TILES + tile(screen[0])) * PROFILE_LEN;
+        let Some(p) = self.optical_depth.get(first..first + PROFILE_LEN) else {
+            return 0.0;
+        };
+        let n = self.range[0].max(1e-4);
+        let f = self.range[1].max(n * 1.001);
+        let x = ((d / n).ln() / (f / n).ln()).clamp(0.0, 1.0) * (PROFILE_LEN - 1) as f32;
+        let k = (x.floor() as usize).min(PROFILE_LEN - 2);
+        let t = x - k as f32;
+        (p[k] + (p[k + 1] - p[k]) * t).min(MAX_FITTED_DEPTH)
+    }
+}
 
 impl WeightFunction {
     /// Every weight function.
@@ -81,7 +114,7 @@ impl WeightFunction {
     }
 
     /// The weight of a fragment (see the module docs for the inputs).
-    pub fn weight(self, z: f32, depth: f32, alpha: f32, range: [f32; 2]) -> f32 {
+    pub fn weight(self, z: f32, depth: f32, alpha: f32, screen: [f32; 2], fit: &WeightFit) -> f32 {
         let cube = |x: f32| x * x * x;
         let d = depth.abs();
         match self {
@@ -100,12 +133,7 @@ impl WeightFunction {
                 alpha * (0.03 / (1e-5 + (d / 200.0).powi(4))).clamp(1e-2, 3e3)
             }
             WeightFunction::McGuire10 => alpha * (3e3 * cube(1.0 - z)).max(1e-2),
-            WeightFunction::Fitted => {
-                let n = range[0].max(1e-4);
-                let f = range[1].max(n * 1.001);
-                let t = ((d / n).ln() / (f / n).ln()).clamp(0.0, 1.0);
-                alpha * alpha * 3e3 * (-FITTED_K * t).exp()
-            }
+            WeightFunction::Fitted => 3e3 * (-fit.optical_depth_at(screen, d)).exp(),
         }
     }
 }
@@ -115,8 +143,12 @@ mod tests {
     use super::*;
     use WeightFunction::*;
 
-    /// A range for the weights that ignore it.
-    const R: [f32; 2] = [0.1, 100.0];
+    /// A screen position and a fit for the weights that ignore them.
+    const S: [f32; 2] = [0.5, 0.5];
+    const R: &WeightFit = &WeightFit {
+        range: [0.1, 100.0],
+        optical_depth: Vec::new(),
+    };
 
     fn close(a: f32, b: f32) {
         assert!((a - b).abs() <= 1e-5 * b.abs().max(1.0), "{a} != {b}");
@@ -127,66 +159,101 @@ mod tests {
     #[test]
     fn seed000() {
         // d = 0.5: (1 - 0.0005)³ = 0.998500749875; × 3000 = 2995.50225; × α 0.5 = 1497.75112
-        close(Seed000.weight(0.5, 10.0, 0.5, R), 1_497.751_1);
+        close(Seed000.weight(0.5, 10.0, 0.5, S, R), 1_497.751_1);
         // α = 1e-6: 3000 × 1e-6 = 0.003, clamped up to 0.01
-        close(Seed000.weight(0.5, 10.0, 1e-6, R), 0.01);
+        close(Seed000.weight(0.5, 10.0, 1e-6, S, R), 0.01);
     }
 
     #[test]
     fn seed002() {
         // 0.5³ × 3000 × 0.5³ = 0.125 × 3000 × 0.125 = 46.875
-        close(Seed002.weight(0.5, 1.0, 0.5, R), 46.875);
+        close(Seed002.weight(0.5, 1.0, 0.5, S, R), 46.875);
         // α 1 at the near plane: 3000, the upper clamp
-        close(Seed002.weight(0.0, 1.0, 1.0, R), 3000.0);
+        close(Seed002.weight(0.0, 1.0, 1.0, S, R), 3000.0);
         // 0.1³ × 3000 × 0.1³ = 0.003, clamped up to 0.01
-        close(Seed002.weight(0.9, 1.0, 0.1, R), 0.01);
+        close(Seed002.weight(0.9, 1.0, 0.1, S, R), 0.01);
     }
 
     #[test]
     fn mcguire7() {
         // |z| 10: (10/5)² = 4, (10/200)⁶ = 1.5625e-8; 10 / 4.0000100156 = 2.49999374; × 0.5
-        close(McGuire7.weight(0.5, 10.0, 0.5, R), 1.249_996_9);
+        close(McGuire7.weight(0.5, 10.0, 0.5, S, R), 1.249_996_9);
         // |z| 0.1: 10 / (1e-5 + 4e-4) = 24390, clamped to 3000; × 0.5 = 1500
-        close(McGuire7.weight(0.5, 0.1, 0.5, R), 1500.0);
+        close(McGuire7.weight(0.5, 0.1, 0.5, S, R), 1500.0);
     }
 
     #[test]
     fn mcguire8() {
         // |z| 10: (10/10)³ = 1; 10 / 1.0000100156 = 9.99989985; × 0.5 = 4.99995
-        close(McGuire8.weight(0.5, 10.0, 0.5, R), 4.999_95);
+        close(McGuire8.weight(0.5, 10.0, 0.5, S, R), 4.999_95);
         // |z| 2000: (200)³ = 8e6 and (10)⁶ = 1e6: 10 / 9e6 ≈ 1.1e-6, clamped to 0.01; × 1
-        close(McGuire8.weight(0.5, 2000.0, 1.0, R), 0.01);
+        close(McGuire8.weight(0.5, 2000.0, 1.0, S, R), 0.01);
     }
 
     #[test]
     fn mcguire9() {
         // |z| 100: (0.5)⁴ = 0.0625; 0.03 / 0.06251 = 0.479923; × 0.5 = 0.239962
-        close(McGuire9.weight(0.5, 100.0, 0.5, R), 0.239_962);
+        close(McGuire9.weight(0.5, 100.0, 0.5, S, R), 0.239_962);
         // |z| 1000: 5⁴ = 625: 4.8e-5, clamped to 0.01; × 0.5 = 0.005
-        close(McGuire9.weight(0.5, 1000.0, 0.5, R), 0.005);
+        close(McGuire9.weight(0.5, 1000.0, 0.5, S, R), 0.005);
     }
 
     #[test]
     fn mcguire10() {
         // z 0.5: 3000 × 0.125 = 375; × 0.5 = 187.5
-        close(McGuire10.weight(0.5, 1.0, 0.5, R), 187.5);
+        close(McGuire10.weight(0.5, 1.0, 0.5, S, R), 187.5);
         // z 1 (far plane): max(0.01, 0) = 0.01; × 0.5 = 0.005
-        close(McGuire10.weight(1.0, 1.0, 0.5, R), 0.005);
+        close(McGuire10.weight(1.0, 1.0, 0.5, S, R), 0.005);
+    }
+
+    /// A fit over [10, 1000] whose tile `(tx, ty)` has optical depth
+    /// `(tx + 1) · 0.1 · k` at its k-th depth `10 · 100^(k/31)`.
+    fn ramp_fit() -> WeightFit {
+        let mut optical_depth = Vec::new();
+        for _ty in 0..TILES {
+            for tx in 0..TILES {
+                optical_depth.extend((0..PROFILE_LEN).map(|k| (tx + 1) as f32 * 0.1 * k as f32));
+            }
+        }
+        WeightFit {
+            range: [10.0, 1000.0],
+            optical_depth,
+        }
     }
 
     #[test]
     fn fitted() {
-        // Range [10, 1000], d 100: t = ln 10 / ln 100 = 0.5; e^(−4.5) = 0.011109;
-        // α² 0.25 × 3000 × 0.011109 = 8.3318
-        close(Fitted.weight(0.5, 100.0, 0.5, [10.0, 1000.0]), 8.331_8);
-        // Near end of the range: 3000·α²; far end: 3000·α²·e^−9 = 0.37023·α²; beyond the
-        // ends the weight stays at their values.
-        close(Fitted.weight(0.5, 10.0, 1.0, [10.0, 1000.0]), 3000.0);
-        close(Fitted.weight(0.5, 1.0, 1.0, [10.0, 1000.0]), 3000.0);
-        close(Fitted.weight(0.5, 1000.0, 1.0, [10.0, 1000.0]), 0.370_23);
-        close(Fitted.weight(0.5, 5000.0, 1.0, [10.0, 1000.0]), 0.370_23);
+        let fit = ramp_fit();
+        // Tile (1, 0) (x 0.2 of 8 tiles), d 100: halfway, x = 15.5: τ = 0.2 × 15.5 = 3.1;
+        // 3000 × e^−3.1 = 3000 × 0.0450492 = 135.148
+        close(Fitted.weight(0.5, 100.0, 0.5, [0.2, 0.1], &fit), 135.147_6);
+        // The same depth in tile (0, 7): τ = 0.1 × 15.5 = 1.55; 3000 × 0.212248 = 636.744
+        close(
+            Fitted.weight(0.5, 100.0, 0.5, [0.01, 0.99], &fit),
+            636.744_3,
+        );
+        // α does not enter (the accumulation multiplies by it once).
+        close(
+            Fitted.weight(0.5, 100.0, 1.0, [0.01, 0.99], &fit),
+            636.744_3,
+        );
+        // The near end: τ 0, 3000; nearer stays there.
+        close(Fitted.weight(0.5, 10.0, 1.0, [0.2, 0.1], &fit), 3000.0);
+        close(Fitted.weight(0.5, 1.0, 1.0, [0.2, 0.1], &fit), 3000.0);
+        // The far end of tile (1, 0): τ 6.2: 3000 × e^−6.2 = 6.08829; beyond stays there.
+        close(Fitted.weight(0.5, 1000.0, 1.0, [0.2, 0.1], &fit), 6.088_29);
+        close(Fitted.weight(0.5, 5000.0, 1.0, [0.2, 0.1], &fit), 6.088_29);
+        // Off-screen positions fall in the edge tiles: x 1.0 is tile 7, τ 0.8 × 31 = 24.8,
+        // cut at MAX_FITTED_DEPTH: 3000 × e^−12 = 0.018433.
+        close(Fitted.weight(0.5, 1000.0, 1.0, [1.0, 0.5], &fit), 0.018_433);
+        // No table (no translucent mesh in view): flat.
+        close(Fitted.weight(0.5, 100.0, 0.5, S, R), 3000.0);
         // A degenerate range (one depth) stays finite.
-        assert!(Fitted.weight(0.5, 10.0, 1.0, [10.0, 10.0]).is_finite());
+        let flat = WeightFit {
+            range: [10.0, 10.0],
+            ..fit
+        };
+        assert!(Fitted.weight(0.5, 10.0, 1.0, S, &flat).is_finite());
     }
 
     #[test]

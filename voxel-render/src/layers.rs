@@ -1,0 +1,315 @@
+//! How much translucent matter lies in front of each depth: what the fitted WBOIT weight
+//! is fitted to.
+//!
+//! The ideal weight of a translucent layer is the transmittance of everything in front of
+//! it: with that weight the weighted average is exact (of two layers, the back one counts
+//! `1 − α_front` times as much as the front one). The accumulation pass cannot know it per
+//! pixel, but the renderer can estimate it per screen tile, cheaply, from the visible
+//! meshes:
+//!
+//! - at upload, each translucent mesh is summed up per plane and facing: the rectangle
+//!   around the quads in that plane, and their area times their block's optical depth
+//!   `−ln(1 − α)`;
+//! - each frame, every plane that faces the eye (back faces are not drawn) adds, to each of
+//!   the `TILES × TILES` screen tiles its projected rectangle overlaps, the optical depth a
+//!   ray through the rectangle crosses (optical area / rectangle area) times the share of
+//!   the tile it covers, spread evenly over the view depths the rectangle spans.
+//!
+//! The result, per tile, is the expected optical depth in front of [`PROFILE_LEN`] depths
+//! spaced evenly in log depth across the translucent depth range in view; the weight is
+//! `3000 · e^−τ(d)` ([`crate::WeightFunction::Fitted`]). An estimate, not the per-pixel
+//! truth: a layer covering a quarter of a tile dims what lies behind it in that tile by a
+//! quarter of its optical depth, and a texel more opaque than its block (a glass frame)
+//! counts as its block.
+//!
+//! The cost is a loop over the planes of the visible translucent meshes (eight projected
+//! corners each, then the tiles they overlap) and an 8 KiB table in the frame uniforms;
+//! the shader interpolates two entries of it.
+
+use glam::{DVec3, Mat4, Vec2, Vec3};
+use voxel_core::{ChunkPos, Face};
+use voxel_mesh::PackedQuad;
+
+use crate::oit::WeightFit;
+
+/// Number of distances of the optical-depth profile (log-spaced, ends included).
+pub const PROFILE_LEN: usize = 32;
+
+/// The screen is cut into `TILES × TILES` tiles, each with its own profile.
+pub const TILES: usize = 8;
+
+/// Optical depth of the most opaque layer the estimate counts (`α` 0.99); a fully opaque
+/// translucent block would otherwise hide everything behind it for the weight.
+const MAX_LAYER_DEPTH: f64 = 4.605;
+
+/// The quads of a mesh that lie in one plane and face one way.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Plane {
+    /// Which way the quads face.
+    face: Face,
+    /// World-space rectangle around the quads (flat along the face's axis).
+    lo: DVec3,
+    hi: DVec3,
+    /// Sum of quad area × optical depth of the quad's block.
+    optical_area: f64,
+}
+
+/// A translucent mesh summed up per plane and facing.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshLayers {
+    planes: Vec<Plane>,
+}
+
+impl MeshLayers {
+    /// Sums up `quads` of the chunk at `pos`; `opacity` is indexed by block id (a block
+    /// past its end counts as clear).
+    pub fn new(pos: ChunkPos, quads: &[PackedQuad], opacity: &[f32]) -> Self {
+        let o = pos.origin();
+        let origin = DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
+        // Six facings × 33 plane positions in a chunk.
+        let mut planes: Vec<Option<Plane>> = vec![None; 6 * 33];
+        for q in quads {
+            let Some(u) = q.unpack() else { continue };
+            let alpha = opacity.get(u.block.index()).copied().unwrap_or(0.0);
+            let depth = (-f64::from(1.0 - alpha.clamp(0.0, 1.0)).ln()).min(MAX_LAYER_DEPTH);
+            let axis = u.face.axis();
+            let [ua, va] = voxel_mesh::UV_AXES[axis];
+            let mut min = u.pos.map(f64::from);
+            if u.face.is_positive() {
+                min[axis] += 1.0;
+            }
+            let mut max = min;
+            max[ua] += f64::from(u.size[0]);
+            max[va] += f64::from(u.size[1]);
+            let (lo, hi) = (origin + DVec3::from(min), origin + DVec3::from(max));
+            let area = f64::from(u.size[0]) * f64::from(u.size[1]);
+            let plane = planes[u.face as usize * 33 + min[axis] as usize].get_or_insert(Plane {
+                face: u.face,
+                lo,
+                hi,
+                optical_area: 0.0,
+            });
+            plane.lo = plane.lo.min(lo);
+            plane.hi = plane.hi.max(hi);
+            plane.optical_area += area * depth;
+        }
+        Self {
+            planes: planes.into_iter().flatten().collect(),
+        }
+    }
+}
+
+/// Fits the weight to the meshes in `layers` seen through `view_proj` (camera-relative:
+/// the eye at the origin) from `eye`, with the camera's `near` and `far` planes: the view
+/// depths the meshes span and, for each screen tile, the expected optical depth in front
+/// of [`PROFILE_LEN`] depths spaced evenly in log depth across them.
+pub fn fit<'a>(
+    layers: impl IntoIterator<Item = &'a MeshLayers>,
+    view_proj: Mat4,
+    eye: DVec3,
+    near: f32,
+    far: f32,
+) -> WeightFit {
+    // Each plane that faces the eye: its optical depth, screen rectangle and depth span.
+    let mut seen = Vec::new();
+    for plane in layers.into_iter().flat_map(|m| &m.planes) {
+        let tau = crossed_optical_depth(plane, eye);
+        if tau > 0.0 {
+            let (rect, span) = projection(plane, view_proj, eye);
+            if rect[1].cmpgt(rect[0]).all() {
+                seen.push((tau as f32, rect, span));
+            }
+        }
+    }
+    let (mut n, mut f) = seen
+        .iter()
+        .fold((f32::INFINITY, 0.0f32), |(n, f), (_, _, [a, b])| {
+            (n.min(*a), f.max(*b))
+        });
+    if seen.is_empty() {
+        (n, f) = (near, far);
+    }
+    let range = [n.clamp(near, far), f.clamp(near, far)];
+    let step = (range[1] / range[0]).max(1.0).ln() / (PROFILE_LEN - 1) as f32;
+    let depths: [f32; PROFILE_LEN] = std::array::from_fn(|k| range[0] * (step * k as f32).exp());
+    let mut optical_depth = vec![0.0f32; TILES * TILES * PROFILE_LEN];
+    let tiles = TILES as f32;
+    for (tau, [lo, hi], [a, b]) in seen {
+        let first = (lo * tiles).floor().as_uvec2();
+        let last = ((hi * tiles).ceil().as_uvec2()).min(glam::UVec2::splat(TILES as u32));
+        for ty in first.y..last.y {
+            for tx in first.x..last.x {
+                // The share of the tile the rectangle covers.
+                let t0 = Vec2::new(tx as f32, ty as f32) / tiles;
+                let size = (hi.min(t0 + 1.0 / tiles) - lo.max(t0)).max(Vec2::ZERO) * tiles;
+                let tau = tau * size.x * size.y;
+                let tile = (ty as usize * TILES + tx as usize) * PROFILE_LEN;
+                // Spread evenly over the depths the plane spans.
+                for (p, d) in optical_depth[tile..tile + PROFILE_LEN]
+                    .iter_mut()
+                    .zip(depths)
+                {
+                    *p += tau * ((d - a) / (b - a).max(1e-6)).clamp(0.0, 1.0);
+                }
+            }
+        }
+    }
+    WeightFit {
+        range,
+        optical_depth,
+    }
+}
+
+/// The optical depth a ray through the plane's rectangle crosses (its optical area over
+/// its area) when the quads face the eye, else 0 (back faces are not drawn).
+fn crossed_optical_depth(plane: &Plane, eye: DVec3) -> f64 {
+    let axis = plane.face.axis();
+    if (eye[axis] > plane.lo[axis]) != plane.face.is_positive() || eye[axis] == plane.lo[axis] {
+        return 0.0;
+    }
+    let [ua, va] = voxel_mesh::UV_AXES[axis];
+    let area = (plane.hi[ua] - plane.lo[ua]) * (plane.hi[va] - plane.lo[va]);
+    plane.optical_area / area.max(1.0)
+}
+
+/// The bounding rectangle of the plane's projection, in screen coordinates (0 to 1, y
+/// down; the whole screen when the plane reaches behind the eye), and the view depths it
+/// spans.
+fn projection(plane: &Plane, view_proj: Mat4, eye: DVec3) -> ([Vec2; 2], [f32; 2]) {
+    let (lo, hi) = ((plane.lo - eye).as_vec3(), (plane.hi - eye).as_vec3());
+    let (mut min, mut max) = (Vec2::splat(f32::INFINITY), Vec2::NEG_INFINITY);
+    let (mut near, mut far) = (f32::INFINITY, f32::NEG_INFINITY);
+    for i in 0..8 {
+        let corner = Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        // Perspective: clip w is the view depth.
+        let clip = view_proj * corner.extend(1.0);
+        near = near.min(clip.w);
+        far = far.max(clip.w);
+        let ndc = clip.truncate().truncate() / clip.w.max(1e-6);
+        let screen = Vec2::new(ndc.x + 1.0, 1.0 - ndc.y) * 0.5;
+        min = min.min(screen);
+        max = max.max(screen);
+    }
+    let span = [near.max(0.0), far.max(0.0)];
+    if near <= 1e-3 {
+        return ([Vec2::ZERO, Vec2::ONE], span);
+    }
+    (
+        [
+            min.clamp(Vec2::ZERO, Vec2::ONE),
+            max.clamp(Vec2::ZERO, Vec2::ONE),
+        ],
+        span,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Camera;
+    use voxel_core::{BlockRegistry, blocks};
+
+    fn opacity() -> Vec<f32> {
+        BlockRegistry::default()
+            .iter()
+            .map(|(_, d)| d.opacity)
+            .collect()
+    }
+
+    /// A `w`×32 sheet of `block` in chunk (0, 0, 0) from x = `x0`, whose +z face is the
+    /// plane z = `z` + 1.
+    fn sheet(x0: usize, w: usize, z: usize, face: Face, block: voxel_core::BlockId) -> PackedQuad {
+        PackedQuad::new([x0, 0, z], w, 32, face, block)
+    }
+
+    /// Looking down −z from (16, 16, 30), square screen, fov 60°.
+    fn fit_for(quads: &[PackedQuad]) -> WeightFit {
+        let cam = Camera::look_at(
+            DVec3::new(16.0, 16.0, 30.0),
+            DVec3::new(16.0, 16.0, 0.0),
+            60.0,
+            0.1,
+            500.0,
+        )
+        .unwrap();
+        let layers = MeshLayers::new(ChunkPos::new(0, 0, 0), quads, &opacity());
+        fit([&layers], cam.view_proj(1.0), cam.eye, 0.1, 500.0)
+    }
+
+    fn tau_at(fit: &WeightFit, tile: [usize; 2], k: usize) -> f32 {
+        fit.optical_depth[(tile[1] * TILES + tile[0]) * PROFILE_LEN + k]
+    }
+
+    const GLASS_DEPTH: f32 = 0.223_143_55; // −ln(1 − 0.2)
+
+    #[test]
+    fn a_sheet_over_the_whole_screen_dims_what_lies_behind_it_everywhere() {
+        // Glass at depth 5 (plane z = 25), water at depth 20 (plane z = 10): both fill
+        // the screen (half-widths 16/5 and 16/20 are past tan 30° = 0.577).
+        let fit = fit_for(&[
+            sheet(0, 32, 24, Face::PosZ, blocks::GLASS),
+            sheet(0, 32, 9, Face::PosZ, blocks::WATER),
+        ]);
+        assert!((fit.range[0] - 5.0).abs() < 1e-3 && (fit.range[1] - 20.0).abs() < 1e-3);
+        for ty in 0..TILES {
+            for tx in 0..TILES {
+                assert_eq!(
+                    tau_at(&fit, [tx, ty], 0),
+                    0.0,
+                    "nothing in front of the glass"
+                );
+                let behind = tau_at(&fit, [tx, ty], 1);
+                assert!((behind - GLASS_DEPTH).abs() < 1e-5, "{behind}");
+                // The water lies at the last depth, nothing beyond it counts.
+                let last = tau_at(&fit, [tx, ty], PROFILE_LEN - 1);
+                assert!((last - GLASS_DEPTH).abs() < 1e-5, "{last}");
+            }
+        }
+        let screen = [0.3, 0.6];
+        assert!((fit.optical_depth_at(screen, 20.0) - GLASS_DEPTH).abs() < 1e-5);
+        assert_eq!(fit.optical_depth_at(screen, 5.0), 0.0);
+    }
+
+    #[test]
+    fn faces_turned_away_from_the_eye_do_not_count() {
+        let front = fit_for(&[
+            sheet(0, 32, 24, Face::PosZ, blocks::GLASS),
+            sheet(0, 32, 9, Face::PosZ, blocks::WATER),
+        ]);
+        let both = fit_for(&[
+            sheet(0, 32, 24, Face::PosZ, blocks::GLASS),
+            sheet(0, 32, 24, Face::NegZ, blocks::GLASS),
+            sheet(0, 32, 9, Face::PosZ, blocks::WATER),
+        ]);
+        assert_eq!(front, both);
+    }
+
+    #[test]
+    fn a_sheet_over_half_the_screen_counts_in_that_half_only() {
+        // Ice over x 16..32, the right half of the screen (the eye is at x = 16).
+        let fit = fit_for(&[
+            sheet(16, 16, 24, Face::PosZ, blocks::ICE),
+            sheet(0, 32, 9, Face::PosZ, blocks::WATER),
+        ]);
+        let ice = -(1.0f32 - 0.92).ln();
+        for ty in 0..TILES {
+            for tx in 0..TILES {
+                let tau = tau_at(&fit, [tx, ty], PROFILE_LEN - 1);
+                let want = if tx < TILES / 2 { 0.0 } else { ice };
+                assert!((tau - want).abs() < 1e-4, "tile {tx},{ty}: {tau}");
+            }
+        }
+    }
+
+    #[test]
+    fn nothing_in_view_leaves_the_weight_flat() {
+        let fit = fit_for(&[]);
+        assert_eq!(fit.range, [0.1, 500.0]);
+        assert!(fit.optical_depth.iter().all(|&t| t == 0.0));
+        assert_eq!(fit.optical_depth_at([0.5, 0.5], 100.0), 0.0);
+    }
+}
