@@ -7,24 +7,29 @@
 //! pixel, but the renderer can estimate it per screen tile, cheaply, from the visible
 //! meshes:
 //!
-//! - at upload, each translucent mesh is summed up per plane and facing: the rectangle
-//!   around the quads in that plane, and their area times their block's optical depth
+//! - at upload, each translucent mesh is summed up per plane, facing and block: the
+//!   rectangle around those quads, and their area times the block's optical depth
 //!   `−ln(1 − α)`;
 //! - each frame, every plane that faces the eye (back faces are not drawn) adds, to each of
 //!   the `TILES × TILES` screen tiles its projected rectangle overlaps, the optical depth a
 //!   ray through the rectangle crosses (optical area / rectangle area) times the share of
-//!   the tile it covers, spread evenly over the view depths the rectangle spans.
+//!   the tile it covers, in front of the view depths past the rectangle's farthest point.
 //!
 //! The result, per tile, is the expected optical depth in front of [`PROFILE_LEN`] depths
 //! spaced evenly in log depth across the translucent depth range in view; the weight is
 //! `3000 · e^−τ(d)` ([`crate::WeightFunction::Fitted`]). An estimate, not the per-pixel
 //! truth: a layer covering a quarter of a tile dims what lies behind it in that tile by a
-//! quarter of its optical depth, and a texel more opaque than its block (a glass frame)
-//! counts as its block.
+//! quarter of its optical depth (also where the two do not overlap: the near and far parts
+//! of a sea, in different chunks, in one tile), a layer seen at a grazing angle does not
+//! dim what lies behind it within its own depth span, and a texel more opaque than its
+//! block (a glass frame) counts as its block.
 //!
 //! The cost is a loop over the planes of the visible translucent meshes (eight projected
 //! corners each, then the tiles they overlap) and an 8 KiB table in the frame uniforms;
-//! the shader interpolates two entries of it.
+//! the shader reads eight entries of it (two depths in four tiles, to interpolate across
+//! tiles without seams).
+
+use std::collections::BTreeMap;
 
 use glam::{DVec3, Mat4, Vec2, Vec3};
 use voxel_core::{ChunkPos, Face};
@@ -42,7 +47,7 @@ pub const TILES: usize = 8;
 /// translucent block would otherwise hide everything behind it for the weight.
 const MAX_LAYER_DEPTH: f64 = 4.605;
 
-/// The quads of a mesh that lie in one plane and face one way.
+/// The quads of one block in a mesh that lie in one plane and face one way.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Plane {
     /// Which way the quads face.
@@ -54,7 +59,7 @@ struct Plane {
     optical_area: f64,
 }
 
-/// A translucent mesh summed up per plane and facing.
+/// A translucent mesh summed up per plane, facing and block.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshLayers {
     planes: Vec<Plane>,
@@ -66,8 +71,9 @@ impl MeshLayers {
     pub fn new(pos: ChunkPos, quads: &[PackedQuad], opacity: &[f32]) -> Self {
         let o = pos.origin();
         let origin = DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
-        // Six facings × 33 plane positions in a chunk.
-        let mut planes: Vec<Option<Plane>> = vec![None; 6 * 33];
+        // By facing, plane position in the chunk and block (ordered: the same sums in the
+        // same order every time).
+        let mut planes: BTreeMap<(usize, u8, u16), Plane> = BTreeMap::new();
         for q in quads {
             let Some(u) = q.unpack() else { continue };
             let alpha = opacity.get(u.block.index()).copied().unwrap_or(0.0);
@@ -83,7 +89,8 @@ impl MeshLayers {
             max[va] += f64::from(u.size[1]);
             let (lo, hi) = (origin + DVec3::from(min), origin + DVec3::from(max));
             let area = f64::from(u.size[0]) * f64::from(u.size[1]);
-            let plane = planes[u.face as usize * 33 + min[axis] as usize].get_or_insert(Plane {
+            let key = (u.face as usize, min[axis] as u8, u.block.0);
+            let plane = planes.entry(key).or_insert(Plane {
                 face: u.face,
                 lo,
                 hi,
@@ -94,7 +101,7 @@ impl MeshLayers {
             plane.optical_area += area * depth;
         }
         Self {
-            planes: planes.into_iter().flatten().collect(),
+            planes: planes.into_values().collect(),
         }
     }
 }
@@ -134,7 +141,10 @@ pub fn fit<'a>(
     let depths: [f32; PROFILE_LEN] = std::array::from_fn(|k| range[0] * (step * k as f32).exp());
     let mut optical_depth = vec![0.0f32; TILES * TILES * PROFILE_LEN];
     let tiles = TILES as f32;
-    for (tau, [lo, hi], [a, b]) in seen {
+    for (tau, [lo, hi], [_, far]) in seen {
+        // The plane counts in front of the depths past its farthest point, so that no part
+        // of it dims another part of it (a sea seen at a grazing angle).
+        let behind = depths.partition_point(|&d| d <= far);
         let first = (lo * tiles).floor().as_uvec2();
         let last = ((hi * tiles).ceil().as_uvec2()).min(glam::UVec2::splat(TILES as u32));
         for ty in first.y..last.y {
@@ -144,12 +154,8 @@ pub fn fit<'a>(
                 let size = (hi.min(t0 + 1.0 / tiles) - lo.max(t0)).max(Vec2::ZERO) * tiles;
                 let tau = tau * size.x * size.y;
                 let tile = (ty as usize * TILES + tx as usize) * PROFILE_LEN;
-                // Spread evenly over the depths the plane spans.
-                for (p, d) in optical_depth[tile..tile + PROFILE_LEN]
-                    .iter_mut()
-                    .zip(depths)
-                {
-                    *p += tau * ((d - a) / (b - a).max(1e-6)).clamp(0.0, 1.0);
+                for p in &mut optical_depth[tile + behind..tile + PROFILE_LEN] {
+                    *p += tau;
                 }
             }
         }
@@ -289,9 +295,11 @@ mod tests {
     }
 
     #[test]
-    fn a_sheet_over_half_the_screen_counts_in_that_half_only() {
-        // Ice over x 16..32, the right half of the screen (the eye is at x = 16).
+    fn each_block_of_a_plane_counts_where_it_is() {
+        // One plane: glass over x 0..16, ice over x 16..32, the left and right halves of
+        // the screen (the eye is at x = 16); water behind both.
         let fit = fit_for(&[
+            sheet(0, 16, 24, Face::PosZ, blocks::GLASS),
             sheet(16, 16, 24, Face::PosZ, blocks::ICE),
             sheet(0, 32, 9, Face::PosZ, blocks::WATER),
         ]);
@@ -299,10 +307,34 @@ mod tests {
         for ty in 0..TILES {
             for tx in 0..TILES {
                 let tau = tau_at(&fit, [tx, ty], PROFILE_LEN - 1);
-                let want = if tx < TILES / 2 { 0.0 } else { ice };
+                let want = if tx < TILES / 2 { GLASS_DEPTH } else { ice };
                 assert!((tau - want).abs() < 1e-4, "tile {tx},{ty}: {tau}");
             }
         }
+    }
+
+    #[test]
+    fn a_plane_seen_at_a_grazing_angle_does_not_dim_itself() {
+        // A water floor (plane y = 10) seen from above and behind its edge.
+        let cam = Camera::look_at(
+            DVec3::new(16.0, 14.0, 40.0),
+            DVec3::new(16.0, 10.0, 0.0),
+            60.0,
+            0.1,
+            500.0,
+        )
+        .unwrap();
+        let quads = [PackedQuad::new(
+            [0, 9, 0],
+            32,
+            32,
+            Face::PosY,
+            blocks::WATER,
+        )];
+        let layers = MeshLayers::new(ChunkPos::new(0, 0, 0), &quads, &opacity());
+        let fit = fit([&layers], cam.view_proj(1.0), cam.eye, 0.1, 500.0);
+        assert!(fit.range[1] > 2.0 * fit.range[0], "{:?}", fit.range);
+        assert!(fit.optical_depth.iter().all(|&t| t == 0.0));
     }
 
     #[test]

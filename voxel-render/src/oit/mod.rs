@@ -105,8 +105,9 @@ pub struct OitConfig {
     pub width: u32,
     /// Render target height in pixels.
     pub height: u32,
-    /// WBOIT weight function. Default: ours, fitted to the translucent depth range in
-    /// view, which had the lowest error of all on the scene suite (`results/`).
+    /// WBOIT weight function. Default: ours, the transmittance in front of the fragment
+    /// estimated from the translucent layers in view, which had the lowest error of all
+    /// on the scene suite (`results/`).
     pub weight: WeightFunction,
 
     /// Accumulate WBOIT in RGBA8 even when RGBA16F works (to test the fallback).

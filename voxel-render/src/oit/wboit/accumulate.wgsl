@@ -40,26 +40,38 @@ fn weight(pixel: vec2<f32>, z: f32, depth: f32, a: f32) -> f32 {
     }
 }
 
-// WeightFit::optical_depth_at in weights.rs: the table of the fragment's screen tile,
-// interpolated in log depth.
+// WeightFit::optical_depth_at in weights.rs: the tables of the four screen tiles around
+// the fragment, interpolated in log depth, then between the tiles' centres.
 const PROFILE_LEN: u32 = 32u;
 const TILES: u32 = 8u;
 const MAX_FITTED_DEPTH: f32 = 12.0;
 
-fn profile(first: u32, k: u32) -> f32 {
-    let i = first + k;
+fn table(tile: vec2<u32>, k: u32) -> f32 {
+    let i = (tile.y * TILES + tile.x) * PROFILE_LEN + k;
     return frame.optical_depth[i / 4u][i % 4u];
 }
 
+fn tile_depth(tile: vec2<u32>, k: u32, t: f32) -> f32 {
+    return mix(table(tile, k), table(tile, k + 1u), t);
+}
+
 fn optical_depth_at(pixel: vec2<f32>, d: f32) -> f32 {
-    let tile = min(vec2<u32>(pixel / frame.viewport * f32(TILES)), vec2<u32>(TILES - 1u));
-    let first = (tile.y * TILES + tile.x) * PROFILE_LEN;
     let n = max(frame.depth_range.x, 1e-4);
     let f = max(frame.depth_range.y, n * 1.001);
     let x = clamp(log(d / n) / log(f / n), 0.0, 1.0) * f32(PROFILE_LEN - 1u);
     let k = min(u32(floor(x)), PROFILE_LEN - 2u);
     let t = x - f32(k);
-    return min(mix(profile(first, k), profile(first, k + 1u), t), MAX_FITTED_DEPTH);
+    let last = f32(TILES - 1u);
+    let p = clamp(pixel / frame.viewport * f32(TILES) - 0.5, vec2<f32>(0.0), vec2<f32>(last));
+    let t0 = min(vec2<u32>(floor(p)), vec2<u32>(TILES - 2u));
+    let s = p - vec2<f32>(t0);
+    let top = mix(tile_depth(t0, k, t), tile_depth(t0 + vec2<u32>(1u, 0u), k, t), s.x);
+    let bottom = mix(
+        tile_depth(t0 + vec2<u32>(0u, 1u), k, t),
+        tile_depth(t0 + vec2<u32>(1u, 1u), k, t),
+        s.x,
+    );
+    return min(mix(top, bottom, s.y), MAX_FITTED_DEPTH);
 }
 
 fn accumulation(in: VsOut) -> vec4<f32> {

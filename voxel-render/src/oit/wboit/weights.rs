@@ -57,21 +57,31 @@ pub struct WeightFit {
 pub const MAX_FITTED_DEPTH: f32 = 12.0;
 
 impl WeightFit {
-    /// The optical depth in front of view depth `d` at `screen` (0 to 1, y down),
-    /// interpolated in log depth and clamped at the ends of the range and at
-    /// [`MAX_FITTED_DEPTH`].
+    /// The optical depth in front of view depth `d` at `screen` (0 to 1, y down):
+    /// interpolated in log depth in the tables of the four tiles around `screen`, then
+    /// bilinearly between the tiles' centres (no seams at tile edges), and clamped at the
+    /// ends of the range and at [`MAX_FITTED_DEPTH`].
     pub fn optical_depth_at(&self, screen: [f32; 2], d: f32) -> f32 {
-        let tile = |v: f32| ((v * TILES as f32) as usize).min(TILES - 1);
-        let first = (tile(screen[1]) * TILES + tile(screen[0])) * PROFILE_LEN;
-        let Some(p) = self.optical_depth.get(first..first + PROFILE_LEN) else {
+        if self.optical_depth.len() < TILES * TILES * PROFILE_LEN {
             return 0.0;
-        };
+        }
         let n = self.range[0].max(1e-4);
         let f = self.range[1].max(n * 1.001);
         let x = ((d / n).ln() / (f / n).ln()).clamp(0.0, 1.0) * (PROFILE_LEN - 1) as f32;
         let k = (x.floor() as usize).min(PROFILE_LEN - 2);
         let t = x - k as f32;
-        (p[k] + (p[k + 1] - p[k]) * t).min(MAX_FITTED_DEPTH)
+        let at = |tx: usize, ty: usize| {
+            let p = &self.optical_depth[(ty * TILES + tx) * PROFILE_LEN..];
+            p[k] + (p[k + 1] - p[k]) * t
+        };
+        let lerp = |a: f32, b: f32, s: f32| a + (b - a) * s;
+        // Tile coordinates of `screen` between the tiles' centres.
+        let p = screen.map(|v| (v * TILES as f32 - 0.5).clamp(0.0, (TILES - 1) as f32));
+        let [tx, ty] = p.map(|v| (v.floor() as usize).min(TILES - 2));
+        let [sx, sy] = [p[0] - tx as f32, p[1] - ty as f32];
+        let top = lerp(at(tx, ty), at(tx + 1, ty), sx);
+        let bottom = lerp(at(tx, ty + 1), at(tx + 1, ty + 1), sx);
+        lerp(top, bottom, sy).min(MAX_FITTED_DEPTH)
     }
 }
 
@@ -224,26 +234,42 @@ mod tests {
     #[test]
     fn fitted() {
         let fit = ramp_fit();
-        // Tile (1, 0) (x 0.2 of 8 tiles), d 100: halfway, x = 15.5: τ = 0.2 × 15.5 = 3.1;
-        // 3000 × e^−3.1 = 3000 × 0.0450492 = 135.148
-        close(Fitted.weight(0.5, 100.0, 0.5, [0.2, 0.1], &fit), 135.147_6);
-        // The same depth in tile (0, 7): τ = 0.1 × 15.5 = 1.55; 3000 × 0.212248 = 636.744
+        // The centre of tile (1, 0) (x 1.5/8, y 0.5/8), d 100: halfway, x = 15.5:
+        // τ = 0.2 × 15.5 = 3.1; 3000 × e^−3.1 = 3000 × 0.0450492 = 135.148
+        close(
+            Fitted.weight(0.5, 100.0, 0.5, [0.1875, 0.0625], &fit),
+            135.147_6,
+        );
+        // The same depth near the corner of tile (0, 7), clamped to its centre:
+        // τ = 0.1 × 15.5 = 1.55; 3000 × 0.212248 = 636.744
         close(
             Fitted.weight(0.5, 100.0, 0.5, [0.01, 0.99], &fit),
             636.744_3,
         );
+        // Halfway between the centres of tiles 1 and 2 (x 2/8): τ = 0.25 × 15.5 = 3.875;
+        // 3000 × e^−3.875 = 62.2630
+        close(Fitted.weight(0.5, 100.0, 0.5, [0.25, 0.3], &fit), 62.263_0);
         // α does not enter (the accumulation multiplies by it once).
         close(
             Fitted.weight(0.5, 100.0, 1.0, [0.01, 0.99], &fit),
             636.744_3,
         );
         // The near end: τ 0, 3000; nearer stays there.
-        close(Fitted.weight(0.5, 10.0, 1.0, [0.2, 0.1], &fit), 3000.0);
-        close(Fitted.weight(0.5, 1.0, 1.0, [0.2, 0.1], &fit), 3000.0);
+        close(
+            Fitted.weight(0.5, 10.0, 1.0, [0.1875, 0.0625], &fit),
+            3000.0,
+        );
+        close(Fitted.weight(0.5, 1.0, 1.0, [0.1875, 0.0625], &fit), 3000.0);
         // The far end of tile (1, 0): τ 6.2: 3000 × e^−6.2 = 6.08829; beyond stays there.
-        close(Fitted.weight(0.5, 1000.0, 1.0, [0.2, 0.1], &fit), 6.088_29);
-        close(Fitted.weight(0.5, 5000.0, 1.0, [0.2, 0.1], &fit), 6.088_29);
-        // Off-screen positions fall in the edge tiles: x 1.0 is tile 7, τ 0.8 × 31 = 24.8,
+        close(
+            Fitted.weight(0.5, 1000.0, 1.0, [0.1875, 0.0625], &fit),
+            6.088_29,
+        );
+        close(
+            Fitted.weight(0.5, 5000.0, 1.0, [0.1875, 0.0625], &fit),
+            6.088_29,
+        );
+        // Off-screen positions take the edge tiles: x 1.0 is tile 7, τ 0.8 × 31 = 24.8,
         // cut at MAX_FITTED_DEPTH: 3000 × e^−12 = 0.018433.
         close(Fitted.weight(0.5, 1000.0, 1.0, [1.0, 0.5], &fit), 0.018_433);
         // No table (no translucent mesh in view): flat.
