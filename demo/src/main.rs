@@ -14,11 +14,40 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+const USAGE: &str = "\
+usage: demo [COMMAND] [OPTIONS]
+
+commands:
+  (none)     the interactive window; without a display, the showcase
+  window     [--seed N] [--size WxH] [--technique NAME] [--view-distance N] [--heatmap]
+             [--frames N] [--screenshot FILE] [--cycle DIR] [--edit] [--resize]
+  showcase   [--out DIR] [--size WxH]: every technique for the default scene, and a quick
+             speed/accuracy evaluation with its chart
+  stats      [--seed N] [--chunks N]: generate and mesh a world, print statistics
+  render     [--technique NAME] [--weight NAME] [--bayer 2|4|8|16] [--layers N] [--scene FILE]
+             [--size WxH] [--seed N] [--msaa] [--frames N] --out FILE.png
+  eval       [--scenes PATH...] [--techniques all|LIST] [--weights all|none|LIST] [--size WxH]
+             [--frames N] [--warmup N] [--no-stability] [--flicker-frames N]
+             [--sweep-points N] [--heatmap-width W] --out DIR
+";
+
 use demo::args::{self, Args};
 use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator};
 
 fn main() {
     let argv: Vec<String> = std::env::args().skip(1).collect();
+    if argv.first().is_some_and(|a| a == "help") || argv.iter().any(|a| a == "--help" || a == "-h")
+    {
+        use voxel_render::{Technique, WeightFunction};
+        print!("{USAGE}");
+        println!(
+            "\ntechniques: {}\nweights: {} (default {})",
+            Technique::ALL.map(Technique::name).join(", "),
+            WeightFunction::ALL.map(WeightFunction::name).join(", "),
+            WeightFunction::Fitted.name()
+        );
+        return;
+    }
     let (cmd, rest) = match argv.first().map(String::as_str) {
         Some(c) if !c.starts_with("--") => (c, &argv[1..]),
         _ => ("", &argv[..]),
