@@ -45,7 +45,7 @@ impl GpuMesh {
         self.quads
     }
 
-    /// The translucent layers the mesh's quads make, per face direction.
+    /// The translucent layers the mesh's quads make, per plane, facing and block.
     pub fn layers(&self) -> &MeshLayers {
         &self.layers
     }

@@ -80,8 +80,9 @@ pub struct FrameStats {
     pub chunks_resorted: usize,
     /// Technique-specific facts (peeled layers, reference overflow).
     pub technique: crate::oit::TechniqueReport,
-    /// What the fitted WBOIT weight was fitted to: the view distances the visible
-    /// translucent meshes span and the optical depth in front of distances across them.
+    /// What the fitted WBOIT weight was fitted to: the view depths the visible translucent
+    /// meshes span and, per screen tile, the optical depth in front of depths across them
+    /// (no table when the frame does not use the fitted weight).
     pub weight_fit: WeightFit,
 }
 
@@ -602,13 +603,26 @@ impl Renderer {
         let cutout = self.chunks.visible(MeshKind::Cutout, &frustum);
         let mut translucent = self.chunks.visible(MeshKind::Translucent, &frustum);
         translucent.reverse();
-        let weight_fit = layers::fit(
-            translucent.iter().map(|v| v.mesh.layers()),
-            view_proj,
-            camera.eye,
-            camera.near as f32,
-            camera.far as f32,
-        );
+        // Only the fitted WBOIT weight needs the estimate of the layers in view.
+        let (near, far) = (camera.near as f32, camera.far as f32);
+        let fitted = matches!(
+            self.oit.technique(),
+            Technique::WboitMrt | Technique::WboitTwoPass
+        ) && self.oit.config().weight == WeightFunction::Fitted;
+        let weight_fit = if fitted {
+            layers::fit(
+                translucent.iter().map(|v| v.mesh.layers()),
+                view_proj,
+                camera.eye,
+                near,
+                far,
+            )
+        } else {
+            WeightFit {
+                range: [near, far],
+                optical_depth: Vec::new(),
+            }
+        };
         let depth_range = weight_fit.range;
         let mut optical_depth = [[0.0; 4]; OPTICAL_DEPTH_VEC4S];
         let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut optical_depth);
