@@ -88,7 +88,7 @@ impl MeshLayers {
             max[ua] += f64::from(u.size[0]);
             max[va] += f64::from(u.size[1]);
             let (lo, hi) = (origin + DVec3::from(min), origin + DVec3::from(max));
-            let area = f64::from(u.size[0]) * f64::from(u.size[1]);
+            let area = f64::from(q.area());
             let key = (u.face as usize, min[axis] as u8, u.block.0);
             let plane = planes.entry(key).or_insert(Plane {
                 face: u.face,
