@@ -1,11 +1,4 @@
-//! The demo's library: scenes, headless rendering, and the lab behind `demo eval`.
+//! The demo's library: the interactive window (winit + egui). The headless tools and the
+//! lab live in `voxel-lab`, which has no window.
 
 pub mod app;
-pub mod args;
-pub mod charts;
-pub mod eval;
-pub mod headless;
-pub mod metrics;
-pub mod report;
-pub mod scene;
-pub mod stability;

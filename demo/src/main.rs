@@ -1,73 +1,227 @@
-//! The demo and headless tools of the voxel OIT renderer.
-//!
-//! - `demo [window] [--seed N] [--size WxH] [--technique NAME] [--view-distance N]
-//!   [--heatmap] [--frames N] [--screenshot FILE] [--cycle DIR] [--edit] [--resize]`: the
-//!   interactive demo (a window); the last five script it for tests. Without a display,
-//!   `demo` runs the showcase instead.
-//! - `demo showcase [--out DIR] [--size WxH]`: every technique rendered for the default scene
-//!   into `DIR` (default `out/`), and a quick speed/accuracy evaluation with its chart.
-//! - `demo stats [--seed N] [--chunks N]`: generate and mesh a world, print statistics.
-//! - `demo render [--technique NAME] [--weight NAME] [--bayer 2|4|8|16] [--layers N]
-//!   [--scene FILE] [--size WxH] [--seed N] [--msaa] [--frames N] --out FILE.png`: render a
-//!   scene file (or the default generated scene) headlessly.
+//! The demo and headless tools of the voxel OIT renderer. `demo --help` lists the
+//! commands, `demo <command> --help` their options.
 
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-const USAGE: &str = "\
-usage: demo [COMMAND] [OPTIONS]
-
-commands:
-  (none)     the interactive window; without a display, the showcase
-  window     [--seed N] [--size WxH] [--technique NAME] [--view-distance N] [--heatmap]
-             [--frames N] [--screenshot FILE] [--cycle DIR] [--edit] [--resize]
-  showcase   [--out DIR] [--size WxH]: every technique for the default scene, and a quick
-             speed/accuracy evaluation with its chart
-  stats      [--seed N] [--chunks N]: generate and mesh a world, print statistics
-  render     [--technique NAME] [--weight NAME] [--bayer 2|4|8|16] [--layers N] [--scene FILE]
-             [--size WxH] [--seed N] [--msaa] [--frames N] --out FILE.png
-  eval       [--scenes PATH...] [--techniques all|LIST] [--weights all|none|LIST] [--size WxH]
-             [--frames N] [--warmup N] [--no-stability] [--flicker-frames N]
-             [--sweep-points N] [--heatmap-width W] --out DIR
-";
-
-use demo::args::{self, Args};
+use clap::{Args, Parser, Subcommand};
 use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator};
+use voxel_lab::{EvalOptions, chain, headless, scene};
+use voxel_render::{BayerSize, RendererConfig, Technique, WeightFunction};
+
+/// The voxel OIT renderer's demo: a window when there is a display, else the headless
+/// showcase.
+#[derive(Parser, Debug)]
+#[command(name = "demo", after_help = names_help())]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Options of the window, when no command is given.
+    #[command(flatten)]
+    window: WindowArgs,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// The interactive window (scripted with --frames for tests and screenshots).
+    Window(WindowArgs),
+    /// Every technique rendered for the default scene, and a quick speed/accuracy
+    /// evaluation of the suite with its chart.
+    Showcase(ShowcaseArgs),
+    /// Generates and meshes a world, prints what it holds and how long it took.
+    Stats(StatsArgs),
+    /// Renders a scene file (or the default generated scene) headlessly to a PNG, with GPU
+    /// times per pass.
+    Render(RenderArgs),
+    /// The lab: every scene × technique against the exact reference; summary, charts,
+    /// heat maps, stability sweeps and report.
+    Eval(EvalArgs),
+}
+
+fn names_help() -> String {
+    format!(
+        "techniques: {}\nweights: {} (default {})",
+        Technique::ALL.map(Technique::name).join(", "),
+        WeightFunction::ALL.map(WeightFunction::name).join(", "),
+        voxel_render::WboitSettings::default().weight.name()
+    )
+}
+
+/// `WxH`, both sides 1 to 16384.
+fn size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?} is not WxH (e.g. 1280x720)"))?;
+    let side = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|n| (1..=16384).contains(n))
+            .ok_or_else(|| format!("{v:?} is not a whole number from 1 to 16384"))
+    };
+    Ok((side(w)?, side(h)?))
+}
+
+fn technique(s: &str) -> Result<Technique, String> {
+    Technique::from_name(s).map_err(|e| e.to_string())
+}
+
+fn weight(s: &str) -> Result<WeightFunction, String> {
+    WeightFunction::from_name(s).map_err(|e| e.to_string())
+}
+
+fn bayer(s: &str) -> Result<BayerSize, String> {
+    let side = s
+        .parse()
+        .map_err(|_| format!("{s:?}: expected 2, 4, 8 or 16"))?;
+    BayerSize::from_side(side).map_err(|e| e.to_string())
+}
+
+#[derive(Args, Debug, Clone)]
+struct WindowArgs {
+    /// World seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Window size.
+    #[arg(long, value_parser = size, default_value = "1280x720")]
+    size: (u32, u32),
+    /// Technique to start with.
+    #[arg(long, value_parser = technique, default_value = "wboit-mrt")]
+    technique: Technique,
+    /// Chunks of terrain around the start, each way (1 to 16).
+    #[arg(long, value_parser = clap::value_parser!(i32).range(1..=16), default_value_t = voxel_lab::scene::DEFAULT_RADIUS)]
+    view_distance: i32,
+    /// Start with the error map against the reference on.
+    #[arg(long)]
+    heatmap: bool,
+    /// Scripted: quit after N frames (per technique with --cycle).
+    #[arg(long)]
+    frames: Option<u64>,
+    /// Scripted: save the last frame, panel included.
+    #[arg(long, requires = "frames")]
+    screenshot: Option<PathBuf>,
+    /// Scripted: step through every technique, saving DIR/<technique>.png for each.
+    #[arg(long, requires = "frames")]
+    cycle: Option<PathBuf>,
+    /// Scripted: place a block in front of the camera on the second frame.
+    #[arg(long, requires = "frames")]
+    edit: bool,
+    /// Scripted: halve the window, get a zero size, restore it (frames 1 to 3).
+    #[arg(long, requires = "frames")]
+    resize: bool,
+}
+
+#[derive(Args, Debug)]
+struct ShowcaseArgs {
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// Picture size.
+    #[arg(long, value_parser = size, default_value = "1280x720")]
+    size: (u32, u32),
+}
+
+#[derive(Args, Debug)]
+struct StatsArgs {
+    /// World seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// The world is N x 2 x N chunks (1 to 256).
+    #[arg(long, value_parser = clap::value_parser!(i32).range(1..=256), default_value_t = 32)]
+    chunks: i32,
+}
+
+#[derive(Args, Debug)]
+struct RenderArgs {
+    /// Technique.
+    #[arg(long, value_parser = technique, default_value = "wboit-mrt")]
+    technique: Technique,
+    /// WBOIT weight (default: the renderer's).
+    #[arg(long, value_parser = weight)]
+    weight: Option<WeightFunction>,
+    /// Stipple's Bayer pattern: 2, 4, 8 or 16.
+    #[arg(long, value_parser = bayer)]
+    bayer: Option<BayerSize>,
+    /// Layers of dual depth peeling (even, 2 to 512).
+    #[arg(long)]
+    layers: Option<u32>,
+    /// Scene file (default: the generated default scene).
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Picture size.
+    #[arg(long, value_parser = size, default_value = "1280x720")]
+    size: (u32, u32),
+    /// Seed of the default scene.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// 4x MSAA for the opaque and cutout passes.
+    #[arg(long)]
+    msaa: bool,
+    /// Timed frames (after one untimed); the medians are printed.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1)]
+    frames: u32,
+    /// Output PNG.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+struct EvalArgs {
+    /// Scene files or folders (default: the suite in scenes/).
+    #[arg(long, num_args = 1..)]
+    scenes: Vec<PathBuf>,
+    /// Techniques: all, or a comma-separated list.
+    #[arg(long, num_args = 1.., value_delimiter = ',', default_value = "all")]
+    techniques: Vec<String>,
+    /// WBOIT weights compared in extra wboit-mrt runs: all, none, or a list.
+    #[arg(long, num_args = 1.., value_delimiter = ',', default_value = "all")]
+    weights: Vec<String>,
+    /// Picture size (default: each scene's own, else 640x360).
+    #[arg(long, value_parser = size)]
+    size: Option<(u32, u32)>,
+    /// Timed frames per picture (the median is reported).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 10)]
+    frames: u32,
+    /// Untimed frames first.
+    #[arg(long, default_value_t = 2)]
+    warmup: u32,
+    /// Skip the stability sweeps and flicker paths.
+    #[arg(long)]
+    no_stability: bool,
+    /// Frames of the flicker camera path.
+    #[arg(long, default_value_t = 60)]
+    flicker_frames: u32,
+    /// Points per stability sweep.
+    #[arg(long, default_value_t = 9)]
+    sweep_points: u32,
+    /// Width of the saved heat maps (downscaled; default full size).
+    #[arg(long)]
+    heatmap_width: Option<u32>,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+}
 
 fn main() {
-    let argv: Vec<String> = std::env::args().skip(1).collect();
-    if argv.first().is_some_and(|a| a == "help") || argv.iter().any(|a| a == "--help" || a == "-h")
-    {
-        use voxel_render::{Technique, WeightFunction};
-        print!("{USAGE}");
-        println!(
-            "\ntechniques: {}\nweights: {} (default {})",
-            Technique::ALL.map(Technique::name).join(", "),
-            WeightFunction::ALL.map(WeightFunction::name).join(", "),
-            WeightFunction::Fitted.name()
-        );
-        return;
-    }
-    let (cmd, rest) = match argv.first().map(String::as_str) {
-        Some(c) if !c.starts_with("--") => (c, &argv[1..]),
-        _ => ("", &argv[..]),
-    };
-    let result = match cmd {
-        "" if demo::app::have_display() => window(rest),
-        "" => {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None if demo::app::have_display() => window(cli.window),
+        None => {
             eprintln!(
                 "no display (neither DISPLAY nor WAYLAND_DISPLAY is set): running the headless showcase instead"
             );
-            showcase(rest)
+            showcase(ShowcaseArgs {
+                out: "out".into(),
+                size: (1280, 720),
+            })
         }
-        "window" => window(rest),
-        "showcase" => showcase(rest),
-        "stats" => stats(rest),
-        "render" => render(rest),
-        "eval" => eval(rest),
-        other => Err(format!(
-            "unknown command {other:?}; commands: window, showcase, stats, render, eval"
-        )),
+        Some(Command::Window(a)) => window(a),
+        Some(Command::Showcase(a)) => showcase(a),
+        Some(Command::Stats(a)) => stats(a),
+        Some(Command::Render(a)) => render(a),
+        Some(Command::Eval(a)) => eval(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e}");
@@ -75,17 +229,38 @@ fn main() {
     }
 }
 
-/// Generates and meshes a world, then prints what it holds and how long it took.
-fn stats(argv: &[String]) -> Result<(), String> {
-    let a = Args::parse(argv, &[], &[])?;
-    a.reject_unknown(&["seed", "chunks"])?;
-    let seed: u32 = a.parse_or("seed", 1)?;
-    let n: i32 = a.parse_or("chunks", 32)?;
-    if !(1..=256).contains(&n) {
+/// Fails early, before any rendering, when `dir` cannot be created or written to.
+fn writable_dir(dir: &Path) -> Result<(), String> {
+    if let Some(file) = dir.ancestors().find(|a| a.is_file()) {
         return Err(format!(
-            "--chunks {n}: must be in 1..=256 (the world is N x 2 x N chunks)"
+            "{}: cannot write into {} because {} is a file, not a folder",
+            dir.display(),
+            dir.display(),
+            file.display()
         ));
     }
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let probe = dir.join(format!(".write-test-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .map_err(|e| format!("{}: cannot write here: {e}", dir.display()))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
+}
+
+/// [`writable_dir`] for the folder of an output file, which must not be a folder itself.
+fn writable_file(path: &Path) -> Result<(), String> {
+    if path.is_dir() {
+        return Err(format!("{}: is a folder, not a file", path.display()));
+    }
+    match path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(dir) => writable_dir(dir),
+        None => writable_dir(Path::new(".")),
+    }
+}
+
+/// Generates and meshes a world, then prints what it holds and how long it took.
+fn stats(a: StatsArgs) -> Result<(), String> {
+    let (seed, n) = (a.seed, a.chunks);
     let registry = Arc::new(BlockRegistry::default());
     let generator = TerrainGenerator::new(TerrainConfig {
         seed,
@@ -132,141 +307,115 @@ fn stats(argv: &[String]) -> Result<(), String> {
     );
     println!("chunks: {} ({uniform} uniform)", world.len());
     println!(
-        "quads: {} opaque, {cutout} cutout (leaves), {translucent} translucent (water, glass); {:.1} MiB of quads",
-        opaque,
+        "quads: {opaque} opaque, {cutout} cutout (leaves), {translucent} translucent (water, glass); {:.1} MiB of quads",
         (opaque + cutout + translucent) as f64 * 8.0 / (1 << 20) as f64
     );
+    let count = |kind| sites.iter().filter(|s| s.kind == kind).count();
     println!(
         "glass structures: {} greenhouses, {} stained-glass pavilions",
-        sites
-            .iter()
-            .filter(|s| s.kind == voxel_core::SiteKind::Greenhouse)
-            .count(),
-        sites
-            .iter()
-            .filter(|s| s.kind == voxel_core::SiteKind::Pavilion)
-            .count()
+        count(voxel_core::SiteKind::Greenhouse),
+        count(voxel_core::SiteKind::Pavilion)
     );
     Ok(())
 }
 
-/// Renders the default scene headlessly to a PNG and prints GPU times per pass.
-fn render(argv: &[String]) -> Result<(), String> {
-    use voxel_render::{RendererConfig, Technique, WeightFunction};
-    let a = Args::parse(argv, &["msaa"], &[])?;
-    a.reject_unknown(&[
-        "technique",
-        "weight",
-        "bayer",
-        "layers",
-        "size",
-        "seed",
-        "scene",
-        "msaa",
-        "frames",
-        "out",
-    ])?;
-
-    let out = a.get("out").ok_or("--out FILE.png is required")?;
-    let (width, height) = args::parse_size(a.get("size").unwrap_or("1280x720"))?;
-    let seed: u32 = a.parse_or("seed", 1)?;
-    let frames: usize = a.parse_or("frames", 1)?;
-    if frames == 0 {
-        return Err("--frames must be at least 1".into());
-    }
-    let technique = Technique::from_name(a.get("technique").unwrap_or("wboit-mrt"))
-        .map_err(|e| e.to_string())?;
+/// Renders the default scene (or a scene file) headlessly to a PNG and prints GPU times
+/// per pass.
+fn render(a: RenderArgs) -> Result<(), String> {
+    writable_file(&a.out)?;
+    let (width, height) = a.size;
     let mut config = RendererConfig {
         width,
         height,
-        msaa: a.flag("msaa"),
+        msaa: a.msaa,
         ..RendererConfig::default()
     };
-    config.oit.technique = technique;
-    if let Some(w) = a.get("weight") {
-        config.oit.weight = WeightFunction::from_name(w).map_err(|e| e.to_string())?;
+    config.oit.technique = a.technique;
+    if let Some(w) = a.weight {
+        config.oit.wboit.weight = w;
     }
-    if let Some(b) = a.get("bayer") {
-        let side = b
-            .parse()
-            .map_err(|_| format!("--bayer {b:?}: expected 2, 4, 8 or 16"))?;
-        config.oit.bayer = voxel_render::BayerSize::from_side(side).map_err(|e| e.to_string())?;
+    if let Some(b) = a.bayer {
+        config.oit.stipple.bayer = b;
     }
-    config.oit.peel_layers = a.parse_or("layers", config.oit.peel_layers)?;
-    if config.oit.peel_layers < 2 || !config.oit.peel_layers.is_multiple_of(2) {
-        return Err(format!(
-            "--layers {}: dual depth peeling takes an even number of layers, at least 2",
-            config.oit.peel_layers
-        ));
+    if let Some(l) = a.layers {
+        config.oit.peeling.layers = l;
     }
-    let t = Instant::now();
-    let scene = match a.get("scene") {
-        Some(path) => demo::scene::Scene::load(std::path::Path::new(path))?,
-        None => demo::scene::default_scene(seed)?,
-    };
+    config
+        .oit
+        .validate()
+        .map_err(|e| format!("--layers: {e}"))?;
 
+    let t = Instant::now();
+    let scene = match &a.scene {
+        Some(path) => scene::Scene::load(path)?,
+        None => scene::default_scene(a.seed)?,
+    };
     println!(
         "scene: {} ({} chunks) built in {:.0} ms",
         scene.name,
         scene.world.len(),
         t.elapsed().as_secs_f64() * 1e3
     );
-    let ctx = demo::headless::context()?;
+    let ctx = headless::context()?;
     println!("adapter: {}", ctx.caps.adapter_name);
-    let mut renderer = demo::headless::renderer_for(&ctx, &scene, config)?;
-    let target = demo::headless::Offscreen::new(&ctx, width, height);
+    let mut renderer = headless::renderer_for(&ctx, &scene, config)?;
+    let target = headless::Offscreen::new(&ctx, width, height);
     let camera = scene.cameras[0];
-    let mut per_pass: Vec<(&'static str, Vec<f64>)> = Vec::new();
+    let frames = a.frames as usize;
+    let mut per_pass: Vec<(voxel_render::GpuPass, Vec<f64>)> = Vec::new();
     let mut stats = None;
     let mut cpu = Vec::new();
-    let mut first_sort = (0.0, 0);
+    let mut first_sort = None;
     // The first frame warms up (pipeline and target creation); it is not timed.
     for i in 0..=frames {
         let s = renderer
             .render_and_submit(&target.view, &camera)
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| chain(&e))?;
         if i == 0 {
-            first_sort = (s.sort_ms, s.chunks_resorted);
+            first_sort = s.technique.sort;
         } else {
             cpu.push(s.cpu_ms);
         }
         stats = Some(s);
         let times = renderer.gpu_times_blocking();
         if i > 0 {
-            for (label, ms) in times {
-                match per_pass.iter_mut().find(|(l, _)| *l == label) {
+            for (pass, ms) in times.iter() {
+                match per_pass.iter_mut().find(|(p, _)| *p == pass) {
                     Some((_, v)) => v.push(ms),
-                    None => per_pass.push((label, vec![ms])),
+                    None => per_pass.push((pass, vec![ms])),
                 }
             }
         }
     }
     let image = target.read(&ctx)?;
-    image
-        .save_png(std::path::Path::new(out))
-        .map_err(|e| e.to_string())?;
+    image.save_png(&a.out).map_err(|e| chain(&e))?;
     let stats = stats.ok_or("no frame rendered")?;
     println!(
-        "technique {technique}: drew {} opaque, {} cutout, {} translucent chunk meshes ({} translucent quads)",
+        "technique {}: drew {} opaque, {} cutout, {} translucent chunk meshes ({} translucent quads)",
+        renderer.config().oit.technique,
         stats.meshes_drawn[0],
         stats.meshes_drawn[1],
         stats.meshes_drawn[2],
         stats.translucent_quads
     );
-    if let Some(layers) = stats.technique.layers {
+    let report = &stats.technique;
+    if let Some(layers) = report.peeling.and_then(|p| p.layers) {
         println!("layers peeled: {layers}");
     }
     cpu.sort_by(f64::total_cmp);
     let cpu_median = cpu.get(cpu.len() / 2).copied().unwrap_or(0.0);
     println!("CPU ms to record a frame, median of {frames}: {cpu_median:.3}");
-    if technique == Technique::SortedQuads {
+    if let Some(sort) = first_sort {
         println!(
             "quad sort: first frame {:.3} ms for all {} visible translucent chunks; a still camera re-sorts nothing",
-            first_sort.0, first_sort.1
+            sort.ms, sort.chunks_resorted
         );
     }
-    if let Some(overflow) = stats.technique.overflow {
-        println!("reference overflow: {overflow} fragments");
+    if let Some(r) = report.reference {
+        println!(
+            "reference: {} fragments lost, {} pixels capped ({} visibly), {}x{} tiles",
+            r.lost_fragments, r.capped_pixels, r.capped_visible_pixels, r.tiles, r.tiles
+        );
     }
     if per_pass.is_empty() {
         println!("GPU times: unavailable (no timestamp queries on this adapter)");
@@ -277,30 +426,30 @@ fn render(argv: &[String]) -> Result<(), String> {
         };
         let line: Vec<String> = per_pass
             .iter_mut()
-            .map(|(l, v)| format!("{l} {:.3}", median(v)))
+            .map(|(p, v)| format!("{p} {:.3}", median(v)))
             .collect();
         println!(
             "GPU ms per pass, median of {frames} frames at {width}x{height}: {}",
             line.join(", ")
         );
     }
-    println!("wrote {out}");
+    println!("wrote {}", a.out.display());
     Ok(())
 }
 
 /// The scene files named on the command line (files or folders), or the `scenes/` folder.
-fn scene_paths(given: &[String]) -> Result<Vec<std::path::PathBuf>, String> {
-    let given: Vec<std::path::PathBuf> = if given.is_empty() {
-        let local = std::path::PathBuf::from("scenes");
-        let repo = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+fn scene_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
+    let given: Vec<PathBuf> = if given.is_empty() {
+        let local = PathBuf::from("scenes");
+        let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
         vec![if local.is_dir() { local } else { repo }]
     } else {
-        given.iter().map(std::path::PathBuf::from).collect()
+        given.to_vec()
     };
     let mut out = Vec::new();
     for p in given {
         if p.is_dir() {
-            out.extend(demo::eval::scene_files(&p)?);
+            out.extend(scene::scene_files(&p)?);
         } else if p.is_file() {
             out.push(p);
         } else {
@@ -310,83 +459,49 @@ fn scene_paths(given: &[String]) -> Result<Vec<std::path::PathBuf>, String> {
     Ok(out)
 }
 
+/// `all`, `none` (when allowed) or a list of names.
+fn names<T: Copy>(
+    given: &[String],
+    all: &[T],
+    none_ok: bool,
+    parse: impl Fn(&str) -> Result<T, String>,
+) -> Result<Vec<T>, String> {
+    let given: Vec<&str> = given
+        .iter()
+        .map(|s| s.trim())
+        .filter(|s| !s.is_empty())
+        .collect();
+    match given.as_slice() {
+        [] | ["all"] => Ok(all.to_vec()),
+        ["none"] if none_ok => Ok(Vec::new()),
+        list => list.iter().map(|n| parse(n)).collect(),
+    }
+}
+
 /// Renders every scene with every technique and the exact reference; writes the summary,
 /// charts, heat maps, stability sweeps and report.
-fn eval(argv: &[String]) -> Result<(), String> {
-    use voxel_render::{Technique, WeightFunction};
-    let a = Args::parse(
-        argv,
-        &["no-stability"],
-        &["scenes", "techniques", "weights"],
-    )?;
-    a.reject_unknown(&[
-        "scenes",
-        "techniques",
-        "weights",
-        "size",
-        "frames",
-        "warmup",
-        "no-stability",
-        "flicker-frames",
-        "sweep-points",
-        "heatmap-width",
-        "out",
-    ])?;
-
-    let out = std::path::PathBuf::from(a.get("out").ok_or("--out DIR is required")?);
-    let list = |name: &str| -> Vec<String> {
-        a.all(name)
-            .iter()
-            .flat_map(|v| v.split(','))
-            .map(|s| s.trim().to_owned())
-            .filter(|s| !s.is_empty())
-            .collect()
-    };
-    let techniques = match list("techniques").as_slice() {
-        [] => Technique::ALL.to_vec(),
-        [all] if all == "all" => Technique::ALL.to_vec(),
-        names => names
-            .iter()
-            .map(|n| Technique::from_name(n))
-            .collect::<Result<_, _>>()
-            .map_err(|e| e.to_string())?,
-    };
-    let weights = match list("weights").as_slice() {
-        [] => WeightFunction::ALL.to_vec(),
-        [all] if all == "all" => WeightFunction::ALL.to_vec(),
-        [none] if none == "none" => Vec::new(),
-        names => names
-            .iter()
-            .map(|n| WeightFunction::from_name(n))
-            .collect::<Result<_, _>>()
-            .map_err(|e| e.to_string())?,
-    };
-    let opts = demo::eval::EvalOptions {
-        scenes: scene_paths(a.all("scenes"))?,
-        techniques,
-        weights,
-        size: a.get("size").map(args::parse_size).transpose()?,
-        frames: a.parse_or("frames", 10)?,
-        warmup: a.parse_or("warmup", 2)?,
-        out: out.clone(),
-        stability: !a.flag("no-stability"),
-        flicker_frames: a.parse_or("flicker-frames", 60)?,
-        sweep_points: a.parse_or("sweep-points", 9)?,
-        command: std::iter::once("demo eval".to_owned())
-            .chain(argv.iter().cloned())
+fn eval(a: EvalArgs) -> Result<(), String> {
+    writable_dir(&a.out)?;
+    let opts = EvalOptions {
+        scenes: scene_paths(&a.scenes)?,
+        techniques: names(&a.techniques, &Technique::ALL, false, technique)
+            .map_err(|e| format!("--techniques: {e}"))?,
+        weights: names(&a.weights, &WeightFunction::ALL, true, weight)
+            .map_err(|e| format!("--weights: {e}"))?,
+        size: a.size,
+        frames: a.frames as usize,
+        warmup: a.warmup as usize,
+        out: a.out.clone(),
+        stability: !a.no_stability,
+        flicker_frames: a.flicker_frames as usize,
+        sweep_points: a.sweep_points as usize,
+        command: std::iter::once("demo".to_owned())
+            .chain(std::env::args().skip(1))
             .collect::<Vec<_>>()
             .join(" "),
-        heatmap_width: a
-            .get("heatmap-width")
-            .map(str::parse)
-            .transpose()
-            .map_err(|e| format!("--heatmap-width: {e}"))?,
+        heatmap_width: a.heatmap_width,
     };
-
-    if opts.frames == 0 {
-        return Err("--frames must be at least 1".into());
-    }
-    let ctx = demo::headless::context()?;
+    let ctx = headless::context()?;
     eprintln!(
         "adapter: {}; {} scenes x {} techniques + {} weights",
         ctx.caps.adapter_name,
@@ -395,111 +510,61 @@ fn eval(argv: &[String]) -> Result<(), String> {
         opts.weights.len()
     );
     let t = Instant::now();
-    let summary = demo::eval::run(&ctx, &opts)?;
-    let worst = summary
-        .reference_checks
-        .iter()
-        .map(|c| c.max_abs_err)
-        .max()
-        .unwrap_or(0);
+    let summary = voxel_lab::evaluate(&ctx, &opts)?;
     println!(
-        "{} records in {:.0} s; exact methods agree within {worst}/255; wrote {}",
+        "{} records in {:.0} s; exact methods agree within {}/255; wrote {}",
         summary.records.len(),
         t.elapsed().as_secs_f64(),
-        out.join("report.md").display()
+        summary.worst_reference_disagreement(),
+        a.out.join("report.md").display()
     );
     Ok(())
 }
 
 /// Opens the interactive demo.
-fn window(argv: &[String]) -> Result<(), String> {
-    let a = Args::parse(argv, &["heatmap", "edit", "resize"], &[])?;
-    a.reject_unknown(&[
-        "seed",
-        "size",
-        "technique",
-        "view-distance",
-        "heatmap",
-        "frames",
-        "screenshot",
-        "cycle",
-        "edit",
-        "resize",
-    ])?;
-    let defaults = demo::app::DemoOptions::default();
-    let opts = demo::app::DemoOptions {
-        seed: a.parse_or("seed", defaults.seed)?,
-        size: a
-            .get("size")
-            .map(args::parse_size)
-            .transpose()?
-            .unwrap_or(defaults.size),
-        technique: match a.get("technique") {
-            Some(t) => voxel_render::Technique::from_name(t).map_err(|e| e.to_string())?,
-            None => defaults.technique,
-        },
-        view_distance: a.parse_or("view-distance", defaults.view_distance)?,
-        frames: a
-            .get("frames")
-            .map(str::parse)
-            .transpose()
-            .map_err(|e| format!("--frames: {e}"))?,
-        screenshot: a.get("screenshot").map(std::path::PathBuf::from),
-        cycle: a.get("cycle").map(std::path::PathBuf::from),
-        heatmap: a.flag("heatmap"),
-        edit: a.flag("edit"),
-        resize: a.flag("resize"),
-    };
-    if !(1..=16).contains(&opts.view_distance) {
-        return Err(format!(
-            "--view-distance {}: must be in 1..=16 chunks",
-            opts.view_distance
-        ));
-    }
-    if (opts.screenshot.is_some() || opts.cycle.is_some() || opts.edit || opts.resize)
-        && opts.frames.is_none()
-    {
-        return Err(
-            "--screenshot, --cycle, --edit and --resize script a run: give --frames N too".into(),
-        );
-    }
-    demo::app::run(opts)
+fn window(a: WindowArgs) -> Result<(), String> {
+    demo::app::run(demo::app::DemoOptions {
+        seed: a.seed,
+        size: a.size,
+        technique: a.technique,
+        view_distance: a.view_distance,
+        frames: a.frames,
+        screenshot: a.screenshot,
+        cycle: a.cycle,
+        heatmap: a.heatmap,
+        edit: a.edit,
+        resize: a.resize,
+    })
 }
 
 /// Without a display: every technique's picture of the default scene, and a quick
 /// evaluation of the suite with its speed/accuracy chart.
-fn showcase(argv: &[String]) -> Result<(), String> {
-    use voxel_render::{RendererConfig, Technique};
-    let a = Args::parse(argv, &[], &[])?;
-    a.reject_unknown(&["out", "size"])?;
-    let out = std::path::PathBuf::from(a.get("out").unwrap_or("out"));
-    let (w, h) = args::parse_size(a.get("size").unwrap_or("1280x720"))?;
-    let ctx = demo::headless::context()?;
+fn showcase(a: ShowcaseArgs) -> Result<(), String> {
+    writable_dir(&a.out)?;
+    let (w, h) = a.size;
+    let ctx = headless::context()?;
     println!("adapter: {}", ctx.caps.adapter_name);
-    let scene = demo::scene::default_scene(1)?;
-    let mut renderer = demo::headless::renderer_for(
-        &ctx,
-        &scene,
-        RendererConfig {
-            width: w,
-            height: h,
-            ..RendererConfig::default()
-        },
-    )?;
-    let target = demo::headless::Offscreen::new(&ctx, w, h);
+    let scene = scene::default_scene(1)?;
+    let config = RendererConfig {
+        width: w,
+        height: h,
+        ..RendererConfig::default()
+    };
+    let mut renderer = headless::renderer_for(&ctx, &scene, config)?;
+    let target = headless::Offscreen::new(&ctx, w, h);
     for t in Technique::ALL {
         renderer.set_technique(t);
         // One frame to settle (adaptive peeling), one to keep.
         renderer
             .render_and_submit(&target.view, &scene.cameras[0])
-            .map_err(|e| e.to_string())?;
-        let img = demo::headless::render_image(&ctx, &mut renderer, &target, &scene.cameras[0])?;
-        let path = out.join(format!("{}.png", t.name()));
-        img.save_png(&path).map_err(|e| e.to_string())?;
+            .map_err(|e| chain(&e))?;
+        let img = headless::render_image(&ctx, &mut renderer, &target, &scene.cameras[0])?;
+        let path = a.out.join(format!("{}.png", t.name()));
+        img.save_png(&path).map_err(|e| chain(&e))?;
         println!("wrote {}", path.display());
     }
-    let eval_out = out.join("eval");
-    let opts = demo::eval::EvalOptions {
+    let eval_out = a.out.join("eval");
+    let opts = EvalOptions {
         scenes: scene_paths(&[])?,
         techniques: Technique::ALL.to_vec(),
         weights: Vec::new(),
@@ -513,7 +578,7 @@ fn showcase(argv: &[String]) -> Result<(), String> {
         command: "demo showcase".into(),
         heatmap_width: Some(240),
     };
-    let summary = demo::eval::run(&ctx, &opts)?;
+    let summary = voxel_lab::evaluate(&ctx, &opts)?;
     println!(
         "evaluated {} scenes x {} techniques: {}",
         summary.reference_checks.len(),

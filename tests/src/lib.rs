@@ -10,8 +10,8 @@ use glam::DVec3;
 use voxel_core::{BlockId, BlockRegistry, World};
 use voxel_render::{Camera, GpuContext, Image, Renderer, RendererConfig, Technique, readback};
 
-pub use demo::headless::{Offscreen, renderer_for};
-pub use demo::scene::Scene;
+pub use voxel_lab::headless::{Offscreen, renderer_for};
+pub use voxel_lab::scene::Scene;
 
 /// A headless Vulkan context (lavapipe on machines without a GPU). Without an adapter, a
 /// test skips with a loud message, unless `CI` is set: then a missing adapter fails.
@@ -43,7 +43,7 @@ pub fn out_dir(name: &str) -> PathBuf {
 pub fn box_world(boxes: &[([i32; 3], [i32; 3], BlockId)]) -> World {
     let mut world = World::new(Arc::new(BlockRegistry::default()));
     for &(min, max, id) in boxes {
-        demo::scene::fill_box(&mut world, min, max, id).unwrap();
+        voxel_lab::scene::fill_box(&mut world, min, max, id).unwrap();
     }
     world
 }
@@ -76,7 +76,7 @@ pub fn render_with(ctx: &GpuContext, scene: &Scene, config: RendererConfig) -> I
     let (w, h) = (config.width, config.height);
     let mut r = renderer_for(ctx, scene, config).unwrap();
     let target = Offscreen::new(ctx, w, h);
-    demo::headless::render_image(ctx, &mut r, &target, &scene.cameras[0]).unwrap()
+    voxel_lab::headless::render_image(ctx, &mut r, &target, &scene.cameras[0]).unwrap()
 }
 
 /// The renderer's HDR scene colour, as f32 RGBA.
@@ -95,7 +95,7 @@ pub fn read_hdr(ctx: &GpuContext, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
 pub fn frame(ctx: &GpuContext, renderer: &mut Renderer, camera: &Camera) -> Image {
     let (w, h) = renderer.size();
     let target = Offscreen::new(ctx, w, h);
-    demo::headless::render_image(ctx, renderer, &target, camera).unwrap()
+    voxel_lab::headless::render_image(ctx, renderer, &target, camera).unwrap()
 }
 
 /// Per-channel comparison of two images of the same size.

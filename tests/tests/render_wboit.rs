@@ -7,7 +7,7 @@
 
 use voxel_core::blocks::*;
 use voxel_render::oit::wboit::{self, HEADROOM_SCALE};
-use voxel_render::{Renderer, RendererConfig, Technique, WeightFunction};
+use voxel_render::{GpuPass, Renderer, RendererConfig, Technique, WeightFunction};
 
 use tests::*;
 
@@ -15,7 +15,7 @@ const W: u32 = 320;
 const H: u32 = 180;
 
 fn default_scene() -> Scene {
-    demo::scene::default_scene(1).unwrap()
+    voxel_lab::scene::default_scene(1).unwrap()
 }
 
 #[test]
@@ -134,8 +134,8 @@ fn overflow_renderer(ctx: &voxel_render::GpuContext, scene: &Scene, headroom: bo
         height: 48,
         ..RendererConfig::default()
     };
-    config.oit.weight = WeightFunction::Seed000;
-    config.oit.wboit_headroom = headroom;
+    config.oit.wboit.weight = WeightFunction::Flat;
+    config.oit.wboit.headroom = headroom;
     renderer_for(ctx, scene, config).unwrap()
 }
 
@@ -188,13 +188,13 @@ fn resize_to_zero_and_back_and_switch_techniques_without_validation_errors() {
     let mut r = renderer_for(&ctx, &scene, config).unwrap();
     let cam = scene.cameras[0];
     let first = frame(&ctx, &mut r, &cam);
-    r.resize(0, 0);
-    r.resize(0, 64);
+    r.resize(0, 0).unwrap();
+    r.resize(0, 64).unwrap();
     assert_eq!(r.size(), (96, 64), "zero sizes are ignored");
     assert_eq!(frame(&ctx, &mut r, &cam), first, "same size, same picture");
-    r.resize(128, 72);
+    r.resize(128, 72).unwrap();
     assert_eq!(frame(&ctx, &mut r, &cam).width, 128);
-    r.resize(96, 64);
+    r.resize(96, 64).unwrap();
     for t in [
         Technique::WboitTwoPass,
         Technique::Sorted,
@@ -205,9 +205,9 @@ fn resize_to_zero_and_back_and_switch_techniques_without_validation_errors() {
         r.set_technique(t);
         frame(&ctx, &mut r, &cam);
     }
-    r.set_msaa(true);
+    r.set_msaa(true).unwrap();
     frame(&ctx, &mut r, &cam);
-    r.set_msaa(false);
+    r.set_msaa(false).unwrap();
     assert_eq!(frame(&ctx, &mut r, &cam), first, "back where we started");
     let error = pollster::block_on(scope.pop());
     assert!(error.is_none(), "validation error: {error:?}");
@@ -243,16 +243,14 @@ fn techniques_create_resources_only_when_translucency_is_on_screen() {
     );
     let times = r.gpu_times_blocking();
     assert!(
-        times
-            .iter()
-            .all(|(l, _)| *l != "translucent" && *l != "composite"),
+        times.get(GpuPass::Translucent).is_none() && times.get(GpuPass::Composite).is_none(),
         "{times:?}"
     );
     frame(&ctx, &mut r, &scene.cameras[0]);
     assert!(r.oit().has_resources());
     let times = r.gpu_times_blocking();
-    assert!(times.iter().any(|(l, _)| *l == "translucent"), "{times:?}");
-    assert!(times.iter().all(|(_, ms)| ms.is_finite() && *ms >= 0.0));
+    assert!(times.get(GpuPass::Translucent).is_some(), "{times:?}");
+    assert!(times.iter().all(|(_, ms)| ms.is_finite() && ms >= 0.0));
 }
 
 /// The shader's weight functions against `weights.rs`: one water sheet straight ahead at a
@@ -287,7 +285,7 @@ fn shader_weights_match_the_rust_formulas() {
             height: 33,
             ..Default::default()
         };
-        config.oit.weight = weight;
+        config.oit.wboit.weight = weight;
         let mut r = renderer_for(&ctx, &scene, config).unwrap();
         let stats = r
             .render_and_submit(&Offscreen::new(&ctx, 33, 33).view, &cam)
@@ -295,7 +293,11 @@ fn shader_weights_match_the_rust_formulas() {
         let accum = read_hdr(&ctx, r.oit().accumulation_target().unwrap());
 
         let got = accum[16 * 33 + 16][3];
-        let fit = stats.weight_fit;
+        let fit = stats
+            .technique
+            .wboit
+            .and_then(|w| w.fit)
+            .unwrap_or_default();
         let centre = [16.5 / 33.0; 2];
         if weight == WeightFunction::Fitted {
             assert!(

@@ -72,7 +72,7 @@ fn depth_peeling_with_enough_layers_equals_the_reference() {
     let reference = render_with(&ctx, &scene, config(Technique::Reference));
     for layers in [6, 8] {
         let mut c = config(Technique::DepthPeeling);
-        c.oit.peel_layers = layers;
+        c.oit.peeling.layers = layers;
         let img = render_with(&ctx, &scene, c);
         assert_close(
             &format!("sheets_depth_peeling_{layers}"),
@@ -83,7 +83,7 @@ fn depth_peeling_with_enough_layers_equals_the_reference() {
     }
     // Four layers of six: the middle two are lost, which shows.
     let mut c = config(Technique::DepthPeeling);
-    c.oit.peel_layers = 4;
+    c.oit.peeling.layers = 4;
     let img = render_with(&ctx, &scene, c);
     assert!(
         diff(&img, &reference).max > 8,
@@ -102,15 +102,15 @@ fn depth_peeling_adapts_its_layer_count() {
     ]);
     let scene = scene("two_sheets", world, [0.5, 0.5, 30.0], [0.5, 0.5, 0.0]);
     let mut c = config(Technique::DepthPeeling);
-    c.oit.peel_layers = 8;
+    c.oit.peeling.layers = 8;
     let mut r = renderer_for(&ctx, &scene, c).unwrap();
     let cam = scene.cameras[0];
     let first = r
         .render_and_submit(&Offscreen::new(&ctx, W, H).view, &cam)
         .unwrap();
     assert_eq!(
-        first.technique.iterations,
-        Some(4),
+        first.technique.peeling.unwrap().iterations,
+        4,
         "the first frame runs all N/2 iterations"
     );
     let mut last = first;
@@ -121,14 +121,15 @@ fn depth_peeling_adapts_its_layer_count() {
             .unwrap();
     }
     // One non-empty iteration plus one probe.
-    assert_eq!(last.technique.iterations, Some(2), "{last:?}");
-    assert_eq!(last.technique.layers, Some(2));
+    let peeled = last.technique.peeling.unwrap();
+    assert_eq!(peeled.iterations, 2, "{last:?}");
+    assert_eq!(peeled.layers, Some(2));
 }
 
 #[test]
 fn the_two_exact_methods_agree() {
     let Some(ctx) = gpu() else { return };
-    let default = demo::scene::default_scene(1).unwrap();
+    let default = voxel_lab::scene::default_scene(1).unwrap();
     for (name, scene) in [("sheets", sheets_scene()), ("default", default)] {
         let a = render_with(&ctx, &scene, config(Technique::Reference));
         let p = render_with(&ctx, &scene, config(Technique::PeelReference));
@@ -160,9 +161,11 @@ fn the_reference_reports_zero_overflow_and_grows_when_short() {
     let stats = r
         .render_and_submit(&Offscreen::new(&ctx, W, H).view, &scene.cameras[0])
         .unwrap();
-    assert_eq!(stats.technique.overflow, Some(0), "nothing may be lost");
+    let report = stats.technique.reference.unwrap();
+    assert_eq!(report.lost_fragments, 0, "nothing may be lost");
+    assert_eq!(report.capped_pixels, 0, "40 layers fit");
     assert!(
-        stats.technique.attempts > Some(1),
+        report.attempts > 1,
         "the initial pool is too small here: {stats:?}"
     );
 
@@ -188,7 +191,7 @@ fn stipple_keeps_exactly_the_pixels_the_bayer_table_says() {
     let alpha = 179.0 / 255.0;
     for size in BayerSize::ALL {
         let mut c = config(Technique::Stipple);
-        c.oit.bayer = size;
+        c.oit.stipple.bayer = size;
         let img = render_with(&ctx, &scene, c);
         img.save_png(&out_dir("stipple").join(format!("bayer_{}.png", size.side())))
             .unwrap();
@@ -221,9 +224,9 @@ fn stipple_depth_write_is_configurable() {
     let Some(ctx) = gpu() else { return };
     let scene = sheets_scene();
     let mut with = config(Technique::Stipple);
-    with.oit.stipple_depth_write = true;
+    with.oit.stipple.depth_write = true;
     let mut without = with.clone();
-    without.oit.stipple_depth_write = false;
+    without.oit.stipple.depth_write = false;
     let mut r = renderer_for(&ctx, &scene, with).unwrap();
     frame(&ctx, &mut r, &scene.cameras[0]);
     let depth_with = voxel_render::readback::read_texture(&ctx, r.scene_depth(), 4).unwrap();

@@ -34,8 +34,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut renderer = Renderer::new(&ctx, &registry, config)?;
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-    let (output, view) =
-        voxel_render::render_target(&ctx.device, "game_output", format, usage, width, height);
+    let output =
+        voxel_render::gpu::target(&ctx.device, "game_output", format, usage, (width, height));
 
     for frame in 0..60u32 {
         // Game logic: a glass pillar grows in front of the camera.
@@ -45,14 +45,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         // Remesh what changed (in parallel) and hand it to the renderer.
         for (pos, meshes) in voxel_mesh::mesh_dirty(&mut world)? {
-            renderer.upload_chunk(pos, &meshes);
+            renderer.upload_chunk(pos, &meshes)?;
         }
         // The camera circles the origin.
         let a = f64::from(frame) * 0.02;
         let eye = DVec3::new(30.0 * a.cos(), 45.0, 30.0 * a.sin());
         let camera = Camera::look_at(eye, DVec3::new(0.0, 28.0, 0.0), 70.0, 0.1, 500.0)?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let stats = renderer.render(&mut encoder, &view, &camera)?;
+        let stats = renderer.render(&mut encoder, &output.view, &camera)?;
         ctx.queue.submit([encoder.finish()]);
         renderer.after_submit();
         if frame % 20 == 0 {
@@ -64,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
     }
-    let rgba = readback::read_texture(&ctx, &output, 4)?;
+    let rgba = readback::read_texture(&ctx, &output.texture, 4)?;
     voxel_render::Image {
         width,
         height,

@@ -6,6 +6,19 @@ use glam::{DMat4, DVec3, Mat4, Vec3};
 
 use crate::{Error, Result};
 
+/// Smallest near plane distance: below it the reverse-Z projection's f32 matrix loses the
+/// depth of nearby surfaces (at 1e-50 the whole floor vanished).
+pub const MIN_NEAR: f64 = 1e-3;
+/// Largest far plane distance: 2^20 blocks, far beyond any view distance (64 chunks are
+/// 2 048 blocks) and still exact to 1/8 block in f32.
+pub const MAX_FAR: f64 = 1_048_576.0;
+/// Smallest vertical field of view in degrees (narrower projects everything off-screen).
+pub const MIN_FOV_DEG: f64 = 0.01;
+/// Largest vertical field of view in degrees.
+pub const MAX_FOV_DEG: f64 = 179.0;
+/// The eye must lie inside the `i32` world (each coordinate within ±2^31 blocks).
+pub const WORLD_EXTENT: f64 = 2_147_483_648.0;
+
 /// A perspective camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -63,24 +76,32 @@ impl Camera {
     }
 
     /// Checks that every number is usable: finite eye and direction, a non-zero direction,
-    /// `0 < near < far`, field of view in (0, 180) degrees.
+    /// the eye inside the `i32` world ([`WORLD_EXTENT`]), [`MIN_NEAR`] ≤ near < far ≤
+    /// [`MAX_FAR`], and a field of view from [`MIN_FOV_DEG`] to [`MAX_FOV_DEG`] degrees.
     pub fn validate(&self) -> Result<()> {
-        let bad = |why: &str| Err(Error::InvalidCamera(format!("{why}: {self:?}")));
+        let bad = |why: String| Err(Error::InvalidCamera(format!("{why}: {self:?}")));
         if !self.eye.is_finite() || !self.forward.is_finite() {
-            return bad("eye and direction must be finite");
+            return bad("eye and direction must be finite".into());
         }
         if self.forward.length_squared() < 1e-12 {
-            return bad("the view direction is zero (eye equals target?)");
+            return bad("the view direction is zero (eye equals target?)".into());
         }
-        if !(self.near.is_finite()
-            && self.far.is_finite()
-            && self.near > 0.0
-            && self.far > self.near)
-        {
-            return bad("need 0 < near < far, both finite");
+        if self.eye.abs().max_element() >= WORLD_EXTENT {
+            return bad(format!(
+                "the eye lies outside the i32 world (each coordinate within ±{WORLD_EXTENT})"
+            ));
         }
-        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
-            return bad("vertical field of view must be in (0, 180) degrees");
+        if !(self.near >= MIN_NEAR && self.far > self.near && self.far <= MAX_FAR) {
+            return bad(format!(
+                "need {MIN_NEAR} <= near < far <= {MAX_FAR}, got near {} and far {}",
+                self.near, self.far
+            ));
+        }
+        if !(MIN_FOV_DEG..=MAX_FOV_DEG).contains(&self.fov_y_deg) {
+            return bad(format!(
+                "vertical field of view {} must be from {MIN_FOV_DEG} to {MAX_FOV_DEG} degrees",
+                self.fov_y_deg
+            ));
         }
         Ok(())
     }
@@ -153,6 +174,21 @@ mod tests {
         assert!(Camera::look_at(e, DVec3::X, 180.0, 0.1, 10.0).is_err());
         assert!(Camera::look_at(e, DVec3::X, 60.0, 0.1, f64::INFINITY).is_err());
         assert!(Camera::from_yaw_pitch(e, f64::NAN, 0.0, 60.0, 0.1, 10.0).is_err());
+        assert!(
+            Camera::look_at(e, DVec3::X, 60.0, 1e-50, 10.0).is_err(),
+            "near"
+        );
+        assert!(
+            Camera::look_at(e, DVec3::X, 1e-40, 0.1, 10.0).is_err(),
+            "fov"
+        );
+        assert!(Camera::look_at(e, DVec3::X, 60.0, 0.1, 1e9).is_err(), "far");
+        let outside = DVec3::new(3e9, 0.0, 0.0);
+        assert!(
+            Camera::look_at(outside, DVec3::ZERO, 60.0, 0.1, 10.0).is_err(),
+            "eye"
+        );
+        assert!(Camera::look_at(e, DVec3::X, MIN_FOV_DEG, MIN_NEAR, MAX_FAR).is_ok());
     }
 
     #[test]

@@ -1,5 +1,9 @@
 //! Chunk meshes on the GPU: one storage buffer of packed quads per non-empty mesh (the
 //! vertex shader pulls from it), a small uniform per chunk, and frustum culling.
+//!
+//! Each upload of a chunk gets a new *generation* number, so that what a technique derives
+//! from a chunk's quads (a sort structure, a summary of its layers) can be cached by
+//! position and generation and recomputed only when the chunk is remeshed.
 
 use std::collections::HashMap;
 
@@ -9,8 +13,7 @@ use voxel_mesh::{ChunkMeshes, PackedQuad};
 use wgpu::util::DeviceExt;
 
 use crate::GpuContext;
-use crate::gpu_types::ChunkUniforms;
-use crate::layers::MeshLayers;
+use crate::bindings::ChunkUniforms;
 
 /// Which of a chunk's three meshes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -29,9 +32,6 @@ pub struct GpuMesh {
     buffer: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     quads: u32,
-    /// The translucent layers the quads make (fitted WBOIT weight); empty for the
-    /// opaque and cutout meshes.
-    layers: MeshLayers,
 }
 
 impl GpuMesh {
@@ -43,11 +43,6 @@ impl GpuMesh {
     /// Number of quads (6 vertices each).
     pub fn quads(&self) -> u32 {
         self.quads
-    }
-
-    /// The translucent layers the mesh's quads make, per plane, facing and block.
-    pub fn layers(&self) -> &MeshLayers {
-        &self.layers
     }
 
     /// Records the draw of this mesh (pipeline and group 0 already set).
@@ -62,8 +57,11 @@ impl GpuMesh {
 pub struct GpuChunk {
     uniform: wgpu::Buffer,
     meshes: [Option<GpuMesh>; 3],
-    /// The translucent quads as uploaded, kept for re-sorting.
+    /// The translucent quads in their current GPU order, kept for techniques that derive
+    /// something from them (sorting, the fitted WBOIT weight).
     translucent: Vec<PackedQuad>,
+    /// Changes with every upload of the chunk.
+    generation: u64,
 }
 
 impl GpuChunk {
@@ -75,6 +73,12 @@ impl GpuChunk {
     /// The translucent quads in their current GPU order.
     pub fn translucent_quads(&self) -> &[PackedQuad] {
         &self.translucent
+    }
+
+    /// A number that changes with every upload (remesh) of this chunk, never repeated by
+    /// the store.
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 }
 
@@ -93,48 +97,18 @@ pub struct Visible<'a> {
 #[derive(Debug)]
 pub struct ChunkStore {
     layout: wgpu::BindGroupLayout,
-    /// Opacity by block id, for the translucent meshes' layers.
-    opacity: Vec<f32>,
     chunks: HashMap<ChunkPos, GpuChunk>,
-}
-
-/// The bind group layout of group 1: the quad storage buffer and the chunk uniform.
-pub fn chunk_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("chunk_layout"),
-        entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: wgpu::BufferSize::new(8),
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: wgpu::BufferSize::new(16),
-                },
-                count: None,
-            },
-        ],
-    })
+    next_generation: u64,
 }
 
 impl ChunkStore {
-    /// An empty store whose bind groups use `layout` (from [`chunk_layout`]); `opacity`
-    /// by block id.
-    pub fn new(layout: wgpu::BindGroupLayout, opacity: Vec<f32>) -> Self {
+    /// An empty store whose bind groups use `layout` (group 1 of
+    /// [`crate::SharedLayouts`]).
+    pub fn new(layout: wgpu::BindGroupLayout) -> Self {
         Self {
             layout,
-            opacity,
             chunks: HashMap::new(),
+            next_generation: 1,
         }
     }
 
@@ -166,7 +140,7 @@ impl ChunkStore {
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 }),
         };
-        let make = |kind: MeshKind, quads: &[PackedQuad], label| {
+        let make = |quads: &[PackedQuad], label| {
             (!quads.is_empty()).then(|| {
                 let buffer = ctx
                     .device
@@ -193,27 +167,20 @@ impl ChunkStore {
                     buffer,
                     bind_group,
                     quads: quads.len() as u32,
-                    layers: if kind == MeshKind::Translucent {
-                        MeshLayers::new(pos, quads, &self.opacity)
-                    } else {
-                        MeshLayers::default()
-                    },
                 }
             })
         };
         let chunk = GpuChunk {
             meshes: [
-                make(MeshKind::Opaque, &meshes.opaque, "chunk_opaque_quads"),
-                make(MeshKind::Cutout, &meshes.cutout, "chunk_cutout_quads"),
-                make(
-                    MeshKind::Translucent,
-                    &meshes.translucent,
-                    "chunk_translucent_quads",
-                ),
+                make(&meshes.opaque, "chunk_opaque_quads"),
+                make(&meshes.cutout, "chunk_cutout_quads"),
+                make(&meshes.translucent, "chunk_translucent_quads"),
             ],
             translucent: meshes.translucent.clone(),
             uniform,
+            generation: self.next_generation,
         };
+        self.next_generation += 1;
         self.chunks.insert(pos, chunk);
     }
 
@@ -242,7 +209,8 @@ impl ChunkStore {
         self.chunks.is_empty()
     }
 
-    /// Rewrites a chunk's translucent quads in a new order (same quads), for sorting.
+    /// Rewrites a chunk's translucent quads in a new order (the same quads: a permutation
+    /// of [`GpuChunk::translucent_quads`]), for sorting. The generation stays.
     pub fn reorder_translucent(&mut self, ctx: &GpuContext, pos: ChunkPos, quads: Vec<PackedQuad>) {
         let Some(c) = self.chunks.get_mut(&pos) else {
             return;

@@ -117,7 +117,7 @@ impl GpuContext {
                 ..Default::default()
             })
             .await
-            .map_err(|e| Error::NoAdapter(format!("{backends:?}: {e}")))?;
+            .map_err(|source| Error::NoAdapter { backends, source })?;
         let (device, queue) = request_device(&adapter).await?;
         Ok(Self::from_device(&adapter, device, queue))
     }
@@ -137,5 +137,5 @@ pub async fn request_device(adapter: &wgpu::Adapter) -> Result<(wgpu::Device, wg
             trace: wgpu::Trace::Off,
         })
         .await
-        .map_err(|e| Error::Device(e.to_string()))
+        .map_err(Error::Device)
 }

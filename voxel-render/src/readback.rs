@@ -29,44 +29,58 @@ impl Image {
 
     /// Writes the image as an sRGB PNG, creating parent folders.
     pub fn save_png(&self, path: &Path) -> Result<()> {
+        let io = |source| Error::Io {
+            path: path.to_owned(),
+            source,
+        };
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| Error::Io(format!("{}: {e}", dir.display())))?;
+            std::fs::create_dir_all(dir).map_err(io)?;
         }
-        let file = std::fs::File::create(path)
-            .map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+        let file = std::fs::File::create(path).map_err(io)?;
+        let png = |source| Error::PngEncode {
+            path: path.to_owned(),
+            source,
+        };
         let mut enc = png::Encoder::new(std::io::BufWriter::new(file), self.width, self.height);
         enc.set_color(png::ColorType::Rgba);
         enc.set_depth(png::BitDepth::Eight);
         enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        let mut w = enc
-            .write_header()
-            .map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
-        w.write_image_data(&self.rgba)
-            .map_err(|e| Error::Io(format!("{}: {e}", path.display())))
+        let mut w = enc.write_header().map_err(png)?;
+        w.write_image_data(&self.rgba).map_err(png)
     }
 
-    /// Reads an RGBA or RGB 8-bit PNG.
+    /// Reads an 8-bit PNG (grey, RGB or RGBA; palettes expanded).
     pub fn load_png(path: &Path) -> Result<Self> {
-        let err = |e: &dyn std::fmt::Display| Error::Io(format!("{}: {e}", path.display()));
-        let file = std::fs::File::open(path).map_err(|e| err(&e))?;
+        let file = std::fs::File::open(path).map_err(|source| Error::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        let png = |source| Error::PngDecode {
+            path: path.to_owned(),
+            source,
+        };
         let mut dec = png::Decoder::new(std::io::BufReader::new(file));
-        dec.set_transformations(png::Transformations::EXPAND);
-        let mut reader = dec.read_info().map_err(|e| err(&e))?;
-        let mut buf = vec![
-            0;
-            reader
-                .output_buffer_size()
-                .ok_or_else(|| err(&"image too large"))?
-        ];
-        let info = reader.next_frame(&mut buf).map_err(|e| err(&e))?;
+        dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+        let mut reader = dec.read_info().map_err(png)?;
+        let size = reader
+            .output_buffer_size()
+            .ok_or_else(|| png(png::DecodingError::LimitsExceeded))?;
+        let mut buf = vec![0; size];
+        let info = reader.next_frame(&mut buf).map_err(png)?;
+        let data = &buf[..info.buffer_size()];
         let rgba = match info.color_type {
-            png::ColorType::Rgba => buf[..info.buffer_size()].to_vec(),
-            png::ColorType::Rgb => buf[..info.buffer_size()]
+            png::ColorType::Rgba => data.to_vec(),
+            png::ColorType::Rgb => data
                 .chunks_exact(3)
                 .flat_map(|p| [p[0], p[1], p[2], 255])
                 .collect(),
-            other => return Err(err(&format!("unsupported PNG colour type {other:?}"))),
+            png::ColorType::GrayscaleAlpha => data
+                .chunks_exact(2)
+                .flat_map(|p| [p[0], p[0], p[0], p[1]])
+                .collect(),
+            png::ColorType::Grayscale | png::ColorType::Indexed => {
+                data.iter().flat_map(|&g| [g, g, g, 255]).collect()
+            }
         };
         Ok(Self {
             width: info.width,
@@ -126,17 +140,10 @@ pub fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| Error::Gpu(format!("waiting for the GPU: {e}")))?;
+    ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
     rx.recv()
-        .map_err(|e| Error::Gpu(format!("readback: {e}")))?
-        .map_err(|e| Error::Gpu(format!("readback: {e}")))?;
-    let data = buffer
-        .slice(..)
-        .get_mapped_range()
-        .map_err(|e| Error::Gpu(format!("readback: {e}")))?
-        .to_vec();
+        .map_err(|_| Error::ReadbackData("the mapping callback never ran".into()))??;
+    let data = buffer.slice(..).get_mapped_range()?.to_vec();
     buffer.unmap();
     Ok(data)
 }
@@ -272,31 +279,36 @@ impl QueryReadback {
             });
     }
 
-    /// The results, once mapped (needs `device.poll` now and then); frees the buffer.
-    pub fn take(&mut self) -> Option<Vec<u64>> {
+    /// The results once mapped (`Ok(None)` until then; needs `device.poll` now and then),
+    /// and frees the buffer for the next copy. A failed mapping is an error.
+    pub fn take(&mut self) -> Result<Option<Vec<u64>>> {
         use std::sync::atomic::Ordering;
         match self.state.load(Ordering::Acquire) {
             MAPPED => {
-                let values = self.readback.slice(..).get_mapped_range().ok().map(|v| {
+                let values = self.readback.slice(..).get_mapped_range().map(|v| {
                     bytemuck::cast_slice::<u8, u64>(&v[..self.pending as usize * 8]).to_vec()
                 });
                 self.readback.unmap();
                 self.state.store(IDLE, Ordering::Release);
-                values
+                Ok(Some(values?))
             }
             FAILED => {
                 self.state.store(IDLE, Ordering::Release);
-                None
+                Err(Error::ReadbackData(
+                    "mapping the query results failed".into(),
+                ))
             }
-            _ => None,
+            _ => Ok(None),
         }
     }
 
-    /// Waits for the GPU, then [`QueryReadback::take`].
-    pub fn wait(&mut self, ctx: &GpuContext) -> Option<Vec<u64>> {
+    /// Waits for the copy in flight, then [`QueryReadback::take`]. An error when no copy
+    /// is in flight or it does not arrive.
+    pub fn wait(&mut self, ctx: &GpuContext) -> Result<Vec<u64>> {
         if self.state.load(std::sync::atomic::Ordering::Acquire) == MAPPING {
-            let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
+            ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
         }
-        self.take()
+        self.take()?
+            .ok_or_else(|| Error::ReadbackData("no query results were in flight".into()))
     }
 }

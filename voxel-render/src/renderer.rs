@@ -4,29 +4,33 @@
 //! tonemap to the output format.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 use std::time::Instant;
 
+use glam::Mat4;
 use voxel_core::{BlockRegistry, ChunkPos};
 use voxel_mesh::ChunkMeshes;
 use wgpu::util::DeviceExt;
 
-use crate::chunks::{ChunkStore, Frustum, MeshKind};
-use crate::gpu_types::{FrameUniforms, OPTICAL_DEPTH_VEC4S};
-use crate::layers;
-use crate::oit::{OitConfig, OitManager, Technique, TranslucentFrame, WeightFit, WeightFunction};
-use crate::pipelines::{
-    self, COMMON_WGSL, DepthMode, SharedLayouts, load_attachment, texture_entry,
+use crate::bindings::{COMMON_WGSL, FrameUniforms, SharedLayouts};
+use crate::chunks::{ChunkStore, Frustum, MeshKind, Visible};
+use crate::error::scoped;
+use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
+use crate::oit::{
+    FrameView, OitConfig, OitManager, Setup, Technique, TechniqueReport, TranslucentFrame,
+    WeightFunction,
 };
 use crate::textures::BlockTextures;
-use crate::timing::GpuTimer;
-use crate::{Camera, DEPTH_FORMAT, GpuContext, Result, SCENE_FORMAT};
+use crate::timing::{GpuPass, GpuTimes, Timer};
+use crate::{Camera, DEPTH_FORMAT, Error, GpuContext, Result, SCENE_FORMAT};
 
 /// Settings of a [`Renderer`]. Every field has a reasoned default.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RendererConfig {
-    /// Output width in pixels. Zero is raised to 1 (a renderer always has targets).
+    /// Output width in pixels. Zero is raised to 1 (a renderer always has targets); more
+    /// than the adapter's `max_texture_dimension_2d` is an error.
     pub width: u32,
-    /// Output height in pixels. Zero is raised to 1.
+    /// Output height in pixels, like `width`.
     pub height: u32,
     /// Format of the textures `render` draws into. Default `Rgba8UnormSrgb`, what
     /// offscreen readback and PNG files want; a window passes its surface format.
@@ -34,7 +38,7 @@ pub struct RendererConfig {
     /// 4× MSAA for the opaque and cutout passes. Default off: the translucent pass is
     /// single-sampled anyway (seed 000) and lavapipe pays 4× for it.
     pub msaa: bool,
-    /// Transparency settings (technique, weight, ...). Its size follows `width`/`height`.
+    /// Transparency settings (technique and each technique's own settings).
     pub oit: OitConfig,
     /// Direction towards the sun (normalised on use). Default: high in the south-east, so
     /// that every face direction gets a different brightness.
@@ -72,31 +76,33 @@ pub struct FrameStats {
     pub meshes_drawn: [usize; 3],
     /// Translucent quads drawn.
     pub translucent_quads: usize,
-    /// CPU time spent recording the frame, milliseconds (sorting included).
+    /// CPU time spent recording the frame, milliseconds (the technique's preparation
+    /// included).
     pub cpu_ms: f64,
-    /// CPU time spent sorting translucent quads (sorted-quads), milliseconds.
-    pub sort_ms: f64,
-    /// Chunks whose translucent quads were re-sorted this frame.
-    pub chunks_resorted: usize,
-    /// Technique-specific facts (peeled layers, reference overflow).
-    pub technique: crate::oit::TechniqueReport,
-    /// What the fitted WBOIT weight was fitted to: the view depths the visible translucent
-    /// meshes span and, per screen tile, the optical depth in front of depths across them
-    /// (no table when the frame does not use the fitted weight).
-    pub weight_fit: WeightFit,
+    /// What the technique did (its CPU time, sorting, layers, overflow, weight fit).
+    pub technique: TechniqueReport,
 }
 
+/// The HDR scene colour and depth, and what reads them.
 #[derive(Debug)]
 struct SceneTargets {
-    width: u32,
-    height: u32,
-    color: wgpu::Texture,
-    color_view: wgpu::TextureView,
-    depth: wgpu::Texture,
-    depth_view: wgpu::TextureView,
-    msaa: Option<(wgpu::TextureView, wgpu::TextureView)>,
+    size: (u32, u32),
+    color: Target,
+    depth: Target,
+    /// MSAA colour and depth, resolved into `color` and `depth`.
+    msaa: Option<(Target, Target)>,
     tonemap_group: wgpu::BindGroup,
     depth_resolve_group: Option<wgpu::BindGroup>,
+}
+
+/// The passes after the technique's: tonemap (per output format) and the MSAA depth
+/// resolve.
+#[derive(Debug)]
+struct Post {
+    tonemap_layout: wgpu::BindGroupLayout,
+    tonemap: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+    depth_resolve_layout: wgpu::BindGroupLayout,
+    depth_resolve: wgpu::RenderPipeline,
 }
 
 const MSAA_SAMPLES: u32 = 4;
@@ -112,136 +118,86 @@ pub struct Renderer {
     chunks: ChunkStore,
     opaque: wgpu::RenderPipeline,
     cutout: wgpu::RenderPipeline,
-    tonemap_layout: wgpu::BindGroupLayout,
-    tonemap: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
-    depth_resolve: (wgpu::BindGroupLayout, wgpu::RenderPipeline),
+    post: Post,
     targets: SceneTargets,
     oit: OitManager,
-    timer: Option<GpuTimer>,
+    timer: Option<Timer>,
     frame_index: u32,
     /// Chunks fading in, with the frame they appeared.
     fading: HashMap<ChunkPos, u32>,
-    /// Sorted-quads: the eye each chunk's translucent quads were last sorted for.
-    sorted_for: HashMap<ChunkPos, glam::DVec3>,
 }
-
-/// Most timed passes in a frame: peeling to convergence can take many.
-const MAX_TIMED_PASSES: u32 = 160;
 
 impl Renderer {
     /// A renderer for the blocks of `registry`. Falls back (with a log line) where the
-    /// adapter lacks something: MSAA off without 4× support.
-    pub fn new(
-        ctx: &GpuContext,
-        registry: &BlockRegistry,
-        mut config: RendererConfig,
-    ) -> Result<Self> {
+    /// adapter lacks something: MSAA off without 4× support, a technique it cannot run.
+    /// A size beyond the adapter's limits or an invalid setting is an error.
+    pub fn new(ctx: &GpuContext, registry: &BlockRegistry, config: RendererConfig) -> Result<Self> {
+        let mut config = config;
         config.width = config.width.max(1);
         config.height = config.height.max(1);
+        check_size(ctx, config.width, config.height)?;
+        config.oit.validate()?;
         if config.msaa && !ctx.caps.msaa4 {
             log::warn!("4x MSAA is not supported for the scene formats: rendering without MSAA");
             config.msaa = false;
         }
+        scoped(&ctx.device, "creating the renderer", || {
+            Self::create(ctx, registry, config)
+        })?
+    }
+
+    fn create(
+        ctx: &GpuContext,
+        registry: &BlockRegistry,
+        mut config: RendererConfig,
+    ) -> Result<Self> {
         let device = &ctx.device;
         let layouts = SharedLayouts::new(device);
         let textures = BlockTextures::new(ctx, registry)?;
         let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("frame_uniforms"),
-            contents: bytemuck::bytes_of(&<FrameUniforms as bytemuck::Zeroable>::zeroed()),
+            contents: bytemuck::bytes_of(&FrameUniforms::default()),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
-        let bayer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("bayer_levels"),
-            contents: bytemuck::cast_slice(&crate::oit::stipple::bayer::bayer_levels()),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let scene_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene"),
-            layout: &layouts.scene,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: frame_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&textures.view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Sampler(&textures.sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: bayer.as_entire_binding(),
-                },
-            ],
-        });
-
-        let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
-        let tonemap_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("tonemap_layout"),
-            entries: &[texture_entry(
-                0,
-                wgpu::TextureSampleType::Float { filterable: false },
-            )],
-        });
-        let depth_resolve_layout =
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("depth_resolve_layout"),
-                entries: &[wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: true,
-                    },
-                    count: None,
-                }],
-            });
-        let depth_resolve = pipelines::fullscreen_pipeline(
+        let scene_group = gpu::bind_group(
             device,
-            "depth_resolve",
-            include_str!("shaders/depth_resolve.wgsl"),
-            "fs_depth_resolve",
-            &[Some(&depth_resolve_layout)],
-            &[],
-            true,
-            &[],
+            "scene",
+            &layouts.scene,
+            &[
+                frame_buffer.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&textures.view),
+                wgpu::BindingResource::Sampler(&textures.sampler),
+            ],
         );
-        let mut oit_config = config.oit.clone();
-        oit_config.width = config.width;
-        oit_config.height = config.height;
-        let oit = OitManager::new(ctx, &layouts, oit_config);
-        let targets = Self::targets(
-            ctx,
-            &tonemap_layout,
-            &depth_resolve_layout,
-            config.width,
-            config.height,
-            config.msaa,
-        );
+        let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
+        let post = Post::new(device);
+        let size = (config.width, config.height);
+        let targets = SceneTargets::new(ctx, &post, size, config.msaa);
+        let setup = Setup {
+            ctx: ctx.clone(),
+            layouts: layouts.clone(),
+            size,
+            block_opacity: registry
+                .iter()
+                .map(|(_, def)| def.opacity)
+                .collect::<Arc<[f32]>>(),
+        };
+        let oit = OitManager::new(setup, config.oit.clone())?;
+        config_with(&mut config.oit, oit.config());
         Ok(Self {
             ctx: ctx.clone(),
-            chunks: ChunkStore::new(
-                layouts.chunk.clone(),
-                registry.iter().map(|(_, def)| def.opacity).collect(),
-            ),
+            chunks: ChunkStore::new(layouts.chunk.clone()),
             layouts,
             frame_buffer,
             scene_group,
             opaque,
             cutout,
-            tonemap_layout,
-            tonemap: HashMap::new(),
-            depth_resolve: (depth_resolve_layout, depth_resolve),
+            post,
             targets,
             oit,
-            timer: GpuTimer::new(ctx, MAX_TIMED_PASSES),
+            timer: Timer::new(ctx),
             frame_index: 0,
             fading: HashMap::new(),
-            sorted_for: HashMap::new(),
             config,
         })
     }
@@ -251,109 +207,25 @@ impl Renderer {
         layouts: &SharedLayouts,
         msaa: bool,
     ) -> (wgpu::RenderPipeline, wgpu::RenderPipeline) {
-        let module = pipelines::shader(
+        let module = gpu::shader(
             &ctx.device,
             "opaque",
-            &[
-                COMMON_WGSL,
-                crate::oit::stipple::DITHER_WGSL,
-                include_str!("shaders/opaque.wgsl"),
-            ],
+            &[COMMON_WGSL, include_str!("shaders/opaque.wgsl")],
         );
-
-        let samples = if msaa { MSAA_SAMPLES } else { 1 };
-        let groups = [Some(&layouts.scene), Some(&layouts.chunk)];
-        let make = |label, entry| {
-            pipelines::chunk_pipeline(
-                &ctx.device,
+        let groups = layouts.with(&[]);
+        let make = |label, fragment_entry| {
+            ChunkPipeline {
                 label,
-                &module,
-                entry,
-                &groups,
-                &[pipelines::scene_target(None)],
-                DepthMode::Write,
-                samples,
-            )
+                module: &module,
+                fragment_entry,
+                groups: &groups,
+                targets: &[gpu::scene_target(None)],
+                depth: DepthMode::Write,
+                samples: if msaa { MSAA_SAMPLES } else { 1 },
+            }
+            .build(&ctx.device)
         };
         (make("opaque", "fs_opaque"), make("cutout", "fs_cutout"))
-    }
-
-    fn targets(
-        ctx: &GpuContext,
-        tonemap_layout: &wgpu::BindGroupLayout,
-        depth_resolve_layout: &wgpu::BindGroupLayout,
-        width: u32,
-        height: u32,
-        msaa: bool,
-    ) -> SceneTargets {
-        use wgpu::TextureUsages as U;
-        let target = |label, format, samples, usage| {
-            pipelines::multisampled_target(
-                &ctx.device,
-                label,
-                format,
-                usage,
-                width,
-                height,
-                samples,
-            )
-        };
-        let (color, color_view) = target(
-            "scene_color",
-            SCENE_FORMAT,
-            1,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST,
-        );
-        let (depth, depth_view) = target(
-            "scene_depth",
-            DEPTH_FORMAT,
-            1,
-            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
-        );
-        let msaa_views = msaa.then(|| {
-            let (_, c) = target(
-                "scene_color_msaa",
-                SCENE_FORMAT,
-                MSAA_SAMPLES,
-                U::RENDER_ATTACHMENT,
-            );
-            let (_, d) = target(
-                "scene_depth_msaa",
-                DEPTH_FORMAT,
-                MSAA_SAMPLES,
-                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
-            );
-            (c, d)
-        });
-        let tonemap_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("tonemap"),
-            layout: tonemap_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&color_view),
-            }],
-        });
-        let depth_resolve_group = msaa_views.as_ref().map(|(_, d)| {
-            ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("depth_resolve"),
-                layout: depth_resolve_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(d),
-                }],
-            })
-        });
-        SceneTargets {
-            width,
-            height,
-            color,
-            color_view,
-            depth,
-            depth_view,
-            msaa: msaa_views,
-            tonemap_group,
-            depth_resolve_group,
-        }
     }
 
     /// The GPU context.
@@ -361,45 +233,69 @@ impl Renderer {
         &self.ctx
     }
 
-    /// The configuration in force (after fallbacks).
+    /// The configuration in force: after fallbacks, and after every `set_*` call.
     pub fn config(&self) -> &RendererConfig {
         &self.config
     }
 
     /// Output size in pixels.
     pub fn size(&self) -> (u32, u32) {
-        (self.targets.width, self.targets.height)
+        self.targets.size
     }
 
     /// Uploads or replaces a chunk's meshes; empty meshes remove it. A chunk that was not
-    /// on the GPU fades in when [`RendererConfig::fade_in_frames`] is set.
-    pub fn upload_chunk(&mut self, pos: ChunkPos, meshes: &ChunkMeshes) {
+    /// on the GPU fades in when [`RendererConfig::fade_in_frames`] is set. A position
+    /// outside the `i32` world ([`ChunkPos::is_valid`]) is an error.
+    pub fn upload_chunk(&mut self, pos: ChunkPos, meshes: &ChunkMeshes) -> Result<()> {
+        if !pos.is_valid() {
+            return Err(Error::InvalidSetting(format!(
+                "chunk position {pos:?} lies outside the i32 world (coordinates {} to {})",
+                ChunkPos::MIN,
+                ChunkPos::MAX
+            )));
+        }
         let new = self.chunks.get(pos).is_none();
         self.chunks.upload(&self.ctx, pos, meshes);
-        self.sorted_for.remove(&pos);
         if new && self.config.fade_in_frames > 0 && self.chunks.get(pos).is_some() {
             self.fading.insert(pos, self.frame_index);
             self.chunks.set_alpha(&self.ctx, pos, 0.0);
         }
+        Ok(())
     }
 
     /// Removes a chunk from the GPU.
     pub fn remove_chunk(&mut self, pos: ChunkPos) {
         self.chunks.remove(pos);
         self.fading.remove(&pos);
-        self.sorted_for.remove(&pos);
     }
 
     /// Removes every chunk.
     pub fn clear_chunks(&mut self) {
         self.chunks.clear();
         self.fading.clear();
-        self.sorted_for.clear();
     }
 
-    /// Changes the transparency settings (technique, weight, Bayer size, peel layers, ...).
-    pub fn set_oit_config(&mut self, config: OitConfig) {
-        self.oit.set_config(config);
+    /// Changes the transparency settings. Resources are rebuilt only where the active
+    /// technique's pipelines depend on what changed. An invalid setting is an error and
+    /// changes nothing.
+    pub fn set_oit_config(&mut self, config: OitConfig) -> Result<()> {
+        self.oit.set_config(config)?;
+        config_with(&mut self.config.oit, self.oit.config());
+        Ok(())
+    }
+
+    /// Switches the transparency technique (or what replaces it on this adapter).
+    pub fn set_technique(&mut self, technique: Technique) {
+        self.oit.set_technique(technique);
+        config_with(&mut self.config.oit, self.oit.config());
+    }
+
+    /// Changes the WBOIT weight function (a uniform: no pipeline is rebuilt).
+    pub fn set_weight(&mut self, weight: WeightFunction) {
+        let mut config = self.oit.config().clone();
+        config.wboit.weight = weight;
+        // Only the weight changed: the configuration stays valid.
+        let _ = self.set_oit_config(config);
     }
 
     /// Changes how many frames new chunks take to fade in (0: no fade).
@@ -422,63 +318,53 @@ impl Renderer {
         &self.oit
     }
 
-    /// Switches the transparency technique.
-    pub fn set_technique(&mut self, technique: Technique) {
-        self.oit.set_technique(technique);
-    }
-
-    /// Changes the WBOIT weight function.
-    pub fn set_weight(&mut self, weight: WeightFunction) {
-        self.oit.set_weight(weight);
-    }
-
-    /// Turns 4× MSAA on or off (rebuilds the opaque pipelines and targets).
-    pub fn set_msaa(&mut self, msaa: bool) {
+    /// Turns 4× MSAA on or off (rebuilds the opaque pipelines and targets). Without 4×
+    /// support it stays off (logged at creation).
+    pub fn set_msaa(&mut self, msaa: bool) -> Result<()> {
         let msaa = msaa && self.ctx.caps.msaa4;
         if msaa == self.config.msaa {
-            return;
+            return Ok(());
         }
+        let (ctx, size) = (&self.ctx, self.size());
+        let (pipelines, targets) = scoped(&ctx.device, "switching MSAA", || {
+            (
+                Self::opaque_pipelines(ctx, &self.layouts, msaa),
+                SceneTargets::new(ctx, &self.post, size, msaa),
+            )
+        })?;
+        (self.opaque, self.cutout) = pipelines;
+        self.targets = targets;
         self.config.msaa = msaa;
-        (self.opaque, self.cutout) = Self::opaque_pipelines(&self.ctx, &self.layouts, msaa);
-        self.targets = Self::targets(
-            &self.ctx,
-            &self.tonemap_layout,
-            &self.depth_resolve.0,
-            self.targets.width,
-            self.targets.height,
-            msaa,
-        );
+        Ok(())
     }
 
     /// Resizes every target. The same size does nothing; a zero width or height (a
-    /// minimised window) does nothing either and keeps the old targets.
-    pub fn resize(&mut self, width: u32, height: u32) {
+    /// minimised window) does nothing either and keeps the old targets until a real size
+    /// comes. A size beyond the adapter's limit is an error and changes nothing.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
         if width == 0 || height == 0 || (width, height) == self.size() {
-            return;
+            return Ok(());
         }
+        check_size(&self.ctx, width, height)?;
+        let ctx = &self.ctx;
+        let targets = scoped(&ctx.device, "resizing", || {
+            SceneTargets::new(ctx, &self.post, (width, height), self.config.msaa)
+        })?;
+        self.targets = targets;
         self.config.width = width;
         self.config.height = height;
-        self.targets = Self::targets(
-            &self.ctx,
-            &self.tonemap_layout,
-            &self.depth_resolve.0,
-            width,
-            height,
-            self.config.msaa,
-        );
-        self.oit.resize(width, height);
+        let oit = &mut self.oit;
+        scoped(&self.ctx.device, "resizing", || oit.resize(width, height))?
     }
 
-    /// GPU milliseconds per pass label of the latest timed frame, if timestamps work.
-    pub fn gpu_times(&mut self) -> Vec<(&'static str, f64)> {
-        self.timer
-            .as_mut()
-            .map(|t| t.poll().to_vec())
-            .unwrap_or_default()
+    /// GPU milliseconds per pass of the latest timed frame (empty without timestamps).
+    /// Needs `device.poll` now and then.
+    pub fn gpu_times(&mut self) -> GpuTimes {
+        self.timer.as_mut().map(Timer::poll).unwrap_or_default()
     }
 
     /// Like [`Renderer::gpu_times`], but waits for the last submitted frame's results.
-    pub fn gpu_times_blocking(&mut self) -> Vec<(&'static str, f64)> {
+    pub fn gpu_times_blocking(&mut self) -> GpuTimes {
         let ctx = self.ctx.clone();
         self.timer
             .as_mut()
@@ -495,85 +381,28 @@ impl Renderer {
         self.oit.after_submit();
     }
 
-    /// Advances chunk fade-ins by one frame.
-    fn update_fades(&mut self) {
-        let frames = self.config.fade_in_frames.max(1);
-        let now = self.frame_index;
-        let mut done = Vec::new();
-        for (&pos, &start) in &self.fading {
-            let t = now.wrapping_sub(start) as f32 / frames as f32;
-            self.chunks.set_alpha(&self.ctx, pos, t.min(1.0));
-            if t >= 1.0 {
-                done.push(pos);
-            }
-        }
-        for pos in done {
-            self.fading.remove(&pos);
-        }
-    }
-
-    /// Sorted-quads: re-sorts the translucent quads of the visible chunks whose last sort
-    /// was for an eye farther than [`OitConfig::resort_distance`] away. Returns (ms, chunks).
-    fn sort_quads(&mut self, positions: &[ChunkPos], eye: glam::DVec3) -> (f64, usize) {
-        let start = Instant::now();
-        let threshold = self.oit.config().resort_distance;
-        let mut n = 0;
-        for &pos in positions {
-            if self
-                .sorted_for
-                .get(&pos)
-                .is_some_and(|e| e.distance(eye) <= threshold)
-            {
-                continue;
-            }
-            let Some(chunk) = self.chunks.get(pos) else {
-                continue;
-            };
-            let mut quads = chunk.translucent_quads().to_vec();
-            let o = pos.origin();
-            let local = eye - glam::DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
-            voxel_mesh::sort::quads_back_to_front(&mut quads, local.as_vec3().to_array());
-            self.chunks.reorder_translucent(&self.ctx, pos, quads);
-            self.sorted_for.insert(pos, eye);
-            n += 1;
-        }
-        (start.elapsed().as_secs_f64() * 1e3, n)
-    }
-
     /// The HDR scene colour (after the composite, before tonemapping).
     pub fn scene_color(&self) -> &wgpu::Texture {
-        &self.targets.color
+        &self.targets.color.texture
     }
 
     /// The single-sample scene depth (reverse-Z).
     pub fn scene_depth(&self) -> &wgpu::Texture {
-        &self.targets.depth
+        &self.targets.depth.texture
     }
 
-    fn tonemap_pipeline(&mut self, format: wgpu::TextureFormat) -> &wgpu::RenderPipeline {
-        let (ctx, layout) = (&self.ctx, &self.tonemap_layout);
-        self.tonemap.entry(format).or_insert_with(|| {
-            let encode = if format.is_srgb() { 0.0 } else { 1.0 };
-            pipelines::fullscreen_pipeline(
-                &ctx.device,
-                "tonemap",
-                include_str!("shaders/tonemap.wgsl"),
-                "fs_tonemap",
-                &[Some(layout)],
-                &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-                false,
-                &[("SRGB_ENCODE", encode)],
-            )
-        })
-    }
-
-    /// Records a frame into `encoder`, ending with the tonemap into `output` (a view of a
-    /// texture of [`RendererConfig::output_format`] and of the renderer's size). Fails on
-    /// an invalid camera (NaN, zero direction, bad planes) without recording anything.
+    /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of a
+    /// whole 2D texture of the renderer's size whose format is
+    /// [`RendererConfig::output_format`] (or its sRGB / linear twin, viewed as that format),
+    /// with `RENDER_ATTACHMENT` usage.
+    ///
+    /// Fails without recording anything on an invalid camera (NaN, zero direction, bad
+    /// planes) or a mismatched output.
+    ///
+    /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
+    /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
+    /// encoder that replaces it (the order of commands is kept). Real-time techniques never
+    /// submit.
     pub fn render(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -581,200 +410,66 @@ impl Renderer {
         camera: &Camera,
     ) -> Result<FrameStats> {
         camera.validate()?;
+        self.check_output(output)?;
         let start = Instant::now();
-        let format = self.config.output_format;
-        self.tonemap_pipeline(format);
+        self.post.make_tonemap(&self.ctx, self.config.output_format);
         self.update_fades();
         let (w, h) = self.size();
         let view_proj = camera.view_proj(f64::from(w) / f64::from(h));
         let frustum = Frustum::new(view_proj, camera.eye);
-        let (sort_ms, chunks_resorted) = if self.oit.technique() == Technique::SortedQuads {
-            let positions: Vec<ChunkPos> = self
-                .chunks
-                .visible(MeshKind::Translucent, &frustum)
-                .iter()
-                .map(|v| v.pos)
-                .collect();
-            self.sort_quads(&positions, camera.eye)
-        } else {
-            (0.0, 0)
+
+        // The technique's CPU work (it may reorder quads) comes before anything borrows
+        // the chunks for drawing. Translucent chunks are drawn farthest first.
+        let far_first: Vec<(ChunkPos, f64)> = self
+            .chunks
+            .visible(MeshKind::Translucent, &frustum)
+            .iter()
+            .rev()
+            .map(|v| (v.pos, v.distance))
+            .collect();
+        let positions: Vec<ChunkPos> = far_first.iter().map(|(p, _)| *p).collect();
+        let view = FrameView {
+            camera,
+            view_proj,
+            translucent: &positions,
         };
+        self.oit.prepare(&mut self.chunks, &view)?;
+        self.write_frame_uniforms(camera, view_proj);
+
         let opaque = self.chunks.visible(MeshKind::Opaque, &frustum);
         let cutout = self.chunks.visible(MeshKind::Cutout, &frustum);
-        let mut translucent = self.chunks.visible(MeshKind::Translucent, &frustum);
-        translucent.reverse();
-        // Only the fitted WBOIT weight needs the estimate of the layers in view.
-        let (near, far) = (camera.near as f32, camera.far as f32);
-        let fitted = matches!(
-            self.oit.technique(),
-            Technique::WboitMrt | Technique::WboitTwoPass
-        ) && self.oit.config().weight == WeightFunction::Fitted;
-        let weight_fit = if fitted {
-            layers::fit(
-                translucent.iter().map(|v| v.mesh.layers()),
-                view_proj,
-                camera.eye,
-                near,
-                far,
-            )
-        } else {
-            WeightFit {
-                range: [near, far],
-                optical_depth: Vec::new(),
-            }
-        };
-        let depth_range = weight_fit.range;
-        let mut optical_depth = [[0.0; 4]; OPTICAL_DEPTH_VEC4S];
-        let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut optical_depth);
-        let n = weight_fit.optical_depth.len().min(flat.len());
-        flat[..n].copy_from_slice(&weight_fit.optical_depth[..n]);
+        let translucent: Vec<Visible<'_>> = far_first
+            .iter()
+            .filter_map(|&(pos, distance)| {
+                let mesh = self.chunks.get(pos)?.mesh(MeshKind::Translucent)?;
+                Some(Visible {
+                    pos,
+                    mesh,
+                    distance,
+                })
+            })
+            .collect();
+        let timer = self.timer.as_ref();
+        self.draw_opaque(encoder, &opaque, &cutout, timer);
+        self.oit.render(
+            encoder,
+            &TranslucentFrame {
+                target: &self.targets.color,
+                depth: &self.targets.depth,
+                scene: &self.scene_group,
+                chunks: &translucent,
+                timer,
+            },
+        )?;
+        self.tonemap(encoder, output, timer);
         let stats = FrameStats {
             meshes_drawn: [opaque.len(), cutout.len(), translucent.len()],
             translucent_quads: translucent.iter().map(|v| v.mesh.quads() as usize).sum(),
-            sort_ms,
-            chunks_resorted,
-            weight_fit,
-            ..FrameStats::default()
+            cpu_ms: 0.0,
+            technique: TechniqueReport::default(),
         };
-
-        let (eye_int, eye_frac) = camera.eye_split();
-        let sun = glam::Vec3::from(self.config.sun_dir).normalize_or(glam::Vec3::Y);
-
-        let oit_config = self.oit.config();
-        let uniforms = FrameUniforms {
-            view_proj: view_proj.to_cols_array_2d(),
-            eye_int: eye_int.map(|v| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32),
-            fov_y: camera.fov_y_deg.to_radians() as f32,
-            eye_frac: eye_frac.to_array(),
-            near: camera.near as f32,
-            sun_dir: sun.to_array(),
-            ambient: self.config.ambient,
-            sky: self.config.sky,
-            far: camera.far as f32,
-            viewport: [w as f32, h as f32],
-            weight_fn: oit_config.weight as u32,
-            accum_scale: self.oit.accum_scale(),
-            shading_state: oit_config.shading_state().pack(),
-            frame_index: self.frame_index,
-            depth_range,
-            optical_depth,
-        };
-        self.frame_index = self.frame_index.wrapping_add(1);
-        self.ctx
-            .queue
-            .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
         if let Some(t) = &mut self.timer {
-            t.begin_frame();
-        }
-
-        let t = &self.targets;
-        let sky = self.config.sky.map(f64::from);
-        let sky = wgpu::Color {
-            r: sky[0],
-            g: sky[1],
-            b: sky[2],
-            a: 1.0,
-        };
-        let (color_view, depth_view, resolve) = match &t.msaa {
-            Some((c, d)) => (c, d, Some(&t.color_view)),
-            None => (&t.color_view, &t.depth_view, None),
-        };
-        // Opaque, then cutout; with MSAA the colour resolves at the end of the last one.
-        for (kind, pipeline, list) in [
-            (MeshKind::Opaque, &self.opaque, &opaque),
-            (MeshKind::Cutout, &self.cutout, &cutout),
-        ] {
-            let first = kind == MeshKind::Opaque;
-            if !first && list.is_empty() {
-                continue;
-            }
-            let last = !first || cutout.is_empty();
-            let label = if first { "opaque" } else { "cutout" };
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(label),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: color_view,
-                    depth_slice: None,
-                    resolve_target: if last { resolve } else { None },
-                    ops: wgpu::Operations {
-                        load: if first {
-                            wgpu::LoadOp::Clear(sky)
-                        } else {
-                            wgpu::LoadOp::Load
-                        },
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        // Reverse-Z: clear to 0, the far plane.
-                        load: if first {
-                            wgpu::LoadOp::Clear(0.0)
-                        } else {
-                            wgpu::LoadOp::Load
-                        },
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: self.timer.as_mut().and_then(|t| t.pass(label)),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &self.scene_group, &[]);
-            for v in list {
-                v.mesh.draw(&mut pass);
-            }
-        }
-        if let Some(group) = &t.depth_resolve_group {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("depth_resolve"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &t.depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(0.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: self.timer.as_mut().and_then(|t| t.pass("opaque")),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.depth_resolve.1);
-            pass.set_bind_group(0, group, &[]);
-            pass.draw(0..3, 0..1);
-        }
-
-        let mut frame = TranslucentFrame {
-            target: &t.color_view,
-            target_texture: &t.color,
-            depth: &t.depth_view,
-            depth_texture: &t.depth,
-            scene: &self.scene_group,
-            chunks: &translucent,
-            timer: self.timer.as_mut(),
-        };
-        self.oit.render(encoder, &mut frame);
-
-        let pipeline = &self.tonemap[&format];
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("tonemap"),
-            color_attachments: &[load_attachment(output)],
-            depth_stencil_attachment: None,
-            timestamp_writes: self.timer.as_mut().and_then(|t| t.pass("tonemap")),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &t.tonemap_group, &[]);
-        pass.draw(0..3, 0..1);
-        drop(pass);
-        if let Some(t) = &mut self.timer {
-            t.end_frame(encoder);
+            t.resolve(encoder);
         }
         Ok(FrameStats {
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
@@ -799,5 +494,294 @@ impl Renderer {
         self.ctx.queue.submit([encoder.finish()]);
         self.after_submit();
         Ok(stats)
+    }
+
+    /// The output must match what the tonemap pipeline and the targets are made for.
+    fn check_output(&self, output: &wgpu::TextureView) -> Result<()> {
+        let t = output.texture();
+        let want = self.config.output_format;
+        let (w, h) = self.size();
+        if (t.width(), t.height()) != (w, h) {
+            return Err(Error::Output(format!(
+                "{}x{} pixels, but the renderer draws {w}x{h} (call resize first)",
+                t.width(),
+                t.height()
+            )));
+        }
+        if t.format() != want && t.format().remove_srgb_suffix() != want.remove_srgb_suffix() {
+            return Err(Error::Output(format!(
+                "format {:?}, but the renderer was made for {want:?} (RendererConfig::output_format)",
+                t.format()
+            )));
+        }
+        if !t.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+            || t.sample_count() != 1
+            || t.dimension() != wgpu::TextureDimension::D2
+        {
+            return Err(Error::Output(
+                "must be a single-sample 2D texture with RENDER_ATTACHMENT usage".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Advances chunk fade-ins by one frame.
+    fn update_fades(&mut self) {
+        let frames = self.config.fade_in_frames.max(1);
+        let now = self.frame_index;
+        let mut done = Vec::new();
+        for (&pos, &start) in &self.fading {
+            let t = now.wrapping_sub(start) as f32 / frames as f32;
+            self.chunks.set_alpha(&self.ctx, pos, t.min(1.0));
+            if t >= 1.0 {
+                done.push(pos);
+            }
+        }
+        for pos in done {
+            self.fading.remove(&pos);
+        }
+        self.frame_index = self.frame_index.wrapping_add(1);
+    }
+
+    fn write_frame_uniforms(&self, camera: &Camera, view_proj: Mat4) {
+        let (eye_int, eye_frac) = camera.eye_split();
+        let sun = glam::Vec3::from(self.config.sun_dir).normalize_or(glam::Vec3::Y);
+        let (w, h) = self.size();
+        let uniforms = FrameUniforms {
+            view_proj: view_proj.to_cols_array_2d(),
+            eye_int: eye_int.map(|v| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32),
+            near: camera.near as f32,
+            eye_frac: eye_frac.to_array(),
+            far: camera.far as f32,
+            sun_dir: sun.to_array(),
+            ambient: self.config.ambient,
+            sky: self.config.sky,
+            viewport: [w as f32, h as f32],
+            ..FrameUniforms::default()
+        };
+        self.ctx
+            .queue
+            .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
+    }
+
+    /// The opaque pass, then the cutout pass; with MSAA the colour resolves at the end of
+    /// the last one and the depth in a pass of its own.
+    fn draw_opaque(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        opaque: &[Visible<'_>],
+        cutout: &[Visible<'_>],
+        timer: Option<&Timer>,
+    ) {
+        let t = &self.targets;
+        let [r, g, b] = self.config.sky.map(f64::from);
+        let sky = wgpu::Color { r, g, b, a: 1.0 };
+        let (color, depth, resolve) = match &t.msaa {
+            Some((c, d)) => (&c.view, &d.view, Some(&t.color.view)),
+            None => (&t.color.view, &t.depth.view, None),
+        };
+        let passes = [
+            (GpuPass::Opaque, &self.opaque, opaque),
+            (GpuPass::Cutout, &self.cutout, cutout),
+        ];
+        for (kind, pipeline, list) in passes {
+            let first = kind == GpuPass::Opaque;
+            if !first && list.is_empty() {
+                continue;
+            }
+            let last = !first || cutout.is_empty();
+            let colors = [gpu::attachment(
+                color,
+                if first {
+                    wgpu::LoadOp::Clear(sky)
+                } else {
+                    wgpu::LoadOp::Load
+                },
+                if last { resolve } else { None },
+            )];
+            // Reverse-Z: clear to 0, the far plane.
+            let depth = if first {
+                Depth::Clear(depth, 0.0)
+            } else {
+                Depth::Load(depth)
+            };
+            Pass::new(kind.name(), kind, &colors)
+                .depth(depth)
+                .record(encoder, timer, |pass| {
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, &self.scene_group, &[]);
+                    for v in list {
+                        v.mesh.draw(pass);
+                    }
+                });
+        }
+        if let Some(group) = &t.depth_resolve_group {
+            Pass::new("depth_resolve", GpuPass::Opaque, &[])
+                .depth(Depth::Clear(&t.depth.view, 0.0))
+                .record(encoder, timer, |pass| {
+                    pass.set_pipeline(&self.post.depth_resolve);
+                    pass.set_bind_group(0, group, &[]);
+                    pass.draw(0..3, 0..1);
+                });
+        }
+    }
+
+    fn tonemap(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        output: &wgpu::TextureView,
+        timer: Option<&Timer>,
+    ) {
+        let Some(pipeline) = self.post.tonemap.get(&self.config.output_format) else {
+            return;
+        };
+        let colors = [gpu::load(output)];
+        Pass::new("tonemap", GpuPass::Tonemap, &colors).record(encoder, timer, |pass| {
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &self.targets.tonemap_group, &[]);
+            pass.draw(0..3, 0..1);
+        });
+    }
+}
+
+/// Copies what the manager holds (technique after fallback) into a renderer's config.
+fn config_with(mine: &mut OitConfig, manager: &OitConfig) {
+    mine.clone_from(manager);
+}
+
+/// A render size must fit the adapter's 2D textures.
+fn check_size(ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
+    let limit = ctx.caps.limits.max_texture_dimension_2d;
+    for (what, value) in [("render width", width), ("render height", height)] {
+        if value > limit {
+            return Err(Error::TooLarge {
+                what: what.into(),
+                value: u64::from(value),
+                limit_name: "max_texture_dimension_2d",
+                limit: u64::from(limit),
+            });
+        }
+    }
+    Ok(())
+}
+
+impl Post {
+    fn new(device: &wgpu::Device) -> Self {
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        let tonemap_layout = gpu::layout(device, "tonemap_layout", &[gpu::texture_entry(0, float)]);
+        let depth_resolve_layout = gpu::layout(
+            device,
+            "depth_resolve_layout",
+            &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: true,
+                },
+                count: None,
+            }],
+        );
+        let depth_resolve = FullscreenPipeline {
+            label: "depth_resolve",
+            source: include_str!("shaders/depth_resolve.wgsl"),
+            fragment_entry: "fs_depth_resolve",
+            groups: &[Some(&depth_resolve_layout)],
+            targets: &[],
+            writes_depth: true,
+            constants: &[],
+        }
+        .build(device);
+        Self {
+            tonemap_layout,
+            tonemap: HashMap::new(),
+            depth_resolve_layout,
+            depth_resolve,
+        }
+    }
+
+    /// Creates the tonemap pipeline for `format` if it does not exist yet.
+    fn make_tonemap(&mut self, ctx: &GpuContext, format: wgpu::TextureFormat) {
+        let layout = &self.tonemap_layout;
+        self.tonemap.entry(format).or_insert_with(|| {
+            FullscreenPipeline {
+                label: "tonemap",
+                source: include_str!("shaders/tonemap.wgsl"),
+                fragment_entry: "fs_tonemap",
+                groups: &[Some(layout)],
+                targets: &[Some(wgpu::ColorTargetState {
+                    format,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+                writes_depth: false,
+                constants: &[("SRGB_ENCODE", if format.is_srgb() { 0.0 } else { 1.0 })],
+            }
+            .build(&ctx.device)
+        });
+    }
+}
+
+impl SceneTargets {
+    fn new(ctx: &GpuContext, post: &Post, size: (u32, u32), msaa: bool) -> Self {
+        use wgpu::TextureUsages as U;
+        let device = &ctx.device;
+        let target = |label, format, samples, usage| {
+            gpu::TargetDesc {
+                label,
+                format,
+                usage,
+                size,
+                samples,
+            }
+            .create(device)
+        };
+        let color = target(
+            "scene_color",
+            SCENE_FORMAT,
+            1,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST,
+        );
+        let depth = target(
+            "scene_depth",
+            DEPTH_FORMAT,
+            1,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC,
+        );
+        let msaa = msaa.then(|| {
+            (
+                target(
+                    "scene_color_msaa",
+                    SCENE_FORMAT,
+                    MSAA_SAMPLES,
+                    U::RENDER_ATTACHMENT,
+                ),
+                target(
+                    "scene_depth_msaa",
+                    DEPTH_FORMAT,
+                    MSAA_SAMPLES,
+                    U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
+                ),
+            )
+        });
+        let tonemap_group =
+            gpu::texture_group(device, "tonemap", &post.tonemap_layout, &[&color.view]);
+        let depth_resolve_group = msaa.as_ref().map(|(_, d)| {
+            gpu::texture_group(
+                device,
+                "depth_resolve",
+                &post.depth_resolve_layout,
+                &[&d.view],
+            )
+        });
+        Self {
+            size,
+            color,
+            depth,
+            msaa,
+            tonemap_group,
+            depth_resolve_group,
+        }
     }
 }

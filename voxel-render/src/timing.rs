@@ -1,105 +1,213 @@
-//! GPU time per pass from timestamp queries (when the adapter has `TIMESTAMP_QUERY`).
+//! GPU time per pass, from timestamp queries written at pass boundaries (when the adapter
+//! has `TIMESTAMP_QUERY`), by [`wgpu_profiler`]: it grows its query pools as a frame needs
+//! (peeling to convergence records hundreds of passes) and reads results back a frame or
+//! more later without stalling.
 //!
-//! Each render pass asks for a pair of queries under a label; passes with the same label
-//! (the many passes of depth peeling, say) add up. Results arrive a frame or more later
-//! without stalling ([`GpuTimer::poll`]), or at once for tools ([`GpuTimer::read_blocking`]).
+//! Passes are named by [`GpuPass`]; passes of the same kind (the many passes of depth
+//! peeling) add up.
+
+use std::fmt;
+
+use wgpu_profiler::{GpuProfiler, GpuProfilerQuery, GpuProfilerSettings, GpuTimerQueryResult};
 
 use crate::GpuContext;
-use crate::readback::QueryReadback;
 
-/// Timestamp queries for the passes of one frame, and the latest results.
-#[derive(Debug)]
-pub struct GpuTimer {
-    queries: QueryReadback,
-    capacity: u32,
-    labels: Vec<&'static str>,
-    /// Labels of the frame whose timestamps are being copied or mapped.
-    in_flight: Vec<&'static str>,
-    latest: Vec<(&'static str, f64)>,
-    period_ns: f64,
+/// The kinds of GPU work a frame is timed by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum GpuPass {
+    /// The opaque pass (and the MSAA depth resolve).
+    Opaque,
+    /// The cutout (alpha-tested) pass.
+    Cutout,
+    /// The technique's passes over the translucent meshes.
+    Translucent,
+    /// The technique's composite(s) into the scene colour.
+    Composite,
+    /// HDR scene colour to the output.
+    Tonemap,
 }
 
-impl GpuTimer {
-    /// A timer for up to `max_passes` timed passes per frame, or `None` without
-    /// timestamp support.
-    pub fn new(ctx: &GpuContext, max_passes: u32) -> Option<Self> {
+impl GpuPass {
+    /// Every pass kind, in frame order.
+    pub const ALL: [GpuPass; 5] = [
+        GpuPass::Opaque,
+        GpuPass::Cutout,
+        GpuPass::Translucent,
+        GpuPass::Composite,
+        GpuPass::Tonemap,
+    ];
+
+    /// The name used in labels and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            GpuPass::Opaque => "opaque",
+            GpuPass::Cutout => "cutout",
+            GpuPass::Translucent => "translucent",
+            GpuPass::Composite => "composite",
+            GpuPass::Tonemap => "tonemap",
+        }
+    }
+
+    fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+}
+
+impl fmt::Display for GpuPass {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Milliseconds of GPU time per [`GpuPass`] of one frame (`None`: no such pass ran).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GpuTimes {
+    ms: [Option<f64>; 5],
+}
+
+impl GpuTimes {
+    /// The time of `pass`, if it ran.
+    pub fn get(&self, pass: GpuPass) -> Option<f64> {
+        self.ms[pass as usize]
+    }
+
+    /// Whether no pass was timed.
+    pub fn is_empty(&self) -> bool {
+        self.ms.iter().all(Option::is_none)
+    }
+
+    /// The passes that ran with their times, in frame order.
+    pub fn iter(&self) -> impl Iterator<Item = (GpuPass, f64)> + '_ {
+        GpuPass::ALL
+            .into_iter()
+            .filter_map(|p| self.get(p).map(|ms| (p, ms)))
+    }
+
+    /// The translucent work of the frame: the technique's passes and composites.
+    pub fn translucent_work(&self) -> f64 {
+        self.get(GpuPass::Translucent).unwrap_or(0.0) + self.get(GpuPass::Composite).unwrap_or(0.0)
+    }
+
+    fn add(&mut self, pass: GpuPass, ms: f64) {
+        *self.ms[pass as usize].get_or_insert(0.0) += ms;
+    }
+}
+
+/// Timestamp queries around the passes of each frame, and the latest results.
+pub struct Timer {
+    profiler: GpuProfiler,
+    period: f32,
+    latest: GpuTimes,
+}
+
+impl fmt::Debug for Timer {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Timer")
+            .field("latest", &self.latest)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Timer {
+    /// A timer, or `None` when the device has no timestamp queries (frames then go
+    /// untimed).
+    pub fn new(ctx: &GpuContext) -> Option<Self> {
         if !ctx.caps.timestamps() {
             return None;
         }
-        Some(Self {
-            queries: QueryReadback::new(
-                ctx,
-                "pass_timestamps",
-                wgpu::QueryType::Timestamp,
-                2 * max_passes,
-            ),
-            capacity: max_passes,
-            labels: Vec::new(),
-            in_flight: Vec::new(),
-            latest: Vec::new(),
-            period_ns: f64::from(ctx.queue.get_timestamp_period()),
-        })
-    }
-
-    /// Starts recording a frame's passes.
-    pub fn begin_frame(&mut self) {
-        self.labels.clear();
-    }
-
-    /// Timestamp writes for one pass under `label`; `None` when the frame's queries are all
-    /// used (the pass then goes untimed).
-    pub fn pass(&mut self, label: &'static str) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        let i = self.labels.len() as u32;
-        if i >= self.capacity {
-            return None;
-        }
-        self.labels.push(label);
-        Some(wgpu::RenderPassTimestampWrites {
-            query_set: self.queries.set(),
-            beginning_of_pass_write_index: Some(2 * i),
-            end_of_pass_write_index: Some(2 * i + 1),
-        })
-    }
-
-    /// Records the copy of this frame's timestamps, unless an earlier frame's are still
-    /// being read (that frame then goes untimed: timing never stalls rendering).
-    pub fn end_frame(&mut self, encoder: &mut wgpu::CommandEncoder) {
-        let n = self.labels.len() as u32 * 2;
-        if self.queries.copy(encoder, 0..n) {
-            self.in_flight = self.labels.clone();
-        }
-    }
-
-    /// Call after submitting the encoder passed to [`GpuTimer::end_frame`]: starts mapping.
-    pub fn after_submit(&mut self) {
-        self.queries.map();
-    }
-
-    fn record(&mut self, ticks: Option<Vec<u64>>) {
-        let Some(ticks) = ticks else { return };
-        let mut out: Vec<(&'static str, f64)> = Vec::new();
-        for (label, pair) in self.in_flight.iter().zip(ticks.chunks_exact(2)) {
-            let ms = pair[1].saturating_sub(pair[0]) as f64 * self.period_ns / 1e6;
-            match out.iter_mut().find(|(l, _)| l == label) {
-                Some((_, total)) => *total += ms,
-                None => out.push((label, ms)),
+        let settings = GpuProfilerSettings {
+            enable_debug_groups: false,
+            ..GpuProfilerSettings::default()
+        };
+        match GpuProfiler::new(&ctx.device, settings) {
+            Ok(profiler) => Some(Self {
+                profiler,
+                period: ctx.queue.get_timestamp_period(),
+                latest: GpuTimes::default(),
+            }),
+            Err(e) => {
+                log::warn!("GPU pass timing off: {e}");
+                None
             }
         }
-        self.latest = out;
     }
 
-    /// Takes finished results, if any, and returns the latest: milliseconds per label, in
-    /// the order the labels first appeared. Needs `device.poll` to be called now and then.
-    pub fn poll(&mut self) -> &[(&'static str, f64)] {
-        let ticks = self.queries.take();
-        self.record(ticks);
-        &self.latest
+    /// Reserves the timestamps of one pass of kind `pass`; give the query to
+    /// [`Timer::end`] once the pass has ended.
+    pub(crate) fn begin(
+        &self,
+        pass: GpuPass,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> GpuProfilerQuery {
+        self.profiler.begin_pass_query(pass.name(), encoder)
     }
 
-    /// Waits for the GPU and returns the results of the last submitted timed frame.
-    pub fn read_blocking(&mut self, ctx: &GpuContext) -> Vec<(&'static str, f64)> {
-        let ticks = self.queries.wait(ctx);
-        self.record(ticks);
-        self.latest.clone()
+    /// Closes a query from [`Timer::begin`].
+    pub(crate) fn end(&self, encoder: &mut wgpu::CommandEncoder, query: GpuProfilerQuery) {
+        self.profiler.end_query(encoder, query);
+    }
+
+    /// Records the copy of the frame's timestamps at the end of `encoder`.
+    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        self.profiler.resolve_queries(encoder);
+    }
+
+    /// Call once the encoder given to [`Timer::resolve`] is submitted: starts reading the
+    /// frame's timestamps back.
+    pub fn after_submit(&mut self) {
+        if let Err(e) = self.profiler.end_frame() {
+            log::warn!("GPU pass timing lost a frame: {e}");
+        }
+    }
+
+    /// Takes finished frames, if any, and returns the latest results. Needs
+    /// `device.poll` to be called now and then.
+    pub fn poll(&mut self) -> GpuTimes {
+        while let Some(results) = self.profiler.process_finished_frame(self.period) {
+            self.latest = Self::sum(&results);
+        }
+        self.latest
+    }
+
+    /// Waits for the GPU, then [`Timer::poll`].
+    pub fn read_blocking(&mut self, ctx: &GpuContext) -> GpuTimes {
+        if let Err(e) = ctx.device.poll(wgpu::PollType::wait_indefinitely()) {
+            log::warn!("waiting for GPU timings: {e}");
+        }
+        self.poll()
+    }
+
+    fn sum(results: &[GpuTimerQueryResult]) -> GpuTimes {
+        let mut times = GpuTimes::default();
+        for r in results {
+            if let (Some(pass), Some(t)) = (GpuPass::from_name(&r.label), &r.time) {
+                times.add(pass, (t.end - t.start) * 1e3);
+            }
+        }
+        times
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn passes_of_a_kind_add_up_and_names_round_trip() {
+        let mut t = GpuTimes::default();
+        assert!(t.is_empty());
+        t.add(GpuPass::Translucent, 1.5);
+        t.add(GpuPass::Translucent, 2.0);
+        t.add(GpuPass::Composite, 0.25);
+        assert_eq!(t.get(GpuPass::Translucent), Some(3.5));
+        assert_eq!(t.get(GpuPass::Opaque), None);
+        assert_eq!(t.translucent_work(), 3.75);
+        assert_eq!(
+            t.iter().collect::<Vec<_>>(),
+            [(GpuPass::Translucent, 3.5), (GpuPass::Composite, 0.25)]
+        );
+        for p in GpuPass::ALL {
+            assert_eq!(GpuPass::from_name(p.name()), Some(p));
+        }
     }
 }

@@ -1,212 +1,270 @@
 //! Order-independent transparency behind one API: [`OitManager`] (seed 002's OITManager in
-//! Rust form) records the translucent pass and its composite for the selected
-//! [`Technique`]. One folder per technique; each implements [`TranslucentTechnique`].
+//! Rust form) prepares and records the translucent passes and their composite for the
+//! selected [`Technique`].
+//!
+//! One folder per technique. Its type implements [`TranslucentTechnique`] (the hooks of a
+//! frame: prepare on the CPU, record, read back, report) and [`TechniqueKind`] (how to
+//! build it, and the key that decides when it must be rebuilt); it owns its pipelines,
+//! targets, uniforms, bind groups (from group 2 on) and per-chunk caches. Adding a technique
+//! is its folder plus one line in the list below (and, if it has settings of its own, their
+//! struct as a field of [`OitConfig`]).
 
+pub mod opaque_only;
 pub mod peeling;
 pub mod reference;
 pub mod sorted;
 pub mod stipple;
 pub mod wboit;
 
-use crate::chunks::Visible;
-use crate::pipelines::SharedLayouts;
-use crate::timing::GpuTimer;
-use crate::{Error, GpuContext, Result};
+use std::fmt;
+use std::sync::Arc;
 
-pub use stipple::{BayerSize, ShadingState, TransparencyMode};
+use glam::Mat4;
+use voxel_core::ChunkPos;
+
+use crate::bindings::SharedLayouts;
+use crate::chunks::{ChunkStore, Visible};
+use crate::context::Capabilities;
+use crate::gpu::Target;
+use crate::timing::Timer;
+use crate::{Camera, Error, GpuContext, Result};
+
+pub use peeling::{PeelReport, PeelingSettings};
+pub use reference::ReferenceReport;
+pub use sorted::{SortReport, SortedSettings};
+pub use stipple::{BayerSize, ShadingState, StippleSettings};
 pub use wboit::weights::{WeightFit, WeightFunction};
+pub use wboit::{WboitReport, WboitSettings};
 
-/// A way to draw the translucent meshes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Technique {
+/// Declares [`Technique`] from the list of techniques: variant, command-line name, and the
+/// type (implementing [`TechniqueKind`]) that draws it.
+macro_rules! techniques {
+    ($( $(#[doc = $doc:literal])* $variant:ident = $name:literal => $kind:ty, )*) => {
+        /// A way to draw the translucent meshes.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum Technique {
+            $( $(#[doc = $doc])* $variant, )*
+        }
+
+        /// The pipeline key of the active technique, by technique.
+        #[derive(Clone, Debug, PartialEq)]
+        enum Key {
+            $( $variant(<$kind as TechniqueKind>::Key), )*
+        }
+
+        impl Technique {
+            /// Number of techniques.
+            pub const COUNT: usize = [$( stringify!($variant) ),*].len();
+
+            /// Every technique, in the order menus and reports list them.
+            pub const ALL: [Technique; Self::COUNT] = [$( Technique::$variant ),*];
+
+            /// The command-line name.
+            pub fn name(self) -> &'static str {
+                match self { $( Technique::$variant => $name, )* }
+            }
+
+            /// Whether the technique computes the exact blend (up to rounding).
+            pub fn is_exact(self) -> bool {
+                match self { $( Technique::$variant => <$kind as TechniqueKind>::is_exact(self), )* }
+            }
+
+            /// Whether the technique draws the translucent meshes at all.
+            pub fn draws(self) -> bool {
+                match self { $( Technique::$variant => <$kind as TechniqueKind>::DRAWS, )* }
+            }
+
+            /// What replaces the technique on an adapter that cannot run it.
+            fn fallback(self, caps: &Capabilities) -> Option<Technique> {
+                match self { $( Technique::$variant => <$kind as TechniqueKind>::fallback(self, caps), )* }
+            }
+
+            fn key(self, config: &OitConfig, caps: &Capabilities) -> Key {
+                match self {
+                    $( Technique::$variant => Key::$variant(<$kind as TechniqueKind>::key(self, config, caps)), )*
+                }
+            }
+
+            fn create(self, setup: &Setup, config: &OitConfig) -> Result<Box<dyn TranslucentTechnique>> {
+                match self {
+                    $( Technique::$variant => Ok(Box::new(<$kind as TechniqueKind>::create(setup, self, config)?)), )*
+                }
+            }
+        }
+    };
+}
+
+techniques! {
     /// Translucent meshes are not drawn at all.
-    OpaqueOnly,
+    OpaqueOnly = "opaque-only" => opaque_only::OpaqueOnly,
     /// Weighted blended OIT, one pass into two targets (MRT) with independent blend states.
-    WboitMrt,
+    WboitMrt = "wboit-mrt" => wboit::Wboit,
     /// Weighted blended OIT, two passes (seed 002): one per target. For adapters without
     /// independent blend.
-    WboitTwoPass,
+    WboitTwoPass = "wboit-two-pass" => wboit::Wboit,
     /// Screen-door transparency with a Bayer pattern (seed 001): the low-end mode.
-    Stipple,
+    Stipple = "stipple" => stipple::Stipple,
     /// Alpha blending of chunks sorted back to front (seed 003): the baseline.
-    Sorted,
+    Sorted = "sorted" => sorted::Sorted,
     /// Like `Sorted`, with the quads inside each chunk sorted back to front too.
-    SortedQuads,
-    /// Dual depth peeling of [`OitConfig::peel_layers`] layers (seed 004).
-    DepthPeeling,
+    SortedQuads = "sorted-quads" => sorted::Sorted,
+    /// Dual depth peeling of [`PeelingSettings::layers`] layers (seed 004).
+    DepthPeeling = "depth-peeling" => peeling::Peeling,
     /// The exact reference: per-pixel sorted fragment lists (A-buffer). Stalls the GPU.
-    Reference,
+    Reference = "reference" => reference::Reference,
     /// The second exact method: front-to-back depth peeling until a pass writes nothing.
     /// Stalls the GPU once per layer.
-    PeelReference,
+    PeelReference = "peel-reference" => peeling::Peeling,
 }
 
 impl Technique {
-    /// Every technique, in the order menus and reports list them.
-    pub const ALL: [Technique; 9] = [
-        Technique::OpaqueOnly,
-        Technique::WboitMrt,
-        Technique::WboitTwoPass,
-        Technique::Stipple,
-        Technique::Sorted,
-        Technique::SortedQuads,
-        Technique::DepthPeeling,
-        Technique::Reference,
-        Technique::PeelReference,
-    ];
-
-    /// The command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Technique::OpaqueOnly => "opaque-only",
-            Technique::WboitMrt => "wboit-mrt",
-            Technique::WboitTwoPass => "wboit-two-pass",
-            Technique::Stipple => "stipple",
-            Technique::Sorted => "sorted",
-            Technique::SortedQuads => "sorted-quads",
-            Technique::DepthPeeling => "depth-peeling",
-            Technique::Reference => "reference",
-            Technique::PeelReference => "peel-reference",
-        }
-    }
-
-    /// Whether the technique computes the exact blend (up to rounding).
-    pub fn is_exact(self) -> bool {
-        matches!(self, Technique::Reference | Technique::PeelReference)
-    }
-
     /// Parses a command-line name; the error lists the known names.
     pub fn from_name(name: &str) -> Result<Self> {
         Self::ALL
             .into_iter()
             .find(|t| t.name() == name)
-            .ok_or_else(|| {
-                Error::UnknownName(format!(
-                    "technique {name:?}; known: {}",
-                    Self::ALL.map(Technique::name).join(", ")
-                ))
-            })
+            .ok_or_else(|| Error::unknown_name("technique", name, Self::ALL.map(Self::name)))
     }
 }
 
-impl std::fmt::Display for Technique {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl fmt::Display for Technique {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }
 }
 
-/// Settings of the transparency techniques. Every field has a reasoned default.
+/// How a technique's type is built; see the module docs.
+pub trait TechniqueKind: TranslucentTechnique + Sized + 'static {
+    /// What its pipelines and targets are built from: the manager rebuilds the technique
+    /// when the key changes. Settings outside the key are read every frame.
+    type Key: Clone + PartialEq + fmt::Debug;
+
+    /// Whether it draws translucent meshes at all (`false`: no resource, no pass).
+    const DRAWS: bool = true;
+
+    /// Whether `technique` (one this type draws) computes the exact blend.
+    fn is_exact(_technique: Technique) -> bool {
+        false
+    }
+
+    /// What replaces `technique` on an adapter that lacks something it needs.
+    fn fallback(_technique: Technique, _caps: &Capabilities) -> Option<Technique> {
+        None
+    }
+
+    /// The key of `technique` with `config` on this adapter.
+    fn key(technique: Technique, config: &OitConfig, caps: &Capabilities) -> Self::Key;
+
+    /// Creates the pipelines and targets of `technique`.
+    fn create(setup: &Setup, technique: Technique, config: &OitConfig) -> Result<Self>;
+}
+
+/// What a technique is created with.
+#[derive(Debug, Clone)]
+pub struct Setup {
+    /// The device.
+    pub ctx: GpuContext,
+    /// Groups 0 and 1 of every chunk pipeline.
+    pub layouts: SharedLayouts,
+    /// Render target size in pixels.
+    pub size: (u32, u32),
+    /// Opacity of each block type, by block id.
+    pub block_opacity: Arc<[f32]>,
+}
+
+/// Settings of the transparency techniques: which one draws, and each one's own settings.
+/// Every field has a reasoned default.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OitConfig {
-    /// The technique to draw translucent meshes with. Default: WBOIT in one MRT pass, the
+    /// The technique that draws translucent meshes. Default: WBOIT in one MRT pass, the
     /// fastest method that looks right on any adapter with independent blend.
     pub technique: Technique,
-    /// Render target width in pixels.
-    pub width: u32,
-    /// Render target height in pixels.
-    pub height: u32,
-    /// WBOIT weight function. Default: ours, the transmittance in front of the fragment
-    /// estimated from the translucent layers in view, which had the lowest error of all
-    /// on the scene suite (`results/`).
-    pub weight: WeightFunction,
-
-    /// Accumulate WBOIT in RGBA8 even when RGBA16F works (to test the fallback).
-    /// Default false: RGBA8 loses most of the weighted sum's precision.
-    pub force_rgba8_accum: bool,
-    /// Scale WBOIT accumulation by 1/64 so that fp16 sums stay finite up to ~1390 layers of
-    /// the maximum weight (without it, 22 such layers reach 65504). Default true; turn off
-    /// only to test the composite's guard against non-finite sums.
-    pub wboit_headroom: bool,
-    /// Stipple pattern. Default 4×4, seed 001's default ("era-authentic").
-    pub bayer: BayerSize,
-    /// Whether kept stipple pixels write depth. Default true, seed 001's behaviour ("writes
-    /// to depth buffer normally"): nearer kept pixels then hide what is behind them.
-    pub stipple_depth_write: bool,
-    /// Uniform alpha of the stipple shading state, multiplying every translucent alpha.
-    /// Default 255 (1.0): surfaces keep their own opacity.
-    pub stipple_alpha: u8,
-    /// Layers dual depth peeling captures at most (even; presets 4, 6, 8). Default 8: the
-    /// depth complexity of glass-over-water views in our terrain stays below it.
-    pub peel_layers: u32,
-    /// Sorted-quads: how far (blocks) the eye may move before a chunk's quads are
-    /// re-sorted. Default 0.25: a quarter block changes the order of few quads, and a
-    /// sort of a chunk's translucent quads takes microseconds.
-    pub resort_distance: f64,
+    /// Weighted blended OIT (both variants).
+    pub wboit: WboitSettings,
+    /// Stipple.
+    pub stipple: StippleSettings,
+    /// The sorted techniques.
+    pub sorted: SortedSettings,
+    /// Depth peeling.
+    pub peeling: PeelingSettings,
 }
 
 impl Default for OitConfig {
     fn default() -> Self {
         Self {
+            // WBOIT in one MRT pass: the fastest method that looks right on any adapter
+            // with independent blend (others fall back to the two-pass variant).
             technique: Technique::WboitMrt,
-            width: 1280,
-            height: 720,
-            weight: WeightFunction::Fitted,
-
-            force_rgba8_accum: false,
-            wboit_headroom: true,
-            bayer: BayerSize::B4,
-            stipple_depth_write: true,
-            stipple_alpha: 255,
-            peel_layers: 8,
-            resort_distance: 0.25,
+            // Each technique's settings carry their own reasoned defaults.
+            wboit: WboitSettings::default(),
+            stipple: StippleSettings::default(),
+            sorted: SortedSettings::default(),
+            peeling: PeelingSettings::default(),
         }
     }
 }
 
 impl OitConfig {
-    /// Seed 001's packed shading state for the frame uniforms (stipple mode, pattern, alpha).
-    pub fn shading_state(&self) -> ShadingState {
-        ShadingState {
-            alpha: self.stipple_alpha,
-            mode: TransparencyMode::Stipple,
-            pattern: self.bayer,
+    /// A default configuration drawing with `technique`.
+    pub fn with(technique: Technique) -> Self {
+        Self {
+            technique,
+            ..Self::default()
         }
+    }
+
+    /// Checks every setting against what the renderer supports.
+    pub fn validate(&self) -> Result<()> {
+        self.stipple.validate()?;
+        self.peeling.validate()?;
+        self.sorted.validate()
     }
 }
 
 /// Technique-specific facts about the last frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct TechniqueReport {
-    /// Layers found (depth peeling).
-    pub layers: Option<u32>,
-    /// Peeling iterations run this frame (each a front and, in dual mode, a back peel).
-    pub iterations: Option<u32>,
+    /// CPU milliseconds the technique spent preparing the frame (sorting, fitting).
+    pub prepare_ms: f64,
+    /// Weighted blended OIT: what the fitted weight was fitted to.
+    pub wboit: Option<WboitReport>,
+    /// Sorted quads: what was re-sorted.
+    pub sort: Option<SortReport>,
+    /// Depth peeling: layers found and iterations run.
+    pub peeling: Option<PeelReport>,
+    /// The A-buffer: attempts, tiles and what did not fit.
+    pub reference: Option<ReferenceReport>,
+}
 
-    /// Fragments that did not fit (reference): should be zero; never hidden.
-    pub overflow: Option<u64>,
-    /// Attempts the reference needed this frame (more than 1 after growing its pool).
-    pub attempts: Option<u32>,
+/// The CPU side of a frame, for [`TranslucentTechnique::prepare`].
+#[derive(Debug)]
+pub struct FrameView<'a> {
+    /// The camera.
+    pub camera: &'a Camera,
+    /// Its camera-relative view-projection for the render target's aspect.
+    pub view_proj: Mat4,
+    /// The visible chunks with translucent meshes, farthest first.
+    pub translucent: &'a [ChunkPos],
 }
 
 /// What a technique draws with and into, for one frame.
 #[derive(Debug)]
 pub struct TranslucentFrame<'a> {
     /// The HDR scene colour holding the opaque image; the composite blends into it.
-    pub target: &'a wgpu::TextureView,
-    /// The texture of `target` (for copies).
-    pub target_texture: &'a wgpu::Texture,
+    pub target: &'a Target,
     /// The opaque depth (single-sample): read-only attachment, or sampled by peeling.
-    pub depth: &'a wgpu::TextureView,
-    /// The texture of `depth` (for copies).
-    pub depth_texture: &'a wgpu::Texture,
+    pub depth: &'a Target,
     /// Group 0: frame uniforms and block textures.
     pub scene: &'a wgpu::BindGroup,
     /// The visible translucent meshes, farthest first.
     pub chunks: &'a [Visible<'a>],
     /// Pass timing, when available.
-    pub timer: Option<&'a mut GpuTimer>,
+    pub timer: Option<&'a Timer>,
 }
 
 impl TranslucentFrame<'_> {
-    /// Timestamp writes for the next pass under `label`.
-    pub fn timestamps(
-        &mut self,
-        label: &'static str,
-    ) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.timer.as_deref_mut().and_then(|t| t.pass(label))
-    }
-
-    /// Records the draws of every visible translucent mesh.
+    /// Records the draws of every visible translucent mesh (group 0 and each chunk's
+    /// group 1 set here; the pipeline and groups from 2 on set by the caller).
     pub fn draw_chunks(&self, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_bind_group(0, self.scene, &[]);
         for c in self.chunks {
@@ -215,28 +273,45 @@ impl TranslucentFrame<'_> {
     }
 }
 
-/// One transparency technique: its pipelines and targets, created when it becomes active
-/// and dropped when another one does.
-pub trait TranslucentTechnique: std::fmt::Debug {
+/// One transparency technique: its pipelines, targets and caches, created when it becomes
+/// active and dropped when another one does.
+pub trait TranslucentTechnique: fmt::Debug {
     /// Rebuilds size-dependent targets; called only when the size really changed.
-    fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32);
+    fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<()>;
+
+    /// CPU work before the frame is recorded (sorting quads, fitting the weight, writing
+    /// the technique's uniforms); may rewrite the order of chunks' translucent quads.
+    fn prepare(
+        &mut self,
+        _ctx: &GpuContext,
+        _config: &OitConfig,
+        _chunks: &mut ChunkStore,
+        _view: &FrameView<'_>,
+    ) -> Result<()> {
+        Ok(())
+    }
+
     /// Records the translucent pass(es) and the composite into `frame.target`.
     fn render(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
-    );
+        frame: &TranslucentFrame<'_>,
+    ) -> Result<()>;
+
     /// Called after the frame's commands were submitted (to start reading results back).
     fn after_submit(&mut self) {}
+
     /// Technique-specific facts about the last frame.
     fn report(&self) -> TechniqueReport {
         TechniqueReport::default()
     }
+
     /// The WBOIT accumulation target, for techniques that have one.
     fn accumulation(&self) -> Option<&wgpu::Texture> {
         None
     }
+
     /// The WBOIT revealage target, for techniques that have one.
     fn revealage(&self) -> Option<&wgpu::Texture> {
         None
@@ -248,44 +323,38 @@ pub trait TranslucentTechnique: std::fmt::Debug {
 /// `render` records the translucent pass and composite; resources freed on drop).
 #[derive(Debug)]
 pub struct OitManager {
-    ctx: GpuContext,
-    layouts: SharedLayouts,
+    setup: Setup,
     config: OitConfig,
-    /// Created on the first frame that has translucent meshes in view.
-    active: Option<Box<dyn TranslucentTechnique>>,
+    /// Created on the first frame that has translucent meshes in view, with its key.
+    active: Option<(Key, Box<dyn TranslucentTechnique>)>,
+    prepare_ms: f64,
 }
 
 impl OitManager {
     /// A manager for `config`. No GPU resource is created until a frame needs one. A
     /// technique the adapter cannot run falls back (logged): two-pass WBOIT without
-    /// independent blend.
-    pub fn new(ctx: &GpuContext, layouts: &SharedLayouts, config: OitConfig) -> Self {
+    /// independent blend, peel-to-convergence as the reference without fragment storage.
+    pub fn new(setup: Setup, config: OitConfig) -> Result<Self> {
+        config.validate()?;
         let mut m = Self {
-            ctx: ctx.clone(),
-            layouts: layouts.clone(),
+            setup,
             config,
             active: None,
+            prepare_ms: 0.0,
         };
         m.config.technique = m.supported(m.config.technique);
-        m.config.width = m.config.width.max(1);
-        m.config.height = m.config.height.max(1);
-        m
+        Ok(m)
     }
 
     /// `technique`, or what replaces it on this adapter.
     fn supported(&self, technique: Technique) -> Technique {
-        let caps = &self.ctx.caps;
-        if technique == Technique::WboitMrt && !caps.independent_blend() {
-            log::warn!("adapter lacks independent blend: using two-pass WBOIT instead of MRT");
-            return Technique::WboitTwoPass;
+        match technique.fallback(&self.setup.ctx.caps) {
+            Some(other) => {
+                log::warn!("this adapter cannot run {technique}: using {other} instead");
+                other
+            }
+            None => technique,
         }
-        if technique == Technique::Reference && !caps.fragment_storage() {
-            log::warn!(
-                "adapter lacks fragment storage writes: using peel-to-convergence as the reference"
-            );
-            return Technique::PeelReference;
-        }
-        technique
     }
 
     /// The configuration in force (after any fallback).
@@ -300,70 +369,66 @@ impl OitManager {
 
     /// Switches technique at run time; the old one's resources are freed at once.
     pub fn set_technique(&mut self, technique: Technique) {
-        let technique = self.supported(technique);
-        if technique != self.config.technique {
-            self.config.technique = technique;
-            self.active = None;
-        }
-    }
-
-    /// Changes the WBOIT weight function (a uniform: no pipeline is rebuilt).
-    pub fn set_weight(&mut self, weight: WeightFunction) {
-        self.config.weight = weight;
-    }
-
-    /// Changes settings other than the size; resources are rebuilt only if a setting the
-    /// active technique's pipelines or targets depend on changed.
-    pub fn set_config(&mut self, config: OitConfig) {
-        let old = &self.config;
-        let rebuild = config.technique != old.technique
-            || config.force_rgba8_accum != old.force_rgba8_accum
-            || config.stipple_depth_write != old.stipple_depth_write
-            || config.peel_layers != old.peel_layers;
-        self.config = OitConfig {
-            width: old.width,
-            height: old.height,
-            ..config
+        let config = OitConfig {
+            technique,
+            ..self.config.clone()
         };
+        // Only the technique changed, and the rest was valid.
+        let _ = self.set_config(config);
+    }
+
+    /// Changes the settings. Resources are rebuilt only when the technique's key (what
+    /// its pipelines and targets are built from) changes; other settings apply from the
+    /// next frame. An invalid setting is an error and changes nothing.
+    pub fn set_config(&mut self, config: OitConfig) -> Result<()> {
+        config.validate()?;
+        self.config = config;
         self.config.technique = self.supported(self.config.technique);
-        if rebuild {
+        let key = self
+            .config
+            .technique
+            .key(&self.config, &self.setup.ctx.caps);
+        if self.active.as_ref().is_some_and(|(k, _)| *k != key) {
             self.active = None;
         }
+        Ok(())
     }
 
     /// Technique-specific facts about the last frame.
     pub fn report(&self) -> TechniqueReport {
-        self.active.as_ref().map(|t| t.report()).unwrap_or_default()
+        let mut r = self
+            .active
+            .as_ref()
+            .map(|(_, t)| t.report())
+            .unwrap_or_default();
+        r.prepare_ms = self.prepare_ms;
+        r
     }
 
     /// Call after the frame's commands were submitted.
     pub fn after_submit(&mut self) {
-        if let Some(t) = &mut self.active {
+        if let Some((_, t)) = &mut self.active {
             t.after_submit();
         }
     }
 
-    /// Resizes the targets. Same size: nothing happens. Zero width or height (a minimised
-    /// window): nothing happens either, and the old targets stay until a real size comes.
-    pub fn resize(&mut self, width: u32, height: u32) {
-        if width == 0 || height == 0 || (width, height) == (self.config.width, self.config.height) {
-            return;
+    /// Resizes the targets (the caller checks that the size is valid and new).
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        self.setup.size = (width, height);
+        if let Some((_, t)) = &mut self.active {
+            t.resize(&self.setup.ctx, width, height)?;
         }
-        self.config.width = width;
-        self.config.height = height;
-        if let Some(t) = &mut self.active {
-            t.resize(&self.ctx, width, height);
-        }
+        Ok(())
     }
 
     /// The WBOIT accumulation target, when WBOIT is active and has drawn.
     pub fn accumulation_target(&self) -> Option<&wgpu::Texture> {
-        self.active.as_ref().and_then(|t| t.accumulation())
+        self.active.as_ref().and_then(|(_, t)| t.accumulation())
     }
 
     /// The WBOIT revealage target, when WBOIT is active and has drawn.
     pub fn revealage_target(&self) -> Option<&wgpu::Texture> {
-        self.active.as_ref().and_then(|t| t.revealage())
+        self.active.as_ref().and_then(|(_, t)| t.revealage())
     }
 
     /// Whether the active technique's GPU resources exist.
@@ -371,58 +436,43 @@ impl OitManager {
         self.active.is_some()
     }
 
-    /// Multiplier of WBOIT accumulation outputs for the frame uniforms.
-    pub fn accum_scale(&self) -> f32 {
-        wboit::accum_scale(&self.ctx, &self.config)
+    /// The active technique, created if translucent meshes are in view and it draws.
+    fn active(&mut self, in_view: bool) -> Result<Option<&mut Box<dyn TranslucentTechnique>>> {
+        let technique = self.config.technique;
+        if !in_view || !technique.draws() {
+            return Ok(None);
+        }
+        if self.active.is_none() {
+            let key = technique.key(&self.config, &self.setup.ctx.caps);
+            let t = technique.create(&self.setup, &self.config)?;
+            self.active = Some((key, t));
+        }
+        Ok(self.active.as_mut().map(|(_, t)| t))
     }
 
-    fn create(&self) -> Option<Box<dyn TranslucentTechnique>> {
-        let c = &self.config;
-        match c.technique {
-            Technique::OpaqueOnly => None,
-            Technique::WboitMrt | Technique::WboitTwoPass => {
-                Some(Box::new(wboit::Wboit::new(&self.ctx, &self.layouts, c)))
-            }
-            Technique::Sorted | Technique::SortedQuads => {
-                Some(Box::new(sorted::Sorted::new(&self.ctx, &self.layouts)))
-            }
-            Technique::Stipple => {
-                Some(Box::new(stipple::Stipple::new(&self.ctx, &self.layouts, c)))
-            }
-            Technique::DepthPeeling => Some(Box::new(peeling::Peeling::new(
-                &self.ctx,
-                &self.layouts,
-                c,
-                peeling::PeelMode::Dual {
-                    layers: c.peel_layers,
-                },
-            ))),
-            Technique::PeelReference => Some(Box::new(peeling::Peeling::new(
-                &self.ctx,
-                &self.layouts,
-                c,
-                peeling::PeelMode::Converge,
-            ))),
-            Technique::Reference => Some(Box::new(reference::Reference::new(
-                &self.ctx,
-                &self.layouts,
-                c,
-            ))),
+    /// The technique's CPU work for the frame (see [`TranslucentTechnique::prepare`]). With
+    /// no visible translucent mesh nothing happens and no resource is created.
+    pub fn prepare(&mut self, chunks: &mut ChunkStore, view: &FrameView<'_>) -> Result<()> {
+        let start = std::time::Instant::now();
+        let (ctx, config) = (self.setup.ctx.clone(), self.config.clone());
+        if let Some(t) = self.active(!view.translucent.is_empty())? {
+            t.prepare(&ctx, &config, chunks, view)?;
         }
+        self.prepare_ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok(())
     }
 
     /// Records the translucent pass(es) and the composite into `frame.target`. With no
-    /// visible translucent mesh (or `OpaqueOnly`) nothing is recorded and no resource is
-    /// created.
-    pub fn render(&mut self, encoder: &mut wgpu::CommandEncoder, frame: &mut TranslucentFrame<'_>) {
-        if frame.chunks.is_empty() || self.config.technique == Technique::OpaqueOnly {
-            return;
-        }
-        if self.active.is_none() {
-            self.active = self.create();
-        }
-        if let Some(t) = &mut self.active {
-            t.render(&self.ctx, encoder, frame);
+    /// visible translucent mesh (or a technique that draws nothing) nothing is recorded.
+    pub fn render(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &TranslucentFrame<'_>,
+    ) -> Result<()> {
+        let ctx = self.setup.ctx.clone();
+        match self.active(!frame.chunks.is_empty())? {
+            Some(t) => t.render(&ctx, encoder, frame),
+            None => Ok(()),
         }
     }
 }

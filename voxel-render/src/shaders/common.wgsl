@@ -1,24 +1,18 @@
-// Shared by every chunk pipeline: frame and chunk uniforms, vertex pulling of the 8-byte
-// packed quads (voxel-mesh's layout), and the shading all passes use (seed 000: Lambert
-// with a sun direction plus ambient, the same for opaque and translucent surfaces).
+// Shared by every chunk pipeline: frame and chunk uniforms (`bindings.rs`, checked equal
+// by a test), vertex pulling of the 8-byte packed quads (voxel-mesh's layout), the shading
+// all passes use (seed 000: Lambert with a sun direction plus ambient, the same for opaque
+// and translucent surfaces), and the dissolve of chunks fading in.
 
 struct Frame {
     view_proj: mat4x4<f32>,
     eye_int: vec3<i32>,
-    fov_y: f32,
-    eye_frac: vec3<f32>,
     near: f32,
+    eye_frac: vec3<f32>,
+    far: f32,
     sun_dir: vec3<f32>,
     ambient: f32,
     sky: vec3<f32>,
-    far: f32,
     viewport: vec2<f32>,
-    weight_fn: u32,
-    accum_scale: f32,
-    shading_state: u32,
-    frame_index: u32,
-    depth_range: vec2<f32>,
-    optical_depth: array<vec4<f32>, 512>,
 };
 
 struct ChunkInfo {
@@ -114,8 +108,22 @@ fn translucent_color(in: VsOut) -> vec4<f32> {
     return vec4<f32>(light(a.rgb, in.face), clamp(a.a * chunk.alpha, 0.0, 1.0));
 }
 
-// Standard (not reversed) window depth in [0, 1], 0 at the near plane, from the reverse-Z
-// fragment depth: the `gl_FragCoord.z` of the seeds' weight functions.
-fn standard_depth(frag_z: f32) -> f32 {
-    return 1.0 - frag_z;
+// Level of the n×n Bayer matrix (n a power of two) at a pixel, over n²: the matrix
+// M₂ₙ = [[4Mₙ, 4Mₙ + 2], [4Mₙ + 3, 4Mₙ + 1]] computed from the bits of the coordinates
+// (no table, so nothing is copied into every fragment's private memory).
+fn bayer_level(frag_xy: vec2<f32>, n: u32) -> f32 {
+    let p = vec2<u32>(frag_xy);
+    var level = 0u;
+    for (var bit = 1u; bit < n; bit <<= 1u) {
+        let x = select(0u, 1u, (p.x & bit) != 0u);
+        let y = select(0u, 1u, (p.y & bit) != 0u);
+        level = level * 4u + 2u * (x ^ y) + y;
+    }
+    return f32(level) / f32(n * n);
+}
+
+// Whether a fragment of a chunk fading in (chunk.alpha < 1) is still dissolved away: a
+// 4×4 screen door, so that kept pixels grow in as the chunk's alpha ramps up.
+fn faded_out(frag_xy: vec2<f32>) -> bool {
+    return chunk.alpha < 1.0 && chunk.alpha <= bayer_level(frag_xy, 4u);
 }

@@ -10,7 +10,7 @@
 //!
 //! Limits between passes are depth textures (ping-pong): a fragment is a candidate only
 //! strictly between the previous front and back layers at its pixel; see `peel.wgsl` for
-//! why no depth epsilon is needed.
+//! why no depth epsilon is needed. They are the technique's group 2.
 //!
 //! Early exit and adaptive layer count: an occlusion query counts the samples each front
 //! peel wrote. Results come back a frame later without stalling; the next frame runs only
@@ -18,17 +18,65 @@
 //! N/2). A frame with no translucent chunk in view records nothing at all.
 //!
 //! Peel to convergence (exact): front peels only, each followed by reading its occlusion
-//! count (a stall per layer), until a pass writes nothing. For measurement, not games.
+//! count (a stall per layer), until a pass writes nothing, at most [`MAX_PEEL_LAYERS`]
+//! layers (reported when reached). For measurement, not games.
 
-use crate::oit::{OitConfig, TechniqueReport, TranslucentFrame, TranslucentTechnique};
-use crate::pipelines::{
-    self, COMMON_WGSL, DepthMode, SharedLayouts, clear_transparent, load_attachment,
+use crate::context::Capabilities;
+use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
+use crate::oit::{
+    OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
+    TranslucentTechnique,
 };
 use crate::readback::QueryReadback;
-use crate::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
+use crate::timing::GpuPass;
+use crate::{DEPTH_FORMAT, Error, GpuContext, Result, SCENE_FORMAT};
 
-/// Iterations peel-to-convergence runs at most (a safety net: 512 layers).
-pub const MAX_CONVERGE_ITERATIONS: u32 = 512;
+/// Most layers either kind of peeling captures: dual peeling's setting may not exceed it,
+/// and peeling to convergence stops there (reporting that it did). Each layer costs a
+/// pass over every translucent mesh; 512 is past any depth complexity the lab uses (its
+/// densest scene has 200 sheets) and keeps a frame bounded.
+pub const MAX_PEEL_LAYERS: u32 = 512;
+
+/// Settings of dual depth peeling. Every field has a reasoned default.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PeelingSettings {
+    /// Layers dual depth peeling captures at most (even, 2 to [`MAX_PEEL_LAYERS`]).
+    pub layers: u32,
+}
+
+impl Default for PeelingSettings {
+    fn default() -> Self {
+        Self {
+            // The depth complexity of glass-over-water views in our terrain stays below 8.
+            layers: 8,
+        }
+    }
+}
+
+impl PeelingSettings {
+    /// The layer count must be even and within 2 to [`MAX_PEEL_LAYERS`].
+    pub fn validate(&self) -> Result<()> {
+        if (2..=MAX_PEEL_LAYERS).contains(&self.layers) && self.layers.is_multiple_of(2) {
+            Ok(())
+        } else {
+            Err(Error::InvalidSetting(format!(
+                "peeling.layers {}: dual depth peeling takes an even number of layers from 2 to {MAX_PEEL_LAYERS}",
+                self.layers
+            )))
+        }
+    }
+}
+
+/// What peeling found in the last frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PeelReport {
+    /// Layers found (dual: from the last counts read back; converge: this frame's).
+    pub layers: Option<u32>,
+    /// Peeling iterations run this frame (each a front and, in dual mode, a back peel).
+    pub iterations: u32,
+    /// Converge mode: the frame stopped at [`MAX_PEEL_LAYERS`] with layers left.
+    pub truncated: bool,
+}
 
 /// Which peeling.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -42,13 +90,23 @@ pub enum PeelMode {
     Converge,
 }
 
+impl PeelMode {
+    /// Iterations a frame runs at most.
+    fn max_iterations(self) -> u32 {
+        match self {
+            PeelMode::Dual { layers } => layers.max(2) / 2,
+            PeelMode::Converge => MAX_PEEL_LAYERS,
+        }
+    }
+}
+
 #[derive(Debug)]
 struct Targets {
-    front: [(wgpu::Texture, wgpu::TextureView); 2],
-    back: [(wgpu::Texture, wgpu::TextureView); 2],
-    front_layer: wgpu::TextureView,
-    back_layer: wgpu::TextureView,
-    front_acc: wgpu::TextureView,
+    front: [Target; 2],
+    back: [Target; 2],
+    front_layer: Target,
+    back_layer: Target,
+    front_acc: Target,
     /// Limits for the front peel of an iteration writing slot `i`: (front[1-i], back[1-i]).
     front_limits: [wgpu::BindGroup; 2],
     /// Limits for the back peel writing slot `i`: (front[i], back[1-i]).
@@ -76,7 +134,7 @@ pub struct Peeling {
     counts: QueryReadback,
     /// Dual mode: iterations to run this frame (adaptive).
     iterations: u32,
-    report: TechniqueReport,
+    report: PeelReport,
 }
 
 const UNDER: wgpu::BlendState = wgpu::BlendState {
@@ -92,150 +150,132 @@ const UNDER: wgpu::BlendState = wgpu::BlendState {
     },
 };
 
-impl Peeling {
-    /// Creates pipelines and targets for `mode`.
-    pub fn new(
-        ctx: &GpuContext,
-        layouts: &SharedLayouts,
-        config: &OitConfig,
-        mode: PeelMode,
-    ) -> Self {
-        let device = &ctx.device;
-        let limits_layout = pipelines::textures_layout(
+impl TechniqueKind for Peeling {
+    type Key = PeelMode;
+
+    fn is_exact(technique: Technique) -> bool {
+        technique == Technique::PeelReference
+    }
+
+    fn key(technique: Technique, config: &OitConfig, _: &Capabilities) -> PeelMode {
+        match technique {
+            Technique::PeelReference => PeelMode::Converge,
+            _ => PeelMode::Dual {
+                layers: config.peeling.layers,
+            },
+        }
+    }
+
+    fn create(setup: &Setup, technique: Technique, config: &OitConfig) -> Result<Self> {
+        let mode = Self::key(technique, config, &setup.ctx.caps);
+        let device = &setup.ctx.device;
+        let limits_layout = gpu::textures_layout(
             device,
             "peel_limits_layout",
             wgpu::TextureSampleType::Depth,
             2,
         );
-        let layer_layout = pipelines::textures_layout(
+        let layer_layout = gpu::textures_layout(
             device,
             "peel_layer_layout",
             wgpu::TextureSampleType::Float { filterable: false },
             1,
         );
-        let module = pipelines::shader(device, "peel", &[COMMON_WGSL, include_str!("peel.wgsl")]);
-        let groups = [
-            Some(&layouts.scene),
-            Some(&layouts.chunk),
-            Some(&limits_layout),
-        ];
+        let module = gpu::shader(
+            device,
+            "peel",
+            &[crate::bindings::COMMON_WGSL, include_str!("peel.wgsl")],
+        );
+        let groups = setup.layouts.with(&[&limits_layout]);
         let peel = |label, depth| {
-            pipelines::chunk_pipeline(
-                device,
+            ChunkPipeline {
                 label,
-                &module,
-                "fs_peel",
-                &groups,
-                &[pipelines::scene_target(None)],
+                module: &module,
+                fragment_entry: "fs_peel",
+                groups: &groups,
+                targets: &[gpu::scene_target(None)],
                 depth,
-                1,
-            )
+                samples: 1,
+            }
+            .build(device)
         };
-        let peel_front = peel("peel_front", DepthMode::Write);
-        let peel_back = peel("peel_back", DepthMode::WriteFarthest);
-        let blend = |label, entry, state| {
-            pipelines::fullscreen_pipeline(
-                device,
+        let blend = |label, fragment_entry, state| {
+            FullscreenPipeline {
                 label,
-                include_str!("blend.wgsl"),
-                entry,
-                &[Some(&layer_layout)],
-                &[pipelines::scene_target(Some(state))],
-                false,
-                &[],
-            )
+                source: include_str!("blend.wgsl"),
+                fragment_entry,
+                groups: &[Some(&layer_layout)],
+                targets: &[gpu::scene_target(Some(state))],
+                writes_depth: false,
+                constants: &[],
+            }
+            .build(device)
         };
-        let under = blend("peel_under", "fs_under", UNDER);
-        let over = blend("peel_over", "fs_over", wgpu::BlendState::ALPHA_BLENDING);
-        let front_composite = blend(
-            "peel_front_composite",
-            "fs_front",
-            wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
-        );
-        let targets = Self::targets(
-            ctx,
-            &limits_layout,
-            &layer_layout,
-            config.width,
-            config.height,
-        );
-        let max_iterations = match mode {
-            PeelMode::Dual { layers } => layers.max(2) / 2,
-            PeelMode::Converge => MAX_CONVERGE_ITERATIONS,
-        };
-        Self {
+        let targets = Self::targets(device, &limits_layout, &layer_layout, setup.size);
+        let max_iterations = mode.max_iterations();
+        Ok(Self {
             mode,
-            peel_front,
-            peel_back,
-            under,
-            over,
-            front_composite,
+            peel_front: peel("peel_front", DepthMode::Write),
+            peel_back: peel("peel_back", DepthMode::WriteFarthest),
+            under: blend("peel_under", "fs_under", UNDER),
+            over: blend("peel_over", "fs_over", wgpu::BlendState::ALPHA_BLENDING),
+            front_composite: blend(
+                "peel_front_composite",
+                "fs_front",
+                wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
+            ),
             limits_layout,
             layer_layout,
             targets,
             counts: QueryReadback::new(
-                ctx,
+                &setup.ctx,
                 "peel_counts",
                 wgpu::QueryType::Occlusion,
                 max_iterations,
             ),
             iterations: max_iterations,
-            report: TechniqueReport::default(),
-        }
+            report: PeelReport::default(),
+        })
     }
+}
 
+impl Peeling {
     fn targets(
-        ctx: &GpuContext,
+        d: &wgpu::Device,
         limits_layout: &wgpu::BindGroupLayout,
         layer_layout: &wgpu::BindGroupLayout,
-        width: u32,
-        height: u32,
+        size: (u32, u32),
     ) -> Targets {
-        let d = &ctx.device;
         use wgpu::TextureUsages as U;
         let depth = |label| {
-            pipelines::target(
-                d,
-                label,
-                DEPTH_FORMAT,
-                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST,
-                width,
-                height,
-            )
+            let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST;
+            gpu::target(d, label, DEPTH_FORMAT, usage, size)
         };
         let color = |label| {
-            pipelines::target(
-                d,
-                label,
-                SCENE_FORMAT,
-                U::RENDER_ATTACHMENT | U::TEXTURE_BINDING,
-                width,
-                height,
-            )
-            .1
+            let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING;
+            gpu::target(d, label, SCENE_FORMAT, usage, size)
         };
         let front = [depth("peel_front_depth_0"), depth("peel_front_depth_1")];
         let back = [depth("peel_back_depth_0"), depth("peel_back_depth_1")];
-        let limits = |label, a: &wgpu::TextureView, b: &wgpu::TextureView| {
-            pipelines::texture_group(d, label, limits_layout, &[a, b])
+        let limits = |label, a: &Target, b: &Target| {
+            gpu::texture_group(d, label, limits_layout, &[&a.view, &b.view])
         };
         let front_limits = [
-            limits("peel_front_limits_0", &front[1].1, &back[1].1),
-            limits("peel_front_limits_1", &front[0].1, &back[0].1),
+            limits("peel_front_limits_0", &front[1], &back[1]),
+            limits("peel_front_limits_1", &front[0], &back[0]),
         ];
         let back_limits = [
-            limits("peel_back_limits_0", &front[0].1, &back[1].1),
-            limits("peel_back_limits_1", &front[1].1, &back[0].1),
+            limits("peel_back_limits_0", &front[0], &back[1]),
+            limits("peel_back_limits_1", &front[1], &back[0]),
         ];
         let converge_limits = [
-            limits("peel_converge_limits_0", &front[1].1, &back[1].1),
-            limits("peel_converge_limits_1", &front[0].1, &back[1].1),
+            limits("peel_converge_limits_0", &front[1], &back[1]),
+            limits("peel_converge_limits_1", &front[0], &back[1]),
         ];
         let front_layer = color("peel_front_layer");
         let back_layer = color("peel_back_layer");
         let front_acc = color("peel_front_accumulation");
-        let layer =
-            |label, v: &wgpu::TextureView| pipelines::texture_group(d, label, layer_layout, &[v]);
+        let layer = |label, t: &Target| gpu::texture_group(d, label, layer_layout, &[&t.view]);
         Targets {
             front_layer_group: layer("peel_front_layer", &front_layer),
             back_layer_group: layer("peel_back_layer", &back_layer),
@@ -251,88 +291,72 @@ impl Peeling {
         }
     }
 
-    /// One geometry peel into `layer` with `depth` as attachment and `limits` as group 2.
-    #[allow(clippy::too_many_arguments)]
+    /// One geometry peel into `layer` with `depth` as attachment and `limits` as group 2,
+    /// counting the samples it writes into occlusion query `query` when given.
     fn peel_pass(
+        &self,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
-        pipeline: &wgpu::RenderPipeline,
-        label: &'static str,
-        layer: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-        depth_load: wgpu::LoadOp<f32>,
+        frame: &TranslucentFrame<'_>,
+        back: bool,
+        depth: Depth<'_>,
         limits: &wgpu::BindGroup,
-        query: Option<(&wgpu::QuerySet, u32)>,
+        query: Option<u32>,
     ) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(label),
-            color_attachments: &[clear_transparent(layer)],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: depth_load,
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: frame.timestamps("translucent"),
-            occlusion_query_set: query.map(|q| q.0),
-            multiview_mask: None,
+        let (label, pipeline, layer) = if back {
+            ("peel_back", &self.peel_back, &self.targets.back_layer)
+        } else {
+            ("peel_front", &self.peel_front, &self.targets.front_layer)
+        };
+        let colors = [gpu::clear(&layer.view, wgpu::Color::TRANSPARENT)];
+        let pass = Pass {
+            occlusion: query.map(|_| self.counts.set()),
+            ..Pass::new(label, GpuPass::Translucent, &colors).depth(depth)
+        };
+        pass.record(encoder, frame.timer, |pass| {
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(2, limits, &[]);
+            if let Some(i) = query {
+                pass.begin_occlusion_query(i);
+            }
+            frame.draw_chunks(pass);
+            if query.is_some() {
+                pass.end_occlusion_query();
+            }
         });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(2, limits, &[]);
-        if let Some((_, i)) = query {
-            pass.begin_occlusion_query(i);
-        }
-        frame.draw_chunks(&mut pass);
-        if query.is_some() {
-            pass.end_occlusion_query();
-        }
     }
 
+    /// Blends `group`'s layer into `target` with `pipeline`.
     fn blend_pass(
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
+        frame: &TranslucentFrame<'_>,
         pipeline: &wgpu::RenderPipeline,
         target: &wgpu::TextureView,
         group: &wgpu::BindGroup,
     ) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("peel_blend"),
-            color_attachments: &[load_attachment(target)],
-            depth_stencil_attachment: None,
-            timestamp_writes: frame.timestamps("composite"),
-            occlusion_query_set: None,
-            multiview_mask: None,
+        let colors = [gpu::load(target)];
+        Pass::new("peel_blend", GpuPass::Composite, &colors).record(encoder, frame.timer, |pass| {
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, group, &[]);
+            pass.draw(0..3, 0..1);
         });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, group, &[]);
-        pass.draw(0..3, 0..1);
     }
 
     /// Clears the front accumulation, sets the first limits: front[1] at the near plane,
     /// back[1] a copy of the opaque depth.
     fn begin(&self, encoder: &mut wgpu::CommandEncoder, frame: &TranslucentFrame<'_>) {
         let t = &self.targets;
-        drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("peel_clear"),
-            color_attachments: &[clear_transparent(&t.front_acc)],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &t.front[1].1,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        }));
+        let colors = [gpu::clear(&t.front_acc.view, wgpu::Color::TRANSPARENT)];
+        Pass {
+            timing: None,
+            ..Pass::new("peel_clear", GpuPass::Translucent, &colors)
+                .depth(Depth::Clear(&t.front[1].view, 1.0))
+        }
+        .record(encoder, None, |_| {});
+        let opaque = &frame.depth.texture;
         encoder.copy_texture_to_texture(
-            frame.depth_texture.as_image_copy(),
-            t.back[1].0.as_image_copy(),
-            frame.depth_texture.size(),
+            opaque.as_image_copy(),
+            t.back[1].texture.as_image_copy(),
+            opaque.size(),
         );
     }
 
@@ -340,34 +364,32 @@ impl Peeling {
     fn front_iteration(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
+        frame: &TranslucentFrame<'_>,
         i: u32,
         limits: &wgpu::BindGroup,
     ) {
         let t = &self.targets;
         let cur = (i % 2) as usize;
         // The candidates must also lie in front of the opaque surfaces: start from them.
+        let opaque = &frame.depth.texture;
         encoder.copy_texture_to_texture(
-            frame.depth_texture.as_image_copy(),
-            t.front[cur].0.as_image_copy(),
-            frame.depth_texture.size(),
+            opaque.as_image_copy(),
+            t.front[cur].texture.as_image_copy(),
+            opaque.size(),
         );
-        Self::peel_pass(
+        self.peel_pass(
             encoder,
             frame,
-            &self.peel_front,
-            "peel_front",
-            &t.front_layer,
-            &t.front[cur].1,
-            wgpu::LoadOp::Load,
+            false,
+            Depth::Load(&t.front[cur].view),
             limits,
-            Some((self.counts.set(), i)),
+            Some(i),
         );
         Self::blend_pass(
             encoder,
             frame,
             &self.under,
-            &t.front_acc,
+            &t.front_acc.view,
             &t.front_layer_group,
         );
     }
@@ -375,36 +397,39 @@ impl Peeling {
     fn render_dual(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
-        max_iterations: u32,
-    ) {
+        frame: &TranslucentFrame<'_>,
+    ) -> Result<()> {
+        let max_iterations = self.mode.max_iterations();
         // Adapt to the last counts that came back: non-empty iterations plus one probe.
-        if let Some(counts) = self.counts.take() {
-            let ran = counts.len() as u32;
-            let non_empty = counts.iter().take_while(|&&c| c > 0).count() as u32;
-            self.iterations = if non_empty == ran {
-                ran + 1
-            } else {
-                non_empty + 1
-            };
-            self.report.layers = Some(2 * non_empty);
+        // A failed readback keeps the last count (logged): peeling stays correct, only
+        // the adaptation waits.
+        match self.counts.take() {
+            Ok(Some(counts)) => {
+                let ran = counts.len() as u32;
+                let non_empty = counts.iter().take_while(|&&c| c > 0).count() as u32;
+                self.iterations = if non_empty == ran {
+                    ran + 1
+                } else {
+                    non_empty + 1
+                };
+                self.report.layers = Some(2 * non_empty);
+            }
+            Ok(None) => {}
+            Err(e) => log::warn!("depth peeling keeps its layer count: {e}"),
         }
         self.iterations = self.iterations.clamp(1, max_iterations);
-        self.report.iterations = Some(self.iterations);
+        self.report.iterations = self.iterations;
         self.begin(encoder, frame);
 
+        let t = &self.targets;
         for i in 0..self.iterations {
             let cur = (i % 2) as usize;
-            let t = &self.targets;
             self.front_iteration(encoder, frame, i, &t.front_limits[cur]);
-            Self::peel_pass(
+            self.peel_pass(
                 encoder,
                 frame,
-                &self.peel_back,
-                "peel_back",
-                &t.back_layer,
-                &t.back[cur].1,
-                wgpu::LoadOp::Clear(1.0),
+                true,
+                Depth::Clear(&t.back[cur].view, 1.0),
                 &t.back_limits[cur],
                 None,
             );
@@ -412,7 +437,7 @@ impl Peeling {
                 encoder,
                 frame,
                 &self.over,
-                frame.target,
+                &frame.target.view,
                 &t.back_layer_group,
             );
         }
@@ -420,62 +445,77 @@ impl Peeling {
             encoder,
             frame,
             &self.front_composite,
-            frame.target,
-            &self.targets.front_acc_group,
+            &frame.target.view,
+            &t.front_acc_group,
         );
         self.counts.copy(encoder, 0..self.iterations);
+        Ok(())
     }
 
     fn render_converge(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
-    ) {
+        frame: &TranslucentFrame<'_>,
+    ) -> Result<()> {
         self.begin(encoder, frame);
         let mut layers = 0;
-        for i in 0..MAX_CONVERGE_ITERATIONS {
+        let mut truncated = true;
+        for i in 0..MAX_PEEL_LAYERS {
             let cur = (i % 2) as usize;
             self.front_iteration(encoder, frame, i, &self.targets.converge_limits[cur]);
             // Wait for this pass's count: zero means every layer has been peeled.
             self.counts.copy(encoder, i..i + 1);
-            pipelines::flush(ctx, encoder);
+            gpu::flush(ctx, encoder);
             self.counts.map();
-            let written = self
-                .counts
-                .wait(ctx)
-                .and_then(|c| c.first().copied())
-                .unwrap_or(0);
+            let written =
+                self.counts.wait(ctx)?.first().copied().ok_or_else(|| {
+                    Error::ReadbackData("an occlusion count came back empty".into())
+                })?;
             if written == 0 {
+                truncated = false;
                 break;
             }
             layers += 1;
         }
-        self.report.layers = Some(layers);
-        self.report.iterations = Some(layers + 1);
+        if truncated {
+            log::warn!("peel-to-convergence stopped at {MAX_PEEL_LAYERS} layers with more left");
+        }
+        self.report = PeelReport {
+            layers: Some(layers),
+            iterations: layers + u32::from(!truncated),
+            truncated,
+        };
         Self::blend_pass(
             encoder,
             frame,
             &self.front_composite,
-            frame.target,
+            &frame.target.view,
             &self.targets.front_acc_group,
         );
+        Ok(())
     }
 }
 
 impl TranslucentTechnique for Peeling {
-    fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) {
-        self.targets = Self::targets(ctx, &self.limits_layout, &self.layer_layout, width, height);
+    fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
+        self.targets = Self::targets(
+            &ctx.device,
+            &self.limits_layout,
+            &self.layer_layout,
+            (width, height),
+        );
+        Ok(())
     }
 
     fn render(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
-    ) {
+        frame: &TranslucentFrame<'_>,
+    ) -> Result<()> {
         match self.mode {
-            PeelMode::Dual { layers } => self.render_dual(encoder, frame, layers.max(2) / 2),
+            PeelMode::Dual { .. } => self.render_dual(encoder, frame),
             PeelMode::Converge => self.render_converge(ctx, encoder, frame),
         }
     }
@@ -485,6 +525,9 @@ impl TranslucentTechnique for Peeling {
     }
 
     fn report(&self) -> TechniqueReport {
-        self.report
+        TechniqueReport {
+            peeling: Some(self.report),
+            ..TechniqueReport::default()
+        }
     }
 }

@@ -1,5 +1,6 @@
-// Exact reference, pass 1 (appended to common.wgsl): every translucent fragment in front of
-// the opaque surfaces is appended to its pixel's linked list (an A-buffer).
+// Exact reference, pass 1 (appended to common.wgsl and types.wgsl): every translucent
+// fragment of the tile in front of the opaque surfaces is appended to its pixel's linked
+// list (an A-buffer).
 
 @group(2) @binding(0) var<storage, read_write> heads: array<atomic<u32>>;
 @group(2) @binding(1) var<storage, read_write> nodes: array<Node>;
@@ -12,7 +13,7 @@ fn fs_abuffer(in: VsOut) {
     let c = translucent_color(in);
     let p = vec2<u32>(in.clip.xy);
     // The depth test, in the shader: a fragment with storage writes may run them before a
-    // late depth test would have dropped it.
+    // late depth test would have dropped it. The scissor keeps fragments in the tile.
     if in.clip.z <= textureLoad(opaque_depth, vec2<i32>(p), 0) || c.a <= 0.0 {
         return;
     }
@@ -22,5 +23,5 @@ fn fs_abuffer(in: VsOut) {
     }
     nodes[index].color = vec2<u32>(pack2x16float(c.rg), pack2x16float(c.ba));
     nodes[index].depth = in.clip.z;
-    nodes[index].next = atomicExchange(&heads[p.y * params.width + p.x], index + 1u);
+    nodes[index].next = atomicExchange(&heads[head_index(p)], index + 1u);
 }

@@ -3,25 +3,33 @@
 //!
 //! Pass 1 appends each translucent fragment in front of the opaque depth to its pixel's
 //! list (a storage buffer of nodes, an atomic head pointer per pixel; needs fragment
-//! shaders that write storage, `DownlevelFlags::FRAGMENT_WRITABLE_STORAGE`). Pass 2 sorts
-//! each list (up to 128 fragments a pixel) and blends it front to back over the opaque
-//! image.
+//! shaders that write storage, `DownlevelFlags::FRAGMENT_WRITABLE_STORAGE`). Pass 2 keeps
+//! each pixel's nearest [`MAX_LAYERS`] fragments, sorted, and blends them front to back
+//! over the opaque image.
 //!
-//! Overflow is counted and reported, never silent. The node pool starts at four nodes a
-//! pixel; after each frame the counters are read back (a stall: this is a measurement
-//! tool), and if nodes ran out the frame is redone with a pool twice as large, up to the
-//! adapter's largest storage binding, then in 2×2, 4×4, ... screen tiles (each tile
-//! re-draws the geometry and reuses the pool), up to 16×16. What still does not fit, and
-//! pixels with more than 128 fragments, are reported in [`TechniqueReport::overflow`].
+//! Limits, none of them silent ([`ReferenceReport`]):
+//! - **Pool**: it starts at four nodes a pixel; after each frame the counters are read back
+//!   (a stall: this is a measurement tool), and if nodes ran out the frame is redone with a
+//!   pool twice as large, up to the adapter's largest storage binding, then in 2×2, 4×4,
+//!   ... screen tiles (each tile re-draws the geometry and reuses the pool), up to
+//!   [`MAX_TILES`]² tiles. Fragments that still do not fit are counted as lost.
+//! - **Head pointers** are per tile: the first tiling is the smallest whose tile's heads
+//!   fit one storage binding, so any render size the adapter's textures allow works.
+//! - **Depth complexity**: a pixel with more than [`MAX_LAYERS`] fragments blends its
+//!   nearest [`MAX_LAYERS`]; it is counted as *capped*, and as *capped visibly* when more
+//!   than half a level (1/510) of light came through the kept layers (then the dropped
+//!   ones could change its 8-bit colour: the picture is not exact there).
 
 use wgpu::util::DeviceExt;
 
-use crate::oit::{OitConfig, TechniqueReport, TranslucentFrame, TranslucentTechnique};
-use crate::pipelines::{self, COMMON_WGSL, DepthMode, SharedLayouts, load_attachment};
-use crate::{GpuContext, readback};
-
-/// WGSL of the node, counter and parameter structs both passes share.
-const TYPES_WGSL: &str = include_str!("types.wgsl");
+use crate::context::Capabilities;
+use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, WgslConsts};
+use crate::oit::{
+    OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
+    TranslucentTechnique,
+};
+use crate::timing::GpuPass;
+use crate::{Error, GpuContext, Result, readback};
 
 /// Bytes per node: colour (4 halves), depth, next.
 pub const NODE_BYTES: u64 = 16;
@@ -29,6 +37,79 @@ pub const NODE_BYTES: u64 = 16;
 pub const INITIAL_NODES_PER_PIXEL: u64 = 4;
 /// Most tiles per axis before giving up on fitting a frame.
 pub const MAX_TILES: u32 = 16;
+/// Fragments a pixel blends at most (its nearest ones).
+pub const MAX_LAYERS: u32 = 128;
+
+/// What the A-buffer did in the last frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ReferenceReport {
+    /// Attempts the frame needed (more than 1 after growing the pool or tiling).
+    pub attempts: u32,
+    /// Tiles per axis of the last attempt.
+    pub tiles: u32,
+    /// Fragments that did not fit in the pool even with the most tiles (should be 0).
+    pub lost_fragments: u64,
+    /// Pixels with more than [`MAX_LAYERS`] fragments (their nearest ones were blended).
+    pub capped_pixels: u64,
+    /// Capped pixels where the dropped fragments could change the 8-bit colour.
+    pub capped_visible_pixels: u64,
+}
+
+impl ReferenceReport {
+    /// Whether the picture is exact: nothing lost, no pixel capped visibly.
+    pub fn exact(&self) -> bool {
+        self.lost_fragments == 0 && self.capped_visible_pixels == 0
+    }
+}
+
+/// The counters read back per tile (`Counters` in `types.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Counters {
+    /// Nodes asked for.
+    pub nodes: u32,
+    /// Pixels with more than [`MAX_LAYERS`] fragments.
+    pub capped: u32,
+    /// Of those, the ones where the dropped fragments could show.
+    pub capped_visible: u32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+/// The tile being drawn (`Params` in `types.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Params {
+    /// Top-left pixel of the tile.
+    pub origin: [u32; 2],
+    /// Width of the tile (row length of its head pointers).
+    pub tile_width: u32,
+    /// Nodes in the pool.
+    pub capacity: u32,
+}
+
+const COUNTERS_BYTES: u64 = std::mem::size_of::<Counters>() as u64;
+
+/// WGSL of the constants and types both passes share.
+fn types_wgsl() -> String {
+    let consts = WgslConsts::default().u32("MAX_LAYERS", MAX_LAYERS).finish();
+    consts + include_str!("types.wgsl")
+}
+
+/// The build pass's shader.
+pub fn build_wgsl() -> String {
+    [
+        crate::bindings::COMMON_WGSL,
+        &types_wgsl(),
+        include_str!("abuffer.wgsl"),
+    ]
+    .concat()
+}
+
+/// The resolve pass's shader (after `fullscreen.wgsl`).
+pub fn resolve_wgsl() -> String {
+    [&types_wgsl(), include_str!("resolve.wgsl")].concat()
+}
 
 #[derive(Debug)]
 struct Buffers {
@@ -36,7 +117,6 @@ struct Buffers {
     capacity: u32,
     build_group: wgpu::BindGroup,
     resolve_group: wgpu::BindGroup,
-    backup: wgpu::Texture,
 }
 
 /// A-buffer resources.
@@ -48,97 +128,92 @@ pub struct Reference {
     resolve_layout: wgpu::BindGroupLayout,
     counters: wgpu::Buffer,
     counters_readback: wgpu::Buffer,
+    /// One [`Params`] per tile, at a stride the uniform offset alignment allows.
     params: wgpu::Buffer,
+    params_stride: u64,
     buffers: Option<Buffers>,
-    width: u32,
-    height: u32,
+    backup: Option<wgpu::Texture>,
+    size: (u32, u32),
     tiles: u32,
-    report: TechniqueReport,
+    report: ReferenceReport,
 }
 
-fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
+impl TechniqueKind for Reference {
+    type Key = ();
+
+    fn is_exact(_: Technique) -> bool {
+        true
     }
-}
 
-fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
+    fn fallback(_: Technique, caps: &Capabilities) -> Option<Technique> {
+        (!caps.fragment_storage()).then_some(Technique::PeelReference)
     }
-}
 
-impl Reference {
-    /// Creates the pipelines; buffers come with the first frame.
-    pub fn new(ctx: &GpuContext, layouts: &SharedLayouts, config: &OitConfig) -> Self {
-        let device = &ctx.device;
-        let build_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("abuffer_build_layout"),
-            entries: &[
-                storage_entry(0, false),
-                storage_entry(1, false),
-                storage_entry(2, false),
-                uniform_entry(3),
-                pipelines::texture_entry(4, wgpu::TextureSampleType::Depth),
-            ],
-        });
-        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("abuffer_resolve_layout"),
-            entries: &[
-                storage_entry(0, true),
-                storage_entry(1, true),
-                storage_entry(2, false),
-                uniform_entry(3),
-            ],
-        });
-        let module = pipelines::shader(
+    fn key(_: Technique, _: &OitConfig, _: &Capabilities) {}
+
+    fn create(setup: &Setup, _: Technique, _: &OitConfig) -> Result<Self> {
+        let device = &setup.ctx.device;
+        use wgpu::BufferBindingType as B;
+        use wgpu::ShaderStages as S;
+        let storage = |i, read_only| gpu::buffer_entry(i, S::FRAGMENT, B::Storage { read_only });
+        let params_entry = wgpu::BindGroupLayoutEntry {
+            binding: 3,
+            visibility: S::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: B::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+            },
+            count: None,
+        };
+        let build_layout = gpu::layout(
             device,
-            "abuffer_build",
-            &[COMMON_WGSL, TYPES_WGSL, include_str!("abuffer.wgsl")],
-        );
-        let build = pipelines::chunk_pipeline(
-            device,
-            "abuffer_build",
-            &module,
-            "fs_abuffer",
+            "abuffer_build_layout",
             &[
-                Some(&layouts.scene),
-                Some(&layouts.chunk),
-                Some(&build_layout),
+                storage(0, false),
+                storage(1, false),
+                storage(2, false),
+                params_entry,
+                gpu::texture_entry(4, wgpu::TextureSampleType::Depth),
             ],
-            &[],
-            DepthMode::ReadOnly,
-            1,
         );
-        let resolve = pipelines::fullscreen_pipeline(
+        let resolve_layout = gpu::layout(
             device,
-            "abuffer_resolve",
-            &[TYPES_WGSL, include_str!("resolve.wgsl")].concat(),
-            "fs_resolve",
-            &[Some(&resolve_layout)],
-            &[pipelines::scene_target(Some(
+            "abuffer_resolve_layout",
+            &[
+                storage(0, true),
+                storage(1, true),
+                storage(2, false),
+                params_entry,
+            ],
+        );
+        let module = gpu::shader(device, "abuffer_build", &[&build_wgsl()]);
+        let build = ChunkPipeline {
+            label: "abuffer_build",
+            module: &module,
+            fragment_entry: "fs_abuffer",
+            groups: &setup.layouts.with(&[&build_layout]),
+            targets: &[],
+            depth: DepthMode::ReadOnly,
+            samples: 1,
+        }
+        .build(device);
+        let resolve = FullscreenPipeline {
+            label: "abuffer_resolve",
+            source: &resolve_wgsl(),
+            fragment_entry: "fs_resolve",
+            groups: &[Some(&resolve_layout)],
+            targets: &[gpu::scene_target(Some(
                 wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
             ))],
-            false,
-            &[],
-        );
+            writes_depth: false,
+            constants: &[],
+        }
+        .build(device);
+        let max_tiles = u64::from(MAX_TILES * MAX_TILES);
         let counters = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("abuffer_counters"),
-            size: 8,
+            size: COUNTERS_BYTES,
             usage: wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::COPY_SRC
                 | wgpu::BufferUsages::COPY_DST,
@@ -146,16 +221,18 @@ impl Reference {
         });
         let counters_readback = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("abuffer_counters_readback"),
-            size: 8 * u64::from(MAX_TILES * MAX_TILES),
+            size: COUNTERS_BYTES * max_tiles,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let align = u64::from(setup.ctx.caps.limits.min_uniform_buffer_offset_alignment);
+        let params_stride = (std::mem::size_of::<Params>() as u64).div_ceil(align) * align;
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("abuffer_params"),
-            contents: bytemuck::cast_slice(&[0u32; 4]),
+            contents: &vec![0; (params_stride * max_tiles) as usize],
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
-        Self {
+        Ok(Self {
             build,
             resolve,
             build_layout,
@@ -163,30 +240,60 @@ impl Reference {
             counters,
             counters_readback,
             params,
+            params_stride,
             buffers: None,
-            width: config.width,
-            height: config.height,
-            tiles: 1,
-            report: TechniqueReport::default(),
-        }
+            backup: None,
+            size: setup.size,
+            tiles: 0,
+            report: ReferenceReport::default(),
+        })
+    }
+}
+
+impl Reference {
+    fn max_binding(ctx: &GpuContext) -> u64 {
+        let l = &ctx.caps.limits;
+        l.max_storage_buffer_binding_size.min(l.max_buffer_size)
     }
 
     /// The largest node pool this adapter can bind.
     fn max_capacity(ctx: &GpuContext) -> u64 {
-        let bytes = ctx
-            .caps
-            .limits
-            .max_storage_buffer_binding_size
-            .min(ctx.caps.limits.max_buffer_size);
-        (bytes / NODE_BYTES).min(u64::from(u32::MAX))
+        (Self::max_binding(ctx) / NODE_BYTES).min(u64::from(u32::MAX))
     }
 
+    /// Tile size for `tiles` per axis.
+    fn tile_size(&self, tiles: u32) -> (u32, u32) {
+        (self.size.0.div_ceil(tiles), self.size.1.div_ceil(tiles))
+    }
+
+    /// The fewest tiles per axis whose head pointers fit one storage binding.
+    fn min_tiles(&self, ctx: &GpuContext) -> Result<u32> {
+        let max = Self::max_binding(ctx);
+        (1..=MAX_TILES)
+            .find(|&t| {
+                let (w, h) = self.tile_size(t);
+                u64::from(w) * u64::from(h) * 4 <= max
+            })
+            .ok_or_else(|| Error::TooLarge {
+                what: format!(
+                    "A-buffer head pointers for {}x{} pixels in {MAX_TILES}x{MAX_TILES} tiles (bytes)",
+                    self.size.0, self.size.1
+                ),
+                value: u64::from(self.tile_size(MAX_TILES).0)
+                    * u64::from(self.tile_size(MAX_TILES).1)
+                    * 4,
+                limit_name: "max_storage_buffer_binding_size",
+                limit: max,
+            })
+    }
+
+    /// (Re)creates the head pointers for the current tiling and a pool of `capacity` nodes.
     fn allocate(&mut self, ctx: &GpuContext, frame: &TranslucentFrame<'_>, capacity: u32) {
         let device = &ctx.device;
-        let pixels = u64::from(self.width) * u64::from(self.height);
+        let (tw, th) = self.tile_size(self.tiles);
         let heads = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("abuffer_heads"),
-            size: pixels * 4,
+            size: u64::from(tw) * u64::from(th) * 4,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -196,203 +303,241 @@ impl Reference {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        ctx.queue.write_buffer(
-            &self.params,
-            0,
-            bytemuck::cast_slice(&[self.width, capacity, 0, 0]),
-        );
-        let entries = |with_depth: bool| {
-            let mut e = vec![
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: heads.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: nodes.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: self.counters.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: self.params.as_entire_binding(),
-                },
-            ];
-            if with_depth {
-                e.push(wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(frame.depth),
-                });
-            }
-            e
-        };
-        let build_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("abuffer_build"),
-            layout: &self.build_layout,
-            entries: &entries(true),
+        let params = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.params,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
         });
-        let resolve_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("abuffer_resolve"),
-            layout: &self.resolve_layout,
-            entries: &entries(false),
-        });
-        let backup = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("abuffer_opaque_backup"),
-            size: frame.target_texture.size(),
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: frame.target_texture.format(),
-            usage: wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let common = [
+            heads.as_entire_binding(),
+            nodes.as_entire_binding(),
+            self.counters.as_entire_binding(),
+            params,
+        ];
+        let mut build = common.to_vec();
+        build.push(wgpu::BindingResource::TextureView(&frame.depth.view));
+        let build_group = gpu::bind_group(device, "abuffer_build", &self.build_layout, &build);
+        let resolve_group =
+            gpu::bind_group(device, "abuffer_resolve", &self.resolve_layout, &common);
         self.buffers = Some(Buffers {
             heads,
             capacity,
             build_group,
             resolve_group,
-            backup,
         });
     }
 
     /// Records one attempt with the current pool and tiling; returns the number of tiles.
-    fn record(&self, encoder: &mut wgpu::CommandEncoder, frame: &mut TranslucentFrame<'_>) -> u32 {
+    fn record(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &TranslucentFrame<'_>,
+    ) -> u32 {
         let Some(b) = &self.buffers else { return 0 };
-        let tiles = self.tiles;
-        let (tw, th) = (self.width.div_ceil(tiles), self.height.div_ceil(tiles));
-        let mut k = 0;
-        for ty in 0..tiles {
-            for tx in 0..tiles {
+        let (width, height) = self.size;
+        let (tw, th) = self.tile_size(self.tiles);
+        let mut k = 0u32;
+        for ty in 0..self.tiles {
+            for tx in 0..self.tiles {
                 let (x, y) = (tx * tw, ty * th);
-                if x >= self.width || y >= self.height {
+                if x >= width || y >= height {
                     continue;
                 }
-                let (w, h) = (tw.min(self.width - x), th.min(self.height - y));
+                let (w, h) = (tw.min(width - x), th.min(height - y));
+                let offset = u64::from(k) * self.params_stride;
+                let params = Params {
+                    origin: [x, y],
+                    tile_width: tw,
+                    capacity: b.capacity,
+                };
+                ctx.queue
+                    .write_buffer(&self.params, offset, bytemuck::bytes_of(&params));
+                let dynamic = [offset as u32];
                 encoder.clear_buffer(&b.heads, 0, None);
                 encoder.clear_buffer(&self.counters, 0, None);
-                {
-                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some("abuffer_build"),
-                        color_attachments: &[],
-                        depth_stencil_attachment: pipelines::read_only_depth(frame.depth),
-                        timestamp_writes: frame.timestamps("translucent"),
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    });
+                Pass {
+                    colors: &[],
+                    ..Pass::new("abuffer_build", GpuPass::Translucent, &[])
+                }
+                .depth(Depth::ReadOnly(&frame.depth.view))
+                .record(encoder, frame.timer, |pass| {
                     pass.set_scissor_rect(x, y, w, h);
                     pass.set_pipeline(&self.build);
-                    pass.set_bind_group(2, &b.build_group, &[]);
-                    frame.draw_chunks(&mut pass);
-                }
-                {
-                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some("abuffer_resolve"),
-                        color_attachments: &[load_attachment(frame.target)],
-                        depth_stencil_attachment: None,
-                        timestamp_writes: frame.timestamps("composite"),
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    });
-                    pass.set_scissor_rect(x, y, w, h);
-                    pass.set_pipeline(&self.resolve);
-                    pass.set_bind_group(0, &b.resolve_group, &[]);
-                    pass.draw(0..3, 0..1);
-                }
+                    pass.set_bind_group(2, &b.build_group, &dynamic);
+                    frame.draw_chunks(pass);
+                });
+                let colors = [gpu::load(&frame.target.view)];
+                Pass::new("abuffer_resolve", GpuPass::Composite, &colors).record(
+                    encoder,
+                    frame.timer,
+                    |pass| {
+                        pass.set_scissor_rect(x, y, w, h);
+                        pass.set_pipeline(&self.resolve);
+                        pass.set_bind_group(0, &b.resolve_group, &dynamic);
+                        pass.draw(0..3, 0..1);
+                    },
+                );
                 encoder.copy_buffer_to_buffer(
                     &self.counters,
                     0,
                     &self.counters_readback,
-                    8 * u64::from(k),
-                    8,
+                    COUNTERS_BYTES * u64::from(k),
+                    COUNTERS_BYTES,
                 );
                 k += 1;
             }
         }
         k
     }
+
+    /// Sums the counters of `tiles` tiles: (lost nodes, most nodes one tile asked for,
+    /// capped, capped visibly).
+    fn read_counters(&self, ctx: &GpuContext, tiles: u32) -> Result<(u64, u64, u64, u64)> {
+        let bytes = readback::map_read(ctx, &self.counters_readback)?;
+        let all: &[Counters] = bytemuck::try_cast_slice(&bytes)
+            .map_err(|e| Error::ReadbackData(format!("A-buffer counters: {e}")))?;
+        let counts = all.get(..tiles as usize).ok_or_else(|| {
+            Error::ReadbackData(format!(
+                "A-buffer counters: {} tiles read back, {tiles} drawn",
+                all.len()
+            ))
+        })?;
+        let capacity = u64::from(self.buffers.as_ref().map_or(0, |b| b.capacity));
+        let mut sums = (0, 0, 0, 0);
+        for c in counts {
+            let nodes = u64::from(c.nodes);
+            sums.0 += nodes.saturating_sub(capacity);
+            sums.1 = sums.1.max(nodes);
+            sums.2 += u64::from(c.capped);
+            sums.3 += u64::from(c.capped_visible);
+        }
+        Ok(sums)
+    }
 }
 
 impl TranslucentTechnique for Reference {
-    fn resize(&mut self, _ctx: &GpuContext, width: u32, height: u32) {
-        self.width = width;
-        self.height = height;
+    fn resize(&mut self, _ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
+        self.size = (width, height);
         self.buffers = None;
-        self.tiles = 1;
+        self.backup = None;
+        self.tiles = 0;
+        Ok(())
     }
 
     fn render(
         &mut self,
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
-    ) {
+        frame: &TranslucentFrame<'_>,
+    ) -> Result<()> {
         let max = Self::max_capacity(ctx);
-        if self.buffers.is_none() {
-            let pixels = u64::from(self.width) * u64::from(self.height);
+        let min_tiles = self.min_tiles(ctx)?;
+        if self.buffers.is_none() || self.tiles < min_tiles {
+            self.tiles = self.tiles.max(min_tiles);
+            let (tw, th) = self.tile_size(self.tiles);
+            let pixels = u64::from(tw) * u64::from(th);
             self.allocate(
                 ctx,
                 frame,
                 (pixels * INITIAL_NODES_PER_PIXEL).clamp(1024, max) as u32,
             );
         }
-        let Some(backup) = self.buffers.as_ref().map(|b| b.backup.clone()) else {
-            return;
-        };
+        let backup = self
+            .backup
+            .get_or_insert_with(|| {
+                ctx.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("abuffer_opaque_backup"),
+                    size: frame.target.texture.size(),
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: frame.target.texture.format(),
+                    usage: wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST,
+                    view_formats: &[],
+                })
+            })
+            .clone();
         // Keep the opaque image, in case the frame has to be redone.
+        let scene = &frame.target.texture;
         encoder.copy_texture_to_texture(
-            frame.target_texture.as_image_copy(),
+            scene.as_image_copy(),
             backup.as_image_copy(),
             backup.size(),
         );
         let mut attempts = 0;
         loop {
             attempts += 1;
-            self.report.attempts = Some(attempts);
-            let tiles_recorded = self.record(encoder, frame);
-
-            pipelines::flush(ctx, encoder);
-            let counts = readback::map_read(ctx, &self.counters_readback).unwrap_or_default();
-            let words: &[u32] = bytemuck::cast_slice(&counts);
-            let capacity = self.buffers.as_ref().map_or(0, |b| b.capacity);
-            let mut lost = 0u64;
-            let mut truncated = 0u64;
-            let mut needed = 0u64;
-            for t in 0..tiles_recorded as usize {
-                let (nodes, trunc) = (u64::from(words[2 * t]), u64::from(words[2 * t + 1]));
-                needed = needed.max(nodes);
-                lost += nodes.saturating_sub(u64::from(capacity));
-                truncated += trunc;
-            }
-            if lost == 0 {
-                self.report.overflow = Some(truncated);
-                self.report.layers = None;
-                return;
+            let tiles_recorded = self.record(ctx, encoder, frame);
+            gpu::flush(ctx, encoder);
+            let (lost, needed, capped, capped_visible) = self.read_counters(ctx, tiles_recorded)?;
+            let capacity = self.buffers.as_ref().map_or(0, |b| u64::from(b.capacity));
+            let give_up = capacity >= max && self.tiles >= MAX_TILES;
+            if lost == 0 || give_up {
+                if lost > 0 {
+                    log::warn!(
+                        "A-buffer: {lost} fragments lost even with {0}x{0} tiles",
+                        self.tiles
+                    );
+                }
+                self.report = ReferenceReport {
+                    attempts,
+                    tiles: self.tiles,
+                    lost_fragments: lost,
+                    capped_pixels: capped,
+                    capped_visible_pixels: capped_visible,
+                };
+                return Ok(());
             }
             // Redo the frame from the opaque image with more room.
             encoder.copy_texture_to_texture(
                 backup.as_image_copy(),
-                frame.target_texture.as_image_copy(),
+                scene.as_image_copy(),
                 backup.size(),
             );
-            if u64::from(capacity) < max {
+            if capacity < max {
                 self.allocate(ctx, frame, needed.next_power_of_two().min(max) as u32);
-            } else if self.tiles < MAX_TILES {
-                self.tiles *= 2;
             } else {
-                self.report.overflow = Some(lost + truncated);
-                log::warn!(
-                    "A-buffer overflow: {lost} fragments lost even with {0}x{0} tiles",
-                    self.tiles
-                );
-                let _ = self.record(encoder, frame);
-                return;
+                self.tiles = (self.tiles * 2).min(MAX_TILES);
+                self.allocate(ctx, frame, capacity as u32);
             }
         }
     }
 
     fn report(&self) -> TechniqueReport {
-        self.report
+        TechniqueReport {
+            reference: Some(self.report),
+            ..TechniqueReport::default()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wgsl_layout::{assert_layout, field, parse};
+
+    #[test]
+    fn shared_structs_match_their_wgsl() {
+        let build = parse(&build_wgsl());
+        assert_layout::<Counters>(
+            &build,
+            "Counters",
+            &[
+                field!(Counters, nodes),
+                field!(Counters, capped),
+                field!(Counters, capped_visible),
+                field!(Counters, _pad),
+            ],
+        );
+        assert_layout::<Params>(
+            &build,
+            "Params",
+            &[
+                field!(Params, origin),
+                field!(Params, tile_width),
+                field!(Params, capacity),
+            ],
+        );
     }
 }

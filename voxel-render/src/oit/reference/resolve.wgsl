@@ -1,6 +1,6 @@
-// Exact reference, pass 2 (appended to fullscreen.wgsl): sort each pixel's fragments by
-// depth and blend them front to back; the result goes over the opaque image with
-// (One, OneMinusSrcAlpha): out = Σ layers (exact "over" order) + Π(1 − α) · opaque.
+// Exact reference, pass 2 (appended to fullscreen.wgsl and types.wgsl): sort each pixel's
+// fragments by depth and blend them front to back; the result goes over the opaque image
+// with (One, OneMinusSrcAlpha): out = Σ layers (exact "over" order) + Π(1 − α) · opaque.
 
 @group(0) @binding(0) var<storage, read> heads: array<u32>;
 @group(0) @binding(1) var<storage, read> nodes: array<Node>;
@@ -11,44 +11,54 @@ fn tie_key(c: vec2<u32>) -> u32 {
     return c.x ^ (c.y * 2654435761u);
 }
 
-// Most fragments one pixel can hold; a longer list is counted in `truncated`.
-const MAX_LAYERS: u32 = 128u;
+// Whether fragment a (depth, colour) lies in front of fragment b. Fragments at exactly the
+// same depth (two faces meeting on an edge through the pixel centre) are ordered by their
+// colour bits, so that the order does not depend on which won the race to the list.
+fn in_front(da: f32, ca: vec2<u32>, db: f32, cb: vec2<u32>) -> bool {
+    return da > db || (da == db && tie_key(ca) > tie_key(cb));
+}
 
 @fragment
 fn fs_resolve(in: FullscreenOut) -> @location(0) vec4<f32> {
     let p = vec2<u32>(in.clip.xy);
-    var next = heads[p.y * params.width + p.x];
+    var next = heads[head_index(p)];
     if next == 0u {
         discard;
     }
+    // The nearest MAX_LAYERS fragments, nearest (largest reverse-Z depth) first, by
+    // insertion while walking the list; a farther fragment than all kept ones of a full
+    // list is dropped, a nearer one replaces the farthest kept.
     var depth: array<f32, MAX_LAYERS>;
     var color: array<vec2<u32>, MAX_LAYERS>;
     var n = 0u;
-    // Insertion sort while walking the list: nearest (largest reverse-Z depth) first.
-    // Fragments at exactly the same depth (two faces meeting on an edge that passes
-    // through the pixel centre) are ordered by their colour bits, so that the order does
-    // not depend on which fragment won the race to the list.
-    while next != 0u && n < MAX_LAYERS {
+    var total = 0u;
+    while next != 0u {
         let node = nodes[next - 1u];
-        var i = n;
-        while i > 0u && (depth[i - 1u] < node.depth
-            || (depth[i - 1u] == node.depth && tie_key(color[i - 1u]) < tie_key(node.color))) {
+        next = node.next;
+        total += 1u;
+        if n == MAX_LAYERS && !in_front(node.depth, node.color, depth[n - 1u], color[n - 1u]) {
+            continue;
+        }
+        var i = min(n, MAX_LAYERS - 1u);
+        while i > 0u && in_front(node.depth, node.color, depth[i - 1u], color[i - 1u]) {
             depth[i] = depth[i - 1u];
             color[i] = color[i - 1u];
             i -= 1u;
         }
         depth[i] = node.depth;
         color[i] = node.color;
-        n += 1u;
-        next = node.next;
-    }
-    if next != 0u {
-        atomicAdd(&counters.truncated, 1u);
+        n = min(n + 1u, MAX_LAYERS);
     }
     var acc = vec4<f32>(0.0);
     for (var i = 0u; i < n; i += 1u) {
         let c = vec4<f32>(unpack2x16float(color[i].x), unpack2x16float(color[i].y));
         acc += (1.0 - acc.a) * vec4<f32>(c.rgb * c.a, c.a);
+    }
+    if total > MAX_LAYERS {
+        atomicAdd(&counters.capped, 1u);
+        if 1.0 - acc.a > 0.5 / 255.0 {
+            atomicAdd(&counters.capped_visible, 1u);
+        }
     }
     return acc;
 }

@@ -1,4 +1,4 @@
-// Types shared by both A-buffer passes.
+// Types shared by both A-buffer passes (after the constants made in Rust: MAX_LAYERS).
 
 struct Node {
     // Colour and alpha as four halves (pack2x16float): exact enough for a reference that
@@ -9,14 +9,27 @@ struct Node {
     next: u32,
 };
 
+// Read back after every tile (`Counters` in mod.rs, checked equal by a test).
 struct Counters {
-    // Nodes asked for, including those that did not fit.
+    // Nodes asked for, including those that did not fit in the pool.
     nodes: atomic<u32>,
-    // Pixels whose list was longer than the resolve can sort (MAX_LAYERS).
-    truncated: atomic<u32>,
+    // Pixels with more than MAX_LAYERS fragments: only the nearest MAX_LAYERS are blended.
+    capped: atomic<u32>,
+    // Of those, pixels where more than half a level of light (1/510) still came through
+    // the kept layers, so that the dropped ones could change the 8-bit colour.
+    capped_visible: atomic<u32>,
+    _pad: u32,
 };
 
+// The tile being drawn (`Params` in mod.rs, checked equal by a test): head pointers are
+// per tile, so that they fit in one storage binding at any render size.
 struct Params {
-    width: u32,
+    origin: vec2<u32>,
+    tile_width: u32,
     capacity: u32,
 };
+
+fn head_index(p: vec2<u32>) -> u32 {
+    let local = p - params.origin;
+    return local.y * params.tile_width + local.x;
+}

@@ -39,7 +39,9 @@ impl BayerSize {
         Self::ALL
             .into_iter()
             .find(|b| b.side() == side)
-            .ok_or_else(|| Error::UnknownName(format!("Bayer size {side}; known: 2, 4, 8, 16")))
+            .ok_or_else(|| {
+                Error::unknown_name("Bayer size", &side.to_string(), ["2", "4", "8", "16"])
+            })
     }
 }
 
@@ -82,27 +84,17 @@ pub fn bayer_offset(size: BayerSize) -> usize {
         .sum()
 }
 
-/// How a surface's alpha turns into coverage (seed 001's modes).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum TransparencyMode {
-    /// No alpha processing, no discard.
-    Opaque = 0,
-    /// Ordered dithering against the Bayer threshold.
-    Stipple = 1,
-    /// Binary cutout at alpha 0.5.
-    AlphaTest = 2,
-    /// Reserved (treated as opaque).
-    Reserved = 3,
-}
+/// Seed 001's mode code for stipple in bits 8–9 of the shading state. (Its other modes,
+/// 0 opaque and 2 alpha test, are what the opaque and cutout passes do; the stipple
+/// technique always sends this one.)
+pub const STIPPLE_MODE: u32 = 1;
 
 /// Seed 001's 32-bit shading state: bits 0–7 uniform alpha (0–255), bits 8–9 transparency
-/// mode, bits 10–11 dither pattern; bits 12–31 are left zero.
+/// mode (always [`STIPPLE_MODE`] here), bits 10–11 dither pattern; bits 12–31 are left zero.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ShadingState {
     /// Whole-draw opacity, 255 = 1.0.
     pub alpha: u8,
-    /// What to do with alpha.
-    pub mode: TransparencyMode,
     /// Which Bayer matrix.
     pub pattern: BayerSize,
 }
@@ -110,20 +102,13 @@ pub struct ShadingState {
 impl ShadingState {
     /// Packs into seed 001's layout.
     pub fn pack(self) -> u32 {
-        u32::from(self.alpha) | (self.mode as u32) << 8 | self.pattern.code() << 10
+        u32::from(self.alpha) | STIPPLE_MODE << 8 | self.pattern.code() << 10
     }
 
-    /// Unpacks seed 001's layout (bits 12–31 are ignored).
+    /// Unpacks seed 001's layout (the mode and bits 12–31 are ignored).
     pub fn unpack(packed: u32) -> Self {
-        let mode = match (packed >> 8) & 3 {
-            0 => TransparencyMode::Opaque,
-            1 => TransparencyMode::Stipple,
-            2 => TransparencyMode::AlphaTest,
-            _ => TransparencyMode::Reserved,
-        };
         Self {
             alpha: (packed & 0xff) as u8,
-            mode,
             pattern: BayerSize::from_code(packed >> 10),
         }
     }
@@ -186,7 +171,6 @@ mod tests {
             let o = bayer_offset(b);
             assert_eq!(levels[o..o + n], bayer(b.side() as usize)[..]);
         }
-        // The offsets dither.wgsl hard-codes.
         assert_eq!(BayerSize::ALL.map(bayer_offset), [0, 4, 20, 84]);
     }
 
@@ -194,7 +178,6 @@ mod tests {
     fn shading_state_bit_layout() {
         let s = ShadingState {
             alpha: 0xab,
-            mode: TransparencyMode::Stipple,
             pattern: BayerSize::B8,
         };
         assert_eq!(s.pack(), 0xab | 1 << 8 | 2 << 10);
@@ -206,21 +189,11 @@ mod tests {
     #[test]
     fn shading_state_round_trips_every_combination() {
         for alpha in [0u8, 1, 127, 255] {
-            for mode in [
-                TransparencyMode::Opaque,
-                TransparencyMode::Stipple,
-                TransparencyMode::AlphaTest,
-                TransparencyMode::Reserved,
-            ] {
-                for pattern in BayerSize::ALL {
-                    let s = ShadingState {
-                        alpha,
-                        mode,
-                        pattern,
-                    };
-                    assert_eq!(ShadingState::unpack(s.pack()), s);
-                    assert_eq!(s.pack() >> 12, 0);
-                }
+            for pattern in BayerSize::ALL {
+                let s = ShadingState { alpha, pattern };
+                assert_eq!(ShadingState::unpack(s.pack()), s);
+                assert_eq!(s.pack() >> 12, 0);
+                assert_eq!((s.pack() >> 8) & 3, STIPPLE_MODE);
             }
         }
     }

@@ -1,33 +1,32 @@
-// Screen-door transparency helpers (seed 001), appended to common.wgsl.
+// Screen-door transparency (seed 001): the technique's own group 2 (appended to
+// common.wgsl and the constant BAYER_OFFSETS made in Rust).
 
+// Seed 001's packed shading state (`StippleParams` in mod.rs, checked equal by a test).
+struct StippleParams {
+    shading_state: u32,
+};
+
+@group(2) @binding(0) var<uniform> params: StippleParams;
 // The 2×2, 4×4, 8×8 and 16×16 Bayer matrices one after the other, made in Rust
 // (`bayer::bayer_levels`, tested equal to seed 001's tables).
-@group(0) @binding(3) var<storage, read> bayer_levels: array<u32>;
+@group(2) @binding(1) var<storage, read> bayer_levels: array<u32>;
 
 // Seed 001's threshold: the Bayer level at the pixel, over n². Pattern codes: 0 = 2×2,
 // 1 = 4×4, 2 = 8×8, 3 = 16×16.
 fn bayer_threshold(pattern: u32, frag_xy: vec2<f32>) -> f32 {
     let n = 2u << (pattern & 3u);
-    // Offsets of the four matrices: 0, 4, 20, 84 (the sums of the smaller ones' sizes).
-    let offset = array<u32, 4>(0u, 4u, 20u, 84u)[pattern & 3u];
     let p = vec2<u32>(frag_xy) % n;
-    return f32(bayer_levels[offset + p.y * n + p.x]) / f32(n * n);
+    return f32(bayer_levels[BAYER_OFFSETS[pattern & 3u] + p.y * n + p.x]) / f32(n * n);
 }
 
-
+// Seed 001's bit layout: bits 0-7 alpha, 8-9 mode (always stipple here), 10-11 pattern.
 struct ShadingParams {
     uniform_alpha: f32,
-    transparency_mode: u32,
     dither_pattern: u32,
 };
 
-// Seed 001's bit layout: bits 0-7 alpha, 8-9 mode, 10-11 pattern.
 fn unpack_shading_state(packed: u32) -> ShadingParams {
-    return ShadingParams(
-        f32(packed & 0xffu) / 255.0,
-        (packed >> 8u) & 0x3u,
-        (packed >> 10u) & 0x3u,
-    );
+    return ShadingParams(f32(packed & 0xffu) / 255.0, (packed >> 10u) & 0x3u);
 }
 
 // Whether a pixel of coverage `alpha` is dropped. Seed 001 writes `alpha < threshold`,

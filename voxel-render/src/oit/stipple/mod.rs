@@ -6,87 +6,217 @@
 //! is what a screen door does; not writing lets farther layers show through the gaps of
 //! nearer ones even where a nearer pixel was kept, which is wrong but softer).
 //!
+//! Its uniform (seed 001's packed shading state) and the Bayer tables are its own group 2.
 //! The shimmer when the camera moves is the technique's nature (seed 001: intentional).
 
 pub mod bayer;
 
-use crate::GpuContext;
-use crate::oit::{OitConfig, TranslucentFrame, TranslucentTechnique};
-use crate::pipelines::{self, COMMON_WGSL, DepthMode, SharedLayouts, load_attachment};
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
 
-pub use bayer::{BayerSize, ShadingState, TransparencyMode};
+use crate::context::Capabilities;
+use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, Pass, WgslConsts};
+use crate::oit::{
+    FrameView, OitConfig, Setup, Technique, TechniqueKind, TranslucentFrame, TranslucentTechnique,
+};
+use crate::timing::GpuPass;
+use crate::{Error, GpuContext, Result};
 
-/// WGSL of the dithering helpers (they read the Bayer levels from group 0, binding 3).
-pub const DITHER_WGSL: &str = include_str!("dither.wgsl");
+pub use bayer::{BayerSize, ShadingState};
 
-/// The stipple pipeline.
-#[derive(Debug)]
-pub struct Stipple {
-    pipeline: wgpu::RenderPipeline,
-    depth_write: bool,
+/// Settings of stipple. Every field has a reasoned default.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StippleSettings {
+    /// The Bayer pattern.
+    pub bayer: BayerSize,
+    /// Whether kept pixels write depth.
+    pub depth_write: bool,
+    /// Uniform alpha of the shading state, multiplying every translucent alpha (255 = 1).
+    pub alpha: u8,
 }
 
-impl Stipple {
-    /// Creates the pipeline (depth write per `config.stipple_depth_write`).
-    pub fn new(ctx: &GpuContext, layouts: &SharedLayouts, config: &OitConfig) -> Self {
-        let module = pipelines::shader(
-            &ctx.device,
-            "stipple",
-            &[COMMON_WGSL, DITHER_WGSL, include_str!("stipple.wgsl")],
-        );
-
-        let depth_write = config.stipple_depth_write;
-        let pipeline = pipelines::chunk_pipeline(
-            &ctx.device,
-            "stipple",
-            &module,
-            "fs_stipple",
-            &[Some(&layouts.scene), Some(&layouts.chunk)],
-            &[pipelines::scene_target(None)],
-            if depth_write {
-                DepthMode::Write
-            } else {
-                DepthMode::ReadOnly
-            },
-            1,
-        );
+impl Default for StippleSettings {
+    fn default() -> Self {
         Self {
-            pipeline,
-            depth_write,
+            // 4×4: seed 001's default ("era-authentic").
+            bayer: BayerSize::B4,
+            // Seed 001's behaviour ("writes to depth buffer normally"): nearer kept pixels
+            // hide what is behind them.
+            depth_write: true,
+            // 1: surfaces keep their own opacity.
+            alpha: 255,
         }
     }
 }
 
+impl StippleSettings {
+    /// Seed 001's packed shading state for these settings.
+    pub fn shading_state(&self) -> ShadingState {
+        ShadingState {
+            alpha: self.alpha,
+            pattern: self.bayer,
+        }
+    }
+
+    /// Every value is valid (the types allow nothing else).
+    pub fn validate(&self) -> Result<(), Error> {
+        Ok(())
+    }
+}
+
+/// The technique's uniform (`StippleParams` in `dither.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct StippleParams {
+    /// [`ShadingState::pack`].
+    pub shading_state: u32,
+}
+
+/// The stipple shader: the Bayer offsets from Rust, the shared code, the screen door.
+pub fn stipple_wgsl() -> String {
+    let offsets = BayerSize::ALL.map(|b| bayer::bayer_offset(b) as u32);
+    let consts = WgslConsts::default()
+        .u32_array("BAYER_OFFSETS", &offsets)
+        .finish();
+    [
+        consts.as_str(),
+        crate::bindings::COMMON_WGSL,
+        include_str!("dither.wgsl"),
+        include_str!("stipple.wgsl"),
+    ]
+    .concat()
+}
+
+/// The stipple pipeline and its uniform.
+#[derive(Debug)]
+pub struct Stipple {
+    pipeline: wgpu::RenderPipeline,
+    depth_write: bool,
+    params: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
+
+impl TechniqueKind for Stipple {
+    /// Depth write is baked into the pipeline; the pattern and alpha are uniforms.
+    type Key = bool;
+
+    fn key(_: Technique, config: &OitConfig, _: &Capabilities) -> bool {
+        config.stipple.depth_write
+    }
+
+    fn create(setup: &Setup, _: Technique, config: &OitConfig) -> Result<Self> {
+        let device = &setup.ctx.device;
+        let layout = gpu::layout(
+            device,
+            "stipple_layout",
+            &[
+                gpu::buffer_entry(
+                    0,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BufferBindingType::Uniform,
+                ),
+                gpu::buffer_entry(
+                    1,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BufferBindingType::Storage { read_only: true },
+                ),
+            ],
+        );
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("stipple_params"),
+            contents: bytemuck::bytes_of(&StippleParams::default()),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let levels = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("bayer_levels"),
+            contents: bytemuck::cast_slice(&bayer::bayer_levels()),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let group = gpu::bind_group(
+            device,
+            "stipple",
+            &layout,
+            &[params.as_entire_binding(), levels.as_entire_binding()],
+        );
+        let module = gpu::shader(device, "stipple", &[&stipple_wgsl()]);
+        let depth_write = config.stipple.depth_write;
+        let pipeline = ChunkPipeline {
+            label: "stipple",
+            module: &module,
+            fragment_entry: "fs_stipple",
+            groups: &setup.layouts.with(&[&layout]),
+            targets: &[gpu::scene_target(None)],
+            depth: if depth_write {
+                DepthMode::Write
+            } else {
+                DepthMode::ReadOnly
+            },
+            samples: 1,
+        }
+        .build(device);
+        Ok(Self {
+            pipeline,
+            depth_write,
+            params,
+            group,
+        })
+    }
+}
+
 impl TranslucentTechnique for Stipple {
-    fn resize(&mut self, _ctx: &GpuContext, _width: u32, _height: u32) {}
+    fn resize(&mut self, _: &GpuContext, _: u32, _: u32) -> Result<()> {
+        Ok(())
+    }
+
+    fn prepare(
+        &mut self,
+        ctx: &GpuContext,
+        config: &OitConfig,
+        _chunks: &mut crate::chunks::ChunkStore,
+        _view: &FrameView<'_>,
+    ) -> Result<()> {
+        let params = StippleParams {
+            shading_state: config.stipple.shading_state().pack(),
+        };
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        Ok(())
+    }
 
     fn render(
         &mut self,
-        _ctx: &GpuContext,
+        _: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
-    ) {
+        frame: &TranslucentFrame<'_>,
+    ) -> Result<()> {
         let depth = if self.depth_write {
-            Some(wgpu::RenderPassDepthStencilAttachment {
-                view: frame.depth,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            })
+            Depth::Load(&frame.depth.view)
         } else {
-            pipelines::read_only_depth(frame.depth)
+            Depth::ReadOnly(&frame.depth.view)
         };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("stipple"),
-            color_attachments: &[load_attachment(frame.target)],
-            depth_stencil_attachment: depth,
-            timestamp_writes: frame.timestamps("translucent"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.pipeline);
-        frame.draw_chunks(&mut pass);
+        let colors = [gpu::load(&frame.target.view)];
+        Pass::new("stipple", GpuPass::Translucent, &colors)
+            .depth(depth)
+            .record(encoder, frame.timer, |pass| {
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(2, &self.group, &[]);
+                frame.draw_chunks(pass);
+            });
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wgsl_layout::{assert_layout, field, parse};
+
+    #[test]
+    fn params_match_their_wgsl() {
+        assert_layout::<StippleParams>(
+            &parse(&stipple_wgsl()),
+            "StippleParams",
+            &[field!(StippleParams, shading_state)],
+        );
     }
 }

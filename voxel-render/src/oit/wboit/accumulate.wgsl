@@ -1,54 +1,71 @@
-// Weighted blended OIT, accumulation (appended to common.wgsl). McGuire & Bavoil 2013.
+// Weighted blended OIT, accumulation (appended to common.wgsl and the constants made in
+// Rust: WEIGHT_* ids, TILES, PROFILE_LEN, TABLE_VEC4S, MAX_FITTED_DEPTH). McGuire & Bavoil
+// 2013.
 //
 // accumulation (RGBA16F, blend ONE, ONE on all channels) += (C·α, α) · w · scale
 // revealage    (R8,      blend ZERO, ONE_MINUS_SRC)     *= (1 − α)
 //
-// `scale` (frame.accum_scale) keeps fp16 sums finite; it cancels in the composite's ratio.
+// `scale` (params.accum_scale) keeps fp16 sums finite; it cancels in the composite's ratio.
 
-// Weight functions: the same formulas as `weights.rs` (unit-tested there).
+// The technique's own uniforms (`WboitParams` in mod.rs, checked equal by a test).
+struct WboitParams {
+    weight_fn: u32,
+    accum_scale: f32,
+    // Nearest and farthest view depth of the visible translucent chunks (fitted weight).
+    depth_range: vec2<f32>,
+    // Per screen tile, the optical depth in front of log-spaced depths (fitted weight).
+    optical_depth: array<vec4<f32>, TABLE_VEC4S>,
+};
+
+@group(2) @binding(0) var<uniform> params: WboitParams;
+
+// Standard (not reversed) window depth in [0, 1], 0 at the near plane, from the reverse-Z
+// fragment depth: the `gl_FragCoord.z` of the seeds' weight functions.
+fn standard_depth(frag_z: f32) -> f32 {
+    return 1.0 - frag_z;
+}
+
+// Weight functions: the same formulas as `weights.rs` (unit-tested there, and a GPU test
+// checks this shader against them).
 fn cube(x: f32) -> f32 {
     return x * x * x;
 }
 
 fn weight(pixel: vec2<f32>, z: f32, depth: f32, a: f32) -> f32 {
     let d = abs(depth);
-    switch frame.weight_fn {
-        case 0u: {
+    switch params.weight_fn {
+        case WEIGHT_FLAT: {
             let zz = clamp(z, 1e-5, 3e4);
             return clamp(a * max(1e-2, 3e3 * cube(1.0 - zz * 0.001)), 1e-2, 3e4);
         }
-        case 1u: {
+        case WEIGHT_ALPHA_CUBED: {
             return clamp(cube(a) * 3000.0 * cube(1.0 - z), 0.01, 3000.0);
         }
-        case 2u: {
+        case WEIGHT_EQ7: {
             let q = d / 5.0;
             return a * clamp(10.0 / (1e-5 + q * q + pow(d / 200.0, 6.0)), 1e-2, 3e3);
         }
-        case 3u: {
+        case WEIGHT_EQ8: {
             return a * clamp(10.0 / (1e-5 + cube(d / 10.0) + pow(d / 200.0, 6.0)), 1e-2, 3e3);
         }
-        case 4u: {
+        case WEIGHT_EQ9: {
             return a * clamp(0.03 / (1e-5 + pow(d / 200.0, 4.0)), 1e-2, 3e3);
         }
-        case 5u: {
+        case WEIGHT_EQ10: {
             return a * max(1e-2, 3e3 * cube(1.0 - z));
         }
         default: {
-            // Fitted: the estimated transmittance in front of the fragment.
+            // WEIGHT_FITTED: the estimated transmittance in front of the fragment.
             return 3e3 * exp(-optical_depth_at(pixel, d));
         }
     }
 }
 
-// WeightFit::optical_depth_at in weights.rs: the tables of the four screen tiles around
-// the fragment, interpolated in log depth, then between the tiles' centres.
-const PROFILE_LEN: u32 = 32u;
-const TILES: u32 = 8u;
-const MAX_FITTED_DEPTH: f32 = 12.0;
-
+// WeightFit::optical_depth_at in fit.rs: the tables of the four screen tiles around the
+// fragment, interpolated in log depth, then between the tiles' centres.
 fn table(tile: vec2<u32>, k: u32) -> f32 {
     let i = (tile.y * TILES + tile.x) * PROFILE_LEN + k;
-    return frame.optical_depth[i / 4u][i % 4u];
+    return params.optical_depth[i / 4u][i % 4u];
 }
 
 fn tile_depth(tile: vec2<u32>, k: u32, t: f32) -> f32 {
@@ -56,8 +73,8 @@ fn tile_depth(tile: vec2<u32>, k: u32, t: f32) -> f32 {
 }
 
 fn optical_depth_at(pixel: vec2<f32>, d: f32) -> f32 {
-    let n = max(frame.depth_range.x, 1e-4);
-    let f = max(frame.depth_range.y, n * 1.001);
+    let n = max(params.depth_range.x, 1e-4);
+    let f = max(params.depth_range.y, n * 1.001);
     let x = clamp(log(d / n) / log(f / n), 0.0, 1.0) * f32(PROFILE_LEN - 1u);
     let k = min(u32(floor(x)), PROFILE_LEN - 2u);
     let t = x - f32(k);
@@ -76,7 +93,7 @@ fn optical_depth_at(pixel: vec2<f32>, d: f32) -> f32 {
 
 fn accumulation(in: VsOut) -> vec4<f32> {
     let c = translucent_color(in);
-    let w = weight(in.clip.xy, standard_depth(in.clip.z), in.view_depth, c.a) * frame.accum_scale;
+    let w = weight(in.clip.xy, standard_depth(in.clip.z), in.view_depth, c.a) * params.accum_scale;
     return vec4<f32>(c.rgb * c.a, c.a) * w;
 }
 

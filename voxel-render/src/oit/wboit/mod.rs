@@ -22,15 +22,32 @@
 //! RGBA8 fallback (seed 000): when `Rgba16Float` cannot be blended, the accumulation is
 //! RGBA8 with outputs scaled so that eight maximum-weight layers fit; the average then has
 //! eight bits of precision at best. Logged when chosen.
+//!
+//! The weight and its parameters (the fitted weight's table, [`fit`]) are the technique's
+//! own uniform, group 2: written each frame by [`Wboit::prepare`](TranslucentTechnique::prepare),
+//! so changing the weight rebuilds nothing.
 
+pub mod fit;
 pub mod weights;
 
-use crate::GpuContext;
-use crate::oit::{OitConfig, Technique, TranslucentFrame, TranslucentTechnique};
-use crate::pipelines::{
-    self, COMMON_WGSL, DepthMode, SharedLayouts, clear_attachment, load_attachment,
-    read_only_depth, texture_entry,
+use std::collections::HashMap;
+
+use bytemuck::{Pod, Zeroable};
+use voxel_core::ChunkPos;
+use wgpu::util::DeviceExt;
+
+use crate::chunks::ChunkStore;
+use crate::context::Capabilities;
+use crate::gpu::{self, ChunkPipeline, Depth, FullscreenPipeline, Pass, Target};
+use crate::oit::{
+    FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
+    TranslucentTechnique,
 };
+use crate::timing::GpuPass;
+use crate::{GpuContext, Result};
+
+use fit::{MeshLayers, PROFILE_LEN, TILES};
+use weights::{MAX_FITTED_DEPTH, WeightFit, WeightFunction};
 
 /// Revealage format (seed 000): one byte of Π(1 − α).
 pub const REVEALAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
@@ -38,25 +55,94 @@ pub const REVEALAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 pub const HEADROOM_SCALE: f32 = 1.0 / 64.0;
 /// Output scale with RGBA8 accumulation: eight layers of the largest weight (3000) fit in 1.
 pub const RGBA8_SCALE: f32 = 1.0 / (3000.0 * 8.0);
+/// `vec4`s of the fitted weight's optical-depth table.
+pub const TABLE_VEC4S: usize = TILES * TILES * PROFILE_LEN / 4;
 
-/// The accumulation format for `config` on this adapter (RGBA16F, or the RGBA8 fallback).
-pub fn accumulation_format(ctx: &GpuContext, config: &OitConfig) -> wgpu::TextureFormat {
-    if config.force_rgba8_accum || !ctx.caps.rgba16f_blendable {
+/// Settings of weighted blended OIT. Every field has a reasoned default.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WboitSettings {
+    /// The weight function.
+    pub weight: WeightFunction,
+    /// Accumulate in RGBA8 even when RGBA16F works (to test the fallback).
+    pub force_rgba8_accum: bool,
+    /// Scale accumulation by 1/64 so that fp16 sums stay finite up to ~1390 layers of the
+    /// maximum weight (without it, 22 such layers reach 65504).
+    pub headroom: bool,
+}
+
+impl Default for WboitSettings {
+    fn default() -> Self {
+        Self {
+            // Ours, the transmittance in front of the fragment estimated from the layers in
+            // view: the lowest error of all weights on the scene suite (`results/`).
+            weight: WeightFunction::Fitted,
+            // RGBA8 loses most of the weighted sum's precision: only as a fallback.
+            force_rgba8_accum: false,
+            // On: turn off only to test the composite's guard against non-finite sums.
+            headroom: true,
+        }
+    }
+}
+
+/// What WBOIT drew with in the last frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WboitReport {
+    /// The weight in force.
+    pub weight: WeightFunction,
+    /// The accumulation format (RGBA16F, or the RGBA8 fallback).
+    pub accumulation: wgpu::TextureFormat,
+    /// What the fitted weight was fitted to (`None` with another weight).
+    pub fit: Option<WeightFit>,
+}
+
+/// The technique's uniform (`WboitParams` in `accumulate.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct WboitParams {
+    /// [`WeightFunction::id`] of the weight.
+    pub weight_fn: u32,
+    /// Scale of accumulation outputs (keeps fp16 sums finite).
+    pub accum_scale: f32,
+    /// Nearest and farthest view depth of the visible translucent chunks (fitted weight).
+    pub depth_range: [f32; 2],
+    /// Per screen tile, the optical depth in front of log-spaced depths (fitted weight).
+    pub optical_depth: [[f32; 4]; TABLE_VEC4S],
+}
+
+/// The accumulation format for `settings` on this adapter (RGBA16F, or the RGBA8 fallback).
+pub fn accumulation_format(caps: &Capabilities, settings: &WboitSettings) -> wgpu::TextureFormat {
+    if settings.force_rgba8_accum || !caps.rgba16f_blendable {
         wgpu::TextureFormat::Rgba8Unorm
     } else {
         wgpu::TextureFormat::Rgba16Float
     }
 }
 
-/// The accumulation output scale for `config` on this adapter.
-pub fn accum_scale(ctx: &GpuContext, config: &OitConfig) -> f32 {
-    if accumulation_format(ctx, config) == wgpu::TextureFormat::Rgba8Unorm {
+/// The accumulation output scale for `settings` on this adapter.
+pub fn accum_scale(caps: &Capabilities, settings: &WboitSettings) -> f32 {
+    if accumulation_format(caps, settings) == wgpu::TextureFormat::Rgba8Unorm {
         RGBA8_SCALE
-    } else if config.wboit_headroom {
+    } else if settings.headroom {
         HEADROOM_SCALE
     } else {
         1.0
     }
+}
+
+/// The accumulation shader: constants from Rust, the shared code, the weights.
+pub fn accumulate_wgsl() -> String {
+    let consts = WeightFunction::wgsl_ids()
+        .u32("TILES", TILES as u32)
+        .u32("PROFILE_LEN", PROFILE_LEN as u32)
+        .u32("TABLE_VEC4S", TABLE_VEC4S as u32)
+        .f32("MAX_FITTED_DEPTH", MAX_FITTED_DEPTH)
+        .finish();
+    [
+        consts.as_str(),
+        crate::bindings::COMMON_WGSL,
+        include_str!("accumulate.wgsl"),
+    ]
+    .concat()
 }
 
 const ADDITIVE: wgpu::BlendState = wgpu::BlendState {
@@ -85,6 +171,13 @@ const MULTIPLY_ONE_MINUS_SRC: wgpu::BlendState = wgpu::BlendState {
     },
 };
 
+const REVEAL_CLEAR: wgpu::Color = wgpu::Color {
+    r: 1.0,
+    g: 1.0,
+    b: 1.0,
+    a: 1.0,
+};
+
 #[derive(Debug)]
 enum Accumulate {
     Mrt(wgpu::RenderPipeline),
@@ -96,14 +189,13 @@ enum Accumulate {
 
 #[derive(Debug)]
 struct Targets {
-    accumulation: wgpu::Texture,
-    accumulation_view: wgpu::TextureView,
-    revealage: wgpu::Texture,
-    revealage_view: wgpu::TextureView,
+    accumulation: Target,
+    revealage: Target,
     composite_group: wgpu::BindGroup,
 }
 
-/// WBOIT resources: pipelines and the two size-dependent targets.
+/// WBOIT resources: pipelines, the two size-dependent targets, the uniform, and the fitted
+/// weight's summary of each translucent mesh.
 #[derive(Debug)]
 pub struct Wboit {
     accumulate: Accumulate,
@@ -111,22 +203,55 @@ pub struct Wboit {
     composite_layout: wgpu::BindGroupLayout,
     accum_format: wgpu::TextureFormat,
     targets: Targets,
+    params: wgpu::Buffer,
+    params_group: wgpu::BindGroup,
+    block_opacity: std::sync::Arc<[f32]>,
+    /// Per chunk: the generation summed up and its layers.
+    layers: HashMap<ChunkPos, (u64, MeshLayers)>,
+    report: Option<WboitReport>,
 }
 
-impl Wboit {
-    /// Creates the pipelines for `config.technique` (MRT or two-pass) and the targets.
-    pub fn new(ctx: &GpuContext, layouts: &SharedLayouts, config: &OitConfig) -> Self {
-        let device = &ctx.device;
-        let accum_format = accumulation_format(ctx, config);
+impl TechniqueKind for Wboit {
+    /// MRT or two passes, and the accumulation format.
+    type Key = (Technique, wgpu::TextureFormat);
+
+    fn fallback(technique: Technique, caps: &Capabilities) -> Option<Technique> {
+        (technique == Technique::WboitMrt && !caps.independent_blend())
+            .then_some(Technique::WboitTwoPass)
+    }
+
+    fn key(technique: Technique, config: &OitConfig, caps: &Capabilities) -> Self::Key {
+        (technique, accumulation_format(caps, &config.wboit))
+    }
+
+    fn create(setup: &Setup, technique: Technique, config: &OitConfig) -> Result<Self> {
+        let device = &setup.ctx.device;
+        let accum_format = accumulation_format(&setup.ctx.caps, &config.wboit);
         if accum_format != wgpu::TextureFormat::Rgba16Float {
             log::warn!("WBOIT accumulates in RGBA8: RGBA16F blending unavailable or disabled");
         }
-        let module = pipelines::shader(
+        let params_layout = gpu::layout(
             device,
-            "wboit_accumulate",
-            &[COMMON_WGSL, include_str!("accumulate.wgsl")],
+            "wboit_params_layout",
+            &[gpu::buffer_entry(
+                0,
+                wgpu::ShaderStages::FRAGMENT,
+                wgpu::BufferBindingType::Uniform,
+            )],
         );
-        let groups = [Some(&layouts.scene), Some(&layouts.chunk)];
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("wboit_params"),
+            contents: bytemuck::bytes_of(&WboitParams::zeroed()),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let params_group = gpu::bind_group(
+            device,
+            "wboit_params",
+            &params_layout,
+            &[params.as_entire_binding()],
+        );
+        let module = gpu::shader(device, "wboit_accumulate", &[&accumulate_wgsl()]);
+        let groups = setup.layouts.with(&[&params_layout]);
         let target = |format, blend| {
             Some(wgpu::ColorTargetState {
                 format,
@@ -136,19 +261,19 @@ impl Wboit {
         };
         let accum_target = target(accum_format, ADDITIVE);
         let reveal_target = target(REVEALAGE_FORMAT, MULTIPLY_ONE_MINUS_SRC);
-        let chunk = |label, entry, targets: &[Option<wgpu::ColorTargetState>]| {
-            pipelines::chunk_pipeline(
-                device,
+        let chunk = |label, fragment_entry, targets: &[Option<wgpu::ColorTargetState>]| {
+            ChunkPipeline {
                 label,
-                &module,
-                entry,
-                &groups,
+                module: &module,
+                fragment_entry,
+                groups: &groups,
                 targets,
-                DepthMode::ReadOnly,
-                1,
-            )
+                depth: gpu::DepthMode::ReadOnly,
+                samples: 1,
+            }
+            .build(device)
         };
-        let accumulate = if config.technique == Technique::WboitTwoPass {
+        let accumulate = if technique == Technique::WboitTwoPass {
             Accumulate::TwoPass {
                 accumulate: chunk("wboit_accumulate", "fs_accumulate", &[accum_target]),
                 revealage: chunk("wboit_revealage", "fs_revealage", &[reveal_target]),
@@ -160,118 +285,158 @@ impl Wboit {
                 &[accum_target, reveal_target],
             ))
         };
-        let composite_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("wboit_composite_layout"),
-            entries: &[
-                texture_entry(0, wgpu::TextureSampleType::Float { filterable: false }),
-                texture_entry(1, wgpu::TextureSampleType::Float { filterable: false }),
-            ],
-        });
-        let composite = pipelines::fullscreen_pipeline(
-            device,
-            "wboit_composite",
-            include_str!("composite.wgsl"),
-            "fs_composite",
-            &[Some(&composite_layout)],
-            &[pipelines::scene_target(Some(
-                wgpu::BlendState::ALPHA_BLENDING,
-            ))],
-            false,
-            &[],
-        );
-        let targets = Self::targets(
-            ctx,
-            &composite_layout,
-            accum_format,
-            config.width,
-            config.height,
-        );
-        Self {
+        let float = wgpu::TextureSampleType::Float { filterable: false };
+        let composite_layout = gpu::textures_layout(device, "wboit_composite_layout", float, 2);
+        let composite = FullscreenPipeline {
+            label: "wboit_composite",
+            source: include_str!("composite.wgsl"),
+            fragment_entry: "fs_composite",
+            groups: &[Some(&composite_layout)],
+            targets: &[gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
+            writes_depth: false,
+            constants: &[],
+        }
+        .build(device);
+        let targets = Self::targets(device, &composite_layout, accum_format, setup.size);
+        Ok(Self {
             accumulate,
             composite,
             composite_layout,
             accum_format,
             targets,
-        }
-    }
-
-    fn targets(
-        ctx: &GpuContext,
-        layout: &wgpu::BindGroupLayout,
-        accum_format: wgpu::TextureFormat,
-        width: u32,
-        height: u32,
-    ) -> Targets {
-        use wgpu::TextureUsages as U;
-        let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC;
-        let make =
-            |label, format| pipelines::target(&ctx.device, label, format, usage, width, height);
-        let (accumulation, accumulation_view) = make("wboit_accumulation", accum_format);
-        let (revealage, revealage_view) = make("wboit_revealage", REVEALAGE_FORMAT);
-        let composite_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("wboit_composite"),
-            layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&accumulation_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&revealage_view),
-                },
-            ],
-        });
-        Targets {
-            accumulation,
-            accumulation_view,
-            revealage,
-            revealage_view,
-            composite_group,
-        }
+            params,
+            params_group,
+            block_opacity: setup.block_opacity.clone(),
+            layers: HashMap::new(),
+            report: None,
+        })
     }
 }
 
-const REVEAL_CLEAR: wgpu::Color = wgpu::Color {
-    r: 1.0,
-    g: 1.0,
-    b: 1.0,
-    a: 1.0,
-};
+impl Wboit {
+    fn targets(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        accum_format: wgpu::TextureFormat,
+        size: (u32, u32),
+    ) -> Targets {
+        use wgpu::TextureUsages as U;
+        let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC;
+        let accumulation = gpu::target(device, "wboit_accumulation", accum_format, usage, size);
+        let revealage = gpu::target(device, "wboit_revealage", REVEALAGE_FORMAT, usage, size);
+        let composite_group = gpu::texture_group(
+            device,
+            "wboit_composite",
+            layout,
+            &[&accumulation.view, &revealage.view],
+        );
+        Targets {
+            accumulation,
+            revealage,
+            composite_group,
+        }
+    }
+
+    /// Fits the weight to the visible translucent meshes, summing up (once per remesh) the
+    /// layers of each.
+    fn fit(&mut self, chunks: &ChunkStore, view: &FrameView<'_>) -> WeightFit {
+        let opacity = &self.block_opacity;
+        for &pos in view.translucent {
+            let Some(chunk) = chunks.get(pos) else {
+                continue;
+            };
+            let fresh = self
+                .layers
+                .get(&pos)
+                .is_some_and(|(g, _)| *g == chunk.generation());
+            if !fresh {
+                let layers = MeshLayers::new(pos, chunk.translucent_quads(), opacity);
+                self.layers.insert(pos, (chunk.generation(), layers));
+            }
+        }
+        // Forget chunks that were removed or remeshed since (kept bounded by the store).
+        if self.layers.len() > 2 * chunks.len() + 64 {
+            self.layers
+                .retain(|pos, (g, _)| chunks.get(*pos).map(|c| c.generation()) == Some(*g));
+        }
+        let cam = view.camera;
+        fit::fit(
+            view.translucent
+                .iter()
+                .filter_map(|p| self.layers.get(p).map(|(_, l)| l)),
+            view.view_proj,
+            cam.eye,
+            cam.near as f32,
+            cam.far as f32,
+        )
+    }
+}
 
 impl TranslucentTechnique for Wboit {
-    fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) {
+    fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
         self.targets = Self::targets(
-            ctx,
+            &ctx.device,
             &self.composite_layout,
             self.accum_format,
-            width,
-            height,
+            (width, height),
         );
+        Ok(())
+    }
+
+    fn prepare(
+        &mut self,
+        ctx: &GpuContext,
+        config: &OitConfig,
+        chunks: &mut ChunkStore,
+        view: &FrameView<'_>,
+    ) -> Result<()> {
+        let settings = &config.wboit;
+        let fit = (settings.weight == WeightFunction::Fitted).then(|| self.fit(chunks, view));
+        let mut params = WboitParams {
+            weight_fn: settings.weight.id(),
+            accum_scale: accum_scale(&ctx.caps, settings),
+            depth_range: [view.camera.near as f32, view.camera.far as f32],
+            optical_depth: [[0.0; 4]; TABLE_VEC4S],
+        };
+        if let Some(fit) = &fit {
+            params.depth_range = fit.range;
+            let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut params.optical_depth);
+            let n = fit.optical_depth.len().min(flat.len());
+            flat[..n].copy_from_slice(&fit.optical_depth[..n]);
+        }
+        ctx.queue
+            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        self.report = Some(WboitReport {
+            weight: settings.weight,
+            accumulation: self.accum_format,
+            fit,
+        });
+        Ok(())
     }
 
     fn render(
         &mut self,
         _ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        frame: &mut TranslucentFrame<'_>,
-    ) {
+        frame: &TranslucentFrame<'_>,
+    ) -> Result<()> {
         let t = &self.targets;
+        let (accum, reveal) = (&t.accumulation.view, &t.revealage.view);
+        let depth = Depth::ReadOnly(&frame.depth.view);
+        let draw = |pass: &mut wgpu::RenderPass<'_>, pipeline| {
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(2, &self.params_group, &[]);
+            frame.draw_chunks(pass);
+        };
         match &self.accumulate {
             Accumulate::Mrt(pipeline) => {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("wboit_accumulate_mrt"),
-                    color_attachments: &[
-                        clear_attachment(&t.accumulation_view, wgpu::Color::TRANSPARENT),
-                        clear_attachment(&t.revealage_view, REVEAL_CLEAR),
-                    ],
-                    depth_stencil_attachment: read_only_depth(frame.depth),
-                    timestamp_writes: frame.timestamps("translucent"),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(pipeline);
-                frame.draw_chunks(&mut pass);
+                let colors = [
+                    gpu::clear(accum, wgpu::Color::TRANSPARENT),
+                    gpu::clear(reveal, REVEAL_CLEAR),
+                ];
+                Pass::new("wboit_accumulate_mrt", GpuPass::Translucent, &colors)
+                    .depth(depth)
+                    .record(encoder, frame.timer, |pass| draw(pass, pipeline));
             }
             Accumulate::TwoPass {
                 accumulate,
@@ -281,47 +446,63 @@ impl TranslucentTechnique for Wboit {
                     (
                         "wboit_accumulate",
                         accumulate,
-                        &t.accumulation_view,
+                        accum,
                         wgpu::Color::TRANSPARENT,
                     ),
-                    (
-                        "wboit_revealage",
-                        revealage,
-                        &t.revealage_view,
-                        REVEAL_CLEAR,
-                    ),
+                    ("wboit_revealage", revealage, reveal, REVEAL_CLEAR),
                 ] {
-                    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some(label),
-                        color_attachments: &[clear_attachment(view, clear)],
-                        depth_stencil_attachment: read_only_depth(frame.depth),
-                        timestamp_writes: frame.timestamps("translucent"),
-                        occlusion_query_set: None,
-                        multiview_mask: None,
-                    });
-                    pass.set_pipeline(pipeline);
-                    frame.draw_chunks(&mut pass);
+                    let colors = [gpu::clear(view, clear)];
+                    Pass::new(label, GpuPass::Translucent, &colors)
+                        .depth(depth)
+                        .record(encoder, frame.timer, |pass| draw(pass, pipeline));
                 }
             }
         }
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("wboit_composite"),
-            color_attachments: &[load_attachment(frame.target)],
-            depth_stencil_attachment: None,
-            timestamp_writes: frame.timestamps("composite"),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.composite);
-        pass.set_bind_group(0, &t.composite_group, &[]);
-        pass.draw(0..3, 0..1);
+        let colors = [gpu::load(&frame.target.view)];
+        Pass::new("wboit_composite", GpuPass::Composite, &colors).record(
+            encoder,
+            frame.timer,
+            |pass| {
+                pass.set_pipeline(&self.composite);
+                pass.set_bind_group(0, &t.composite_group, &[]);
+                pass.draw(0..3, 0..1);
+            },
+        );
+        Ok(())
+    }
+
+    fn report(&self) -> TechniqueReport {
+        TechniqueReport {
+            wboit: self.report.clone(),
+            ..TechniqueReport::default()
+        }
     }
 
     fn accumulation(&self) -> Option<&wgpu::Texture> {
-        Some(&self.targets.accumulation)
+        Some(&self.targets.accumulation.texture)
     }
 
     fn revealage(&self) -> Option<&wgpu::Texture> {
-        Some(&self.targets.revealage)
+        Some(&self.targets.revealage.texture)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wgsl_layout::{assert_layout, field, parse};
+
+    #[test]
+    fn params_match_their_wgsl() {
+        assert_layout::<WboitParams>(
+            &parse(&accumulate_wgsl()),
+            "WboitParams",
+            &[
+                field!(WboitParams, weight_fn),
+                field!(WboitParams, accum_scale),
+                field!(WboitParams, depth_range),
+                field!(WboitParams, optical_depth),
+            ],
+        );
     }
 }

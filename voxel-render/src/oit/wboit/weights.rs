@@ -8,18 +8,19 @@
 //! fragment's position on screen (0 to 1, y down), and `fit`, the frame's estimate of the
 //! translucent layers in view ([`WeightFit`]).
 
-use crate::layers::{PROFILE_LEN, TILES};
+pub use super::fit::{MAX_FITTED_DEPTH, WeightFit};
 use crate::{Error, Result};
 
 /// A weight function.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum WeightFunction {
-    /// Seed 000: `α · max(1e-2, 3e3 · (1 − 0.001·d)³)` clamped to [1e-2, 3e4], `d` the
-    /// window depth clamped to [1e-5, 3e4]. With a window depth below 1 this is almost
-    /// `3000·α`: close to a plain average.
-    Seed000 = 0,
-    /// Seed 002 (Voxelize): `clamp(α³ · 3000 · (1 − z)³, 0.01, 3000)`.
-    Seed002 = 1,
+    /// `α · max(1e-2, 3e3 · (1 − 0.001·z)³)` clamped to [1e-2, 3e4], `z` the window depth
+    /// clamped to [1e-5, 3e4] (seed 000's weight). With window depths below 1 this is
+    /// almost `3000·α`: nearly flat, a plain α-weighted average.
+    Flat = 0,
+    /// `clamp(α³ · 3000 · (1 − z)³, 0.01, 3000)` (seed 002's weight, Voxelize's): α cubed,
+    /// so that dense layers dominate, falling with the cube of the window depth.
+    AlphaCubed = 1,
     /// McGuire & Bavoil 2013 eq. 7: `α · clamp(10 / (1e-5 + (|z|/5)² + (|z|/200)⁶), 1e-2, 3e3)`.
     McGuire7 = 2,
     /// McGuire & Bavoil 2013 eq. 8: `α · clamp(10 / (1e-5 + (|z|/10)³ + (|z|/200)⁶), 1e-2, 3e3)`.
@@ -30,7 +31,7 @@ pub enum WeightFunction {
     McGuire10 = 5,
     /// Ours: `3000 · e^−τ`, where `τ` is the optical depth expected in front of the
     /// fragment, estimated each frame from the visible translucent meshes for the
-    /// fragment's screen tile and interpolated in log depth ([`crate::layers`]). The ideal
+    /// fragment's screen tile and interpolated in log depth ([`super::fit`]). The ideal
     /// weight of a layer is the transmittance in front of it (with it the weighted average
     /// is exact), so this weight falls where translucent layers are and stays flat where
     /// there are none: steep through a stack of dense sheets, flat between clear glass at
@@ -41,55 +42,11 @@ pub enum WeightFunction {
     Fitted = 6,
 }
 
-/// What the fitted weight is fitted to in a frame (see [`crate::layers`]).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct WeightFit {
-    /// Nearest and farthest view depth of the visible translucent meshes.
-    pub range: [f32; 2],
-    /// For each screen tile (row by row, [`TILES`] × [`TILES`]), the expected optical
-    /// depth in front of [`PROFILE_LEN`] depths spaced evenly in log depth across `range`.
-    /// Empty: none anywhere.
-    pub optical_depth: Vec<f32>,
-}
-
-/// The most optical depth the fitted weight falls by: `e^−12`, 6·10⁻⁶ (the weight must
-/// stay above fp16's smallest numbers once times α·3000).
-pub const MAX_FITTED_DEPTH: f32 = 12.0;
-
-impl WeightFit {
-    /// The optical depth in front of view depth `d` at `screen` (0 to 1, y down):
-    /// interpolated in log depth in the tables of the four tiles around `screen`, then
-    /// bilinearly between the tiles' centres (no seams at tile edges), and clamped at the
-    /// ends of the range and at [`MAX_FITTED_DEPTH`].
-    pub fn optical_depth_at(&self, screen: [f32; 2], d: f32) -> f32 {
-        if self.optical_depth.len() < TILES * TILES * PROFILE_LEN {
-            return 0.0;
-        }
-        let n = self.range[0].max(1e-4);
-        let f = self.range[1].max(n * 1.001);
-        let x = ((d / n).ln() / (f / n).ln()).clamp(0.0, 1.0) * (PROFILE_LEN - 1) as f32;
-        let k = (x.floor() as usize).min(PROFILE_LEN - 2);
-        let t = x - k as f32;
-        let at = |tx: usize, ty: usize| {
-            let p = &self.optical_depth[(ty * TILES + tx) * PROFILE_LEN..];
-            p[k] + (p[k + 1] - p[k]) * t
-        };
-        let lerp = |a: f32, b: f32, s: f32| a + (b - a) * s;
-        // Tile coordinates of `screen` between the tiles' centres.
-        let p = screen.map(|v| (v * TILES as f32 - 0.5).clamp(0.0, (TILES - 1) as f32));
-        let [tx, ty] = p.map(|v| (v.floor() as usize).min(TILES - 2));
-        let [sx, sy] = [p[0] - tx as f32, p[1] - ty as f32];
-        let top = lerp(at(tx, ty), at(tx + 1, ty), sx);
-        let bottom = lerp(at(tx, ty + 1), at(tx + 1, ty + 1), sx);
-        lerp(top, bottom, sy).min(MAX_FITTED_DEPTH)
-    }
-}
-
 impl WeightFunction {
     /// Every weight function.
     pub const ALL: [WeightFunction; 7] = [
-        WeightFunction::Seed000,
-        WeightFunction::Seed002,
+        WeightFunction::Flat,
+        WeightFunction::AlphaCubed,
         WeightFunction::McGuire7,
         WeightFunction::McGuire8,
         WeightFunction::McGuire9,
@@ -100,8 +57,8 @@ impl WeightFunction {
     /// The command-line name.
     pub fn name(self) -> &'static str {
         match self {
-            WeightFunction::Seed000 => "seed000",
-            WeightFunction::Seed002 => "seed002",
+            WeightFunction::Flat => "flat",
+            WeightFunction::AlphaCubed => "alpha-cubed",
             WeightFunction::McGuire7 => "eq7",
             WeightFunction::McGuire8 => "eq8",
             WeightFunction::McGuire9 => "eq9",
@@ -110,16 +67,32 @@ impl WeightFunction {
         }
     }
 
-    /// Parses a command-line name; the error lists the known names.
+    /// Parses a command-line name (the weights of seeds 000 and 002 also answer to
+    /// `seed000` and `seed002`); the error lists the known names.
     pub fn from_name(name: &str) -> Result<Self> {
+        let name_or_alias = match name {
+            "seed000" => "flat",
+            "seed002" => "alpha-cubed",
+            other => other,
+        };
         Self::ALL
             .into_iter()
-            .find(|w| w.name() == name)
-            .ok_or_else(|| {
-                Error::UnknownName(format!(
-                    "weight {name:?}; known: {}",
-                    Self::ALL.map(WeightFunction::name).join(", ")
-                ))
+            .find(|w| w.name() == name_or_alias)
+            .ok_or_else(|| Error::unknown_name("weight", name, Self::ALL.map(Self::name)))
+    }
+
+    /// The id the shader switches on (`WEIGHT_<NAME>` constants, generated from this).
+    pub fn id(self) -> u32 {
+        self as u32
+    }
+
+    /// WGSL constants `WEIGHT_FLAT`, `WEIGHT_ALPHA_CUBED`, ... holding each weight's id.
+    pub fn wgsl_ids() -> crate::gpu::WgslConsts {
+        Self::ALL
+            .into_iter()
+            .fold(crate::gpu::WgslConsts::default(), |c, w| {
+                let name = format!("WEIGHT_{}", w.name().to_uppercase().replace('-', "_"));
+                c.u32(&name, w.id())
             })
     }
 
@@ -128,11 +101,13 @@ impl WeightFunction {
         let cube = |x: f32| x * x * x;
         let d = depth.abs();
         match self {
-            WeightFunction::Seed000 => {
+            WeightFunction::Flat => {
                 let d = z.clamp(1e-5, 3e4);
                 (alpha * (3e3 * cube(1.0 - d * 0.001)).max(1e-2)).clamp(1e-2, 3e4)
             }
-            WeightFunction::Seed002 => (cube(alpha) * 3000.0 * cube(1.0 - z)).clamp(0.01, 3000.0),
+            WeightFunction::AlphaCubed => {
+                (cube(alpha) * 3000.0 * cube(1.0 - z)).clamp(0.01, 3000.0)
+            }
             WeightFunction::McGuire7 => {
                 alpha * (10.0 / (1e-5 + (d / 5.0).powi(2) + (d / 200.0).powi(6))).clamp(1e-2, 3e3)
             }
@@ -150,6 +125,7 @@ impl WeightFunction {
 
 #[cfg(test)]
 mod tests {
+    use super::super::fit::{PROFILE_LEN, TILES};
     use super::*;
     use WeightFunction::*;
 
@@ -167,21 +143,21 @@ mod tests {
     // Each expected value is worked out by hand in the comment beside it.
 
     #[test]
-    fn seed000() {
+    fn flat() {
         // d = 0.5: (1 - 0.0005)³ = 0.998500749875; × 3000 = 2995.50225; × α 0.5 = 1497.75112
-        close(Seed000.weight(0.5, 10.0, 0.5, S, R), 1_497.751_1);
+        close(Flat.weight(0.5, 10.0, 0.5, S, R), 1_497.751_1);
         // α = 1e-6: 3000 × 1e-6 = 0.003, clamped up to 0.01
-        close(Seed000.weight(0.5, 10.0, 1e-6, S, R), 0.01);
+        close(Flat.weight(0.5, 10.0, 1e-6, S, R), 0.01);
     }
 
     #[test]
-    fn seed002() {
+    fn alpha_cubed() {
         // 0.5³ × 3000 × 0.5³ = 0.125 × 3000 × 0.125 = 46.875
-        close(Seed002.weight(0.5, 1.0, 0.5, S, R), 46.875);
+        close(AlphaCubed.weight(0.5, 1.0, 0.5, S, R), 46.875);
         // α 1 at the near plane: 3000, the upper clamp
-        close(Seed002.weight(0.0, 1.0, 1.0, S, R), 3000.0);
+        close(AlphaCubed.weight(0.0, 1.0, 1.0, S, R), 3000.0);
         // 0.1³ × 3000 × 0.1³ = 0.003, clamped up to 0.01
-        close(Seed002.weight(0.9, 1.0, 0.1, S, R), 0.01);
+        close(AlphaCubed.weight(0.9, 1.0, 0.1, S, R), 0.01);
     }
 
     #[test]
@@ -293,5 +269,7 @@ mod tests {
                 .to_string()
                 .contains("eq10")
         );
+        assert_eq!(WeightFunction::from_name("seed002").unwrap(), AlphaCubed);
+        assert_eq!(WeightFunction::from_name("seed000").unwrap(), Flat);
     }
 }

@@ -9,7 +9,7 @@ use crate::scene::Scene;
 /// named by `WGPU_BACKEND`.
 pub fn context() -> Result<GpuContext, String> {
     let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
-    GpuContext::headless(backends).map_err(|e| e.to_string())
+    GpuContext::headless(backends).map_err(|e| crate::chain(&e))
 }
 
 /// An RGBA8 sRGB texture to render into and read back.
@@ -25,20 +25,22 @@ impl Offscreen {
     /// A `width` × `height` target.
     pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Self {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-        let (texture, view) = voxel_render::render_target(
+        let t = voxel_render::gpu::target(
             &ctx.device,
             "offscreen_output",
             wgpu::TextureFormat::Rgba8UnormSrgb,
             usage,
-            width,
-            height,
+            (width, height),
         );
-        Self { texture, view }
+        Self {
+            texture: t.texture,
+            view: t.view,
+        }
     }
 
     /// Reads the target back.
     pub fn read(&self, ctx: &GpuContext) -> Result<Image, String> {
-        let rgba = readback::read_texture(ctx, &self.texture, 4).map_err(|e| e.to_string())?;
+        let rgba = readback::read_texture(ctx, &self.texture, 4).map_err(|e| crate::chain(&e))?;
         Ok(Image {
             width: self.texture.width(),
             height: self.texture.height(),
@@ -54,10 +56,12 @@ pub fn renderer_for(
     config: RendererConfig,
 ) -> Result<Renderer, String> {
     let mut renderer =
-        Renderer::new(ctx, scene.world.registry(), config).map_err(|e| e.to_string())?;
+        Renderer::new(ctx, scene.world.registry(), config).map_err(|e| crate::chain(&e))?;
     let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
     for (pos, meshes) in mesh_chunks(&scene.world, &positions).map_err(|e| e.to_string())? {
-        renderer.upload_chunk(pos, &meshes);
+        renderer
+            .upload_chunk(pos, &meshes)
+            .map_err(|e| crate::chain(&e))?;
     }
     Ok(renderer)
 }
@@ -71,6 +75,6 @@ pub fn render_image(
 ) -> Result<Image, String> {
     renderer
         .render_and_submit(&target.view, camera)
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| crate::chain(&e))?;
     target.read(ctx)
 }

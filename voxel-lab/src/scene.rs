@@ -32,7 +32,7 @@
 //! path_to = [6.5, 3.5, 12.0]        # the flicker test moves the eye here in 60 frames
 //! ```
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::DVec3;
@@ -372,6 +372,20 @@ pub fn fill_box(
             id,
         )
         .map_err(|e| e.to_string())
+}
+
+/// The scene files of a folder, sorted.
+pub fn scene_files(dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    if v.is_empty() {
+        return Err(format!("{}: no .toml scene files", dir.display()));
+    }
+    Ok(v)
 }
 
 #[cfg(test)]

@@ -7,9 +7,9 @@
 //! pixel, but the renderer can estimate it per screen tile, cheaply, from the visible
 //! meshes:
 //!
-//! - at upload, each translucent mesh is summed up per plane, facing and block: the
-//!   rectangle around those quads, and their area times the block's optical depth
-//!   `−ln(1 − α)`;
+//! - once per chunk mesh (cached by the technique until the chunk is remeshed), the
+//!   translucent quads are summed up per plane, facing and block: the rectangle around
+//!   those quads, and their area times the block's optical depth `−ln(1 − α)`;
 //! - each frame, every plane that faces the eye (back faces are not drawn) adds, to each of
 //!   the `TILES × TILES` screen tiles its projected rectangle overlaps, the optical depth a
 //!   ray through the rectangle crosses (optical area / rectangle area) times the share of
@@ -17,7 +17,7 @@
 //!
 //! The result, per tile, is the expected optical depth in front of [`PROFILE_LEN`] depths
 //! spaced evenly in log depth across the translucent depth range in view; the weight is
-//! `3000 · e^−τ(d)` ([`crate::WeightFunction::Fitted`]). An estimate, not the per-pixel
+//! `3000 · e^−τ(d)` ([`super::WeightFunction::Fitted`]). An estimate, not the per-pixel
 //! truth: a layer covering a quarter of a tile dims what lies behind it in that tile by a
 //! quarter of its optical depth (also where the two do not overlap: the near and far parts
 //! of a sea, in different chunks, in one tile), a layer seen at a grazing angle does not
@@ -25,7 +25,7 @@
 //! block (a glass frame) counts as its block.
 //!
 //! The cost is a loop over the planes of the visible translucent meshes (eight projected
-//! corners each, then the tiles they overlap) and an 8 KiB table in the frame uniforms;
+//! corners each, then the tiles they overlap) and an 8 KiB table in the technique's uniforms;
 //! the shader reads eight entries of it (two depths in four tiles, to interpolate across
 //! tiles without seams).
 
@@ -34,8 +34,6 @@ use std::collections::BTreeMap;
 use glam::{DVec3, Mat4, Vec2, Vec3};
 use voxel_core::{ChunkPos, Face};
 use voxel_mesh::PackedQuad;
-
-use crate::oit::WeightFit;
 
 /// Number of distances of the optical-depth profile (log-spaced, ends included).
 pub const PROFILE_LEN: usize = 32;
@@ -211,6 +209,50 @@ fn projection(plane: &Plane, view_proj: Mat4, eye: DVec3) -> ([Vec2; 2], [f32; 2
         ],
         span,
     )
+}
+
+/// What the fitted weight is fitted to in a frame (see the module docs).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WeightFit {
+    /// Nearest and farthest view depth of the visible translucent meshes.
+    pub range: [f32; 2],
+    /// For each screen tile (row by row, [`TILES`] × [`TILES`]), the expected optical
+    /// depth in front of [`PROFILE_LEN`] depths spaced evenly in log depth across `range`.
+    /// Empty: none anywhere.
+    pub optical_depth: Vec<f32>,
+}
+
+/// The most optical depth the fitted weight falls by: `e^−12`, 6·10⁻⁶ (the weight must
+/// stay above fp16's smallest numbers once times α·3000).
+pub const MAX_FITTED_DEPTH: f32 = 12.0;
+
+impl WeightFit {
+    /// The optical depth in front of view depth `d` at `screen` (0 to 1, y down):
+    /// interpolated in log depth in the tables of the four tiles around `screen`, then
+    /// bilinearly between the tiles' centres (no seams at tile edges), and clamped at the
+    /// ends of the range and at [`MAX_FITTED_DEPTH`].
+    pub fn optical_depth_at(&self, screen: [f32; 2], d: f32) -> f32 {
+        if self.optical_depth.len() < TILES * TILES * PROFILE_LEN {
+            return 0.0;
+        }
+        let n = self.range[0].max(1e-4);
+        let f = self.range[1].max(n * 1.001);
+        let x = ((d / n).ln() / (f / n).ln()).clamp(0.0, 1.0) * (PROFILE_LEN - 1) as f32;
+        let k = (x.floor() as usize).min(PROFILE_LEN - 2);
+        let t = x - k as f32;
+        let at = |tx: usize, ty: usize| {
+            let p = &self.optical_depth[(ty * TILES + tx) * PROFILE_LEN..];
+            p[k] + (p[k + 1] - p[k]) * t
+        };
+        let lerp = |a: f32, b: f32, s: f32| a + (b - a) * s;
+        // Tile coordinates of `screen` between the tiles' centres.
+        let p = screen.map(|v| (v * TILES as f32 - 0.5).clamp(0.0, (TILES - 1) as f32));
+        let [tx, ty] = p.map(|v| (v.floor() as usize).min(TILES - 2));
+        let [sx, sy] = [p[0] - tx as f32, p[1] - ty as f32];
+        let top = lerp(at(tx, ty), at(tx + 1, ty), sx);
+        let bottom = lerp(at(tx, ty + 1), at(tx + 1, ty + 1), sx);
+        lerp(top, bottom, sy).min(MAX_FITTED_DEPTH)
+    }
 }
 
 #[cfg(test)]

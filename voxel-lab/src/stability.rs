@@ -10,17 +10,20 @@ use voxel_core::{BlockDef, BlockId, BlockRegistry, World};
 
 use voxel_render::{Camera, GpuContext, Technique};
 
-use crate::charts::{self, Series};
-use crate::eval::{self, EvalOptions, Progress, make_renderer, measure, oit_config};
+use crate::eval::{default_weight, make_renderer, measure, oit_config};
 use crate::headless::Offscreen;
 use crate::metrics;
+use crate::progress::Progress;
 use crate::scene::Scene;
+use crate::summary::{EvalOptions, write_json};
 
 /// One sweep: a parameter and each technique's mean FLIP at each of its values.
 #[derive(Clone, Debug, Serialize)]
 pub struct Sweep {
     /// Short name (file stem of its chart).
     pub name: String,
+    /// Whether its values are best shown on a log axis.
+    pub log: bool,
     /// What is swept.
     pub parameter: String,
     /// The values, in order.
@@ -121,7 +124,7 @@ fn sheets(
         0.1,
         4000.0,
     )
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| crate::chain(&e))?;
     Ok(Scene::new("sweep", world, camera))
 }
 
@@ -136,7 +139,7 @@ fn errors(
     let mut renderer = make_renderer(ctx, scene, size)?;
     let target = Offscreen::new(ctx, size.0, size.1);
     let cam = scene.cameras[0];
-    let weight = voxel_render::OitConfig::default().weight;
+    let weight = default_weight();
     let reference = measure(
         ctx,
         &mut renderer,
@@ -165,7 +168,7 @@ fn errors(
 
 const COLORS: [[u8; 3]; 4] = [[210, 60, 40], [40, 90, 210], [60, 180, 70], [230, 200, 60]];
 
-/// Runs the sweeps and the flicker paths, writes `stability/` charts and JSON.
+/// Runs the sweeps and the flicker paths, writes `stability/stability.json`.
 pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability, String> {
     let dir = opts.out.join("stability");
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -185,6 +188,7 @@ pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability, String> {
 
     let mut sweep = |name: &str,
                      parameter: &str,
+                     log: bool,
                      values: &[f64],
                      build: &dyn Fn(f64) -> Result<Scene, String>|
      -> Result<Sweep, String> {
@@ -201,6 +205,7 @@ pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability, String> {
         }
         Ok(Sweep {
             name: name.to_owned(),
+            log,
             parameter: parameter.to_owned(),
             values: values.to_vec(),
             flip: techniques
@@ -213,20 +218,28 @@ pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability, String> {
     let opacity = sweep(
         "opacity",
         "opacity of every layer (6 layers)",
+        false,
         &opacities,
         &|a| {
             let (reg, ids) = sweep_registry(a as f32, &COLORS[..2]);
             sheets(reg, &ids, &[0, -2, -4, -6, -8, -10], 12, 14.0)
         },
     )?;
-    let layer_count = sweep("layers", "number of layers (opacity 0.3)", &layers, &|n| {
-        let (reg, ids) = sweep_registry(0.3, &COLORS[..3]);
-        let zs: Vec<i32> = (0..n as i32).map(|i| -2 * i).collect();
-        sheets(reg, &ids, &zs, 14, 8.0)
-    })?;
+    let layer_count = sweep(
+        "layers",
+        "number of layers (opacity 0.3)",
+        true,
+        &layers,
+        &|n| {
+            let (reg, ids) = sweep_registry(0.3, &COLORS[..3]);
+            let zs: Vec<i32> = (0..n as i32).map(|i| -2 * i).collect();
+            sheets(reg, &ids, &zs, 14, 8.0)
+        },
+    )?;
     let distance = sweep(
         "distance",
         "distance from the eye to the stack (blocks)",
+        true,
         &distances,
         &|d| {
             let (reg, ids) = sweep_registry(0.4, &COLORS);
@@ -236,38 +249,14 @@ pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability, String> {
         },
     )?;
     let sweeps = vec![opacity, layer_count, distance];
-    for (s, log) in sweeps.iter().zip([false, true, true]) {
-        let series: Vec<Series> = s
-            .flip
-            .iter()
-            .map(|(t, f)| Series {
-                name: t.clone(),
-                points: s.values.iter().copied().zip(f.iter().copied()).collect(),
-            })
-            .collect();
-        charts::sweep(
-            &dir.join(&s.name),
-            &format!("Error against {}", s.parameter),
-            &s.parameter,
-            log,
-            &series,
-        )?;
-    }
-
     let mut flicker = Vec::new();
     for (stem, scene) in flicker_scenes {
         progress.step(&format!("stability: flicker {stem}"));
-        let f = flicker_path(ctx, &stem, &scene, opts, size, &techniques)?;
-        charts::bars(
-            &dir.join(format!("flicker_{stem}")),
-            &format!("Flicker beyond the reference, {stem}, {} frames", f.frames),
-            "mean excess change per frame (1/255)",
-            &f.excess,
-        )?;
-        flicker.push(f);
+        flicker.push(flicker_path(ctx, &stem, &scene, opts, size, &techniques)?);
     }
+    progress.finish();
     let result = Stability { sweeps, flicker };
-    eval::write_json(&dir.join("stability.json"), &result)?;
+    write_json(&dir.join("stability.json"), &result)?;
     Ok(result)
 }
 
@@ -315,7 +304,7 @@ fn flicker_path(
         .collect();
     let mut renderer = make_renderer(ctx, scene, size)?;
     let target = Offscreen::new(ctx, size.0, size.1);
-    let weight = voxel_render::OitConfig::default().weight;
+    let weight = default_weight();
     let path = |renderer: &mut voxel_render::Renderer,
                 t: Technique|
      -> Result<Vec<voxel_render::Image>, String> {
@@ -334,7 +323,7 @@ fn flicker_path(
             .map(|c| {
                 renderer
                     .render_and_submit(&target.view, c)
-                    .map_err(|e| e.to_string())?;
+                    .map_err(|e| crate::chain(&e))?;
                 target.read(ctx)
             })
             .collect()

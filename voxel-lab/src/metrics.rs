@@ -129,6 +129,35 @@ pub fn excess_change(prev: &Image, cur: &Image, ref_prev: &Image, ref_cur: &Imag
     total / (3.0 * f64::from(cur.width) * f64::from(cur.height))
 }
 
+/// `img` scaled down (box filter) to `width` pixels wide, or as it is if not wider.
+pub fn thumbnail(img: &Image, width: Option<u32>) -> Image {
+    let Some(w) = width.filter(|w| *w > 0 && *w < img.width) else {
+        return img.clone();
+    };
+    let f = img.width.div_ceil(w);
+    let (nw, nh) = (img.width / f, img.height / f);
+    let mut rgba = Vec::with_capacity((nw * nh * 4) as usize);
+    for y in 0..nh {
+        for x in 0..nw {
+            let mut acc = [0u32; 4];
+            for dy in 0..f {
+                for dx in 0..f {
+                    let p = img.pixel(x * f + dx, y * f + dy);
+                    for c in 0..4 {
+                        acc[c] += u32::from(p[c]);
+                    }
+                }
+            }
+            rgba.extend(acc.map(|v| (v / (f * f)) as u8));
+        }
+    }
+    Image {
+        width: nw,
+        height: nh,
+        rgba,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,850 @@
+//! The interactive demo: a winit window with a wgpu surface, generated terrain drawn by the
+//! voxel renderer, an egui side panel to switch techniques and settings, a fly camera,
+//! block edits remeshed in the background, live GPU timings and a live error map against
+//! the exact reference.
+//!
+//! A frame is drawn into an sRGB offscreen target (the scene, then the panel), which is
+//! blitted to the surface: one picture for the window and for screenshots.
+
+mod display;
+mod panel;
+mod post;
+mod raycast;
+
+use std::collections::{HashMap, HashSet};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::time::Instant;
+
+use glam::DVec3;
+use voxel_core::{BlockId, ChunkPos, RenderClass, World};
+use voxel_lab::{chain, scene};
+use voxel_mesh::{ChunkMeshes, Mesher};
+use voxel_render::{
+    Camera, FrameStats, GpuContext, GpuTimes, Image, OitConfig, Renderer, RendererConfig,
+    Technique, readback,
+};
+use winit::application::ApplicationHandler;
+use winit::event::{DeviceEvent, ElementState, MouseButton, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::keyboard::{KeyCode, PhysicalKey};
+use winit::window::{Window, WindowId};
+
+use display::Display;
+use post::{FRAME_FORMAT, Frames, Post};
+pub use raycast::raycast;
+
+/// How the demo starts, and what a scripted run does.
+#[derive(Clone, Debug)]
+pub struct DemoOptions {
+    /// World seed.
+    pub seed: u32,
+    /// Initial window size.
+    pub size: (u32, u32),
+    /// Initial technique.
+    pub technique: Technique,
+    /// Chunks of terrain around the start, each way.
+    pub view_distance: i32,
+    /// Scripted: quit after this many frames (per technique with `cycle`).
+    pub frames: Option<u64>,
+    /// Scripted: save the last frame (with the panel) here.
+    pub screenshot: Option<PathBuf>,
+    /// Scripted: step through every technique, saving `DIR/<technique>.png` for each.
+    pub cycle: Option<PathBuf>,
+    /// Start with the error map on.
+    pub heatmap: bool,
+    /// Scripted: place a block in front of the camera on the second frame (remeshing test).
+    pub edit: bool,
+    /// Scripted: on frames 1 to 3, halve the window, get a zero size (what a minimised
+    /// window reports), then restore the size (resize test).
+    pub resize: bool,
+}
+
+impl Default for DemoOptions {
+    fn default() -> Self {
+        Self {
+            seed: 1,
+            size: (1280, 720),
+            technique: Technique::WboitMrt,
+            view_distance: scene::DEFAULT_RADIUS,
+            frames: None,
+            screenshot: None,
+            cycle: None,
+            heatmap: false,
+            edit: false,
+            resize: false,
+        }
+    }
+}
+
+/// Whether a window can be opened: an X11 or Wayland display is named in the environment.
+pub fn have_display() -> bool {
+    ["DISPLAY", "WAYLAND_DISPLAY"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
+}
+
+/// Opens the window and runs until it is closed (or the script ends).
+pub fn run(opts: DemoOptions) -> Result<(), String> {
+    let event_loop = EventLoop::new().map_err(|e| format!("cannot open a window: {e}"))?;
+    let mut app = App {
+        opts,
+        gfx: None,
+        error: None,
+    };
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| format!("event loop: {e}"))?;
+    app.error.map_or(Ok(()), Err)
+}
+
+struct App {
+    opts: DemoOptions,
+    gfx: Option<Gfx>,
+    error: Option<String>,
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_some() {
+            return;
+        }
+        let attrs = Window::default_attributes()
+            .with_title("voxel-oit")
+            .with_inner_size(winit::dpi::PhysicalSize::new(
+                self.opts.size.0,
+                self.opts.size.1,
+            ));
+        let result = event_loop
+            .create_window(attrs)
+            .map_err(|e| format!("cannot create the window: {e}"))
+            .and_then(|w| Gfx::new(Arc::new(w), self.opts.clone()));
+        match result {
+            Ok(g) => {
+                g.display.window.request_redraw();
+                self.gfx = Some(g);
+            }
+            Err(e) => {
+                self.error = Some(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(g) = &mut self.gfx else { return };
+        let egui_wants =
+            g.ui.state
+                .on_window_event(&g.display.window, &event)
+                .consumed;
+        let result = match event {
+            WindowEvent::CloseRequested => Ok(Flow::Quit),
+            WindowEvent::Resized(size) => g.resize(size.width, size.height).map(|_| Flow::Continue),
+            WindowEvent::RedrawRequested => g.frame(),
+            WindowEvent::KeyboardInput { event, .. } if !egui_wants => {
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    g.key(code, event.state == ElementState::Pressed);
+                }
+                Ok(Flow::Continue)
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                g.mouse_button(button, state == ElementState::Pressed, egui_wants);
+                Ok(Flow::Continue)
+            }
+            WindowEvent::ModifiersChanged(m) => {
+                g.input.ctrl = m.state().control_key();
+                Ok(Flow::Continue)
+            }
+            _ => Ok(Flow::Continue),
+        };
+        match result {
+            Ok(Flow::Continue) => {}
+            Ok(Flow::Quit) => event_loop.exit(),
+            Err(e) => {
+                self.error = Some(e);
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn device_event(
+        &mut self,
+        _event_loop: &ActiveEventLoop,
+        _id: winit::event::DeviceId,
+        event: DeviceEvent,
+    ) {
+        if let (Some(g), DeviceEvent::MouseMotion { delta }) = (&mut self.gfx, event)
+            && g.input.looking
+        {
+            let i = &mut g.input;
+            i.dragged += delta.0.abs() + delta.1.abs();
+            i.fly.yaw += delta.0 * 0.003;
+            i.fly.pitch = (i.fly.pitch - delta.1 * 0.003).clamp(-1.5, 1.5);
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Some(g) = &self.gfx {
+            g.display.window.request_redraw();
+        }
+    }
+}
+
+enum Flow {
+    Continue,
+    Quit,
+}
+
+/// Fly camera state.
+#[derive(Clone, Copy, Debug)]
+struct Fly {
+    eye: DVec3,
+    yaw: f64,
+    pitch: f64,
+    speed: f64,
+}
+
+/// Keyboard and mouse state.
+#[derive(Debug)]
+struct Input {
+    fly: Fly,
+    keys: HashSet<KeyCode>,
+    /// Right button held: mouse motion turns the camera.
+    looking: bool,
+    /// How far the mouse moved since the right button went down.
+    dragged: f64,
+    ctrl: bool,
+}
+
+/// Settings the panel edits.
+#[derive(Clone, Debug, PartialEq)]
+struct Settings {
+    oit: OitConfig,
+    msaa: bool,
+    fade_in_frames: u32,
+    seed: u32,
+    view_distance: i32,
+    heatmap: bool,
+    place: BlockId,
+}
+
+/// egui's state.
+struct Ui {
+    ctx: egui::Context,
+    state: egui_winit::State,
+    renderer: egui_wgpu::Renderer,
+}
+
+/// One frame's panel: what to paint, and the right edge of the panel in pixels.
+struct PanelFrame {
+    paint_jobs: Vec<egui::ClippedPrimitive>,
+    free: Vec<egui::TextureId>,
+    pixels_per_point: f32,
+    view_x: u32,
+}
+
+type MeshResult = (ChunkPos, u64, Result<ChunkMeshes, String>);
+
+/// The world and its background remeshing: edited chunks are meshed on rayon's pool and
+/// uploaded by the frame that receives them, so that no frame waits for a mesh.
+struct Remesher {
+    world: World,
+    tx: Sender<MeshResult>,
+    rx: Receiver<MeshResult>,
+    /// The latest job per chunk: older results are dropped.
+    generation: HashMap<ChunkPos, u64>,
+    pending: usize,
+}
+
+/// What the panel shows about the last frames.
+#[derive(Default)]
+struct Status {
+    stats: FrameStats,
+    gpu_times: GpuTimes,
+    fps: f64,
+    frame_index: u64,
+    message: String,
+}
+
+/// A scripted run: technique cycling, screenshots, quitting.
+struct Script {
+    opts: DemoOptions,
+    cycle: Vec<Technique>,
+    screenshot_request: Option<PathBuf>,
+}
+
+struct Gfx {
+    display: Display,
+    ctx: GpuContext,
+    renderer: Renderer,
+    /// The exact reference, drawn beside for the error map.
+    reference: Option<Renderer>,
+    post: Post,
+    frames: Frames,
+    ui: Ui,
+    remesher: Remesher,
+    input: Input,
+    far: f64,
+    settings: Settings,
+    applied: Settings,
+    status: Status,
+    last: Instant,
+    script: Script,
+}
+
+impl Gfx {
+    fn new(window: Arc<Window>, opts: DemoOptions) -> Result<Self, String> {
+        let (display, ctx) = Display::new(window)?;
+        let scene = scene::default_scene_with_radius(opts.seed, opts.view_distance)?;
+        let cam = scene.cameras[0];
+        let (yaw, pitch) = cam.yaw_pitch();
+        let settings = Settings {
+            oit: OitConfig::with(opts.technique),
+            msaa: false,
+            // New chunks dissolve in over 20 frames; a scripted run (a test, a screenshot)
+            // shows the settled picture from its first frame instead.
+            fade_in_frames: if opts.frames.is_some() { 0 } else { 20 },
+            seed: opts.seed,
+            view_distance: opts.view_distance,
+            heatmap: opts.heatmap,
+            place: voxel_core::blocks::GLASS,
+        };
+        let (w, h) = display.size();
+        let config = RendererConfig {
+            width: w,
+            height: h,
+            output_format: FRAME_FORMAT,
+            oit: settings.oit.clone(),
+            fade_in_frames: settings.fade_in_frames,
+            ..RendererConfig::default()
+        };
+        let renderer =
+            Renderer::new(&ctx, scene.world.registry(), config).map_err(|e| chain(&e))?;
+        let post = Post::new(&ctx.device, display.config.format);
+        let frames = Frames::new(&ctx.device, &post, w, h, 0);
+        let ui = Ui::new(&display.window, &ctx);
+        let cycle = if opts.cycle.is_some() {
+            Technique::ALL.to_vec()
+        } else {
+            Vec::new()
+        };
+        let (tx, rx) = channel();
+        let mut g = Self {
+            display,
+            ctx,
+            renderer,
+            reference: None,
+            post,
+            frames,
+            ui,
+            remesher: Remesher {
+                world: scene.world,
+                tx,
+                rx,
+                generation: HashMap::new(),
+                pending: 0,
+            },
+            input: Input {
+                fly: Fly {
+                    eye: cam.eye,
+                    yaw,
+                    pitch,
+                    speed: 12.0,
+                },
+                keys: HashSet::new(),
+                looking: false,
+                dragged: 0.0,
+                ctrl: false,
+            },
+            far: cam.far,
+            applied: settings.clone(),
+            settings,
+            status: Status::default(),
+            last: Instant::now(),
+            script: Script {
+                opts,
+                cycle,
+                screenshot_request: None,
+            },
+        };
+        if let Some(t) = g.script.cycle.first() {
+            g.settings.oit.technique = *t;
+        }
+        // The first meshes: all at once, in parallel (a start-up cost, not a frame hitch).
+        g.upload_all()?;
+        Ok(g)
+    }
+
+    /// Every chunk of the world meshed and uploaded, to the renderer and the reference.
+    fn upload_all(&mut self) -> Result<(), String> {
+        let world = &mut self.remesher.world;
+        let positions: Vec<ChunkPos> = world.iter().map(|(p, _)| p).collect();
+        world.take_dirty();
+        let meshes = voxel_mesh::mesh_chunks(world, &positions).map_err(|e| e.to_string())?;
+        for r in std::iter::once(&mut self.renderer).chain(self.reference.as_mut()) {
+            r.clear_chunks();
+            for (pos, m) in &meshes {
+                r.upload_chunk(*pos, m).map_err(|e| chain(&e))?;
+            }
+        }
+        Ok(())
+    }
+
+    fn camera(&self) -> Result<Camera, String> {
+        let f = &self.input.fly;
+        Camera::from_yaw_pitch(f.eye, f.yaw, f.pitch, 70.0, 0.1, self.far).map_err(|e| chain(&e))
+    }
+
+    fn resize(&mut self, w: u32, h: u32) -> Result<(), String> {
+        // Minimised: keep everything as it is until a real size comes back.
+        if w == 0 || h == 0 {
+            return Ok(());
+        }
+        self.display.resize(&self.ctx, w, h);
+        self.layout(self.frames.view_x)
+    }
+
+    /// Sizes the frame targets to the window and the 3D view to the room right of the
+    /// panel (`view_x` pixels wide); renderers follow the view. Nothing happens when
+    /// nothing changed.
+    fn layout(&mut self, view_x: u32) -> Result<(), String> {
+        let (w, h) = self.display.size();
+        let view_x = view_x.min(w.saturating_sub(16));
+        let frame = &self.frames.frame.texture;
+        if (frame.width(), frame.height(), self.frames.view_x) == (w, h, view_x) {
+            return Ok(());
+        }
+        self.frames = Frames::new(&self.ctx.device, &self.post, w, h, view_x);
+        let (vw, vh) = self.frames.view_size();
+        for r in std::iter::once(&mut self.renderer).chain(self.reference.as_mut()) {
+            r.resize(vw, vh).map_err(|e| chain(&e))?;
+        }
+        Ok(())
+    }
+
+    fn key(&mut self, code: KeyCode, pressed: bool) {
+        if pressed {
+            self.input.keys.insert(code);
+        } else {
+            self.input.keys.remove(&code);
+            return;
+        }
+        let digits = [
+            KeyCode::Digit1,
+            KeyCode::Digit2,
+            KeyCode::Digit3,
+            KeyCode::Digit4,
+            KeyCode::Digit5,
+            KeyCode::Digit6,
+            KeyCode::Digit7,
+            KeyCode::Digit8,
+            KeyCode::Digit9,
+        ];
+        if let Some(t) = digits
+            .iter()
+            .position(|d| *d == code)
+            .and_then(|i| Technique::ALL.get(i))
+        {
+            self.settings.oit.technique = *t;
+        }
+        match code {
+            KeyCode::F2 | KeyCode::KeyP => self.request_screenshot(),
+            KeyCode::KeyH => self.settings.heatmap = !self.settings.heatmap,
+            KeyCode::KeyE => self.edit(true),
+            KeyCode::KeyQ => self.edit(false),
+            _ => {}
+        }
+    }
+
+    fn mouse_button(&mut self, button: MouseButton, pressed: bool, egui_wants: bool) {
+        match (button, pressed) {
+            (MouseButton::Right, true) if !egui_wants => {
+                self.input.looking = true;
+                self.input.dragged = 0.0;
+            }
+            (MouseButton::Right, false) => {
+                // A right click that did not turn the camera removes a block.
+                if self.input.looking && self.input.dragged < 4.0 && !egui_wants {
+                    self.edit(false);
+                }
+                self.input.looking = false;
+            }
+            (MouseButton::Left, true) if !egui_wants => self.edit(!self.input.ctrl),
+            _ => {}
+        }
+    }
+
+    fn request_screenshot(&mut self) {
+        let n = self.status.frame_index;
+        self.script.screenshot_request =
+            Some(PathBuf::from(format!("screenshots/voxel-oit-{n}.png")));
+    }
+
+    /// Places the selected block in front of the aimed face, or removes the aimed block.
+    fn edit(&mut self, place: bool) {
+        let f = self.input.fly;
+        let dir = Camera::from_yaw_pitch(DVec3::ZERO, f.yaw, f.pitch, 70.0, 0.1, 10.0)
+            .map(|c| c.forward)
+            .unwrap_or(DVec3::NEG_Z);
+        let world = &mut self.remesher.world;
+        let registry = world.registry().clone();
+        let solid = |p| {
+            registry
+                .class(world.get_block(p))
+                .is_ok_and(|c| c != RenderClass::Air)
+        };
+        let Some((hit, before)) = raycast(f.eye, dir, 64.0, solid) else {
+            self.status.message = "nothing to edit within 64 blocks".into();
+            return;
+        };
+        let (pos, id) = if place {
+            (before, self.settings.place)
+        } else {
+            (hit, BlockId::AIR)
+        };
+        match world.set_block(pos, id) {
+            Ok(_) => self.remesher.schedule(),
+            Err(e) => self.status.message = e.to_string(),
+        }
+    }
+
+    fn fly(&mut self, dt: f64) {
+        let i = &mut self.input;
+        let forward = DVec3::new(i.fly.yaw.sin(), 0.0, -i.fly.yaw.cos());
+        let right = DVec3::new(-forward.z, 0.0, forward.x);
+        let mut v = DVec3::ZERO;
+        for (key, dir) in [
+            (KeyCode::KeyW, forward),
+            (KeyCode::KeyS, -forward),
+            (KeyCode::KeyD, right),
+            (KeyCode::KeyA, -right),
+            (KeyCode::Space, DVec3::Y),
+            (KeyCode::ShiftLeft, -DVec3::Y),
+        ] {
+            if i.keys.contains(&key) {
+                v += dir;
+            }
+        }
+        let turn = 1.5 * dt;
+        for (key, dyaw, dpitch) in [
+            (KeyCode::ArrowLeft, -turn, 0.0),
+            (KeyCode::ArrowRight, turn, 0.0),
+            (KeyCode::ArrowUp, 0.0, turn),
+            (KeyCode::ArrowDown, 0.0, -turn),
+        ] {
+            if i.keys.contains(&key) {
+                i.fly.yaw += dyaw;
+                i.fly.pitch = (i.fly.pitch + dpitch).clamp(-1.5, 1.5);
+            }
+        }
+        let fast = if i.keys.contains(&KeyCode::ControlLeft) {
+            4.0
+        } else {
+            1.0
+        };
+        i.fly.eye += v.normalize_or_zero() * i.fly.speed * fast * dt;
+    }
+
+    /// Applies what the panel changed.
+    fn apply_settings(&mut self) -> Result<(), String> {
+        let s = self.settings.clone();
+        let a = self.applied.clone();
+        if s.seed != a.seed || s.view_distance != a.view_distance {
+            let scene = scene::default_scene_with_radius(s.seed, s.view_distance)?;
+            self.remesher.world = scene.world;
+            self.remesher.generation.clear();
+            self.far = (f64::from(s.view_distance) * 32.0 * 1.8).max(200.0);
+            if s.seed != a.seed {
+                let (yaw, pitch) = scene.cameras[0].yaw_pitch();
+                self.input.fly.eye = scene.cameras[0].eye;
+                self.input.fly.yaw = yaw;
+                self.input.fly.pitch = pitch;
+            }
+            self.upload_all()?;
+        }
+        if s.oit != a.oit {
+            self.renderer
+                .set_oit_config(s.oit.clone())
+                .map_err(|e| chain(&e))?;
+        }
+        if s.msaa != a.msaa {
+            self.renderer.set_msaa(s.msaa).map_err(|e| chain(&e))?;
+        }
+        if s.fade_in_frames != a.fade_in_frames {
+            self.renderer.set_fade_in_frames(s.fade_in_frames);
+        }
+        if s.heatmap && self.reference.is_none() {
+            self.reference = Some(self.reference_renderer()?);
+        } else if !s.heatmap {
+            self.reference = None;
+        }
+        self.applied = s;
+        Ok(())
+    }
+
+    /// A renderer drawing the exact reference of the same world and view.
+    fn reference_renderer(&self) -> Result<Renderer, String> {
+        let (w, h) = self.renderer.size();
+        let config = RendererConfig {
+            width: w,
+            height: h,
+            output_format: FRAME_FORMAT,
+            oit: OitConfig::with(Technique::Reference),
+            ..RendererConfig::default()
+        };
+        let world = &self.remesher.world;
+        let mut r = Renderer::new(&self.ctx, world.registry(), config).map_err(|e| chain(&e))?;
+        let positions: Vec<ChunkPos> = world.iter().map(|(p, _)| p).collect();
+        for (pos, m) in voxel_mesh::mesh_chunks(world, &positions).map_err(|e| e.to_string())? {
+            r.upload_chunk(pos, &m).map_err(|e| chain(&e))?;
+        }
+        Ok(r)
+    }
+
+    /// Frame time and FPS.
+    fn tick(&mut self) -> f64 {
+        let now = Instant::now();
+        let dt = now.duration_since(self.last).as_secs_f64().min(0.25);
+        self.last = now;
+        if dt > 0.0 {
+            let fps = &mut self.status.fps;
+            *fps = if *fps == 0.0 {
+                1.0 / dt
+            } else {
+                *fps * 0.9 + 0.1 / dt
+            };
+        }
+        dt
+    }
+
+    /// The scripted edit and resizes of the window test.
+    fn scripted_events(&mut self) -> Result<(), String> {
+        let n = self.status.frame_index;
+        if self.script.opts.edit && n == 1 {
+            self.edit(true);
+        }
+        if self.script.opts.resize {
+            let (w, h) = self.script.opts.size;
+            let window = &self.display.window;
+            match n {
+                1 => {
+                    let _ = window.request_inner_size(winit::dpi::PhysicalSize::new(w / 2, h / 2));
+                }
+                2 => self.resize(0, 0)?,
+                3 => {
+                    let _ = window.request_inner_size(winit::dpi::PhysicalSize::new(w, h));
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn frame(&mut self) -> Result<Flow, String> {
+        let dt = self.tick();
+        if let Some(message) = self
+            .remesher
+            .receive(&mut self.renderer, self.reference.as_mut())
+        {
+            self.status.message = message;
+        }
+        self.fly(dt);
+        self.scripted_events()?;
+        let panel = self.run_panel();
+        self.apply_settings()?;
+        self.layout(panel.view_x)?;
+
+        let Some(surface_texture) = self.display.acquire(&self.ctx)? else {
+            // No frame this time (outdated surface, minimised): the panel's texture
+            // updates are already applied, only what it freed is let go.
+            self.ui.free(&panel.free);
+            return Ok(Flow::Continue);
+        };
+        let surface_view = surface_texture.texture.create_view(&Default::default());
+        let mut encoder = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("demo_frame"),
+            });
+        self.draw_scene(&mut encoder)?;
+        let extra = self.draw_panel(&mut encoder, &panel);
+        Post::draw(
+            &mut encoder,
+            &self.post.blit,
+            &self.frames.blit_group,
+            &surface_view,
+        );
+        self.ctx
+            .queue
+            .submit(extra.into_iter().chain([encoder.finish()]));
+        self.ui.free(&panel.free);
+        self.renderer.after_submit();
+        if let Some(r) = &mut self.reference {
+            r.after_submit();
+        }
+        self.display.window.pre_present_notify();
+        self.ctx.queue.present(surface_texture);
+        let _ = self.ctx.device.poll(wgpu::PollType::Poll);
+        let times = self.renderer.gpu_times();
+        if !times.is_empty() {
+            self.status.gpu_times = times;
+        }
+        if let Some(path) = self.script.screenshot_request.take() {
+            self.save_screenshot(&path)?;
+        }
+        self.status.frame_index += 1;
+        self.script()
+    }
+
+    /// The 3D view (and the error map against the reference when on), copied right of
+    /// the panel.
+    fn draw_scene(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<(), String> {
+        let camera = self.camera()?;
+        let frames = &self.frames;
+        match &mut self.reference {
+            Some(reference) => {
+                self.status.stats = self
+                    .renderer
+                    .render(encoder, &frames.technique.view, &camera)
+                    .map_err(|e| chain(&e))?;
+                reference
+                    .render(encoder, &frames.reference.view, &camera)
+                    .map_err(|e| chain(&e))?;
+                Post::draw(
+                    encoder,
+                    &self.post.diff,
+                    &frames.diff_group,
+                    &frames.view.view,
+                );
+            }
+            None => {
+                self.status.stats = self
+                    .renderer
+                    .render(encoder, &frames.view.view, &camera)
+                    .map_err(|e| chain(&e))?;
+            }
+        }
+        encoder.copy_texture_to_texture(
+            frames.view.texture.as_image_copy(),
+            wgpu::TexelCopyTextureInfo {
+                texture: &frames.frame.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: frames.view_x,
+                    y: 0,
+                    z: 0,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            frames.view.texture.size(),
+        );
+        Ok(())
+    }
+
+    /// The scripted run: screenshots, technique cycling, quitting.
+    fn script(&mut self) -> Result<Flow, String> {
+        let Some(frames) = self.script.opts.frames else {
+            return Ok(Flow::Continue);
+        };
+        // Edits are remeshed in the background: let them land before the last frame.
+        if self.status.frame_index < frames || self.remesher.pending > 0 {
+            return Ok(Flow::Continue);
+        }
+        if let Some(dir) = self.script.opts.cycle.clone() {
+            let t = self.settings.oit.technique;
+            self.save_screenshot(&dir.join(format!("{}.png", t.name())))?;
+            let next = self
+                .script
+                .cycle
+                .iter()
+                .position(|c| *c == t)
+                .map(|i| i + 1);
+            match next.and_then(|i| self.script.cycle.get(i)) {
+                Some(n) => {
+                    self.settings.oit.technique = *n;
+                    self.status.frame_index = 0;
+                    return Ok(Flow::Continue);
+                }
+                None => return Ok(Flow::Quit),
+            }
+        }
+        if let Some(path) = self.script.opts.screenshot.clone() {
+            self.save_screenshot(&path)?;
+        }
+        Ok(Flow::Quit)
+    }
+
+    fn save_screenshot(&mut self, path: &std::path::Path) -> Result<(), String> {
+        let texture = &self.frames.frame.texture;
+        let rgba = readback::read_texture(&self.ctx, texture, 4).map_err(|e| chain(&e))?;
+        Image {
+            width: texture.width(),
+            height: texture.height(),
+            rgba,
+        }
+        .save_png(path)
+        .map_err(|e| chain(&e))?;
+        self.status.message = format!("saved {}", path.display());
+        Ok(())
+    }
+}
+
+impl Remesher {
+    /// Remeshes the dirty chunks on rayon's pool; results come back through a channel and
+    /// are uploaded by the frame that receives them: editing never stalls a frame.
+    fn schedule(&mut self) {
+        for pos in self.world.take_dirty() {
+            let generation = self.generation.entry(pos).or_insert(0);
+            *generation += 1;
+            let generation = *generation;
+            let chunk = self.world.chunk(pos).cloned();
+            let neighbours: [Option<voxel_core::Chunk>; 6] =
+                self.world.neighbours(pos).map(|c| c.cloned());
+            let registry = self.world.registry().clone();
+            let tx = self.tx.clone();
+            self.pending += 1;
+            rayon::spawn(move || {
+                let meshes = match &chunk {
+                    Some(c) => {
+                        let nb: [Option<&voxel_core::Chunk>; 6] =
+                            std::array::from_fn(|i| neighbours[i].as_ref());
+                        Mesher::new(&registry)
+                            .mesh(c, nb)
+                            .map_err(|e| e.to_string())
+                    }
+                    None => Ok(ChunkMeshes::default()),
+                };
+                let _ = tx.send((pos, generation, meshes));
+            });
+        }
+    }
+
+    /// Uploads the meshes that came back; returns an error to show, if any.
+    fn receive(
+        &mut self,
+        renderer: &mut Renderer,
+        mut reference: Option<&mut Renderer>,
+    ) -> Option<String> {
+        let mut message = None;
+        while let Ok((pos, generation, meshes)) = self.rx.try_recv() {
+            self.pending = self.pending.saturating_sub(1);
+            // A later edit of the same chunk has a newer job in flight: skip this one.
+            if self.generation.get(&pos) != Some(&generation) {
+                continue;
+            }
+            let uploaded = meshes.and_then(|m| {
+                renderer.upload_chunk(pos, &m).map_err(|e| chain(&e))?;
+                if let Some(r) = reference.as_deref_mut() {
+                    r.upload_chunk(pos, &m).map_err(|e| chain(&e))?;
+                }
+                Ok(())
+            });
+            if let Err(e) = uploaded {
+                message = Some(e);
+            }
+        }
+        message
+    }
+}

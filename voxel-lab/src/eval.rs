@@ -1,0 +1,293 @@
+//! Runs of the lab: every scene of a suite rendered with every technique and with both
+//! exact methods; error and cost per picture, as [`Record`]s.
+
+use std::path::Path;
+
+use voxel_render::{
+    Camera, FrameStats, GpuContext, Image, OitConfig, Renderer, RendererConfig, Technique,
+    WeightFunction,
+};
+
+use crate::headless::{Offscreen, renderer_for};
+use crate::metrics::{self, Metrics, thumbnail};
+use crate::progress::Progress;
+use crate::scene::Scene;
+use crate::summary::{EXACT_AGREEMENT, EvalOptions, Record, ReferenceCheck, Summary};
+
+/// A renderer for measurements, sized `size`.
+pub fn make_renderer(
+    ctx: &GpuContext,
+    scene: &Scene,
+    size: (u32, u32),
+) -> Result<Renderer, String> {
+    let config = RendererConfig {
+        width: size.0,
+        height: size.1,
+        ..RendererConfig::default()
+    };
+    renderer_for(ctx, scene, config)
+}
+
+/// What [`measure`] returns: the last picture, its HDR non-finite count, the frame stats.
+#[derive(Debug)]
+pub struct Measured {
+    /// The last frame.
+    pub image: Image,
+    /// Median GPU ms of the translucent work (the technique's passes and composites).
+    pub gpu_ms: Option<f64>,
+    /// Median CPU ms per frame.
+    pub cpu_ms: f64,
+    /// Non-finite HDR pixels of the last frame.
+    pub nan_px: usize,
+    /// Stats of the last frame.
+    pub stats: FrameStats,
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    Some(v[v.len() / 2])
+}
+
+/// Renders `warmup + frames` frames of `camera` with `config` and returns the last picture
+/// with the median timings.
+pub fn measure(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    target: &Offscreen,
+    camera: &Camera,
+    config: &OitConfig,
+    warmup: usize,
+    frames: usize,
+) -> Result<Measured, String> {
+    renderer
+        .set_oit_config(config.clone())
+        .map_err(|e| crate::chain(&e))?;
+    let mut gpu = Vec::new();
+    let mut cpu = Vec::new();
+    let mut stats = FrameStats::default();
+    for i in 0..warmup + frames.max(1) {
+        stats = renderer
+            .render_and_submit(&target.view, camera)
+            .map_err(|e| crate::chain(&e))?;
+        let times = renderer.gpu_times_blocking();
+        if i >= warmup {
+            cpu.push(stats.cpu_ms);
+            if !times.is_empty() {
+                gpu.push(times.translucent_work());
+            }
+        }
+    }
+    let image = target.read(ctx)?;
+    let hdr = read_hdr(ctx, renderer.scene_color())?;
+    Ok(Measured {
+        image,
+        gpu_ms: median(gpu),
+        cpu_ms: median(cpu).unwrap_or(0.0),
+        nan_px: metrics::non_finite_pixels(&hdr),
+        stats,
+    })
+}
+
+/// The HDR scene colour as f32 RGBA.
+pub fn read_hdr(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>, String> {
+    let bytes =
+        voxel_render::readback::read_texture(ctx, texture, 8).map_err(|e| crate::chain(&e))?;
+    Ok(bytes
+        .chunks_exact(8)
+        .map(|p| {
+            let h =
+                |i: usize| voxel_render::readback::f16_to_f32(u16::from_le_bytes([p[i], p[i + 1]]));
+            [h(0), h(2), h(4), h(6)]
+        })
+        .collect())
+}
+
+/// The default WBOIT weight.
+pub fn default_weight() -> WeightFunction {
+    voxel_render::WboitSettings::default().weight
+}
+
+/// The default configuration drawing with `technique` and WBOIT weight `weight`.
+pub fn oit_config(technique: Technique, weight: WeightFunction) -> OitConfig {
+    let mut c = OitConfig::with(technique);
+    c.wboit.weight = weight;
+    c
+}
+
+/// Both exact methods on one scene: the reference picture, and whether it is exact.
+#[derive(Debug)]
+pub struct Reference {
+    /// The A-buffer's picture.
+    pub image: Image,
+    /// The check of the two methods against each other.
+    pub check: ReferenceCheck,
+}
+
+/// Renders `camera` of `renderer`'s scene with both exact methods and checks them against
+/// each other.
+pub fn reference(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    target: &Offscreen,
+    camera: &Camera,
+    scene: &str,
+) -> Result<Reference, String> {
+    let weight = default_weight();
+    let abuffer = measure(
+        ctx,
+        renderer,
+        target,
+        camera,
+        &oit_config(Technique::Reference, weight),
+        0,
+        1,
+    )?;
+    let peel = measure(
+        ctx,
+        renderer,
+        target,
+        camera,
+        &oit_config(Technique::PeelReference, weight),
+        0,
+        1,
+    )?;
+    let agreement = metrics::compare(&abuffer.image, &peel.image).0.max_abs_err;
+    let r = abuffer.stats.technique.reference.unwrap_or_default();
+    let peeled = peel.stats.technique.peeling.unwrap_or_default();
+    Ok(Reference {
+        image: abuffer.image,
+        check: ReferenceCheck {
+            scene: scene.to_owned(),
+            max_abs_err: agreement,
+            exact: agreement <= EXACT_AGREEMENT && r.exact() && !peeled.truncated,
+            lost_fragments: r.lost_fragments,
+            capped_pixels: r.capped_pixels,
+            capped_visible_pixels: r.capped_visible_pixels,
+            depth_complexity: peeled.layers.unwrap_or(0),
+        },
+    })
+}
+
+/// The runs of one scene: each technique at the default weight, then `wboit-mrt` with each
+/// of `weights`.
+fn runs(opts: &EvalOptions) -> Vec<(String, OitConfig)> {
+    let default = default_weight();
+    let mut runs: Vec<(String, OitConfig)> = opts
+        .techniques
+        .iter()
+        .map(|t| (t.name().to_owned(), oit_config(*t, default)))
+        .collect();
+    for w in &opts.weights {
+        runs.push((
+            format!("wboit-mrt/{}", w.name()),
+            oit_config(Technique::WboitMrt, *w),
+        ));
+    }
+    runs
+}
+
+/// Measures every run of `opts` on the scene at `path` against its reference; saves the
+/// reference picture and one heat map per run under `out/heatmaps/`.
+fn scene_records(
+    ctx: &GpuContext,
+    opts: &EvalOptions,
+    path: &Path,
+    progress: &mut Progress,
+) -> Result<(Vec<Record>, ReferenceCheck), String> {
+    let stem = path
+        .file_stem()
+        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+    let scene = Scene::load(path)?;
+    let size = opts.size.or(scene.size).unwrap_or((640, 360));
+    let mut renderer = make_renderer(ctx, &scene, size)?;
+    let target = Offscreen::new(ctx, size.0, size.1);
+    let camera = scene.cameras[0];
+    let heatmaps = opts.out.join("heatmaps");
+
+    progress.step(&format!("{stem}: exact references"));
+    let reference = reference(ctx, &mut renderer, &target, &camera, &stem)?;
+    save(
+        &thumbnail(&reference.image, opts.heatmap_width),
+        &heatmaps.join(format!("{stem}__reference.png")),
+    )?;
+
+    let mut records = Vec::new();
+    for (name, config) in runs(opts) {
+        progress.step(&format!("{stem}: {name}"));
+        let m = measure(
+            ctx,
+            &mut renderer,
+            &target,
+            &camera,
+            &config,
+            opts.warmup,
+            opts.frames,
+        )?;
+        let (metrics, heat) = metrics::compare(&reference.image, &m.image);
+        let file = format!("{stem}__{}.png", name.replace('/', "_"));
+        save(&thumbnail(&heat, opts.heatmap_width), &heatmaps.join(&file))?;
+        let Metrics {
+            rmse,
+            psnr,
+            flip_mean,
+            max_abs_err,
+            frac_bad_px,
+        } = metrics;
+        let report = &m.stats.technique;
+        records.push(Record {
+            scene: stem.clone(),
+            technique: name,
+            weight: report.wboit.as_ref().map(|w| w.weight.name().to_owned()),
+            width: size.0,
+            height: size.1,
+            gpu_ms: m.gpu_ms,
+            cpu_ms: m.cpu_ms,
+            rmse,
+            psnr,
+            flip_mean,
+            max_abs_err,
+            frac_bad_px,
+            nan_px: m.nan_px,
+            layers: report.peeling.and_then(|p| p.layers),
+            lost_fragments: report.reference.map(|r| r.lost_fragments),
+            capped_pixels: report.reference.map(|r| r.capped_pixels),
+            reference_exact: reference.check.exact,
+            heatmap: format!("heatmaps/{file}"),
+        });
+    }
+    Ok((records, reference.check))
+}
+
+fn save(image: &Image, path: &Path) -> Result<(), String> {
+    image.save_png(path).map_err(|e| crate::chain(&e))
+}
+
+/// Measures every scene of `opts` with every technique against its reference.
+pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary, String> {
+    let dir = opts.out.join("heatmaps");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut progress = Progress::new(opts.scenes.len() * (runs(opts).len() + 1));
+    let mut records = Vec::new();
+    let mut checks = Vec::new();
+    for path in &opts.scenes {
+        let (r, check) = scene_records(ctx, opts, path, &mut progress)?;
+        if !check.exact {
+            log::warn!(
+                "{}: the exact methods disagree by {}/255 (or the A-buffer capped pixels): its errors are not scored",
+                check.scene,
+                check.max_abs_err
+            );
+        }
+        records.extend(r);
+        checks.push(check);
+    }
+    progress.finish();
+    Ok(Summary {
+        adapter: ctx.caps.adapter_name.clone(),
+        records,
+        reference_checks: checks,
+    })
+}

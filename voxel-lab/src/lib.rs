@@ -1,0 +1,56 @@
+//! The lab of the voxel OIT renderer: scenes (TOML files, generated terrain), headless
+//! rendering, every technique measured against the exact reference, charts and reports.
+//! It has no window: the demo's window and the integration tests both build on it.
+//!
+//! Modules depend on each other one way:
+//! - the model: [`scene`], [`headless`], [`metrics`], [`summary`], [`progress`];
+//! - the runs, which use the model: [`eval`] (every scene × technique against the
+//!   reference), [`stability`] (sweeps and flicker);
+//! - the report, which reads what the runs produced: [`charts`], [`report`];
+//! - [`evaluate`] here, which runs everything and writes every file.
+
+pub mod charts;
+pub mod eval;
+pub mod headless;
+pub mod metrics;
+pub mod progress;
+pub mod report;
+pub mod scene;
+pub mod stability;
+pub mod summary;
+
+pub use summary::{EvalOptions, Summary};
+
+/// `e` and its sources, joined by ": " (what a user needs to see of a renderer error).
+pub fn chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut source = e.source();
+    while let Some(inner) = source {
+        s += &format!(": {inner}");
+        source = inner.source();
+    }
+    s
+}
+
+/// Runs the evaluation `opts` asks for and writes every file into `opts.out`:
+/// `summary.json`, `reference_checks.json`, heat maps, the speed-against-accuracy chart,
+/// the stability sweeps (when asked) and `report.md`.
+pub fn evaluate(ctx: &voxel_render::GpuContext, opts: &EvalOptions) -> Result<Summary, String> {
+    let out = &opts.out;
+    let summary = eval::run_suite(ctx, opts)?;
+    summary::write_json(&out.join("summary.json"), &summary.records)?;
+    summary::write_json(
+        &out.join("reference_checks.json"),
+        &summary.reference_checks,
+    )?;
+    report::chart(out, &summary, opts)?;
+    let stability = if opts.stability {
+        let st = stability::run(ctx, opts)?;
+        report::stability_charts(out, &st)?;
+        Some(st)
+    } else {
+        None
+    };
+    report::write(out, &summary, stability.as_ref(), opts)?;
+    Ok(summary)
+}

@@ -1,0 +1,203 @@
+//! The lab's results: what was asked ([`EvalOptions`]), one [`Record`] per scene ×
+//! technique, the exact methods' agreement per scene ([`ReferenceCheck`]), and the
+//! questions the charts and the report ask of them.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use voxel_render::{Technique, WeightFunction};
+
+/// The two exact methods must agree within this many 1/255 levels on every channel for a
+/// scene's reference to count as exact (rounding of two different blend orders and of
+/// the A-buffer's half-float colours stays within it).
+pub const EXACT_AGREEMENT: u32 = 2;
+
+/// What to run.
+#[derive(Clone, Debug)]
+pub struct EvalOptions {
+    /// Scene files, in order.
+    pub scenes: Vec<PathBuf>,
+    /// Techniques to measure (the exact reference is always rendered too).
+    pub techniques: Vec<Technique>,
+    /// WBOIT weights compared in extra `wboit-mrt` runs (empty: none).
+    pub weights: Vec<WeightFunction>,
+    /// Output size; `None`: each scene's own, else 640×360.
+    pub size: Option<(u32, u32)>,
+    /// Timed frames per picture (the median is reported).
+    pub frames: usize,
+    /// Untimed frames first (pipelines, targets, adaptive peeling settle).
+    pub warmup: usize,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Run the stability sweeps too.
+    pub stability: bool,
+    /// Frames of the flicker camera path.
+    pub flicker_frames: usize,
+    /// Points per sweep (the parameter lists are cut to this many, spread over their range).
+    pub sweep_points: usize,
+    /// The command line, for the report.
+    pub command: String,
+    /// Width of the saved heat maps and reference pictures (downscaled, to keep results
+    /// small); `None`: full size.
+    pub heatmap_width: Option<u32>,
+}
+
+/// One scene × technique measurement (the keys of `summary.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Record {
+    /// Scene file stem.
+    pub scene: String,
+    /// Technique name (with `/weight` for the weight comparison runs).
+    pub technique: String,
+    /// WBOIT weight in force, for WBOIT techniques.
+    pub weight: Option<String>,
+    /// Picture width.
+    pub width: u32,
+    /// Picture height.
+    pub height: u32,
+    /// Median GPU ms of the translucent work per frame (the technique's passes and
+    /// composites); `null` without timestamp queries.
+    pub gpu_ms: Option<f64>,
+    /// Median CPU ms to record a frame (quad sorting and the exact methods' waits included).
+    pub cpu_ms: f64,
+    /// Root mean square error, [0, 1] units.
+    pub rmse: f64,
+    /// PSNR in dB (100: identical).
+    pub psnr: f64,
+    /// Mean FLIP.
+    pub flip_mean: f64,
+    /// Largest channel error in 1/255 steps.
+    pub max_abs_err: u32,
+    /// Share of pixels off by more than 1/255.
+    pub frac_bad_px: f64,
+    /// Pixels of the HDR scene colour holding NaN or inf.
+    pub nan_px: usize,
+    /// Depth peeling: layers found.
+    pub layers: Option<u32>,
+    /// The A-buffer: fragments that did not fit its pool (should be 0).
+    pub lost_fragments: Option<u64>,
+    /// The A-buffer: pixels with more fragments than it blends.
+    pub capped_pixels: Option<u64>,
+    /// Whether the scene's reference is exact ([`ReferenceCheck::exact`]); the errors of
+    /// a scene whose reference is not are not scored in means and charts.
+    pub reference_exact: bool,
+    /// The FLIP heat map, relative to the output folder.
+    pub heatmap: String,
+}
+
+/// The exact methods against each other, per scene.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReferenceCheck {
+    /// Scene file stem.
+    pub scene: String,
+    /// Largest channel difference between the A-buffer and peel-to-convergence pictures.
+    pub max_abs_err: u32,
+    /// Whether the reference counts as exact: the two methods agree within
+    /// [`EXACT_AGREEMENT`] and the A-buffer lost nothing and capped no pixel visibly.
+    pub exact: bool,
+    /// A-buffer fragments that did not fit (must be 0).
+    pub lost_fragments: u64,
+    /// A-buffer pixels with more fragments than it blends.
+    pub capped_pixels: u64,
+    /// Of those, pixels where the fragments it dropped could change the colour.
+    pub capped_visible_pixels: u64,
+    /// Layers peel-to-convergence found (the scene's depth complexity).
+    pub depth_complexity: u32,
+}
+
+/// Everything an evaluation produced.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Adapter the pictures were rendered on.
+    pub adapter: String,
+    /// One record per scene × technique.
+    pub records: Vec<Record>,
+    /// The exact methods' agreement per scene.
+    pub reference_checks: Vec<ReferenceCheck>,
+}
+
+/// A technique's means over the scenes whose reference is exact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SuiteMean {
+    /// Mean GPU ms, if every scene has a GPU time.
+    pub gpu_ms: Option<f64>,
+    /// Mean CPU ms.
+    pub cpu_ms: f64,
+    /// Mean FLIP.
+    pub flip: f64,
+    /// Mean RMSE.
+    pub rmse: f64,
+    /// Scenes counted.
+    pub scenes: usize,
+}
+
+impl Summary {
+    /// The techniques of the main chart and tables, in order: the runs without a weight
+    /// suffix.
+    pub fn main_techniques(&self) -> Vec<String> {
+        let mut names: Vec<String> = Vec::new();
+        for r in &self.records {
+            if !r.technique.contains('/') && !names.contains(&r.technique) {
+                names.push(r.technique.clone());
+            }
+        }
+        names
+    }
+
+    /// The weight comparison runs (`wboit-mrt/<weight>`), in order.
+    pub fn weight_runs(&self) -> Vec<String> {
+        let mut names: Vec<String> = Vec::new();
+        for r in &self.records {
+            if r.technique.contains('/') && !names.contains(&r.technique) {
+                names.push(r.technique.clone());
+            }
+        }
+        names
+    }
+
+    /// The records of `technique` on scenes whose reference is exact.
+    pub fn scored<'a>(&'a self, technique: &'a str) -> impl Iterator<Item = &'a Record> + 'a {
+        self.records
+            .iter()
+            .filter(move |r| r.technique == technique && r.reference_exact)
+    }
+
+    /// Means of `technique` over the scored scenes.
+    pub fn suite_mean(&self, technique: &str) -> SuiteMean {
+        let rs: Vec<&Record> = self.scored(technique).collect();
+        let n = rs.len().max(1) as f64;
+        SuiteMean {
+            gpu_ms: rs
+                .iter()
+                .map(|r| r.gpu_ms)
+                .collect::<Option<Vec<f64>>>()
+                .map(|v| v.iter().sum::<f64>() / n),
+            cpu_ms: rs.iter().map(|r| r.cpu_ms).sum::<f64>() / n,
+            flip: rs.iter().map(|r| r.flip_mean).sum::<f64>() / n,
+            rmse: rs.iter().map(|r| r.rmse).sum::<f64>() / n,
+            scenes: rs.len(),
+        }
+    }
+
+    /// The largest disagreement of the exact methods over all scenes.
+    pub fn worst_reference_disagreement(&self) -> u32 {
+        self.reference_checks
+            .iter()
+            .map(|c| c.max_abs_err)
+            .max()
+            .unwrap_or(0)
+    }
+}
+
+/// Whether a run name (`wboit-mrt/fitted` counts as `wboit-mrt`) is one of the real-time
+/// techniques that draw: not an exact method, not `opaque-only`.
+pub fn is_real_time(run: &str) -> bool {
+    let name = run.split('/').next().unwrap_or(run);
+    Technique::from_name(name).is_ok_and(|t| t.draws() && !t.is_exact())
+}
+
+/// Writes `value` as pretty JSON.
+pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), String> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
+    std::fs::write(path, text + "\n").map_err(|e| format!("{}: {e}", path.display()))
+}

@@ -1,0 +1,142 @@
+//! What every chunk pipeline binds: group 0 (the frame: camera, light, sky, viewport, and
+//! the block textures) and group 1 (a chunk mesh's quads and its uniform), with the
+//! structs shared with WGSL (`shaders/common.wgsl`) byte for byte. Techniques add their own
+//! groups from 2 on; nothing here belongs to one technique.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::gpu::{self, buffer_entry};
+
+/// WGSL shared by every chunk pipeline: the structs below, vertex pulling and shading.
+pub const COMMON_WGSL: &str = include_str!("shaders/common.wgsl");
+
+/// Per-frame uniforms every pass uses (`Frame` in WGSL).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FrameUniforms {
+    /// Camera-relative view × reverse-Z projection.
+    pub view_proj: [[f32; 4]; 4],
+    /// Integer part of the eye, clamped to the i32 world.
+    pub eye_int: [i32; 3],
+    /// Near plane distance.
+    pub near: f32,
+    /// Fractional part of the eye, in [0, 1).
+    pub eye_frac: [f32; 3],
+    /// Far plane distance.
+    pub far: f32,
+    /// Unit vector towards the sun.
+    pub sun_dir: [f32; 3],
+    /// Ambient light in [0, 1]: the share of light that does not depend on the normal.
+    pub ambient: f32,
+    /// Sky colour, linear.
+    pub sky: [f32; 3],
+    /// Padding (WGSL aligns `viewport` to 8 bytes after the vec3).
+    pub _pad: f32,
+    /// Render target size in pixels.
+    pub viewport: [f32; 2],
+    /// Padding to the struct's 16-byte alignment.
+    pub _pad2: [f32; 2],
+}
+
+/// Per-chunk uniforms (`ChunkInfo` in WGSL).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ChunkUniforms {
+    /// World coordinates of the chunk's block (0, 0, 0).
+    pub origin: [i32; 3],
+    /// Whole-chunk opacity multiplier (fade-in), 1 when settled.
+    pub alpha: f32,
+}
+
+/// Layouts every chunk pipeline is built against.
+#[derive(Debug, Clone)]
+pub struct SharedLayouts {
+    /// Group 0: frame uniforms, block textures, sampler.
+    pub scene: wgpu::BindGroupLayout,
+    /// Group 1: a chunk mesh's quads and the chunk uniform.
+    pub chunk: wgpu::BindGroupLayout,
+}
+
+impl SharedLayouts {
+    /// Creates both layouts.
+    pub fn new(device: &wgpu::Device) -> Self {
+        use wgpu::BufferBindingType as B;
+        use wgpu::ShaderStages as S;
+        let scene = gpu::layout(
+            device,
+            "scene_layout",
+            &[
+                buffer_entry(0, S::VERTEX_FRAGMENT, B::Uniform),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: S::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: S::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        );
+        let chunk = gpu::layout(
+            device,
+            "chunk_layout",
+            &[
+                buffer_entry(0, S::VERTEX, B::Storage { read_only: true }),
+                buffer_entry(1, S::VERTEX_FRAGMENT, B::Uniform),
+            ],
+        );
+        Self { scene, chunk }
+    }
+
+    /// Groups 0 and 1, then `extra` (a technique's own groups from 2 on).
+    pub fn with<'a>(
+        &'a self,
+        extra: &[&'a wgpu::BindGroupLayout],
+    ) -> Vec<Option<&'a wgpu::BindGroupLayout>> {
+        [&self.scene, &self.chunk]
+            .into_iter()
+            .chain(extra.iter().copied())
+            .map(Some)
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wgsl_layout::{assert_layout, field};
+
+    /// The Rust structs are laid out exactly as naga lays out the WGSL ones.
+    #[test]
+    fn structs_match_their_wgsl() {
+        let module = crate::wgsl_layout::parse(COMMON_WGSL);
+        assert_layout::<FrameUniforms>(
+            &module,
+            "Frame",
+            &[
+                field!(FrameUniforms, view_proj),
+                field!(FrameUniforms, eye_int),
+                field!(FrameUniforms, near),
+                field!(FrameUniforms, eye_frac),
+                field!(FrameUniforms, far),
+                field!(FrameUniforms, sun_dir),
+                field!(FrameUniforms, ambient),
+                field!(FrameUniforms, sky),
+                field!(FrameUniforms, viewport),
+            ],
+        );
+        assert_layout::<ChunkUniforms>(
+            &module,
+            "ChunkInfo",
+            &[field!(ChunkUniforms, origin), field!(ChunkUniforms, alpha)],
+        );
+    }
+}

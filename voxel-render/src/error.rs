@@ -1,0 +1,142 @@
+//! Everything that can go wrong in the renderer. Each variant says what was at fault and
+//! keeps the error it came from as its [`std::error::Error::source`].
+
+use std::path::PathBuf;
+
+/// An error of the renderer.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// No adapter of the asked backends was found.
+    #[error("no GPU adapter found for {backends:?}")]
+    NoAdapter {
+        /// The backends that were searched.
+        backends: wgpu::Backends,
+        /// Why wgpu found none.
+        #[source]
+        source: wgpu::RequestAdapterError,
+    },
+    /// The adapter refused to create a device.
+    #[error("could not create a device")]
+    Device(#[from] wgpu::RequestDeviceError),
+    /// A camera with NaN, infinite or contradictory values.
+    #[error("invalid camera: {0}")]
+    InvalidCamera(String),
+    /// A technique, weight or other name that does not exist.
+    #[error("unknown {kind} {name:?}; known: {known}")]
+    UnknownName {
+        /// What kind of name (technique, weight, Bayer size).
+        kind: &'static str,
+        /// The name given.
+        name: String,
+        /// The names that exist, comma-separated.
+        known: String,
+    },
+    /// A setting outside what the renderer supports (the message names the setting and
+    /// the allowed range).
+    #[error("invalid setting: {0}")]
+    InvalidSetting(String),
+    /// A size beyond what this adapter can do.
+    #[error("{what} {value} exceeds this adapter's {limit_name} ({limit})")]
+    TooLarge {
+        /// What was too large (e.g. "render width").
+        what: String,
+        /// The size asked for.
+        value: u64,
+        /// The adapter limit it broke.
+        limit_name: &'static str,
+        /// The limit's value.
+        limit: u64,
+    },
+    /// The texture given to draw into does not match the renderer.
+    #[error("output texture: {0}")]
+    Output(String),
+    /// The adapter cannot do something that has no fallback.
+    #[error("unsupported by this adapter: {0}")]
+    Unsupported(String),
+    /// A file could not be read or written.
+    #[error("{}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A PNG file could not be encoded.
+    #[error("{}: PNG encoding", path.display())]
+    PngEncode {
+        /// The file.
+        path: PathBuf,
+        /// What the encoder said.
+        #[source]
+        source: png::EncodingError,
+    },
+    /// A PNG file could not be decoded (or holds a layout we do not read).
+    #[error("{}: PNG decoding", path.display())]
+    PngDecode {
+        /// The file.
+        path: PathBuf,
+        /// What the decoder said.
+        #[source]
+        source: png::DecodingError,
+    },
+    /// wgpu reported a validation or out-of-memory error for an operation of ours.
+    #[error("GPU {operation} failed")]
+    Gpu {
+        /// What we were doing.
+        operation: &'static str,
+        /// wgpu's error.
+        #[source]
+        source: wgpu::Error,
+    },
+    /// Waiting for the GPU failed (device lost, timeout).
+    #[error("waiting for the GPU")]
+    Poll(#[from] wgpu::PollError),
+    /// Mapping a buffer to read results back failed.
+    #[error("reading GPU results back")]
+    Readback(#[from] wgpu::BufferAsyncError),
+    /// A mapped buffer's contents could not be accessed.
+    #[error("reading GPU results back")]
+    MapRange(#[from] wgpu::MapRangeError),
+    /// A readback finished but its data cannot be what the GPU wrote (wrong length).
+    #[error("reading GPU results back: {0}")]
+    ReadbackData(String),
+}
+
+/// `Result` with this crate's [`Error`] as the default error.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    /// An [`Error::UnknownName`] listing `known`.
+    pub fn unknown_name<'a>(
+        kind: &'static str,
+        name: &str,
+        known: impl IntoIterator<Item = &'a str>,
+    ) -> Self {
+        Error::UnknownName {
+            kind,
+            name: name.to_owned(),
+            known: known.into_iter().collect::<Vec<_>>().join(", "),
+        }
+    }
+}
+
+/// Runs `f` inside a wgpu validation and out-of-memory error scope, so that what wgpu
+/// would report to the device's uncaptured-error handler (a panic by default) comes back
+/// as an [`Error::Gpu`] instead.
+pub fn scoped<T>(
+    device: &wgpu::Device,
+    operation: &'static str,
+    f: impl FnOnce() -> T,
+) -> Result<T> {
+    let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let value = f();
+    let validation = pollster::block_on(validation.pop());
+    let oom = pollster::block_on(oom.pop());
+    match validation.or(oom) {
+        Some(source) => Err(Error::Gpu { operation, source }),
+        None => Ok(value),
+    }
+}

@@ -1,0 +1,515 @@
+//! Plumbing every pass shares: shader assembly (with constants generated from Rust),
+//! pipeline builders for chunk quads and fullscreen triangles, render targets, and one
+//! helper that records a render pass with its attachments and timing.
+
+use crate::timing::{GpuPass, Timer};
+use crate::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
+
+/// WGSL shared by every fullscreen pipeline.
+pub const FULLSCREEN_WGSL: &str = include_str!("shaders/fullscreen.wgsl");
+
+/// A shader module made of `parts` concatenated (shared code first).
+pub fn shader(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(parts.concat().into()),
+    })
+}
+
+/// WGSL `const` declarations made from Rust values, so that a constant the CPU and GPU
+/// share has one source: prepend [`WgslConsts::finish`] to the shader.
+#[derive(Debug, Default)]
+pub struct WgslConsts(String);
+
+impl WgslConsts {
+    /// A `u32` constant.
+    pub fn u32(mut self, name: &str, value: u32) -> Self {
+        self.0 += &format!("const {name}: u32 = {value}u;\n");
+        self
+    }
+
+    /// An `f32` constant.
+    pub fn f32(mut self, name: &str, value: f32) -> Self {
+        self.0 += &format!("const {name}: f32 = {value:?};\n");
+        self
+    }
+
+    /// A `u32` array constant.
+    pub fn u32_array(mut self, name: &str, values: &[u32]) -> Self {
+        let items: Vec<String> = values.iter().map(|v| format!("{v}u")).collect();
+        self.0 += &format!(
+            "const {name} = array<u32, {}>({});\n",
+            values.len(),
+            items.join(", ")
+        );
+        self
+    }
+
+    /// The declarations.
+    pub fn finish(self) -> String {
+        self.0
+    }
+}
+
+/// How a chunk pipeline tests and writes depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthMode {
+    /// Reverse-Z test (nearer passes) and write: opaque, cutout, stipple.
+    Write,
+    /// Reverse-Z test, no write: blended translucent passes.
+    ReadOnly,
+    /// Reverse-Z test, nearer or equal, no write: the sorted baseline (seed 003's LessEqual
+    /// in a standard depth range).
+    ReadOnlyOrEqual,
+    /// Keep the farthest fragment and write it: back-layer peeling.
+    WriteFarthest,
+}
+
+/// A pipeline that draws chunk quads with `common.wgsl`'s `vs_main` (vertex pulling).
+#[derive(Debug)]
+pub struct ChunkPipeline<'a> {
+    /// Debug label.
+    pub label: &'a str,
+    /// The module holding `vs_main` and the fragment entry.
+    pub module: &'a wgpu::ShaderModule,
+    /// The fragment entry point.
+    pub fragment_entry: &'a str,
+    /// Bind group layouts: group 0 the scene, group 1 the chunk, then the technique's.
+    pub groups: &'a [Option<&'a wgpu::BindGroupLayout>],
+    /// Colour targets.
+    pub targets: &'a [Option<wgpu::ColorTargetState>],
+    /// Depth test and write.
+    pub depth: DepthMode,
+    /// Samples per pixel (1 or 4).
+    pub samples: u32,
+}
+
+impl ChunkPipeline<'_> {
+    /// Creates the pipeline.
+    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(self.label),
+            bind_group_layouts: self.groups,
+            immediate_size: 0,
+        });
+        let (write, compare) = match self.depth {
+            DepthMode::Write => (true, wgpu::CompareFunction::Greater),
+            DepthMode::ReadOnly => (false, wgpu::CompareFunction::Greater),
+            DepthMode::ReadOnlyOrEqual => (false, wgpu::CompareFunction::GreaterEqual),
+            DepthMode::WriteFarthest => (true, wgpu::CompareFunction::Less),
+        };
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(self.label),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: self.module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                // Every face is an entry surface seen from its front: the mesher emits the face
+                // of each side of a boundary, and back faces are culled everywhere.
+                cull_mode: Some(wgpu::Face::Back),
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(write),
+                depth_compare: Some(compare),
+                stencil: wgpu::StencilState::default(),
+                bias: wgpu::DepthBiasState::default(),
+            }),
+            multisample: wgpu::MultisampleState {
+                count: self.samples,
+                ..Default::default()
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: self.module,
+                entry_point: Some(self.fragment_entry),
+                compilation_options: Default::default(),
+                targets: self.targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+}
+
+/// A fullscreen-triangle pipeline: `source` (a fragment shader, after `fullscreen.wgsl`,
+/// whose `vs_fullscreen` it uses).
+#[derive(Debug)]
+pub struct FullscreenPipeline<'a> {
+    /// Debug label.
+    pub label: &'a str,
+    /// WGSL of the fragment shader and what it needs.
+    pub source: &'a str,
+    /// The fragment entry point.
+    pub fragment_entry: &'a str,
+    /// Bind group layouts.
+    pub groups: &'a [Option<&'a wgpu::BindGroupLayout>],
+    /// Colour targets.
+    pub targets: &'a [Option<wgpu::ColorTargetState>],
+    /// A depth target that always passes and is written (a depth copy).
+    pub writes_depth: bool,
+    /// Values of the shader's pipeline-overridable constants.
+    pub constants: &'a [(&'a str, f64)],
+}
+
+impl FullscreenPipeline<'_> {
+    /// Creates the pipeline.
+    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        let module = &shader(device, self.label, &[FULLSCREEN_WGSL, self.source]);
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(self.label),
+            bind_group_layouts: self.groups,
+            immediate_size: 0,
+        });
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(self.label),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module,
+                entry_point: Some("vs_fullscreen"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: self.writes_depth.then(|| wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: wgpu::StencilState::default(),
+                bias: wgpu::DepthBiasState::default(),
+            }),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module,
+                entry_point: Some(self.fragment_entry),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: self.constants,
+                    ..Default::default()
+                },
+                targets: self.targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+}
+
+/// A colour target of the HDR scene format with `blend`.
+pub fn scene_target(blend: Option<wgpu::BlendState>) -> Option<wgpu::ColorTargetState> {
+    Some(wgpu::ColorTargetState {
+        format: SCENE_FORMAT,
+        blend,
+        write_mask: wgpu::ColorWrites::ALL,
+    })
+}
+
+/// A layout entry for a non-filterable 2D texture read with `textureLoad` in fragments.
+pub fn texture_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A layout entry for a buffer seen by `visibility`.
+pub fn buffer_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    ty: wgpu::BufferBindingType,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A bind group layout of `entries`.
+pub fn layout(
+    device: &wgpu::Device,
+    label: &str,
+    entries: &[wgpu::BindGroupLayoutEntry],
+) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries,
+    })
+}
+
+/// A layout of `count` fragment textures at bindings 0, 1, ... of `sample_type`.
+pub fn textures_layout(
+    device: &wgpu::Device,
+    label: &str,
+    sample_type: wgpu::TextureSampleType,
+    count: u32,
+) -> wgpu::BindGroupLayout {
+    let entries: Vec<wgpu::BindGroupLayoutEntry> =
+        (0..count).map(|i| texture_entry(i, sample_type)).collect();
+    layout(device, label, &entries)
+}
+
+/// A bind group of `resources` at bindings 0, 1, ...
+pub fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    resources: &[wgpu::BindingResource<'_>],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry<'_>> = resources
+        .iter()
+        .enumerate()
+        .map(|(i, r)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: r.clone(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// A bind group of texture views at bindings 0, 1, ...
+pub fn texture_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    views: &[&wgpu::TextureView],
+) -> wgpu::BindGroup {
+    let resources: Vec<wgpu::BindingResource<'_>> = views
+        .iter()
+        .map(|v| wgpu::BindingResource::TextureView(v))
+        .collect();
+    bind_group(device, label, layout, &resources)
+}
+
+/// A 2D render target and its default view.
+#[derive(Debug)]
+pub struct Target {
+    /// The texture.
+    pub texture: wgpu::Texture,
+    /// Its default view.
+    pub view: wgpu::TextureView,
+}
+
+/// What a [`Target`] is.
+#[derive(Clone, Copy, Debug)]
+pub struct TargetDesc<'a> {
+    /// Debug label.
+    pub label: &'a str,
+    /// Texel format.
+    pub format: wgpu::TextureFormat,
+    /// Usages.
+    pub usage: wgpu::TextureUsages,
+    /// Width and height in pixels.
+    pub size: (u32, u32),
+    /// Samples per pixel.
+    pub samples: u32,
+}
+
+impl TargetDesc<'_> {
+    /// Creates the texture and its view.
+    pub fn create(&self, device: &wgpu::Device) -> Target {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(self.label),
+            size: wgpu::Extent3d {
+                width: self.size.0,
+                height: self.size.1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: self.samples,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.format,
+            usage: self.usage,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Target { texture, view }
+    }
+}
+
+/// A single-sample 2D texture of `format` and `usage` at `size`, with its default view.
+pub fn target(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    size: (u32, u32),
+) -> Target {
+    TargetDesc {
+        label,
+        format,
+        usage,
+        size,
+        samples: 1,
+    }
+    .create(device)
+}
+
+/// A colour attachment that loads what is there and stores the result.
+pub fn load(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    attachment(view, wgpu::LoadOp::Load, None)
+}
+
+/// A colour attachment cleared to `color`.
+pub fn clear(
+    view: &wgpu::TextureView,
+    color: wgpu::Color,
+) -> Option<wgpu::RenderPassColorAttachment<'_>> {
+    attachment(view, wgpu::LoadOp::Clear(color), None)
+}
+
+/// A colour attachment with `load`, resolved into `resolve` when given (MSAA).
+pub fn attachment<'a>(
+    view: &'a wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+    resolve: Option<&'a wgpu::TextureView>,
+) -> Option<wgpu::RenderPassColorAttachment<'a>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: resolve,
+        ops: wgpu::Operations {
+            load,
+            store: wgpu::StoreOp::Store,
+        },
+    })
+}
+
+/// The depth attachment of a pass.
+#[derive(Clone, Copy, Debug, Default)]
+pub enum Depth<'a> {
+    /// No depth attachment.
+    #[default]
+    None,
+    /// Tested, never written (translucent passes against the opaque depth).
+    ReadOnly(&'a wgpu::TextureView),
+    /// Tested and written, starting from what is there.
+    Load(&'a wgpu::TextureView),
+    /// Cleared to the value, then tested and written.
+    Clear(&'a wgpu::TextureView, f32),
+}
+
+impl<'a> Depth<'a> {
+    fn attachment(self) -> Option<wgpu::RenderPassDepthStencilAttachment<'a>> {
+        let ops = |load| {
+            Some(wgpu::Operations {
+                load,
+                store: wgpu::StoreOp::Store,
+            })
+        };
+        let (view, depth_ops) = match self {
+            Depth::None => return None,
+            Depth::ReadOnly(view) => (view, None),
+            Depth::Load(view) => (view, ops(wgpu::LoadOp::Load)),
+            Depth::Clear(view, v) => (view, ops(wgpu::LoadOp::Clear(v))),
+        };
+        Some(wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops,
+            stencil_ops: None,
+        })
+    }
+}
+
+/// One render pass: what it draws into and how it is timed.
+#[derive(Debug)]
+pub struct Pass<'a> {
+    /// Debug label.
+    pub label: &'a str,
+    /// Colour attachments ([`load`], [`clear`], [`attachment`]).
+    pub colors: &'a [Option<wgpu::RenderPassColorAttachment<'a>>],
+    /// Depth attachment.
+    pub depth: Depth<'a>,
+    /// Which kind of GPU work its time counts as (`None`: untimed).
+    pub timing: Option<GpuPass>,
+    /// Occlusion queries the pass writes to.
+    pub occlusion: Option<&'a wgpu::QuerySet>,
+}
+
+impl<'a> Pass<'a> {
+    /// A timed pass into `colors` without depth.
+    pub fn new(
+        label: &'a str,
+        timing: GpuPass,
+        colors: &'a [Option<wgpu::RenderPassColorAttachment<'a>>],
+    ) -> Self {
+        Self {
+            label,
+            colors,
+            depth: Depth::None,
+            timing: Some(timing),
+            occlusion: None,
+        }
+    }
+
+    /// The same pass with `depth`.
+    pub fn depth(self, depth: Depth<'a>) -> Self {
+        Self { depth, ..self }
+    }
+
+    /// Records the pass into `encoder` (timed by `timer` when given): `body` sets
+    /// pipelines and draws.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: Option<&Timer>,
+        body: impl FnOnce(&mut wgpu::RenderPass<'_>),
+    ) {
+        let query = self
+            .timing
+            .zip(timer)
+            .map(|(pass, t)| t.begin(pass, encoder));
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(self.label),
+                color_attachments: self.colors,
+                depth_stencil_attachment: self.depth.attachment(),
+                timestamp_writes: query
+                    .as_ref()
+                    .and_then(|q| q.render_pass_timestamp_writes()),
+                occlusion_query_set: self.occlusion,
+                multiview_mask: None,
+            });
+            body(&mut pass);
+        }
+        if let (Some(q), Some(t)) = (query, timer) {
+            t.end(encoder, q);
+        }
+    }
+}
+
+/// Submits what `encoder` holds and replaces it with a fresh one, so that a technique can
+/// wait for GPU results in the middle of a frame (the exact methods do; real-time ones
+/// never do). Commands keep their order: the rest of the frame follows in the new encoder.
+pub fn flush(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+    let fresh = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("frame_continued"),
+        });
+    let done = std::mem::replace(encoder, fresh);
+    ctx.queue.submit([done.finish()]);
+}
