@@ -181,3 +181,46 @@ pub fn distinct_colours(img: &Image) -> usize {
     v.dedup();
     v.len()
 }
+
+/// A headless Vulkan context whose device has `limits` changed from the adapter's (to test
+/// the renderer at an adapter's limits without a huge render). `None` as [`gpu`].
+pub fn gpu_with_limits(change: impl FnOnce(&mut wgpu::Limits)) -> Option<GpuContext> {
+    gpu()?;
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::VULKAN;
+    let instance = wgpu::Instance::new(desc);
+    let adapter = pollster::block_on(instance.request_adapter(&Default::default())).unwrap();
+    let mut limits = adapter.limits();
+    change(&mut limits);
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("limited"),
+        required_features: adapter.features() & voxel_render::WANTED_FEATURES,
+        required_limits: limits,
+        ..Default::default()
+    }))
+    .unwrap();
+    Some(GpuContext::from_device(&adapter, device, queue))
+}
+
+/// `n` sheets of a block of `opacity` facing +z, one block apart, in front of a stone
+/// wall, seen head-on from in front of the first: `n` layers on every pixel.
+pub fn dense_sheets(n: i32, opacity: f32) -> Scene {
+    let mut registry = BlockRegistry::default();
+    let dense = registry
+        .register(voxel_core::BlockDef::new("dense", [200, 120, 60], opacity))
+        .unwrap();
+    let mut world = World::new(Arc::new(registry));
+    let back = -2 * n - 2;
+    voxel_lab::scene::fill_box(
+        &mut world,
+        [-40, -40, back - 1],
+        [40, 40, back],
+        voxel_core::blocks::STONE,
+    )
+    .unwrap();
+    for i in 0..n {
+        let z = -2 * i;
+        voxel_lab::scene::fill_box(&mut world, [-40, -40, z], [40, 40, z], dense).unwrap();
+    }
+    scene("dense_sheets", world, [0.5, 0.5, 8.0], [0.5, 0.5, -10.0])
+}

@@ -214,9 +214,9 @@ fn default_far() -> f64 {
 
 /// Most chunks a scene's terrain may generate (64 × 8 × 64 = 32768 chunks would not fit in
 /// memory: this keeps a typo from taking the machine down).
-const MAX_TERRAIN_CHUNKS: i64 = 4096;
+const MAX_TERRAIN_CHUNKS: i128 = 4096;
 /// Most blocks all boxes together may fill.
-const MAX_BOX_BLOCKS: i64 = 20_000_000;
+const MAX_BOX_BLOCKS: i128 = 20_000_000;
 
 /// `line N: message` for the byte offset `at` of `text`.
 fn at_line(text: &str, at: usize, message: impl std::fmt::Display) -> String {
@@ -270,8 +270,9 @@ pub fn parse(text: &str) -> Result<Scene, String> {
     let mut world = match &file.terrain {
         Some(t) => {
             let (span, t) = (t.span(), t.get_ref());
-            let count: i64 = (0..3)
-                .map(|i| i64::from(t.max_chunk[i]) - i64::from(t.min_chunk[i]) + 1)
+            // i128: three extents of up to 2^32 each cannot overflow it.
+            let count: i128 = (0..3)
+                .map(|i| i128::from(t.max_chunk[i]) - i128::from(t.min_chunk[i]) + 1)
                 .product();
             if (0..3).any(|i| t.min_chunk[i] > t.max_chunk[i]) || count > MAX_TERRAIN_CHUNKS {
                 return Err(at_line(
@@ -294,7 +295,7 @@ pub fn parse(text: &str) -> Result<Scene, String> {
         }
         None => World::new(registry.clone()),
     };
-    let mut filled: i64 = 0;
+    let mut filled: i128 = 0;
     for b in &file.boxes {
         let (span, def) = (b.span(), b.get_ref());
         let id = registry
@@ -308,8 +309,8 @@ pub fn parse(text: &str) -> Result<Scene, String> {
             ));
         }
         filled += (0..3)
-            .map(|i| i64::from(def.max[i]) - i64::from(def.min[i]) + 1)
-            .product::<i64>();
+            .map(|i| i128::from(def.max[i]) - i128::from(def.min[i]) + 1)
+            .product::<i128>();
         if filled > MAX_BOX_BLOCKS {
             return Err(at_line(
                 text,
@@ -473,5 +474,27 @@ path_to = [3.0, 1.0, 10.0]
         assert!(e.contains("at most 4096 chunks"), "{e}");
         let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [3000, 3000, 3000]")).unwrap_err();
         assert!(e.contains("blocks in all"), "{e}");
+        // Volumes whose i64 product wraps: the whole i32 range on two or three axes.
+        for (min, max) in [
+            (
+                "[-2147483648, 0, -2147483648]",
+                "[2147483647, 0, 2147483647]",
+            ),
+            (
+                "[-2147483648, -2147483648, -2147483648]",
+                "[2147483647, 2147483647, 2147483647]",
+            ),
+        ] {
+            let text = GOOD
+                .replace("min = [0, 0, 0]", &format!("min = {min}"))
+                .replace("max = [3, 2, 0]", &format!("max = {max}"));
+            let e = parse(&text).unwrap_err();
+            assert!(e.contains("20000000 blocks in all"), "{e}");
+        }
+        let e = parse(&format!(
+            "{GOOD}\n[terrain]\nmin_chunk = [-2147483648, -2147483648, -2147483648]\nmax_chunk = [2147483647, 2147483647, 2147483647]\n"
+        ))
+        .unwrap_err();
+        assert!(e.contains("at most 4096 chunks"), "{e}");
     }
 }

@@ -1,0 +1,114 @@
+//! The command line on bad input: every mistake is an error that names the input, found
+//! before any rendering starts (no GPU is needed for these).
+
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use std::process::{Command, Output};
+
+fn demo(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_demo"))
+        .args(args)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap()
+}
+
+/// Runs `args`, expects a failure whose stderr contains every one of `words`.
+fn fails_saying(args: &[&str], words: &[&str]) {
+    let out = demo(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    for w in words {
+        assert!(err.contains(w), "{args:?}: {w:?} not in {err}");
+    }
+}
+
+#[test]
+fn unknown_options_and_values_are_named() {
+    fails_saying(
+        &["render", "--bar", "--out", "x.png"],
+        &["unexpected argument", "--bar"],
+    );
+    fails_saying(&["--bar"], &["unexpected argument", "--bar"]);
+    fails_saying(
+        &["render", "--technique", "nope", "--out", "x.png"],
+        &["nope", "wboit-mrt"],
+    );
+    fails_saying(
+        &["render", "--weight", "eq11", "--out", "x.png"],
+        &["eq11", "fitted"],
+    );
+    fails_saying(&["render", "--bayer", "3", "--out", "x.png"], &["3", "16"]);
+    fails_saying(
+        &["render", "--size", "0x10", "--out", "x.png"],
+        &["--size", "\"0\""],
+    );
+    fails_saying(&["render"], &["--out"]);
+    fails_saying(
+        &["eval", "--techniques", "wboit,sorted", "--out", "x"],
+        &["wboit", "known"],
+    );
+    fails_saying(
+        &["window", "--view-distance", "40"],
+        &["--view-distance", "40"],
+    );
+}
+
+#[test]
+fn peel_layers_beyond_the_limit_are_refused_before_rendering() {
+    fails_saying(
+        &[
+            "render",
+            "--technique",
+            "depth-peeling",
+            "--layers",
+            "8194",
+            "--out",
+            "x.png",
+        ],
+        &["8194", "512"],
+    );
+}
+
+#[test]
+fn an_output_that_cannot_be_written_is_refused_before_rendering() {
+    let dir = std::env::temp_dir().join(format!("demo-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("a_file");
+    std::fs::write(&file, b"x").unwrap();
+    let under_file = file.join("x.png");
+    fails_saying(
+        &["render", "--out", under_file.to_str().unwrap()],
+        &["is a file, not a folder", "a_file"],
+    );
+    fails_saying(
+        &["render", "--out", dir.to_str().unwrap()],
+        &["is a folder"],
+    );
+    // /proc refuses new files even to root.
+    fails_saying(
+        &["render", "--out", "/proc/voxel-oit/x.png"],
+        &["/proc/voxel-oit"],
+    );
+    fails_saying(
+        &["eval", "--out", under_file.to_str().unwrap()],
+        &["is a file"],
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn help_comes_from_clap_for_every_command() {
+    for args in [&["--help"][..], &["eval", "--help"], &["render", "--help"]] {
+        let out = demo(args);
+        assert!(out.status.success(), "{args:?}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("Usage: demo"), "{args:?}: {text}");
+    }
+    let text = String::from_utf8_lossy(&demo(&["--help"]).stdout).into_owned();
+    assert!(
+        text.contains("techniques: opaque-only, wboit-mrt"),
+        "{text}"
+    );
+}
