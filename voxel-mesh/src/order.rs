@@ -1,0 +1,1335 @@
+//! Exact back-to-front order of a chunk's translucent quads, re-sorted only when the eye
+//! crosses a plane that can change it; exact back-to-front order of chunks.
+//!
+//! (Module documentation: see the following commits.)
+
+use std::cmp::Reverse;
+
+use voxel_core::{CHUNK_SIZE, ChunkPos};
+
+use crate::{PackedQuad, UV_AXES};
+
+/// "No node" / "not a trigger plane".
+const NONE: u32 = u32::MAX;
+
+/// Coordinates of quads are 0..=32 for quads the mesher makes; garbage packed quads can
+/// reach 63. Keys, masks and look-up tables cover 0..=63 so that no input indexes out of
+/// range.
+const MAX_COORD: usize = 63;
+/// Number of look-up values per axis: coordinates 0..=63 and 64.
+const VALUES: usize = MAX_COORD + 2;
+/// Number of mask values per axis: -1..=64.
+const MASK_VALUES: usize = VALUES + 1;
+
+/// A quad as a closed, flat, axis-aligned box in chunk-local block units.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct QBox {
+    /// Minimum corner.
+    lo: [i32; 3],
+    /// Maximum corner; `lo[axis] == hi[axis]` is the quad's plane.
+    hi: [i32; 3],
+    /// Normal axis, 0..3.
+    axis: usize,
+    /// Whether the face points along +axis (its block lies below the plane).
+    positive: bool,
+}
+
+impl QBox {
+    /// The box of a packed quad. Face bits 6 and 7 (never made by [`PackedQuad::new`]) are
+    /// read as -z, as [`PackedQuad::center`] does.
+    fn of(q: PackedQuad) -> Self {
+        let g = q.geometry;
+        let mut lo = [g & 31, (g >> 5) & 31, (g >> 10) & 31].map(|v| v as i32);
+        let face = q.face_index().min(5);
+        let axis = face / 2;
+        let positive = face.is_multiple_of(2);
+        if positive {
+            lo[axis] += 1;
+        }
+        let mut hi = lo;
+        let [u, v] = UV_AXES[axis];
+        hi[u] += ((g >> 15) & 31) as i32 + 1;
+        hi[v] += ((g >> 20) & 31) as i32 + 1;
+        Self {
+            lo,
+            hi,
+            axis,
+            positive,
+        }
+    }
+
+    /// The plane coordinate along the normal axis.
+    #[inline]
+    fn plane(&self) -> i32 {
+        self.lo[self.axis]
+    }
+
+    /// Squared distance from the centre to `eye` (NaN for a NaN eye).
+    fn centre_distance2(&self, eye: [f64; 3]) -> f64 {
+        (0..3)
+            .map(|k| {
+                let v = f64::from(self.lo[k] + self.hi[k]) * 0.5 - eye[k];
+                v * v
+            })
+            .sum()
+    }
+
+    /// Whether two coplanar quads' footprints share interior points.
+    fn footprints_overlap(&self, o: &Self) -> bool {
+        let [u, v] = UV_AXES[self.axis];
+        self.lo[u] < o.hi[u] && o.lo[u] < self.hi[u] && self.lo[v] < o.hi[v] && o.lo[v] < self.hi[v]
+    }
+
+    /// Whether `self` and `o` are opposite faces on one plane with overlapping footprints.
+    fn ties_with(&self, o: &Self) -> bool {
+        self.axis == o.axis
+            && self.plane() == o.plane()
+            && self.positive != o.positive
+            && self.footprints_overlap(o)
+    }
+}
+
+/// The bounds of an open cell along one axis; `None` for an unbounded side.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Span {
+    lo: Option<i32>,
+    hi: Option<i32>,
+}
+
+impl Span {
+    /// Whether the cell lies above `p` (it is open, so `lo >= p` means every eye in it).
+    fn above(self, p: i32) -> bool {
+        self.lo.is_some_and(|l| l >= p)
+    }
+
+    /// Whether the cell lies below `p`.
+    fn below(self, p: i32) -> bool {
+        self.hi.is_some_and(|h| h <= p)
+    }
+}
+
+/// The open interval of `s > 0` allowed by constraints `s * alpha < beta`, with rational
+/// ends in integers.
+struct SInterval {
+    /// Lower end `num / den` (exclusive), `den > 0`.
+    lo: (i64, i64),
+    /// Upper end (exclusive); `None` is +infinity.
+    hi: Option<(i64, i64)>,
+    empty: bool,
+}
+
+impl SInterval {
+    fn new() -> Self {
+        Self {
+            lo: (0, 1),
+            hi: None,
+            empty: false,
+        }
+    }
+
+    /// Adds `s * alpha < beta`.
+    #[inline]
+    fn less(&mut self, alpha: i64, beta: i64) {
+        match alpha.signum() {
+            0 => self.empty |= beta <= 0,
+            1 => {
+                if self.hi.is_none_or(|h| beta * h.1 < h.0 * alpha) {
+                    self.hi = Some((beta, alpha));
+                }
+            }
+            _ => {
+                // s > beta / alpha = (-beta) / (-alpha)
+                let b = (-beta, -alpha);
+                if b.0 * self.lo.1 > self.lo.0 * b.1 {
+                    self.lo = b;
+                }
+            }
+        }
+    }
+
+    /// Adds `s * alpha > beta`.
+    #[inline]
+    fn greater(&mut self, alpha: i64, beta: i64) {
+        self.less(-alpha, -beta);
+    }
+
+    fn feasible(&self) -> bool {
+        !self.empty && self.hi.is_none_or(|h| self.lo.0 * h.1 < h.0 * self.lo.1)
+    }
+}
+
+/// The region relation (lemma 2 of the module docs): whether `b` hides part of `a` from
+/// some eye of the open box `cell`, so that `a` must be drawn before `b` for that eye.
+/// Exact, in integers. Coplanar quads never hide each other; opposite faces with
+/// overlapping footprints get the tie-break instead ([`tie_in`]).
+fn may_hide_in_cell(a: &QBox, b: &QBox, cell: &[Span; 3]) -> bool {
+    if a.axis == b.axis && a.plane() == b.plane() {
+        return tie_in(a, b, cell);
+    }
+    let mut s = SInterval::new();
+    for (k, c) in cell.iter().enumerate() {
+        let (alo, ahi, blo, bhi) = (
+            i64::from(a.lo[k]),
+            i64::from(a.hi[k]),
+            i64::from(b.lo[k]),
+            i64::from(b.hi[k]),
+        );
+        if alo == ahi && blo == bhi {
+            // Parallel planes: E_k = b + s (b - a), strictly inside the cell.
+            let d = blo - alo;
+            if let Some(lo) = c.lo {
+                s.greater(d, i64::from(lo) - blo);
+            }
+            if let Some(hi) = c.hi {
+                s.less(d, i64::from(hi) - blo);
+            }
+        } else {
+            // E_k ranges over the open interval ((1+s) b.lo - s a.hi, (1+s) b.hi - s a.lo).
+            if let Some(hi) = c.hi {
+                s.less(blo - ahi, i64::from(hi) - blo);
+            }
+            if let Some(lo) = c.lo {
+                s.greater(bhi - alo, i64::from(lo) - bhi);
+            }
+        }
+        if s.empty {
+            return false;
+        }
+    }
+    s.feasible()
+}
+
+/// The coplanar tie-break over a cell: `a` before `b` when they are opposite faces on one
+/// plane with overlapping footprints and `a`'s block lies on the far side of the plane
+/// (for a cell above the plane, the positive face, whose block lies below).
+fn tie_in(a: &QBox, b: &QBox, cell: &[Span; 3]) -> bool {
+    let c = cell[a.axis];
+    a.ties_with(b) && ((c.above(a.plane()) && a.positive) || (c.below(a.plane()) && !a.positive))
+}
+
+/// The coplanar tie-break at a point eye (see [`tie_in`]).
+fn tie_at(eye: [f64; 3], a: &QBox, b: &QBox) -> bool {
+    let (e, p) = (eye[a.axis], f64::from(a.plane()));
+    a.ties_with(b) && ((e > p && a.positive) || (e < p && !a.positive))
+}
+
+/// The relation at a point (lemma 2 with a one-point cell): whether `b` hides part of `a`
+/// from `eye`. Quads seen edge-on hide and are hidden by nothing; coplanar quads never
+/// hide each other. Floating point: exact when the eye's coordinates have few significant
+/// bits (every product compared below is then exact), otherwise wrong only for eyes
+/// within rounding error of the boundary of the set of eyes that see the two quads
+/// overlap, where their overlap on screen is far below a pixel.
+fn hides_at(eye: [f64; 3], a: &QBox, b: &QBox) -> bool {
+    let (pa, pb) = (f64::from(a.plane()), f64::from(b.plane()));
+    if eye[a.axis] == pa || eye[b.axis] == pb || (a.axis == b.axis && pa == pb) {
+        return false;
+    }
+    // Bounds on s as (numerator, denominator > 0).
+    let lt = |x: (f64, f64), y: (f64, f64)| x.0 * y.1 < y.0 * x.1;
+    let mut lo = (0.0, 1.0);
+    let mut hi: Option<(f64, f64)> = None;
+    let mut eq: Option<(f64, f64)> = None;
+    let mut ok = true;
+    let mut less = |alpha: f64, beta: f64| {
+        if alpha > 0.0 {
+            if hi.is_none_or(|h| lt((beta, alpha), h)) {
+                hi = Some((beta, alpha));
+            }
+        } else if alpha < 0.0 {
+            if lt(lo, (-beta, -alpha)) {
+                lo = (-beta, -alpha);
+            }
+        } else {
+            ok &= beta > 0.0;
+        }
+    };
+    for (k, &e) in eye.iter().enumerate() {
+        let (alo, ahi, blo, bhi) = (
+            f64::from(a.lo[k]),
+            f64::from(a.hi[k]),
+            f64::from(b.lo[k]),
+            f64::from(b.hi[k]),
+        );
+        if alo == ahi && blo == bhi {
+            // Parallel planes: s = (e - b) / (b - a).
+            let d = blo - alo;
+            eq = Some(if d > 0.0 { (e - blo, d) } else { (blo - e, -d) });
+        } else {
+            less(blo - ahi, e - blo);
+            less(alo - bhi, bhi - e);
+        }
+    }
+    ok && match eq {
+        Some(s) => lt(lo, s) && hi.is_none_or(|h| lt(s, h)),
+        None => hi.is_none_or(|h| lt(lo, h)),
+    }
+}
+
+/// Which region of a [`QuadOrder`]'s trigger planes an eye is in: per axis, how many
+/// trigger planes lie strictly below the eye. An eye exactly on a plane shares the key of
+/// the open interval below it, whose order is exact on the plane too (module docs).
+/// Compare keys of the same [`QuadOrder`] only.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct RegionKey(pub [u8; 3]);
+
+/// What a sort met, for the renderer to count and report.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SortStats {
+    /// Cycles met: groups of quads (strongly connected components, of more than one quad,
+    /// of the relation at the eye itself, tie-breaks included) that no order draws exactly.
+    /// Each is drawn in centre-distance order, farthest first.
+    pub cycles: u32,
+    /// Quads in those groups.
+    pub quads_in_cycles: u32,
+    /// Groups whose order is exact at this eye but not at every eye of its region (the
+    /// relation over the region is cyclic there, the relation at the eye is not). While it
+    /// is non-zero, re-sort when the eye moves, not only when the region key changes.
+    pub eye_dependent: u32,
+    /// Quads ordered by the pairwise path (stuck leaves of the plane tree); diagnostic.
+    pub pairwise_quads: u32,
+}
+
+impl SortStats {
+    /// Whether the order is exact at the eye it was computed for.
+    pub fn is_exact(&self) -> bool {
+        self.cycles == 0
+    }
+
+    /// Whether the order is exact at every eye of the region it was computed for.
+    pub fn is_exact_in_region(&self) -> bool {
+        self.cycles == 0 && self.eye_dependent == 0
+    }
+
+    fn add(&mut self, o: SortStats) {
+        self.cycles += o.cycles;
+        self.quads_in_cycles += o.quads_in_cycles;
+        self.eye_dependent += o.eye_dependent;
+        self.pairwise_quads += o.pairwise_quads;
+    }
+}
+
+/// A node of the plane tree.
+#[derive(Clone, Copy, Debug)]
+enum Node {
+    /// Quads on one plane (stored `start..mid` face +axis, `mid..end` face -axis), the
+    /// subtree wholly below the plane and the one wholly above it along `axis`.
+    Split {
+        axis: u8,
+        /// Index of the plane in the axis's trigger planes, or [`NONE`] when the node has
+        /// no children and no opposite faces that overlap (then any order is exact).
+        trigger: u32,
+        below: u32,
+        above: u32,
+        start: u32,
+        mid: u32,
+        end: u32,
+    },
+    /// Quads that no free axis-aligned plane separates: ordered pairwise per region.
+    Stuck { leaf: u32 },
+}
+
+/// The precomputed per-chunk structure for exact ordering: build it once when the mesh is
+/// uploaded ([`QuadOrder::new`]), compute [`QuadOrder::region_key`] every frame and call
+/// [`QuadOrder::sort_into`] when the key differs from the one last sorted for.
+#[derive(Clone, Debug)]
+pub struct QuadOrder {
+    /// The quads, grouped by node.
+    quads: Vec<PackedQuad>,
+    nodes: Vec<Node>,
+    root: u32,
+    /// Trigger planes per axis, sorted, distinct.
+    planes: [Vec<u8>; 3],
+    /// `lut[k][j]`: how many trigger planes of axis `k` lie below `j`, for j in 0..=64.
+    lut: [[u8; VALUES]; 3],
+    leaves: Vec<Leaf>,
+}
+
+impl Default for QuadOrder {
+    fn default() -> Self {
+        Self::new(&[])
+    }
+}
+
+/// Work item of the build.
+struct Job {
+    ids: Vec<u32>,
+    parent: u32,
+    /// 0: below child, 1: above child, 2: root.
+    slot: u8,
+}
+
+impl QuadOrder {
+    /// Builds the structure for a chunk's translucent quads: the plane tree, its trigger
+    /// planes and the pairwise leaves. Do it once per mesh upload.
+    pub fn new(quads: &[PackedQuad]) -> Self {
+        Self::build(quads, false)
+    }
+
+    /// Like [`QuadOrder::new`] but with every quad in one pairwise leaf (no plane tree):
+    /// for tests and benchmarks of the pairwise path.
+    #[doc(hidden)]
+    pub fn pairwise_only(quads: &[PackedQuad]) -> Self {
+        Self::build(quads, true)
+    }
+
+    fn build(quads: &[PackedQuad], no_tree: bool) -> Self {
+        let all: Vec<QBox> = quads.iter().map(|&q| QBox::of(q)).collect();
+        let mut out = Self {
+            quads: Vec::with_capacity(quads.len()),
+            nodes: Vec::new(),
+            root: NONE,
+            planes: Default::default(),
+            lut: [[0; VALUES]; 3],
+            leaves: Vec::new(),
+        };
+        // Trigger planes as (axis, coordinate) flags. Node triggers hold coordinates until
+        // the planes are known, then indices.
+        let mut is_trigger = [[false; MAX_COORD + 1]; 3];
+        let mut leaf_boxes = Vec::new();
+        let mut jobs = vec![Job {
+            ids: (0..quads.len() as u32).collect(),
+            parent: NONE,
+            slot: 2,
+        }];
+        while let Some(mut job) = jobs.pop() {
+            if job.ids.is_empty() {
+                continue;
+            }
+            let node = out.nodes.len() as u32;
+            match job.slot {
+                2 => out.root = node,
+                slot => {
+                    if let Node::Split { below, above, .. } = &mut out.nodes[job.parent as usize] {
+                        *(if slot == 0 { below } else { above }) = node;
+                    }
+                }
+            }
+            let first = all[job.ids[0] as usize];
+            let coplanar = job.ids.iter().all(|&i| {
+                let b = &all[i as usize];
+                b.axis == first.axis && b.plane() == first.plane()
+            });
+            let split = if coplanar {
+                Some((first.axis, first.plane()))
+            } else if no_tree {
+                None
+            } else {
+                best_split(&all, &job.ids, &is_trigger)
+            };
+            let Some((axis, c)) = split else {
+                // Stuck: every plane that could separate cuts a quad. A pairwise leaf,
+                // sorted by (axis, plane, facing) so that coplanar groups are ranges; all
+                // its coordinates are trigger planes.
+                job.ids.sort_by_key(|&i| {
+                    let b = &all[i as usize];
+                    (b.axis, b.plane(), !b.positive, i)
+                });
+                let start = out.quads.len() as u32;
+                let boxes: Vec<QBox> = job.ids.iter().map(|&i| all[i as usize]).collect();
+                for b in &boxes {
+                    for k in 0..3 {
+                        is_trigger[k][b.lo[k] as usize] = true;
+                        is_trigger[k][b.hi[k] as usize] = true;
+                    }
+                }
+                out.quads.extend(job.ids.iter().map(|&i| quads[i as usize]));
+                out.nodes.push(Node::Stuck {
+                    leaf: out.leaves.len() as u32,
+                });
+                leaf_boxes.push((start, boxes));
+                out.leaves.push(Leaf::default());
+                continue;
+            };
+            let (mut below, mut pos, mut neg, mut above) = (vec![], vec![], vec![], vec![]);
+            for &i in &job.ids {
+                let b = &all[i as usize];
+                if b.axis == axis && b.plane() == c {
+                    if b.positive {
+                        pos.push(i);
+                    } else {
+                        neg.push(i);
+                    }
+                } else if b.hi[axis] <= c {
+                    below.push(i);
+                } else {
+                    debug_assert!(b.lo[axis] >= c, "a split plane cuts no quad");
+                    above.push(i);
+                }
+            }
+            let start = out.quads.len() as u32;
+            out.quads
+                .extend(pos.iter().chain(&neg).map(|&i| quads[i as usize]));
+            let mid = start + pos.len() as u32;
+            let end = out.quads.len() as u32;
+            // The plane is a trigger when it separates children, or when opposite faces on
+            // it overlap (their tie-break depends on the side of the eye).
+            let needs = !below.is_empty()
+                || !above.is_empty()
+                || (!pos.is_empty() && !neg.is_empty() && opposite_overlap(&all, &pos, &neg, axis));
+            if needs {
+                is_trigger[axis][c as usize] = true;
+            }
+            out.nodes.push(Node::Split {
+                axis: axis as u8,
+                trigger: if needs { c as u32 } else { NONE },
+                below: NONE,
+                above: NONE,
+                start,
+                mid,
+                end,
+            });
+            jobs.push(Job {
+                ids: below,
+                parent: node,
+                slot: 0,
+            });
+            jobs.push(Job {
+                ids: above,
+                parent: node,
+                slot: 1,
+            });
+        }
+        // Trigger planes, their look-up tables, node triggers as plane indices.
+        for ((planes, lut), flags) in out.planes.iter_mut().zip(&mut out.lut).zip(&is_trigger) {
+            *planes = (0..=MAX_COORD as u8)
+                .filter(|&c| flags[usize::from(c)])
+                .collect();
+            let mut n = 0u8;
+            for (j, l) in lut.iter_mut().enumerate() {
+                *l = n;
+                if flags.get(j) == Some(&true) {
+                    n += 1;
+                }
+            }
+        }
+        for node in &mut out.nodes {
+            if let Node::Split { axis, trigger, .. } = node
+                && *trigger != NONE
+            {
+                *trigger = u32::from(out.lut[usize::from(*axis)][*trigger as usize]);
+            }
+        }
+        for (leaf, (start, boxes)) in out.leaves.iter_mut().zip(leaf_boxes) {
+            *leaf = Leaf::new(start, boxes);
+        }
+        out
+    }
+
+    /// Number of quads.
+    pub fn len(&self) -> usize {
+        self.quads.len()
+    }
+
+    /// Whether there are no quads.
+    pub fn is_empty(&self) -> bool {
+        self.quads.is_empty()
+    }
+
+    /// The quads in storage order (grouped by tree node).
+    pub fn quads(&self) -> &[PackedQuad] {
+        &self.quads
+    }
+
+    /// The trigger planes of each axis, chunk-local, sorted: the order can change only
+    /// where the eye crosses one of them.
+    pub fn trigger_planes(&self) -> [&[u8]; 3] {
+        [&self.planes[0], &self.planes[1], &self.planes[2]]
+    }
+
+    /// Stuck leaves (sets that no free plane separates) and the quads in them.
+    pub fn stuck(&self) -> (usize, usize) {
+        (
+            self.leaves.len(),
+            self.leaves.iter().map(|l| l.boxes.len()).sum(),
+        )
+    }
+
+    /// Number of tree nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// The region of an eye in chunk-local block units (eye minus chunk origin, computed in
+    /// f64). Exact: it only compares the eye with integer planes. A NaN coordinate counts
+    /// as below every plane, an infinite one as beyond every plane.
+    #[inline]
+    pub fn region_key(&self, eye_local: [f64; 3]) -> RegionKey {
+        RegionKey(std::array::from_fn(|k| {
+            let e = eye_local[k];
+            // Integer planes c < e are those c < ceil(e), for e in (0, 64].
+            let j = if e > 0.0 {
+                (e.ceil() as usize).min(VALUES - 1)
+            } else {
+                0
+            };
+            self.lut[k][j]
+        }))
+    }
+
+    /// Writes the quads into `out` (cleared first) back to front for the eye (chunk-local
+    /// block units). Exact for every eye of the eye's region when
+    /// [`SortStats::is_exact_in_region`] holds, and at this eye when
+    /// [`SortStats::is_exact`] holds; see the module docs. Never panics, whatever the eye.
+    pub fn sort_into(&self, eye_local: [f64; 3], out: &mut Vec<PackedQuad>) -> SortStats {
+        out.clear();
+        out.reserve(self.quads.len());
+        let mut stats = SortStats::default();
+        if self.root == NONE {
+            return stats;
+        }
+        let key = self.region_key(eye_local);
+        // Tasks: a node, or a range of stored quads (tagged by the top bit).
+        const RANGE: u64 = 1 << 63;
+        let range = |s: u32, e: u32| RANGE | u64::from(s) << 32 | u64::from(e);
+        let mut stack: Vec<u64> = Vec::with_capacity(64);
+        let mut scratch = Vec::new();
+        stack.push(u64::from(self.root));
+        while let Some(t) = stack.pop() {
+            if t & RANGE != 0 {
+                let (s, e) = (((t >> 32) as u32 & 0x7fff_ffff) as usize, t as u32 as usize);
+                out.extend_from_slice(&self.quads[s..e]);
+                continue;
+            }
+            match self.nodes[t as usize] {
+                Node::Split {
+                    axis,
+                    trigger,
+                    below,
+                    above,
+                    start,
+                    mid,
+                    end,
+                } => {
+                    let eye_above =
+                        trigger != NONE && u32::from(key.0[usize::from(axis)]) > trigger;
+                    // Eye above: the subtree below, the faces whose blocks lie below the
+                    // plane (+axis, far), the others, the subtree above. Pushed reversed.
+                    let (first, last) = if eye_above {
+                        (below, above)
+                    } else {
+                        (above, below)
+                    };
+                    let (r1, r2) = if eye_above {
+                        (range(start, mid), range(mid, end))
+                    } else {
+                        (range(mid, end), range(start, mid))
+                    };
+                    if last != NONE {
+                        stack.push(u64::from(last));
+                    }
+                    stack.push(r2);
+                    stack.push(r1);
+                    if first != NONE {
+                        stack.push(u64::from(first));
+                    }
+                }
+                Node::Stuck { leaf } => {
+                    let leaf = &self.leaves[leaf as usize];
+                    scratch.clear();
+                    let s = leaf.order(&self.cell(key), Some(eye_local), &mut scratch);
+                    stats.add(s.unwrap_or_default());
+                    let quads = &self.quads[leaf.start as usize..];
+                    out.extend(scratch.iter().map(|&i| quads[i as usize]));
+                }
+            }
+        }
+        stats
+    }
+
+    /// The open cell of a region key.
+    fn cell(&self, key: RegionKey) -> [Span; 3] {
+        std::array::from_fn(|k| {
+            let (p, i) = (&self.planes[k], usize::from(key.0[k]));
+            Span {
+                lo: i
+                    .checked_sub(1)
+                    .and_then(|j| p.get(j))
+                    .map(|&c| i32::from(c)),
+                hi: p.get(i).map(|&c| i32::from(c)),
+            }
+        })
+    }
+}
+
+/// A stuck leaf: quads that no free plane separates, sorted by (axis, plane, facing), with
+/// the bit masks that give a row of the separating-axis relation in O(m / 64) words.
+#[derive(Clone, Debug, Default)]
+struct Leaf {
+    /// Index of the leaf's first quad among the stored ones.
+    start: u32,
+    boxes: Vec<QBox>,
+    /// Words per bit set over the leaf's quads.
+    words: usize,
+    /// `masks[((k * 2 + w) * MASK_VALUES + v + 1) * words..][..words]`: the quads whose
+    /// `lo[k] < v` (w = 0) or whose `hi[k] > v` (w = 1), for v in -1..=64.
+    masks: Vec<u64>,
+    /// Per quad and axis, the offsets of its masks `lo < hi[k]` and `hi > lo[k]`.
+    offsets: Vec<[[usize; 2]; 3]>,
+    /// Per quad, the range of its coplanar group.
+    group: Vec<(u32, u32)>,
+    /// Per quad, `tie_list[tie_start[i]..tie_start[i + 1]]`: the opposite coplanar quads
+    /// whose footprints overlap its own.
+    tie_start: Vec<u32>,
+    tie_list: Vec<u32>,
+    /// Bounding box of the leaf.
+    bbox: ([i32; 3], [i32; 3]),
+    /// For eyes beyond the bounding box along every axis (octant bit k: above along k),
+    /// the order, precomputed; `None` where it needs the eye itself.
+    octants: [Option<Vec<u32>>; 8],
+}
+
+impl Leaf {
+    fn new(start: u32, boxes: Vec<QBox>) -> Self {
+        let m = boxes.len();
+        let words = m.div_ceil(64);
+        let offset = |k: usize, hi: bool, v: i32| {
+            ((k * 2 + usize::from(hi)) * MASK_VALUES + (v + 1) as usize) * words
+        };
+        let mut masks = vec![0u64; 3 * 2 * MASK_VALUES * words];
+        for (i, b) in boxes.iter().enumerate() {
+            let bit = 1u64 << (i % 64);
+            for k in 0..3 {
+                for v in b.lo[k] + 1..=VALUES as i32 - 1 {
+                    masks[offset(k, false, v) + i / 64] |= bit;
+                }
+                for v in -1..b.hi[k] {
+                    masks[offset(k, true, v) + i / 64] |= bit;
+                }
+            }
+        }
+        let offsets = boxes
+            .iter()
+            .map(|b| std::array::from_fn(|k| [offset(k, false, b.hi[k]), offset(k, true, b.lo[k])]))
+            .collect();
+        let mut group = vec![(0, 0); m];
+        let mut tie_start = vec![0u32; m + 1];
+        let mut tie_list = Vec::new();
+        let mut g = 0;
+        while g < m {
+            let mut e = g;
+            while e < m && boxes[e].axis == boxes[g].axis && boxes[e].plane() == boxes[g].plane() {
+                e += 1;
+            }
+            for i in g..e {
+                group[i] = (g as u32, e as u32);
+                tie_list.extend(
+                    (g..e)
+                        .filter(|&j| boxes[i].ties_with(&boxes[j]))
+                        .map(|j| j as u32),
+                );
+                tie_start[i + 1] = tie_list.len() as u32;
+            }
+            g = e;
+        }
+        let mut bbox = ([i32::MAX; 3], [i32::MIN; 3]);
+        for b in &boxes {
+            for k in 0..3 {
+                bbox.0[k] = bbox.0[k].min(b.lo[k]);
+                bbox.1[k] = bbox.1[k].max(b.hi[k]);
+            }
+        }
+        let mut leaf = Self {
+            start,
+            boxes,
+            words,
+            masks,
+            offsets,
+            group,
+            tie_start,
+            tie_list,
+            bbox,
+            octants: Default::default(),
+        };
+        let octants = std::array::from_fn(|o| {
+            let cell = leaf.octant_cell(o);
+            let mut order = Vec::new();
+            leaf.order_live(&cell, None, &mut order).map(|_| order)
+        });
+        leaf.octants = octants;
+        leaf
+    }
+
+    /// The cell of all eyes beyond the bounding box along every axis, on the sides of
+    /// octant `o`.
+    fn octant_cell(&self, o: usize) -> [Span; 3] {
+        std::array::from_fn(|k| {
+            if o >> k & 1 == 1 {
+                Span {
+                    lo: Some(self.bbox.1[k]),
+                    hi: None,
+                }
+            } else {
+                Span {
+                    lo: None,
+                    hi: Some(self.bbox.0[k]),
+                }
+            }
+        })
+    }
+
+    /// The octant of a cell that lies beyond the bounding box along every axis.
+    fn octant_of(&self, cell: &[Span; 3]) -> Option<usize> {
+        let mut o = 0;
+        for (k, c) in cell.iter().enumerate() {
+            if c.above(self.bbox.1[k]) {
+                o |= 1 << k;
+            } else if !c.below(self.bbox.0[k]) {
+                return None;
+            }
+        }
+        Some(o)
+    }
+
+    /// Writes the leaf-local indices of the quads into `out` in drawing order for the eyes
+    /// of `cell` (and the eye itself where the cell does not decide). `None` when the eye
+    /// is needed but not given.
+    fn order(
+        &self,
+        cell: &[Span; 3],
+        eye: Option<[f64; 3]>,
+        out: &mut Vec<u32>,
+    ) -> Option<SortStats> {
+        if let Some(order) = self.octant_of(cell).and_then(|o| self.octants[o].as_ref()) {
+            // The cell lies in the octant's cell, so the octant's order is exact in it.
+            out.extend_from_slice(order);
+            return Some(SortStats {
+                pairwise_quads: self.boxes.len() as u32,
+                ..SortStats::default()
+            });
+        }
+        self.order_live(cell, eye, out)
+    }
+
+    fn mask_offset(&self, k: usize, hi: bool, v: i32) -> usize {
+        ((k * 2 + usize::from(hi)) * MASK_VALUES + (v + 1) as usize) * self.words
+    }
+
+    /// A row of the separating-axis relation over the open cell `cell` (module docs), as a
+    /// bit set over the leaf's quads: with `pred`, the quads `a` that quad `i` may hide
+    /// (they must be drawn before it); otherwise the quads `b` that may hide quad `i` (drawn
+    /// after it). Tie-breaks included, coplanar quads otherwise excluded.
+    ///
+    /// Per axis k a pair passes when the quads are not separated along k (open intervals
+    /// overlap), or when they are and the cell lies beyond the near face of the hiding quad
+    /// `b`: for `a` wholly below `b` (`a.hi <= b.lo`), above `b.lo`; for `a` wholly above,
+    /// below `b.hi`. Every leaf coordinate is a trigger plane, so the open cell lies on one
+    /// side of each.
+    fn relation_row(&self, i: usize, cell: &[Span; 3], pred: bool, row: &mut [u64]) {
+        let words = self.words;
+        let (g0, g1) = self.group[i];
+        let q = &self.boxes[i];
+        let all = |o: usize| &self.masks[o..o + words];
+        let row = &mut row[..words];
+        if pred {
+            // With x = {lo < q.hi} and y = {hi > q.lo} (so !x: wholly above q, !y: wholly
+            // below), an axis passes (x & y) | (!y & cell above q.lo) | (!x & cell below
+            // q.hi): x | !y, !x | y, or everything (never neither, as q.lo <= q.hi). As
+            // (x ^ f) | (y ^ g), with x = y = all ones for everything.
+            let ones = all(self.mask_offset(0, false, VALUES as i32 - 1));
+            let mut axes: [(&[u64], &[u64], u64, u64); 3] = [(ones, ones, 0, 0); 3];
+            for (k, (ax, c)) in axes.iter_mut().zip(cell).enumerate() {
+                let above = c.lo.is_some_and(|l| q.lo[k] <= l);
+                let below = c.hi.is_some_and(|h| q.hi[k] >= h);
+                let [xo, yo] = self.offsets[i][k];
+                match (above, below) {
+                    (true, false) => *ax = (all(xo), all(yo), 0, u64::MAX),
+                    (false, true) => *ax = (all(xo), all(yo), u64::MAX, 0),
+                    _ => {}
+                }
+            }
+            let [(x0, y0, f0, g0), (x1, y1, f1, g1), (x2, y2, f2, g2)] = axes;
+            let (x0, y0, x1, y1, x2, y2) = (
+                &x0[..words],
+                &y0[..words],
+                &x1[..words],
+                &y1[..words],
+                &x2[..words],
+                &y2[..words],
+            );
+            for w in 0..words {
+                row[w] = ((x0[w] ^ f0) | (y0[w] ^ g0))
+                    & ((x1[w] ^ f1) | (y1[w] ^ g1))
+                    & ((x2[w] ^ f2) | (y2[w] ^ g2));
+            }
+        } else {
+            // b wholly above q (!x) needs the cell above b.lo (b.lo <= c.lo, the mask
+            // lo < c.lo + 1); b wholly below (!y) needs it below b.hi (hi > c.hi - 1).
+            let none = all(self.mask_offset(0, false, -1));
+            let mut axes: [[&[u64]; 4]; 3] = [[none; 4]; 3];
+            for (k, (ax, c)) in axes.iter_mut().zip(cell).enumerate() {
+                let [xo, yo] = self.offsets[i][k];
+                let lo =
+                    c.lo.map_or(none, |l| all(self.mask_offset(k, false, l + 1)));
+                let hi = c.hi.map_or(none, |h| all(self.mask_offset(k, true, h - 1)));
+                *ax = [all(xo), all(yo), lo, hi];
+            }
+            let [[x0, y0, l0, h0], [x1, y1, l1, h1], [x2, y2, l2, h2]] = axes;
+            for w in 0..words {
+                let f = |x: u64, y: u64, l: u64, h: u64| (x & y) | (!x & l) | (!y & h);
+                row[w] = f(x0[w], y0[w], l0[w], h0[w])
+                    & f(x1[w], y1[w], l1[w], h1[w])
+                    & f(x2[w], y2[w], l2[w], h2[w]);
+            }
+        }
+        let m = self.boxes.len();
+        if !m.is_multiple_of(64) {
+            row[words - 1] &= (1u64 << (m % 64)) - 1;
+        }
+        clear_bits(row, g0 as usize, g1 as usize);
+        // Tie partners are coplanar, so inside the group's words.
+        for &j in &self.tie_list[self.tie_start[i] as usize..self.tie_start[i + 1] as usize] {
+            let (a, b) = if pred { (j, i as u32) } else { (i as u32, j) };
+            if tie_in(&self.boxes[a as usize], &self.boxes[b as usize], cell) {
+                row[j as usize / 64] |= 1u64 << (j % 64);
+            }
+        }
+    }
+
+    /// Depth-first search over the predecessor rows for the cell, computed when a quad is
+    /// first reached: the post-order (every quad after the quads it may hide, if there is
+    /// no cycle), and whether an edge to a quad on the stack (a cycle) was met. Roots go
+    /// farthest first (by the sum over axes of the integer distance from the quad to the
+    /// cell), so that most quads find their predecessors done and leave at once without
+    /// keeping their row; only quads with pending predecessors keep theirs on the stack.
+    fn dfs_post(&self, cell: &[Span; 3]) -> (Vec<u32>, bool) {
+        let m = self.boxes.len();
+        let words = self.words;
+        // Counting sort of the roots by distance to the cell, farthest first.
+        let dist = |q: &QBox| -> usize {
+            (0..3)
+                .map(|k| {
+                    let c = cell[k];
+                    match (c.lo, c.hi) {
+                        (Some(l), _) if l >= q.hi[k] => (l - q.hi[k]) as usize,
+                        (_, Some(h)) if h <= q.lo[k] => (q.lo[k] - h) as usize,
+                        _ => 0,
+                    }
+                })
+                .sum()
+        };
+        const BUCKETS: usize = 3 * (MAX_COORD + 1) + 1;
+        let mut count = [0u32; BUCKETS + 1];
+        let keys: Vec<u8> = self
+            .boxes
+            .iter()
+            .map(|q| dist(q).min(BUCKETS - 1) as u8)
+            .collect();
+        for &d in &keys {
+            count[BUCKETS - 1 - usize::from(d) + 1] += 1;
+        }
+        for i in 1..=BUCKETS {
+            count[i] += count[i - 1];
+        }
+        let mut roots = vec![0u32; m];
+        for (i, &d) in keys.iter().enumerate() {
+            let slot = &mut count[BUCKETS - 1 - usize::from(d)];
+            roots[*slot as usize] = i as u32;
+            *slot += 1;
+        }
+
+        let mut visited = vec![0u64; words];
+        let mut on_stack = vec![0u64; words];
+        let mut post = Vec::with_capacity(m);
+        // (quad, scan cursor, offset of its row in `rows`)
+        let mut stack: Vec<(u32, usize, usize)> = Vec::new();
+        let mut rows: Vec<u64> = Vec::new();
+        let mut buf = vec![0u64; words];
+        let mut cyclic = false;
+        // Computes the row of `v`, marks it visited; true if it has pending predecessors
+        // (then it goes on the stack with its row), false if it is finished.
+        let mut visit = |v: u32,
+                         visited: &mut [u64],
+                         on_stack: &mut [u64],
+                         stack: &mut Vec<(u32, usize, usize)>,
+                         rows: &mut Vec<u64>,
+                         post: &mut Vec<u32>| {
+            self.relation_row(v as usize, cell, true, &mut buf);
+            let (mut back, mut pending) = (0, 0);
+            for ((r, s), vis) in buf.iter().zip(on_stack.iter()).zip(visited.iter()) {
+                back |= r & s;
+                pending |= r & !vis;
+            }
+            cyclic |= back != 0;
+            let (w, b) = (v as usize / 64, 1u64 << (v % 64));
+            visited[w] |= b;
+            if pending == 0 {
+                post.push(v);
+            } else {
+                on_stack[w] |= b;
+                stack.push((v, 0, rows.len()));
+                rows.extend_from_slice(&buf);
+            }
+        };
+        for &r in &roots {
+            if visited[r as usize / 64] & (1 << (r % 64)) != 0 {
+                continue;
+            }
+            visit(
+                r,
+                &mut visited,
+                &mut on_stack,
+                &mut stack,
+                &mut rows,
+                &mut post,
+            );
+            while let Some(top) = stack.last_mut() {
+                let (v, off) = (top.0, top.2);
+                if let Some(w) = next_unvisited(&rows[off..off + words], &visited, &mut top.1) {
+                    visit(
+                        w,
+                        &mut visited,
+                        &mut on_stack,
+                        &mut stack,
+                        &mut rows,
+                        &mut post,
+                    );
+                } else {
+                    stack.pop();
+                    rows.truncate(off);
+                    on_stack[v as usize / 64] &= !(1u64 << (v % 64));
+                    post.push(v);
+                }
+            }
+        }
+        (post, cyclic)
+    }
+
+    /// The live path: a depth-first search over the separating-axis relation's rows,
+    /// computed as visited; if it meets a cycle, the strongly connected groups (Kosaraju),
+    /// each refined by [`refine`].
+    fn order_live(
+        &self,
+        cell: &[Span; 3],
+        eye: Option<[f64; 3]>,
+        out: &mut Vec<u32>,
+    ) -> Option<SortStats> {
+        let m = self.boxes.len();
+        let words = self.words;
+        let mut stats = SortStats {
+            pairwise_quads: m as u32,
+            ..SortStats::default()
+        };
+        let (post, cyclic) = self.dfs_post(cell);
+        if !cyclic {
+            // Post-order over predecessors: every quad after the ones it may hide.
+            out.extend_from_slice(&post);
+            return Some(stats);
+        }
+        let mut rows = vec![0u64; m * words];
+        for (i, row) in rows.chunks_exact_mut(words).enumerate() {
+            self.relation_row(i, cell, false, row);
+        }
+        let mut visited = vec![0u64; words];
+        let mut groups = Vec::new();
+        let mut stack: Vec<(u32, usize)> = Vec::new();
+        // Kosaraju's second pass, over successors in decreasing finish time of the first:
+        // each tree is a strongly connected group; groups come sinks first.
+        for &r in post.iter().rev() {
+            if visited[r as usize / 64] & (1 << (r % 64)) != 0 {
+                continue;
+            }
+            let mut g = vec![r];
+            visited[r as usize / 64] |= 1 << (r % 64);
+            stack.push((r, 0));
+            while let Some(top) = stack.last_mut() {
+                let v = top.0 as usize;
+                if let Some(w) =
+                    next_unvisited(&rows[v * words..(v + 1) * words], &visited, &mut top.1)
+                {
+                    visited[w as usize / 64] |= 1 << (w % 64);
+                    g.push(w);
+                    stack.push((w, 0));
+                } else {
+                    stack.pop();
+                }
+            }
+            g.sort_unstable();
+            groups.push(g);
+        }
+        for g in groups.iter().rev() {
+            if g.len() == 1 {
+                out.push(g[0]);
+            } else {
+                stats.add(refine(&self.boxes, g, cell, eye, out)?);
+            }
+        }
+        Some(stats)
+    }
+}
+
+/// Clears bits `from..to` of a bit set.
+fn clear_bits(row: &mut [u64], from: usize, to: usize) {
+    if from >= to {
+        return;
+    }
+    let (w0, w1) = (from / 64, (to - 1) / 64);
+    let head = u64::MAX << (from % 64);
+    let tail = u64::MAX >> (63 - (to - 1) % 64);
+    if w0 == w1 {
+        row[w0] &= !(head & tail);
+    } else {
+        row[w0] &= !head;
+        row[w0 + 1..w1].fill(0);
+        row[w1] &= !tail;
+    }
+}
+
+/// The first set bit of `row & !visited` from word `*cur` on (which it advances).
+#[inline]
+fn next_unvisited(row: &[u64], visited: &[u64], cur: &mut usize) -> Option<u32> {
+    while *cur < row.len() {
+        let w = row[*cur] & !visited[*cur];
+        if w != 0 {
+            return Some((*cur * 64) as u32 + w.trailing_zeros());
+        }
+        *cur += 1;
+    }
+    None
+}
+
+/// Orders a group that the separating-axis relation leaves cyclic: by the exact relation
+/// over the cell, then, for groups still cyclic, by the relation at the eye (counted as
+/// eye-dependent), then by centre distance (counted as a cycle). `None` when the eye is
+/// needed but not given.
+fn refine(
+    boxes: &[QBox],
+    group: &[u32],
+    cell: &[Span; 3],
+    eye: Option<[f64; 3]>,
+    out: &mut Vec<u32>,
+) -> Option<SortStats> {
+    let mut stats = SortStats::default();
+    let adjacency = |members: &[u32], rel: &dyn Fn(&QBox, &QBox) -> bool| -> Vec<Vec<u32>> {
+        (0..members.len())
+            .map(|i| {
+                let a = &boxes[members[i] as usize];
+                (0..members.len() as u32)
+                    .filter(|&j| j as usize != i && rel(a, &boxes[members[j as usize] as usize]))
+                    .collect()
+            })
+            .collect()
+    };
+    let by_cell = adjacency(group, &|a, b| may_hide_in_cell(a, b, cell));
+    for comp in tarjan(&by_cell).iter().rev() {
+        if let [only] = comp[..] {
+            out.push(group[only as usize]);
+            continue;
+        }
+        let eye = eye?;
+        let members: Vec<u32> = comp.iter().map(|&c| group[c as usize]).collect();
+        stats.eye_dependent += 1;
+        let comps = if eye.iter().all(|e| e.is_finite()) {
+            let at_eye = adjacency(&members, &|a, b| hides_at(eye, a, b) || tie_at(eye, a, b));
+            tarjan(&at_eye)
+        } else {
+            // No eye to refine with: the whole group falls back.
+            vec![(0..members.len() as u32).collect()]
+        };
+        for c in comps.iter().rev() {
+            if let [only] = c[..] {
+                out.push(members[only as usize]);
+                continue;
+            }
+            stats.cycles += 1;
+            stats.quads_in_cycles += c.len() as u32;
+            let mut c: Vec<u32> = c.iter().map(|&i| members[i as usize]).collect();
+            // Farthest centre first; a NaN distance sorts first, deterministically.
+            c.sort_by_cached_key(|&i| {
+                (
+                    Reverse(boxes[i as usize].centre_distance2(eye).to_bits()),
+                    i,
+                )
+            });
+            out.extend_from_slice(&c);
+        }
+    }
+    Some(stats)
+}
+
+/// Whether some positive quad of `pos` and negative quad of `neg` (all on one plane) share
+/// footprint area.
+fn opposite_overlap(all: &[QBox], pos: &[u32], neg: &[u32], axis: usize) -> bool {
+    let [u, v] = UV_AXES[axis];
+    let mut grid = [0u64; MAX_COORD + 1];
+    for &i in pos {
+        let b = &all[i as usize];
+        let bits = span_bits(b.lo[v], b.hi[v]);
+        for r in b.lo[u]..b.hi[u] {
+            grid[r as usize] |= bits;
+        }
+    }
+    neg.iter().any(|&i| {
+        let b = &all[i as usize];
+        let bits = span_bits(b.lo[v], b.hi[v]);
+        (b.lo[u]..b.hi[u]).any(|r| grid[r as usize] & bits != 0)
+    })
+}
+
+fn span_bits(lo: i32, hi: i32) -> u64 {
+    let w = (hi - lo) as u32;
+    let ones = if w >= 64 { u64::MAX } else { (1u64 << w) - 1 };
+    ones << lo
+}
+
+/// The free plane that best splits `ids`, as (axis, coordinate): no quad's relative
+/// interior crosses it, and at least two of below / on / above are non-empty. Prefers
+/// planes that are already triggers, then balanced splits, then planes holding quads.
+fn best_split(
+    all: &[QBox],
+    ids: &[u32],
+    is_trigger: &[[bool; MAX_COORD + 1]; 3],
+) -> Option<(usize, i32)> {
+    let m = ids.len() as i32;
+    let mut best: Option<((bool, i32, bool), usize, i32)> = None;
+    for k in 0..3 {
+        let mut hi_at = [0i32; MAX_COORD + 1];
+        let mut lo_at = [0i32; MAX_COORD + 1];
+        let mut on_at = [0i32; MAX_COORD + 1];
+        let (mut min_c, mut max_c) = (MAX_COORD as i32, 0);
+        for &i in ids {
+            let b = &all[i as usize];
+            hi_at[b.hi[k] as usize] += 1;
+            lo_at[b.lo[k] as usize] += 1;
+            if b.axis == k {
+                on_at[b.lo[k] as usize] += 1;
+            }
+            min_c = min_c.min(b.lo[k]);
+            max_c = max_c.max(b.hi[k]);
+        }
+        // le_hi: quads with hi <= c; ge_lo: quads with lo >= c.
+        let mut le_hi = 0;
+        let mut ge_lo = m;
+        for c in 0..=max_c {
+            le_hi += hi_at[c as usize];
+            if c > 0 {
+                ge_lo -= lo_at[c as usize - 1];
+            }
+            if c < min_c {
+                continue;
+            }
+            let on = on_at[c as usize];
+            let below = le_hi - on;
+            let above = ge_lo - on;
+            if below + above + on != m {
+                continue; // some quad straddles c
+            }
+            if [below, on, above].iter().filter(|&&n| n > 0).count() < 2 {
+                continue;
+            }
+            let score = (is_trigger[k][c as usize], -below.max(above), on > 0);
+            if best.is_none_or(|(s, _, _)| score > s) {
+                best = Some((score, k, c));
+            }
+        }
+    }
+    best.map(|(_, k, c)| (k, c))
+}
+
+/// Strongly connected components of a small graph, sinks first (Tarjan, iterative).
+fn tarjan(succ: &[Vec<u32>]) -> Vec<Vec<u32>> {
+    let m = succ.len();
+    const UNSEEN: u32 = u32::MAX;
+    let mut index = vec![UNSEEN; m];
+    let mut low = vec![0u32; m];
+    let mut on_stack = vec![false; m];
+    let mut stack: Vec<u32> = Vec::new();
+    let mut comps = Vec::new();
+    let mut next = 0u32;
+    // Call stack: (node, next successor position).
+    let mut calls: Vec<(u32, usize)> = Vec::new();
+    for root in 0..m as u32 {
+        if index[root as usize] != UNSEEN {
+            continue;
+        }
+        calls.push((root, 0));
+        while let Some(&mut (v, ref mut pos)) = calls.last_mut() {
+            let vu = v as usize;
+            if *pos == 0 && index[vu] == UNSEEN {
+                index[vu] = next;
+                low[vu] = next;
+                next += 1;
+                stack.push(v);
+                on_stack[vu] = true;
+            }
+            if let Some(&w) = succ[vu].get(*pos) {
+                *pos += 1;
+                let wu = w as usize;
+                if index[wu] == UNSEEN {
+                    calls.push((w, 0));
+                } else if on_stack[wu] {
+                    low[vu] = low[vu].min(index[wu]);
+                }
+                continue;
+            }
+            calls.pop();
+            if let Some(&(p, _)) = calls.last() {
+                let pu = p as usize;
+                low[pu] = low[pu].min(low[vu]);
+            }
+            if low[vu] == index[vu] {
+                let mut comp = Vec::new();
+                while let Some(w) = stack.pop() {
+                    on_stack[w as usize] = false;
+                    comp.push(w);
+                    if w == v {
+                        break;
+                    }
+                }
+                comp.sort_unstable();
+                comps.push(comp);
+            }
+        }
+    }
+    comps
+}
+
+/// The draw-order key of a chunk for an eye in world block coordinates: sort by it,
+/// largest (farthest) first, ties in any order. It is the squared distance, in chunks,
+/// between the chunk and the chunk that holds the eye, so it is computed in integers and
+/// changes only when the eye crosses a chunk border; exact for a grid of equal cubes (see
+/// "Order across chunks" in the module docs). Never panics: a NaN coordinate counts as 0,
+/// far and infinite eyes are clamped beyond every `i32` chunk.
+pub fn chunk_order_key(pos: ChunkPos, eye: [f64; 3]) -> u128 {
+    let s = CHUNK_SIZE as f64;
+    let p = [pos.x, pos.y, pos.z];
+    (0..3)
+        .map(|k| {
+            let e = ((eye[k] / s).floor() as i64)
+                .clamp(i64::from(i32::MIN) - 1, i64::from(i32::MAX) + 1);
+            let d = u128::from((i64::from(p[k]) - e).unsigned_abs());
+            d * d
+        })
+        .sum()
+}
+
+/// Sorts chunks back to front by [`chunk_order_key`] (farthest first), ties by position.
+pub fn chunks_back_to_front(chunks: &mut [ChunkPos], eye: [f64; 3]) {
+    chunks.sort_by_cached_key(|&p| (Reverse(chunk_order_key(p, eye)), p));
+}
+
+/// Internals exposed for the integration tests; not part of the API.
+#[doc(hidden)]
+pub mod testing {
+    use super::*;
+
+    /// The relation at a point: whether `b` hides part of `a` from `eye`.
+    pub fn hides_at(eye: [f64; 3], a: PackedQuad, b: PackedQuad) -> bool {
+        super::hides_at(eye, &QBox::of(a), &QBox::of(b))
+    }
+
+    /// The region relation: whether `b` may hide part of `a` from some eye of the region
+    /// `key` of `order` (tie-breaks included).
+    pub fn may_hide_in_region(
+        order: &QuadOrder,
+        key: RegionKey,
+        a: PackedQuad,
+        b: PackedQuad,
+    ) -> bool {
+        may_hide_in_cell(&QBox::of(a), &QBox::of(b), &order.cell(key))
+    }
+
+    /// The open cell of a region: per axis `(lo, hi)`, `None` for unbounded.
+    pub fn region_cell(order: &QuadOrder, key: RegionKey) -> [(Option<i32>, Option<i32>); 3] {
+        order.cell(key).map(|s| (s.lo, s.hi))
+    }
+}
