@@ -324,8 +324,13 @@ enum Node {
         mid: u32,
         end: u32,
     },
-    /// Quads that no free axis-aligned plane separates: ordered pairwise per region.
+    /// Quads that no free axis-aligned plane separates and that form one object: ordered
+    /// pairwise per region.
     Stuck { leaf: u32 },
+    /// Quads that no free axis-aligned plane separates but that fall apart into objects
+    /// (see [`objects`]): the objects are ordered pairwise by their bounding boxes per
+    /// region, each by its own subtree (`children[first..first + count]`).
+    Objects { leaf: u32, first: u32 },
 }
 
 /// The precomputed per-chunk structure for exact ordering: build it once when the mesh is
@@ -337,6 +342,10 @@ pub struct QuadOrder {
     quads: Vec<PackedQuad>,
     nodes: Vec<Node>,
     root: u32,
+    /// Child nodes of object nodes.
+    children: Vec<u32>,
+    /// Per node, the range of stored quads of its subtree.
+    spans: Vec<(u32, u32)>,
     /// Trigger planes per axis, sorted, distinct.
     planes: [Vec<u8>; 3],
     /// `lut[k][j]`: how many trigger planes of axis `k` lie below `j`, for j in 0..=64.
@@ -354,8 +363,9 @@ impl Default for QuadOrder {
 struct Job {
     ids: Vec<u32>,
     parent: u32,
-    /// 0: below child, 1: above child, 2: root.
-    slot: u8,
+    /// The child's place in its parent: 0 below, 1 above (split nodes), the object's index
+    /// (object nodes), unused for the root.
+    slot: u32,
 }
 
 impl QuadOrder {
@@ -378,6 +388,8 @@ impl QuadOrder {
             quads: Vec::with_capacity(quads.len()),
             nodes: Vec::new(),
             root: NONE,
+            children: Vec::new(),
+            spans: Vec::new(),
             planes: Default::default(),
             lut: [[0; VALUES]; 3],
             leaves: Vec::new(),
@@ -389,20 +401,24 @@ impl QuadOrder {
         let mut jobs = vec![Job {
             ids: (0..quads.len() as u32).collect(),
             parent: NONE,
-            slot: 2,
+            slot: 0,
         }];
         while let Some(mut job) = jobs.pop() {
             if job.ids.is_empty() {
                 continue;
             }
             let node = out.nodes.len() as u32;
-            match job.slot {
-                2 => out.root = node,
-                slot => {
-                    if let Node::Split { below, above, .. } = &mut out.nodes[job.parent as usize] {
-                        *(if slot == 0 { below } else { above }) = node;
-                    }
+            let here = out.quads.len() as u32;
+            out.spans.push((here, here));
+            match out.nodes.get_mut(job.parent as usize) {
+                None => out.root = node,
+                Some(Node::Split { below, above, .. }) => {
+                    *(if job.slot == 0 { below } else { above }) = node;
                 }
+                Some(Node::Objects { first, .. }) => {
+                    out.children[(*first + job.slot) as usize] = node;
+                }
+                Some(Node::Stuck { .. }) => unreachable!("leaves have no children"),
             }
             let first = all[job.ids[0] as usize];
             let coplanar = job.ids.iter().all(|&i| {
@@ -416,6 +432,48 @@ impl QuadOrder {
             } else {
                 best_split(&all, &job.ids, &is_trigger)
             };
+            let objects = if split.is_none() && !no_tree {
+                objects(&all, &job.ids)
+            } else {
+                Vec::new()
+            };
+            if objects.len() > 1 {
+                // Every plane that could separate cuts a quad, but the quads fall apart into
+                // objects: an object leaf over their bounding boxes (whose coordinates are
+                // trigger planes), each object a child.
+                let boxes: Vec<QBox> = objects
+                    .iter()
+                    .map(|(_, (lo, hi))| QBox {
+                        lo: *lo,
+                        hi: *hi,
+                        axis: 0,
+                        positive: false,
+                    })
+                    .collect();
+                for b in &boxes {
+                    for k in 0..3 {
+                        is_trigger[k][b.lo[k] as usize] = true;
+                        is_trigger[k][b.hi[k] as usize] = true;
+                    }
+                }
+                let first = out.children.len() as u32;
+                out.children
+                    .extend(std::iter::repeat_n(NONE, objects.len()));
+                out.nodes.push(Node::Objects {
+                    leaf: out.leaves.len() as u32,
+                    first,
+                });
+                out.leaves.push(Leaf::new(0, boxes, true));
+                // Pushed in reverse so that object i is built (and stored) i-th.
+                for (i, (ids, _)) in objects.into_iter().enumerate().rev() {
+                    jobs.push(Job {
+                        ids,
+                        parent: node,
+                        slot: i as u32,
+                    });
+                }
+                continue;
+            }
             let Some((axis, c)) = split else {
                 // Stuck: every plane that could separate cuts a quad. A pairwise leaf,
                 // sorted by (axis, plane, facing) so that coplanar groups are ranges; all
@@ -433,10 +491,11 @@ impl QuadOrder {
                     }
                 }
                 out.quads.extend(job.ids.iter().map(|&i| quads[i as usize]));
+                out.spans[node as usize].1 = out.quads.len() as u32;
                 out.nodes.push(Node::Stuck {
                     leaf: out.leaves.len() as u32,
                 });
-                leaf_boxes.push((start, boxes));
+                leaf_boxes.push((out.leaves.len(), start, boxes));
                 out.leaves.push(Leaf::default());
                 continue;
             };
@@ -461,6 +520,7 @@ impl QuadOrder {
                 .extend(pos.iter().chain(&neg).map(|&i| quads[i as usize]));
             let mid = start + pos.len() as u32;
             let end = out.quads.len() as u32;
+            out.spans[node as usize].1 = end;
             // The plane is a trigger when it separates children, or when opposite faces on
             // it overlap (their tie-break depends on the side of the eye).
             let needs = !below.is_empty()
@@ -509,8 +569,22 @@ impl QuadOrder {
                 *trigger = u32::from(out.lut[usize::from(*axis)][*trigger as usize]);
             }
         }
-        for (leaf, (start, boxes)) in out.leaves.iter_mut().zip(leaf_boxes) {
-            *leaf = Leaf::new(start, boxes);
+        for (leaf, start, boxes) in leaf_boxes {
+            out.leaves[leaf] = Leaf::new(start, boxes, false);
+        }
+        // Subtree spans: children come after their parents.
+        for n in (0..out.nodes.len()).rev() {
+            let kids: Vec<u32> = match out.nodes[n] {
+                Node::Split { below, above, .. } => vec![below, above],
+                Node::Objects { leaf, first } => {
+                    let count = out.leaves[leaf as usize].boxes.len() as u32;
+                    out.children[first as usize..(first + count) as usize].to_vec()
+                }
+                Node::Stuck { .. } => Vec::new(),
+            };
+            for c in kids.into_iter().filter(|&c| c != NONE) {
+                out.spans[n].1 = out.spans[n].1.max(out.spans[c as usize].1);
+            }
         }
         out
     }
@@ -536,17 +610,20 @@ impl QuadOrder {
         [&self.planes[0], &self.planes[1], &self.planes[2]]
     }
 
-    /// Stuck leaves (sets that no free plane separates) and the quads in them.
+    /// Stuck leaves (single objects that no free plane separates) and the quads in them.
     pub fn stuck(&self) -> (usize, usize) {
-        (
-            self.leaves.len(),
-            self.leaves.iter().map(|l| l.boxes.len()).sum(),
-        )
+        let stuck = self.leaves.iter().filter(|l| !l.objects);
+        (stuck.clone().count(), stuck.map(|l| l.boxes.len()).sum())
     }
 
-    /// Number of tree nodes.
-    pub fn node_count(&self) -> usize {
-        self.nodes.len()
+    /// Number of tree nodes, and of those the object nodes.
+    pub fn node_count(&self) -> (usize, usize) {
+        let objects = self
+            .nodes
+            .iter()
+            .filter(|n| matches!(n, Node::Objects { .. }))
+            .count();
+        (self.nodes.len(), objects)
     }
 
     /// The region of an eye in chunk-local block units (eye minus chunk origin, computed in
@@ -578,16 +655,21 @@ impl QuadOrder {
             return stats;
         }
         let key = self.region_key(eye_local);
-        // Tasks: a node, or a range of stored quads (tagged by the top bit).
+        let cell = self.cell(key);
+        // Tasks: a node, a range of stored quads (tagged by the top bit) or a range of
+        // `extra`, quads ordered on the way (tagged by the next bit).
         const RANGE: u64 = 1 << 63;
+        const EXTRA: u64 = 1 << 62;
         let range = |s: u32, e: u32| RANGE | u64::from(s) << 32 | u64::from(e);
         let mut stack: Vec<u64> = Vec::with_capacity(64);
         let mut scratch = Vec::new();
+        let mut extra: Vec<PackedQuad> = Vec::new();
         stack.push(u64::from(self.root));
         while let Some(t) = stack.pop() {
-            if t & RANGE != 0 {
-                let (s, e) = (((t >> 32) as u32 & 0x7fff_ffff) as usize, t as u32 as usize);
-                out.extend_from_slice(&self.quads[s..e]);
+            if t & (RANGE | EXTRA) != 0 {
+                let (s, e) = (((t >> 32) as u32 & 0x3fff_ffff) as usize, t as u32 as usize);
+                let from = if t & RANGE != 0 { &self.quads } else { &extra };
+                out.extend_from_slice(&from[s..e]);
                 continue;
             }
             match self.nodes[t as usize] {
@@ -626,10 +708,37 @@ impl QuadOrder {
                 Node::Stuck { leaf } => {
                     let leaf = &self.leaves[leaf as usize];
                     scratch.clear();
-                    let s = leaf.order(&self.cell(key), Some(eye_local), &mut scratch);
+                    let s = leaf.order(&cell, Some(eye_local), &mut scratch);
                     stats.add(s.unwrap_or_default());
                     let quads = &self.quads[leaf.start as usize..];
                     out.extend(scratch.iter().map(|&i| quads[i as usize]));
+                }
+                Node::Objects { leaf, first } => {
+                    let (seq, groups) = self.leaves[leaf as usize].object_order(&cell);
+                    let mut tasks = Vec::with_capacity(seq.len());
+                    for v in seq {
+                        let Some(group) = group_of(v, &groups) else {
+                            tasks.push(u64::from(self.children[(first + v) as usize]));
+                            continue;
+                        };
+                        // Objects whose boxes the separating axes leave cyclic: their quads
+                        // together, by the exact relation.
+                        let mut quads = Vec::new();
+                        for &o in group {
+                            let (s, e) = self.spans[self.children[(first + o) as usize] as usize];
+                            quads.extend_from_slice(&self.quads[s as usize..e as usize]);
+                        }
+                        let boxes: Vec<QBox> = quads.iter().map(|&q| QBox::of(q)).collect();
+                        let all: Vec<u32> = (0..boxes.len() as u32).collect();
+                        scratch.clear();
+                        let s = refine(&boxes, &all, &cell, Some(eye_local), &mut scratch);
+                        stats.add(s.unwrap_or_default());
+                        stats.pairwise_quads += boxes.len() as u32;
+                        let at = extra.len() as u32;
+                        extra.extend(scratch.iter().map(|&i| quads[i as usize]));
+                        tasks.push(EXTRA | u64::from(at) << 32 | u64::from(extra.len() as u32));
+                    }
+                    stack.extend(tasks.into_iter().rev());
                 }
             }
         }
@@ -655,8 +764,11 @@ impl QuadOrder {
 /// the bit masks that give a row of the separating-axis relation in O(m / 64) words.
 #[derive(Clone, Debug, Default)]
 struct Leaf {
-    /// Index of the leaf's first quad among the stored ones.
+    /// Index of the leaf's first quad among the stored ones (quad leaves).
     start: u32,
+    /// Whether the boxes are the bounding boxes of objects (interior-disjoint components
+    /// of an object node) rather than quads.
+    objects: bool,
     boxes: Vec<QBox>,
     /// Words per bit set over the leaf's quads.
     words: usize,
@@ -672,14 +784,14 @@ struct Leaf {
     tie_start: Vec<u32>,
     tie_list: Vec<u32>,
     /// Bounding box of the leaf.
-    bbox: ([i32; 3], [i32; 3]),
+    bbox: Bounds,
     /// For eyes beyond the bounding box along every axis (octant bit k: above along k),
     /// the order, precomputed; `None` where it needs the eye itself.
     octants: [Option<Vec<u32>>; 8],
 }
 
 impl Leaf {
-    fn new(start: u32, boxes: Vec<QBox>) -> Self {
+    fn new(start: u32, boxes: Vec<QBox>, objects: bool) -> Self {
         let m = boxes.len();
         let words = m.div_ceil(64);
         let offset = |k: usize, hi: bool, v: i32| {
@@ -706,8 +818,12 @@ impl Leaf {
         let mut tie_list = Vec::new();
         let mut g = 0;
         while g < m {
-            let mut e = g;
-            while e < m && boxes[e].axis == boxes[g].axis && boxes[e].plane() == boxes[g].plane() {
+            let mut e = g + 1;
+            while !objects
+                && e < m
+                && boxes[e].axis == boxes[g].axis
+                && boxes[e].plane() == boxes[g].plane()
+            {
                 e += 1;
             }
             for i in g..e {
@@ -730,6 +846,7 @@ impl Leaf {
         }
         let mut leaf = Self {
             start,
+            objects,
             boxes,
             words,
             masks,
@@ -742,8 +859,13 @@ impl Leaf {
         };
         let octants = std::array::from_fn(|o| {
             let cell = leaf.octant_cell(o);
-            let mut order = Vec::new();
-            leaf.order_live(&cell, None, &mut order).map(|_| order)
+            if leaf.objects {
+                let (seq, groups) = leaf.components(&cell);
+                groups.is_empty().then_some(seq)
+            } else {
+                let mut order = Vec::new();
+                leaf.order(&cell, None, &mut order).map(|_| order)
+            }
         });
         leaf.octants = octants;
         leaf
@@ -789,15 +911,38 @@ impl Leaf {
         eye: Option<[f64; 3]>,
         out: &mut Vec<u32>,
     ) -> Option<SortStats> {
-        if let Some(order) = self.octant_of(cell).and_then(|o| self.octants[o].as_ref()) {
-            // The cell lies in the octant's cell, so the octant's order is exact in it.
+        let mut stats = SortStats {
+            pairwise_quads: self.boxes.len() as u32,
+            ..SortStats::default()
+        };
+        if let Some(order) = self.octant_order(cell) {
             out.extend_from_slice(order);
-            return Some(SortStats {
-                pairwise_quads: self.boxes.len() as u32,
-                ..SortStats::default()
-            });
+            return Some(stats);
         }
-        self.order_live(cell, eye, out)
+        let (seq, groups) = self.components(cell);
+        for v in seq {
+            match group_of(v, &groups) {
+                None => out.push(v),
+                Some(g) => stats.add(refine(&self.boxes, g, cell, eye, out)?),
+            }
+        }
+        Some(stats)
+    }
+
+    /// The precomputed order of an octant cell that contains `cell`, if any: then it is
+    /// exact in `cell`.
+    fn octant_order(&self, cell: &[Span; 3]) -> Option<&Vec<u32>> {
+        self.octant_of(cell).and_then(|o| self.octants[o].as_ref())
+    }
+
+    /// The order of an object leaf's objects for the cell: the sequence, in which groups of
+    /// objects that the separating-axis relation leaves cyclic appear as placeholders (see
+    /// [`group_of`]), and the groups.
+    fn object_order(&self, cell: &[Span; 3]) -> (Vec<u32>, Vec<Vec<u32>>) {
+        match self.octant_order(cell) {
+            Some(seq) => (seq.clone(), Vec::new()),
+            None => self.components(cell),
+        }
     }
 
     fn mask_offset(&self, k: usize, hi: bool, v: i32) -> usize {
@@ -885,15 +1030,22 @@ impl Leaf {
         }
     }
 
-    /// Depth-first search over the predecessor rows for the cell, computed when a quad is
-    /// first reached: the post-order (every quad after the quads it may hide, if there is
-    /// no cycle), and whether an edge to a quad on the stack (a cycle) was met. Roots go
-    /// farthest first (by the sum over axes of the integer distance from the quad to the
-    /// cell), so that most quads find their predecessors done and leave at once without
-    /// keeping their row; only quads with pending predecessors keep theirs on the stack.
-    fn dfs_post(&self, cell: &[Span; 3]) -> (Vec<u32>, bool) {
+    /// Tarjan's strongly connected components of the separating-axis relation over the
+    /// cell, searched over predecessor rows computed when a quad is first reached, so that
+    /// components come out in drawing order (every component after the ones it may hide):
+    /// the sequence of single quads and placeholders of groups (see [`group_of`]), and the
+    /// groups.
+    ///
+    /// Roots go farthest first (by the sum over axes of the integer distance from the quad
+    /// to the cell), so that most quads find their predecessors done: they are their own
+    /// component and leave at once without keeping their row; only quads with pending
+    /// predecessors keep theirs, on the stack. Edges back to Tarjan's stack are looked for
+    /// when a quad is reached only: an edge to a quad reached later cannot lower its low
+    /// link, which starts at its own index.
+    fn components(&self, cell: &[Span; 3]) -> (Vec<u32>, Vec<Vec<u32>>) {
         let m = self.boxes.len();
         let words = self.words;
+        let mut out = Vec::with_capacity(m);
         // Counting sort of the roots by distance to the cell, farthest first.
         let dist = |q: &QBox| -> usize {
             (0..3)
@@ -912,148 +1064,135 @@ impl Leaf {
         let keys: Vec<u8> = self
             .boxes
             .iter()
-            .map(|q| dist(q).min(BUCKETS - 1) as u8)
+            .map(|q| (BUCKETS - 1 - dist(q).min(BUCKETS - 1)) as u8)
             .collect();
-        for &d in &keys {
-            count[BUCKETS - 1 - usize::from(d) + 1] += 1;
+        for &b in &keys {
+            count[usize::from(b) + 1] += 1;
         }
         for i in 1..=BUCKETS {
             count[i] += count[i - 1];
         }
         let mut roots = vec![0u32; m];
-        for (i, &d) in keys.iter().enumerate() {
-            let slot = &mut count[BUCKETS - 1 - usize::from(d)];
-            roots[*slot as usize] = i as u32;
-            *slot += 1;
+        for (i, &b) in keys.iter().enumerate() {
+            roots[count[usize::from(b)] as usize] = i as u32;
+            count[usize::from(b)] += 1;
         }
 
+        let mut t = Tarjan {
+            index: vec![u32::MAX; m],
+            low: vec![0; m],
+            next: 0,
+            tstack: Vec::new(),
+            on_tstack: vec![0; words],
+            groups: Vec::new(),
+        };
         let mut visited = vec![0u64; words];
-        let mut on_stack = vec![0u64; words];
-        let mut post = Vec::with_capacity(m);
-        // (quad, scan cursor, offset of its row in `rows`)
+        // Search stack: (quad, scan cursor, offset of its row in `rows`).
         let mut stack: Vec<(u32, usize, usize)> = Vec::new();
         let mut rows: Vec<u64> = Vec::new();
         let mut buf = vec![0u64; words];
-        let mut cyclic = false;
-        // Computes the row of `v`, marks it visited; true if it has pending predecessors
-        // (then it goes on the stack with its row), false if it is finished.
-        let mut visit = |v: u32,
-                         visited: &mut [u64],
-                         on_stack: &mut [u64],
-                         stack: &mut Vec<(u32, usize, usize)>,
-                         rows: &mut Vec<u64>,
-                         post: &mut Vec<u32>| {
-            self.relation_row(v as usize, cell, true, &mut buf);
-            let (mut back, mut pending) = (0, 0);
-            for ((r, s), vis) in buf.iter().zip(on_stack.iter()).zip(visited.iter()) {
-                back |= r & s;
-                pending |= r & !vis;
-            }
-            cyclic |= back != 0;
-            let (w, b) = (v as usize / 64, 1u64 << (v % 64));
-            visited[w] |= b;
-            if pending == 0 {
-                post.push(v);
-            } else {
-                on_stack[w] |= b;
-                stack.push((v, 0, rows.len()));
-                rows.extend_from_slice(&buf);
-            }
-        };
         for &r in &roots {
-            if visited[r as usize / 64] & (1 << (r % 64)) != 0 {
+            if t.index[r as usize] != u32::MAX {
                 continue;
             }
-            visit(
-                r,
-                &mut visited,
-                &mut on_stack,
-                &mut stack,
-                &mut rows,
-                &mut post,
-            );
-            while let Some(top) = stack.last_mut() {
+            let mut reach = Some(r);
+            loop {
+                if let Some(v) = reach.take() {
+                    // First reached: its row, its edges back to Tarjan's stack, whether it
+                    // has predecessors not reached yet.
+                    let vi = v as usize;
+                    t.index[vi] = t.next;
+                    t.low[vi] = t.next;
+                    t.next += 1;
+                    visited[vi / 64] |= 1u64 << (vi % 64);
+                    self.relation_row(vi, cell, true, &mut buf);
+                    let (mut back, mut pending) = (0u64, 0u64);
+                    for ((r, s), vis) in buf.iter().zip(&t.on_tstack).zip(&visited) {
+                        back |= r & s;
+                        pending |= r & !vis;
+                    }
+                    if back != 0 {
+                        for (w, (r, s)) in buf.iter().zip(&t.on_tstack).enumerate() {
+                            let mut bits = r & s;
+                            while bits != 0 {
+                                let u = w * 64 + bits.trailing_zeros() as usize;
+                                t.low[vi] = t.low[vi].min(t.index[u]);
+                                bits &= bits - 1;
+                            }
+                        }
+                    }
+                    t.tstack.push(v);
+                    t.on_tstack[vi / 64] |= 1u64 << (vi % 64);
+                    if pending != 0 {
+                        stack.push((v, 0, rows.len()));
+                        rows.extend_from_slice(&buf);
+                        continue;
+                    }
+                    // No predecessor left to reach: finished at once.
+                    t.finish(v, &mut out);
+                    if let Some(&(p, ..)) = stack.last() {
+                        t.low[p as usize] = t.low[p as usize].min(t.low[vi]);
+                    }
+                }
+                let Some(top) = stack.last_mut() else { break };
                 let (v, off) = (top.0, top.2);
                 if let Some(w) = next_unvisited(&rows[off..off + words], &visited, &mut top.1) {
-                    visit(
-                        w,
-                        &mut visited,
-                        &mut on_stack,
-                        &mut stack,
-                        &mut rows,
-                        &mut post,
-                    );
-                } else {
-                    stack.pop();
-                    rows.truncate(off);
-                    on_stack[v as usize / 64] &= !(1u64 << (v % 64));
-                    post.push(v);
+                    reach = Some(w);
+                    continue;
+                }
+                stack.pop();
+                rows.truncate(off);
+                t.finish(v, &mut out);
+                if let Some(&(p, ..)) = stack.last() {
+                    t.low[p as usize] = t.low[p as usize].min(t.low[v as usize]);
                 }
             }
         }
-        (post, cyclic)
+        (out, t.groups)
     }
+}
 
-    /// The live path: a depth-first search over the separating-axis relation's rows,
-    /// computed as visited; if it meets a cycle, the strongly connected groups (Kosaraju),
-    /// each refined by [`refine`].
-    fn order_live(
-        &self,
-        cell: &[Span; 3],
-        eye: Option<[f64; 3]>,
-        out: &mut Vec<u32>,
-    ) -> Option<SortStats> {
-        let m = self.boxes.len();
-        let words = self.words;
-        let mut stats = SortStats {
-            pairwise_quads: m as u32,
-            ..SortStats::default()
-        };
-        let (post, cyclic) = self.dfs_post(cell);
-        if !cyclic {
-            // Post-order over predecessors: every quad after the ones it may hide.
-            out.extend_from_slice(&post);
-            return Some(stats);
+/// The group a placeholder of [`Leaf::components`]'s sequence stands for (`u32::MAX -
+/// group number`), or `None` for a plain index.
+fn group_of(v: u32, groups: &[Vec<u32>]) -> Option<&[u32]> {
+    let g = (u32::MAX - v) as usize;
+    groups.get(g).map(Vec::as_slice)
+}
+
+/// Tarjan's bookkeeping for [`Leaf::components`].
+struct Tarjan {
+    index: Vec<u32>,
+    low: Vec<u32>,
+    next: u32,
+    /// Tarjan's stack, as a list and as a bit set.
+    tstack: Vec<u32>,
+    on_tstack: Vec<u64>,
+    /// Components of more than one quad, to refine.
+    groups: Vec<Vec<u32>>,
+}
+
+impl Tarjan {
+    /// Tarjan's step when `v` is finished: if it roots a component, pops the component and
+    /// writes it to `out` (a group as the placeholder `u32::MAX - group number`).
+    fn finish(&mut self, v: u32, out: &mut Vec<u32>) {
+        if self.low[v as usize] != self.index[v as usize] {
+            return;
         }
-        let mut rows = vec![0u64; m * words];
-        for (i, row) in rows.chunks_exact_mut(words).enumerate() {
-            self.relation_row(i, cell, false, row);
+        let mut g = Vec::new();
+        while let Some(w) = self.tstack.pop() {
+            self.on_tstack[w as usize / 64] &= !(1u64 << (w % 64));
+            g.push(w);
+            if w == v {
+                break;
+            }
         }
-        let mut visited = vec![0u64; words];
-        let mut groups = Vec::new();
-        let mut stack: Vec<(u32, usize)> = Vec::new();
-        // Kosaraju's second pass, over successors in decreasing finish time of the first:
-        // each tree is a strongly connected group; groups come sinks first.
-        for &r in post.iter().rev() {
-            if visited[r as usize / 64] & (1 << (r % 64)) != 0 {
-                continue;
-            }
-            let mut g = vec![r];
-            visited[r as usize / 64] |= 1 << (r % 64);
-            stack.push((r, 0));
-            while let Some(top) = stack.last_mut() {
-                let v = top.0 as usize;
-                if let Some(w) =
-                    next_unvisited(&rows[v * words..(v + 1) * words], &visited, &mut top.1)
-                {
-                    visited[w as usize / 64] |= 1 << (w % 64);
-                    g.push(w);
-                    stack.push((w, 0));
-                } else {
-                    stack.pop();
-                }
-            }
+        if let [only] = g[..] {
+            out.push(only);
+        } else {
             g.sort_unstable();
-            groups.push(g);
+            out.push(u32::MAX - self.groups.len() as u32);
+            self.groups.push(g);
         }
-        for g in groups.iter().rev() {
-            if g.len() == 1 {
-                out.push(g[0]);
-            } else {
-                stats.add(refine(&self.boxes, g, cell, eye, out)?);
-            }
-        }
-        Some(stats)
     }
 }
 
@@ -1144,6 +1283,110 @@ fn refine(
         }
     }
     Some(stats)
+}
+
+/// A bounding box: minimum and maximum corners.
+type Bounds = ([i32; 3], [i32; 3]);
+
+/// Splits the quads `ids` into objects: the classes of quads whose closed boxes chain
+/// together by touching or overlapping, merged while the bounding boxes of two classes are
+/// not separated along any axis (so that any two objects' boxes are). Each with its
+/// bounding box, in order of smallest member.
+fn objects(all: &[QBox], ids: &[u32]) -> Vec<(Vec<u32>, Bounds)> {
+    let n = ids.len();
+    let (mut lo, mut hi) = ([i32::MAX; 3], [i32::MIN; 3]);
+    for &i in ids {
+        let b = &all[i as usize];
+        for k in 0..3 {
+            lo[k] = lo[k].min(b.lo[k]);
+            hi[k] = hi[k].max(b.hi[k]);
+        }
+    }
+    let dim = [0, 1, 2].map(|k| (hi[k] - lo[k] + 1) as usize);
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    fn union(p: &mut [u32], a: u32, b: u32) {
+        let (a, b) = (find(p, a), find(p, b));
+        p[a.max(b) as usize] = a.min(b);
+    }
+    // Closed integer boxes that meet share a lattice point: union through a lattice grid.
+    let mut grid = vec![u32::MAX; dim[0] * dim[1] * dim[2]];
+    for (j, &i) in ids.iter().enumerate() {
+        let b = &all[i as usize];
+        for x in b.lo[0]..=b.hi[0] {
+            for y in b.lo[1]..=b.hi[1] {
+                for z in b.lo[2]..=b.hi[2] {
+                    let at = (((x - lo[0]) as usize * dim[1]) + (y - lo[1]) as usize) * dim[2]
+                        + (z - lo[2]) as usize;
+                    match grid[at] {
+                        u32::MAX => grid[at] = j as u32,
+                        o => union(&mut parent, j as u32, o),
+                    }
+                }
+            }
+        }
+    }
+    let bounds = |members: &[u32]| {
+        let (mut lo, mut hi) = ([i32::MAX; 3], [i32::MIN; 3]);
+        for &j in members {
+            let b = &all[ids[j as usize] as usize];
+            for k in 0..3 {
+                lo[k] = lo[k].min(b.lo[k]);
+                hi[k] = hi[k].max(b.hi[k]);
+            }
+        }
+        (lo, hi)
+    };
+    let not_separated = |a: &Bounds, b: &Bounds| (0..3).all(|k| a.0[k] < b.1[k] && b.0[k] < a.1[k]);
+    loop {
+        let mut classes: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
+        for j in 0..n as u32 {
+            classes.entry(find(&mut parent, j)).or_default().push(j);
+        }
+        let classes: Vec<(u32, Bounds)> = classes
+            .into_iter()
+            .map(|(root, members)| (root, bounds(&members)))
+            .collect();
+        let mut merged = false;
+        for a in 0..classes.len() {
+            for b in a + 1..classes.len() {
+                if not_separated(&classes[a].1, &classes[b].1) {
+                    union(&mut parent, classes[a].0, classes[b].0);
+                    merged = true;
+                }
+            }
+        }
+        if !merged {
+            break;
+        }
+    }
+    let mut classes: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
+    for j in 0..n as u32 {
+        classes
+            .entry(find(&mut parent, j))
+            .or_default()
+            .push(ids[j as usize]);
+    }
+    classes
+        .into_values()
+        .map(|members| {
+            let (mut lo, mut hi) = ([i32::MAX; 3], [i32::MIN; 3]);
+            for &i in &members {
+                let b = &all[i as usize];
+                for k in 0..3 {
+                    lo[k] = lo[k].min(b.lo[k]);
+                    hi[k] = hi[k].max(b.hi[k]);
+                }
+            }
+            (members, (lo, hi))
+        })
+        .collect()
 }
 
 /// Whether some positive quad of `pos` and negative quad of `neg` (all on one plane) share

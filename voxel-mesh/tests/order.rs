@@ -289,12 +289,13 @@ fn random_chunks_are_exact() {
     let start = std::time::Instant::now();
     for i in 0..1500 {
         let n = rng.range(2, 30) as usize;
-        let chunk = match i % 6 {
+        let chunk = match i % 7 {
             0 => random_boxes(&mut rng, n / 3 + 2, 8, 24),
             1 => random_boxes(&mut rng, n + 8, 5, 32),
             2 => water_with_objects(&mut rng),
             3 => floors_and_walls(&mut rng),
             4 => stairs(&mut rng),
+            5 => structures(&mut rng, 40 + 6 * n).0,
             _ => random_boxes(&mut rng, n / 4 + 3, 12, 20),
         };
         let quads = mesh(&chunk);
@@ -317,6 +318,71 @@ fn random_chunks_are_exact() {
         tally.arrangements > 1200 && tally.exact > tally.sorts * 9 / 10,
         "{tally:?}"
     );
+}
+
+#[test]
+fn separate_structures_are_ordered_as_objects() {
+    // Many structures apart from each other: no free plane splits them all, but they fall
+    // apart into objects, ordered by their bounding boxes.
+    let mut rng = Rng::new(9);
+    let mut tally = Tally::default();
+    let mut object_nodes = 0;
+    for _ in 0..40 {
+        let (_, quads) = structures(&mut rng, 500);
+        let order = QuadOrder::new(&quads);
+        object_nodes += order.node_count().1;
+        let e = eyes(&mut rng, &quads, 4);
+        check(&order, &quads, &e, &mut tally);
+    }
+    println!("structures: {tally:?}, {object_nodes} object nodes");
+    assert!(object_nodes >= 20, "{object_nodes}");
+    assert!(tally.exact > tally.sorts * 9 / 10, "{tally:?}");
+}
+
+#[test]
+fn a_pinwheel_of_objects_is_ordered_through_their_quads() {
+    // Four bars around a hole, apart from each other, in a pinwheel: no plane splits them
+    // and from above the hole their bounding boxes form a cycle of the separating-axis
+    // relation; their quads together have none.
+    let mut c = voxel_core::Chunk::uniform(voxel_core::blocks::AIR);
+    let bars = [
+        ([8, 8, 8], [10, 8, 8]),
+        ([12, 8, 8], [12, 8, 10]),
+        ([10, 8, 12], [12, 8, 12]),
+        ([8, 8, 10], [8, 8, 12]),
+    ];
+    for ((lo, hi), id) in bars.into_iter().zip([
+        GLASS,
+        RED_GLASS,
+        GREEN_GLASS,
+        voxel_core::blocks::BLUE_GLASS,
+    ]) {
+        c.fill_box(lo, hi, id).unwrap();
+    }
+    let quads = mesh(&c);
+    let order = QuadOrder::new(&quads);
+    assert!(order.node_count().1 >= 1, "an object node");
+    assert_eq!(order.stuck().0, 0, "each bar alone is split by planes");
+    let mut rng = Rng::new(10);
+    let mut tally = Tally::default();
+    let mut e = eyes(&mut rng, &quads, 64);
+    let mut grouped = 0;
+    for _ in 0..64 {
+        // Above and below the hole, and level with the bars inside it.
+        let y = [
+            coord(&mut rng, 9.5, 40.0),
+            coord(&mut rng, -30.0, 7.5),
+            coord(&mut rng, 8.0, 9.0),
+        ][rng.below(3) as usize];
+        e.push([coord(&mut rng, 9.0, 12.0), y, coord(&mut rng, 9.0, 12.0)]);
+    }
+    for &eye in &e {
+        let mut out = Vec::new();
+        grouped += usize::from(order.sort_into(eye, &mut out).pairwise_quads > 0);
+    }
+    check(&order, &quads, &e, &mut tally);
+    assert!(grouped > 0, "some eyes order the bars through their quads");
+    assert_eq!(tally.cyclic, 0, "{tally:?}");
 }
 
 #[test]

@@ -354,3 +354,81 @@ pub fn ray_violations(
     bad.dedup();
     bad
 }
+
+/// One random translucent structure in the box `o..=hi`: a glass house (hollow, walls of
+/// one glass or of four stained glasses, a roof), a glass tank full of water, a glass or ice
+/// pillar, a stained-glass slab, or a staircase.
+pub fn add_structure(rng: &mut Rng, c: &mut Chunk, o: [usize; 3], hi: [usize; 3]) {
+    let glass = [GLASS, RED_GLASS, GREEN_GLASS, BLUE_GLASS];
+    match rng.below(5) {
+        0 => {
+            let one = rng.chance(0.5);
+            let pick = |rng: &mut Rng| if one { GLASS } else { rng.pick(&glass) };
+            let walls = [pick(rng), pick(rng), pick(rng), pick(rng), pick(rng)];
+            c.fill_box([o[0], o[1], o[2]], [o[0], hi[1], hi[2]], walls[0])
+                .unwrap();
+            c.fill_box([hi[0], o[1], o[2]], [hi[0], hi[1], hi[2]], walls[1])
+                .unwrap();
+            c.fill_box([o[0] + 1, o[1], o[2]], [hi[0] - 1, hi[1], o[2]], walls[2])
+                .unwrap();
+            c.fill_box([o[0] + 1, o[1], hi[2]], [hi[0] - 1, hi[1], hi[2]], walls[3])
+                .unwrap();
+            c.fill_box([o[0], hi[1], o[2]], [hi[0], hi[1], hi[2]], walls[4])
+                .unwrap();
+        }
+        1 => {
+            c.fill_box(o, hi, GLASS).unwrap();
+            c.fill_box(
+                [o[0] + 1, o[1] + 1, o[2] + 1],
+                [hi[0] - 1, hi[1], hi[2] - 1],
+                WATER,
+            )
+            .unwrap();
+        }
+        2 => c
+            .fill_box(
+                [o[0], o[1], o[2]],
+                [o[0], hi[1], o[2]],
+                rng.pick(&[GLASS, ICE]),
+            )
+            .unwrap(),
+        3 => c
+            .fill_box([o[0], o[1], o[2]], [hi[0], o[1], hi[2]], rng.pick(&glass))
+            .unwrap(),
+        _ => {
+            let id = rng.pick(&glass);
+            for x in o[0]..=hi[0] {
+                let y = (o[1] + x - o[0]).min(hi[1]);
+                c.fill_box([x, o[1], o[2]], [x, y, hi[2]], id).unwrap();
+            }
+        }
+    }
+}
+
+/// Random translucent structures (see [`add_structure`]), each 3 to 8 blocks a side, placed
+/// apart from each other (one air block between any two), until the translucent mesh has at
+/// least `target` quads or no more fits; with the mesh.
+pub fn structures(rng: &mut Rng, target: usize) -> (Chunk, Vec<PackedQuad>) {
+    let mut c = Chunk::uniform(AIR);
+    let mut quads = Vec::new();
+    for _ in 0..3000 {
+        let s = [0; 3].map(|_| rng.range(3, 9) as usize);
+        let o: [usize; 3] = std::array::from_fn(|k| rng.range(0, (33 - s[k]) as i64) as usize);
+        let hi: [usize; 3] = std::array::from_fn(|k| o[k] + s[k] - 1);
+        let free = (o[0].saturating_sub(1)..=(hi[0] + 1).min(31)).all(|x| {
+            (o[1].saturating_sub(1)..=(hi[1] + 1).min(31)).all(|y| {
+                (o[2].saturating_sub(1)..=(hi[2] + 1).min(31))
+                    .all(|z| c.get(x, y, z).unwrap() == AIR)
+            })
+        });
+        if !free {
+            continue;
+        }
+        add_structure(rng, &mut c, o, hi);
+        quads = mesh(&c);
+        if quads.len() >= target {
+            break;
+        }
+    }
+    (c, quads)
+}
