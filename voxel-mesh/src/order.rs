@@ -463,7 +463,7 @@ impl QuadOrder {
                     leaf: out.leaves.len() as u32,
                     first,
                 });
-                out.leaves.push(Leaf::new(0, boxes, true));
+                out.leaves.push(Leaf::new(0, boxes, true, true));
                 // Pushed in reverse so that object i is built (and stored) i-th.
                 for (i, (ids, _)) in objects.into_iter().enumerate().rev() {
                     jobs.push(Job {
@@ -570,7 +570,7 @@ impl QuadOrder {
             }
         }
         for (leaf, start, boxes) in leaf_boxes {
-            out.leaves[leaf] = Leaf::new(start, boxes, false);
+            out.leaves[leaf] = Leaf::new(start, boxes, false, true);
         }
         // Subtree spans: children come after their parents.
         for n in (0..out.nodes.len()).rev() {
@@ -728,12 +728,15 @@ impl QuadOrder {
                             let (s, e) = self.spans[self.children[(first + o) as usize] as usize];
                             quads.extend_from_slice(&self.quads[s as usize..e as usize]);
                         }
-                        let boxes: Vec<QBox> = quads.iter().map(|&q| QBox::of(q)).collect();
-                        let all: Vec<u32> = (0..boxes.len() as u32).collect();
+                        let mut boxes: Vec<(QBox, PackedQuad)> =
+                            quads.iter().map(|&q| (QBox::of(q), q)).collect();
+                        boxes.sort_by_key(|(b, q)| (b.axis, b.plane(), !b.positive, q.geometry));
+                        quads = boxes.iter().map(|b| b.1).collect();
+                        let group =
+                            Leaf::new(0, boxes.into_iter().map(|b| b.0).collect(), false, false);
                         scratch.clear();
-                        let s = refine(&boxes, &all, &cell, Some(eye_local), &mut scratch);
+                        let s = group.order(&cell, Some(eye_local), &mut scratch);
                         stats.add(s.unwrap_or_default());
-                        stats.pairwise_quads += boxes.len() as u32;
                         let at = extra.len() as u32;
                         extra.extend(scratch.iter().map(|&i| quads[i as usize]));
                         tasks.push(EXTRA | u64::from(at) << 32 | u64::from(extra.len() as u32));
@@ -791,21 +794,35 @@ struct Leaf {
 }
 
 impl Leaf {
-    fn new(start: u32, boxes: Vec<QBox>, objects: bool) -> Self {
+    /// A leaf over `boxes` (quads, or objects' bounding boxes), with its octant orders
+    /// precomputed when `octants` is set.
+    fn new(start: u32, boxes: Vec<QBox>, objects: bool, octants: bool) -> Self {
         let m = boxes.len();
         let words = m.div_ceil(64);
         let offset = |k: usize, hi: bool, v: i32| {
             ((k * 2 + usize::from(hi)) * MASK_VALUES + (v + 1) as usize) * words
         };
+        // Each box enters `lo < v` at v = lo + 1 and `hi > v` at v = hi - 1; cumulative ORs
+        // up (lo) and down (hi) the values fill in the rest.
         let mut masks = vec![0u64; 3 * 2 * MASK_VALUES * words];
         for (i, b) in boxes.iter().enumerate() {
             let bit = 1u64 << (i % 64);
             for k in 0..3 {
-                for v in b.lo[k] + 1..=VALUES as i32 - 1 {
-                    masks[offset(k, false, v) + i / 64] |= bit;
+                masks[offset(k, false, b.lo[k] + 1) + i / 64] |= bit;
+                masks[offset(k, true, b.hi[k] - 1) + i / 64] |= bit;
+            }
+        }
+        for k in 0..3 {
+            for v in 0..=VALUES as i32 - 1 {
+                let (from, to) = (offset(k, false, v - 1), offset(k, false, v));
+                for w in 0..words {
+                    masks[to + w] |= masks[from + w];
                 }
-                for v in -1..b.hi[k] {
-                    masks[offset(k, true, v) + i / 64] |= bit;
+            }
+            for v in (-1..VALUES as i32 - 1).rev() {
+                let (from, to) = (offset(k, true, v + 1), offset(k, true, v));
+                for w in 0..words {
+                    masks[to + w] |= masks[from + w];
                 }
             }
         }
@@ -857,6 +874,9 @@ impl Leaf {
             bbox,
             octants: Default::default(),
         };
+        if !octants {
+            return leaf;
+        }
         let octants = std::array::from_fn(|o| {
             let cell = leaf.octant_cell(o);
             if leaf.objects {
@@ -955,10 +975,11 @@ impl Leaf {
     /// after it). Tie-breaks included, coplanar quads otherwise excluded.
     ///
     /// Per axis k a pair passes when the quads are not separated along k (open intervals
-    /// overlap), or when they are and the cell lies beyond the near face of the hiding quad
-    /// `b`: for `a` wholly below `b` (`a.hi <= b.lo`), above `b.lo`; for `a` wholly above,
-    /// below `b.hi`. Every leaf coordinate is a trigger plane, so the open cell lies on one
-    /// side of each.
+    /// overlap), or when they are and some eye of the cell lies beyond the near face of the
+    /// hiding quad `b`: for `a` wholly below `b` (`a.hi <= b.lo`), above `b.lo`; for `a`
+    /// wholly above, below `b.hi`. The cell is a box, so eyes chosen per axis make one eye.
+    /// (For a leaf of the tree every coordinate is a trigger plane, so the whole open cell
+    /// lies on one side of each, and "some eye" is "every eye".)
     fn relation_row(&self, i: usize, cell: &[Span; 3], pred: bool, row: &mut [u64]) {
         let words = self.words;
         let (g0, g1) = self.group[i];
@@ -967,14 +988,15 @@ impl Leaf {
         let row = &mut row[..words];
         if pred {
             // With x = {lo < q.hi} and y = {hi > q.lo} (so !x: wholly above q, !y: wholly
-            // below), an axis passes (x & y) | (!y & cell above q.lo) | (!x & cell below
-            // q.hi): x | !y, !x | y, or everything (never neither, as q.lo <= q.hi). As
-            // (x ^ f) | (y ^ g), with x = y = all ones for everything.
+            // below), an axis passes (x & y) | (!y & some eye of the cell above q.lo) | (!x &
+            // some eye below q.hi): x | !y, !x | y, or everything (never neither, as
+            // q.lo <= q.hi and the cell is not empty). As (x ^ f) | (y ^ g), with x = y = all
+            // ones for everything.
             let ones = all(self.mask_offset(0, false, VALUES as i32 - 1));
             let mut axes: [(&[u64], &[u64], u64, u64); 3] = [(ones, ones, 0, 0); 3];
             for (k, (ax, c)) in axes.iter_mut().zip(cell).enumerate() {
-                let above = c.lo.is_some_and(|l| q.lo[k] <= l);
-                let below = c.hi.is_some_and(|h| q.hi[k] >= h);
+                let above = c.hi.is_none_or(|h| q.lo[k] < h);
+                let below = c.lo.is_none_or(|l| q.hi[k] > l);
                 let [xo, yo] = self.offsets[i][k];
                 match (above, below) {
                     (true, false) => *ax = (all(xo), all(yo), 0, u64::MAX),
@@ -997,15 +1019,14 @@ impl Leaf {
                     & ((x2[w] ^ f2) | (y2[w] ^ g2));
             }
         } else {
-            // b wholly above q (!x) needs the cell above b.lo (b.lo <= c.lo, the mask
-            // lo < c.lo + 1); b wholly below (!y) needs it below b.hi (hi > c.hi - 1).
-            let none = all(self.mask_offset(0, false, -1));
-            let mut axes: [[&[u64]; 4]; 3] = [[none; 4]; 3];
+            // b wholly above q (!x) needs some eye of the cell above b.lo (b.lo < c.hi);
+            // b wholly below (!y) needs some eye below b.hi (b.hi > c.lo).
+            let ones = all(self.mask_offset(0, false, VALUES as i32 - 1));
+            let mut axes: [[&[u64]; 4]; 3] = [[ones; 4]; 3];
             for (k, (ax, c)) in axes.iter_mut().zip(cell).enumerate() {
                 let [xo, yo] = self.offsets[i][k];
-                let lo =
-                    c.lo.map_or(none, |l| all(self.mask_offset(k, false, l + 1)));
-                let hi = c.hi.map_or(none, |h| all(self.mask_offset(k, true, h - 1)));
+                let lo = c.hi.map_or(ones, |h| all(self.mask_offset(k, false, h)));
+                let hi = c.lo.map_or(ones, |l| all(self.mask_offset(k, true, l)));
                 *ax = [all(xo), all(yo), lo, hi];
             }
             let [[x0, y0, l0, h0], [x1, y1, l1, h1], [x2, y2, l2, h2]] = axes;
@@ -1178,21 +1199,21 @@ impl Tarjan {
         if self.low[v as usize] != self.index[v as usize] {
             return;
         }
-        let mut g = Vec::new();
-        while let Some(w) = self.tstack.pop() {
+        let Some(at) = self.tstack.iter().rposition(|&w| w == v) else {
+            return;
+        };
+        for &w in &self.tstack[at..] {
             self.on_tstack[w as usize / 64] &= !(1u64 << (w % 64));
-            g.push(w);
-            if w == v {
-                break;
-            }
         }
-        if let [only] = g[..] {
-            out.push(only);
+        if at + 1 == self.tstack.len() {
+            out.push(v);
         } else {
+            let mut g = self.tstack[at..].to_vec();
             g.sort_unstable();
             out.push(u32::MAX - self.groups.len() as u32);
             self.groups.push(g);
         }
+        self.tstack.truncate(at);
     }
 }
 
@@ -1574,5 +1595,269 @@ pub mod testing {
     /// The open cell of a region: per axis `(lo, hi)`, `None` for unbounded.
     pub fn region_cell(order: &QuadOrder, key: RegionKey) -> [(Option<i32>, Option<i32>); 3] {
         order.cell(key).map(|s| (s.lo, s.hi))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Mesher;
+    use voxel_core::blocks::{AIR, GLASS, RED_GLASS, WATER};
+    use voxel_core::{BlockRegistry, Chunk, Face};
+
+    /// xorshift64*.
+    struct Rng(u64);
+
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+        }
+        fn below(&mut self, n: u64) -> u64 {
+            self.next() % n
+        }
+        /// A dyadic coordinate in `lo..hi`.
+        fn coord(&mut self, lo: f64, hi: f64) -> f64 {
+            lo + ((hi - lo) * 1024.0 * (self.below(1 << 20) as f64 / (1 << 20) as f64)).floor()
+                / 1024.0
+        }
+    }
+
+    fn random_quads(rng: &mut Rng) -> Vec<PackedQuad> {
+        let mut c = Chunk::uniform(AIR);
+        for _ in 0..1 + rng.below(8) {
+            let id = [GLASS, RED_GLASS, WATER, AIR][rng.below(4) as usize];
+            let lo = [0; 3].map(|_| 4 + rng.below(12) as usize);
+            let hi = lo.map(|v| v + rng.below(5) as usize);
+            c.fill_box(lo, hi, id).unwrap_or_default();
+        }
+        let reg = BlockRegistry::default();
+        Mesher::new(&reg)
+            .mesh(&c, [None; 6])
+            .map(|m| m.translucent)
+            .unwrap_or_default()
+    }
+
+    /// A random open cell with integer bounds (possibly unbounded), and an eye inside it.
+    fn random_cell(rng: &mut Rng) -> ([Span; 3], [f64; 3]) {
+        let mut cell = [Span { lo: None, hi: None }; 3];
+        let mut eye = [0.0; 3];
+        for k in 0..3 {
+            let a = 2 + rng.below(20) as i32;
+            let b = a + 1 + rng.below(4) as i32;
+            cell[k] = match rng.below(4) {
+                0 => Span {
+                    lo: None,
+                    hi: Some(b),
+                },
+                1 => Span {
+                    lo: Some(a),
+                    hi: None,
+                },
+                _ => Span {
+                    lo: Some(a),
+                    hi: Some(b),
+                },
+            };
+            let lo = cell[k].lo.map_or(f64::from(b) - 40.0, f64::from);
+            let hi = cell[k].hi.map_or(f64::from(a) + 40.0, f64::from);
+            eye[k] = rng.coord(lo, hi).max(lo + 1.0 / 1024.0);
+        }
+        (cell, eye)
+    }
+
+    /// The relation at a point, with the tie-breaks of planes that the cell does not
+    /// straddle (the structure makes every tie plane a trigger plane, so its cells never
+    /// straddle one; these tests draw cells at random).
+    fn before_at(eye: [f64; 3], a: &QBox, b: &QBox, cell: &[Span; 3]) -> bool {
+        let c = cell[a.axis];
+        let straddled = !c.above(a.plane()) && !c.below(a.plane());
+        hides_at(eye, a, b) || (tie_at(eye, a, b) && !straddled)
+    }
+
+    #[test]
+    fn the_region_relation_contains_the_relation_at_every_eye_of_the_cell() {
+        let mut rng = Rng(7);
+        let mut related = 0;
+        for _ in 0..200 {
+            let quads: Vec<QBox> = random_quads(&mut rng).into_iter().map(QBox::of).collect();
+            for _ in 0..4 {
+                let (cell, _) = random_cell(&mut rng);
+                for _ in 0..4 {
+                    let (_, eye) = {
+                        // Another eye of the same cell.
+                        let mut e = [0.0; 3];
+                        for k in 0..3 {
+                            let lo = cell[k].lo.map_or(-60.0, f64::from);
+                            let hi = cell[k].hi.map_or(90.0, f64::from);
+                            e[k] = (rng.coord(lo, hi)).max(lo + 1.0 / 1024.0);
+                        }
+                        ((), e)
+                    };
+                    for a in &quads {
+                        for b in &quads {
+                            if before_at(eye, a, b, &cell) {
+                                related += 1;
+                                assert!(
+                                    may_hide_in_cell(a, b, &cell),
+                                    "{a:?} {b:?} {cell:?} {eye:?}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(related > 1000, "{related}");
+    }
+
+    #[test]
+    fn leaves_order_exactly_for_any_cell() {
+        // Cells whose bounds need not be the leaf's coordinates (as for groups of objects):
+        // the order must hold at every eye of the cell when exact for the region, and at the
+        // eye itself otherwise.
+        let mut rng = Rng(8);
+        let (mut sorts, mut region_exact) = (0, 0);
+        for _ in 0..300 {
+            let mut boxes: Vec<QBox> = random_quads(&mut rng).into_iter().map(QBox::of).collect();
+            if boxes.is_empty() {
+                continue;
+            }
+            boxes.sort_by_key(|b| (b.axis, b.plane(), !b.positive, b.lo, b.hi));
+            let leaf = Leaf::new(0, boxes.clone(), false, true);
+            for _ in 0..6 {
+                let (cell, eye) = random_cell(&mut rng);
+                let mut order = Vec::new();
+                let Some(stats) = leaf.order(&cell, Some(eye), &mut order) else {
+                    panic!("the eye was given");
+                };
+                let mut sorted = order.clone();
+                sorted.sort_unstable();
+                assert_eq!(sorted, (0..boxes.len() as u32).collect::<Vec<_>>());
+                sorts += 1;
+                let eyes: Vec<[f64; 3]> = if stats.is_exact_in_region() {
+                    region_exact += 1;
+                    (0..4)
+                        .map(|_| {
+                            let mut e = eye;
+                            for k in 0..3 {
+                                let lo = cell[k].lo.map_or(eye[k] - 50.0, f64::from);
+                                let hi = cell[k].hi.map_or(eye[k] + 50.0, f64::from);
+                                e[k] = rng.coord(lo, hi).max(lo + 1.0 / 1024.0);
+                            }
+                            e
+                        })
+                        .chain([eye])
+                        .collect()
+                } else if stats.is_exact() {
+                    vec![eye]
+                } else {
+                    continue;
+                };
+                for e in eyes {
+                    for (i, &a) in order.iter().enumerate() {
+                        for &b in &order[..i] {
+                            // b is drawn before a: wrong if b must come after a.
+                            assert!(
+                                !before_at(e, &boxes[a as usize], &boxes[b as usize], &cell),
+                                "cell {cell:?} eye {e:?}: {:?} before {:?}",
+                                boxes[b as usize],
+                                boxes[a as usize]
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            sorts > 1000 && region_exact > sorts / 4,
+            "{sorts} {region_exact}"
+        );
+    }
+
+    #[test]
+    fn interval_of_s() {
+        let mut s = SInterval::new();
+        s.less(1, 3); // s < 3
+        s.greater(2, 2); // s > 1
+        assert!(s.feasible());
+        s.less(3, 3); // s < 1
+        assert!(!s.feasible());
+        let mut s = SInterval::new();
+        s.less(0, 0); // 0 < 0: never
+        assert!(!s.feasible());
+        let mut s = SInterval::new();
+        s.less(-1, 5); // s > -5: no bound above 0
+        assert!(s.feasible());
+    }
+
+    #[test]
+    fn region_keys_count_planes_strictly_below() {
+        let glass = GLASS;
+        let quads = [
+            PackedQuad::new([1, 0, 0], 4, 4, Face::NegX, glass),
+            PackedQuad::new([2, 0, 0], 4, 4, Face::NegX, glass),
+            PackedQuad::new([3, 0, 0], 4, 4, Face::NegX, glass),
+        ];
+        let order = QuadOrder::new(&quads);
+        assert_eq!(order.trigger_planes()[0], &[2]);
+        let key = |x: f64| order.region_key([x, 0.5, 0.5]).0[0];
+        assert_eq!(
+            [
+                key(-1.0e9),
+                key(1.5),
+                key(2.0),
+                key(2.0 + 1e-12),
+                key(1e300)
+            ],
+            [0, 0, 0, 1, 1]
+        );
+        assert_eq!(
+            [key(f64::NAN), key(f64::INFINITY), key(f64::NEG_INFINITY)],
+            [0, 1, 0]
+        );
+    }
+
+    #[test]
+    fn bit_ranges_clear() {
+        for (from, to) in [(0, 0), (0, 1), (3, 64), (63, 65), (10, 200), (64, 128)] {
+            let mut row = [u64::MAX; 4];
+            clear_bits(&mut row, from, to);
+            for i in 0..256 {
+                let set = row[i / 64] >> (i % 64) & 1 == 1;
+                assert_eq!(set, !(from..to).contains(&i), "{from}..{to} at {i}");
+            }
+        }
+    }
+
+    #[test]
+    fn objects_are_classes_with_separated_boxes() {
+        let mut rng = Rng(9);
+        for _ in 0..100 {
+            let all: Vec<QBox> = random_quads(&mut rng).into_iter().map(QBox::of).collect();
+            let ids: Vec<u32> = (0..all.len() as u32).collect();
+            if ids.is_empty() {
+                continue;
+            }
+            let objs = objects(&all, &ids);
+            let mut seen: Vec<u32> = objs.iter().flat_map(|o| o.0.clone()).collect();
+            seen.sort_unstable();
+            assert_eq!(seen, ids);
+            for (i, a) in objs.iter().enumerate() {
+                for b in &objs[i + 1..] {
+                    let separated = (0..3).any(|k| a.1.1[k] <= b.1.0[k] || b.1.1[k] <= a.1.0[k]);
+                    assert!(separated, "{a:?} {b:?}");
+                    // Quads of different objects never touch.
+                    for &p in &a.0 {
+                        for &q in &b.0 {
+                            let (p, q) = (&all[p as usize], &all[q as usize]);
+                            assert!((0..3).any(|k| p.hi[k] < q.lo[k] || q.hi[k] < p.lo[k]));
+                        }
+                    }
+                }
+            }
+        }
     }
 }
