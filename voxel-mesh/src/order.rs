@@ -501,7 +501,8 @@ pub struct SortStats {
     /// relation over the region is cyclic there, the relation at the eye is not). While it
     /// is non-zero, re-sort when the eye moves, not only when the region key changes.
     pub eye_dependent: u32,
-    /// Quads ordered by the pairwise path (stuck leaves of the plane tree); diagnostic.
+    /// Quads ordered pairwise (in stuck leaves, and in groups of objects ordered through
+    /// their quads); a diagnostic of cost.
     pub pairwise_quads: u32,
 }
 

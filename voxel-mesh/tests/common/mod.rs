@@ -359,8 +359,14 @@ pub fn ray_violations(
 /// one glass or of four stained glasses, a roof), a glass tank full of water, a glass or ice
 /// pillar, a stained-glass slab, or a staircase.
 pub fn add_structure(rng: &mut Rng, c: &mut Chunk, o: [usize; 3], hi: [usize; 3]) {
+    let kind = rng.below(5);
+    add_structure_of(rng, c, o, hi, kind);
+}
+
+/// [`add_structure`] of a given kind: 0 house, 1 tank, 2 pillar, 3 slab, 4 stairs.
+pub fn add_structure_of(rng: &mut Rng, c: &mut Chunk, o: [usize; 3], hi: [usize; 3], kind: u64) {
     let glass = [GLASS, RED_GLASS, GREEN_GLASS, BLUE_GLASS];
-    match rng.below(5) {
+    match kind {
         0 => {
             let one = rng.chance(0.5);
             let pick = |rng: &mut Rng| if one { GLASS } else { rng.pick(&glass) };
