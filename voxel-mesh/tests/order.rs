@@ -588,6 +588,33 @@ fn non_finite_and_far_eyes_never_panic() {
     assert!(out.is_empty());
 }
 
+#[test]
+fn garbage_quads_never_panic() {
+    // Packed quads the mesher never makes: any bits, crossing each other, faces 6 and 7.
+    let mut rng = Rng::new(11);
+    for _ in 0..200 {
+        let n = rng.below(60) as usize;
+        let quads: Vec<PackedQuad> = (0..n)
+            .map(|_| PackedQuad {
+                geometry: rng.next() as u32,
+                block: rng.next() as u32,
+            })
+            .collect();
+        for order in [QuadOrder::new(&quads), QuadOrder::pairwise_only(&quads)] {
+            let mut out = Vec::new();
+            for eye in [
+                [f64::NAN; 3],
+                [1.0e9, -3.0, 70.5],
+                [31.5, 63.5, 0.25],
+                [16.0, 16.0, 16.0],
+            ] {
+                order.sort_into(eye, &mut out);
+                assert!(same_multiset(&out, &quads));
+            }
+        }
+    }
+}
+
 /// Three glass pieces (a cube, a block and a beam) whose merged quads form a real cycle
 /// from this eye: found by a random search, checked by the oracle.
 fn cyclic_scene() -> (Vec<PackedQuad>, [f64; 3]) {
