@@ -4,10 +4,13 @@
 //! - [`Mesher`]: one chunk with its neighbours → [`ChunkMeshes`] (binary greedy meshing).
 //! - [`PackedQuad`]: the 8-byte quad format the renderer expands in its vertex shader.
 //! - [`mesh_dirty`]: remesh a world's dirty chunks in parallel with rayon.
+//! - [`order`]: exact back-to-front order of a chunk's translucent quads, re-sorted only
+//!   when the eye crosses a trigger plane; exact chunk order.
 //! - [`sort`]: back-to-front ordering of translucent quads and chunks for a camera.
 
 mod bits;
 mod mesher;
+pub mod order;
 mod quad;
 pub mod sort;
 mod world;
