@@ -222,4 +222,22 @@ fn the_window_runs_every_technique_under_xvfb() {
         max_diff(&view(&img), &view(before)) > 8,
         "the placed block shows"
     );
+    // The panel's settings (everything above its statistics, which change from run to
+    // run) look the same after the resize: frames skipped for an outdated surface did not
+    // lose egui's font-texture updates (glyphs went missing when they did).
+    let settings = |img: &Image| -> Vec<[u8; 3]> {
+        let edge = panel_edge(img) - 8;
+        (0..300)
+            .flat_map(|y| (0..edge).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let p = img.pixel(x, y);
+                [p[0], p[1], p[2]]
+            })
+            .collect()
+    };
+    assert_eq!(
+        max_diff(&settings(&img), &settings(before)),
+        0,
+        "the panel's text changed after the resize"
+    );
 }
