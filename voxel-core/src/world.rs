@@ -163,6 +163,20 @@ impl World {
         &self.registry
     }
 
+    /// The translucent block type at `point` (world block units; the block containing
+    /// it), or `None` when that block is not translucent, or the point is not finite or
+    /// lies outside the `i32` world: what an eye at `point` is immersed in.
+    pub fn medium_at(&self, point: [f64; 3]) -> Option<BlockId> {
+        let inside =
+            |v: f64| v.is_finite() && v >= f64::from(i32::MIN) && v < f64::from(i32::MAX) + 1.0;
+        if !point.iter().all(|&v| inside(v)) {
+            return None;
+        }
+        let p = point.map(|v| v.floor() as i32);
+        let id = self.get_block(WorldPos::new(p[0], p[1], p[2]));
+        (self.registry.class(id).ok()? == crate::RenderClass::Translucent).then_some(id)
+    }
+
     /// The block at `pos`; air where no chunk is loaded.
     pub fn get_block(&self, pos: WorldPos) -> BlockId {
         let (c, [x, y, z]) = pos.split();
@@ -480,5 +494,22 @@ mod tests {
         assert_eq!(w.set_block(WorldPos::new(1, 2, 3), AIR).unwrap(), AIR);
         assert!(w.is_empty());
         assert!(w.dirty().is_empty());
+    }
+
+    #[test]
+    fn the_medium_at_a_point_is_its_translucent_block() {
+        let mut w = World::new(Arc::new(BlockRegistry::default()));
+        w.set_block(WorldPos::new(0, -1, 0), WATER).unwrap();
+        w.set_block(WorldPos::new(0, 0, 0), STONE).unwrap();
+        assert_eq!(w.medium_at([0.5, -0.5, 0.5]), Some(WATER));
+        assert_eq!(
+            w.medium_at([0.5, -1.0, 0.99]),
+            Some(WATER),
+            "the bottom face is inside"
+        );
+        assert_eq!(w.medium_at([0.5, 0.0, 0.5]), None, "stone is no medium");
+        assert_eq!(w.medium_at([0.5, 1.5, 0.5]), None, "air");
+        assert_eq!(w.medium_at([f64::NAN, 0.0, 0.0]), None);
+        assert_eq!(w.medium_at([3e9, 0.0, 0.0]), None);
     }
 }

@@ -61,8 +61,10 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// A scene of `world` with one camera and nothing else.
+    /// A scene of `world` with one camera and nothing else; the camera's medium is taken
+    /// from the world at its eye.
     pub fn new(name: &str, world: World, camera: Camera) -> Self {
+        let camera = camera.in_medium(world.medium_at(camera.eye.to_array()));
         Self {
             name: name.to_owned(),
             description: String::new(),
@@ -130,7 +132,9 @@ pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene, String
     let ground = generator.height_at(eye.x.floor() as i64, eye.z.floor() as i64) as f64;
     eye.y = eye.y.max(ground + 3.5);
     let target = center + dir * 12.0 + DVec3::Y * (sea - center.y + 1.0);
-    let camera = Camera::look_at(eye, target, 70.0, 0.1, 600.0).map_err(|e| e.to_string())?;
+    let camera = Camera::look_at(eye, target, 70.0, 0.1, 600.0)
+        .map_err(|e| e.to_string())?
+        .in_medium(world.medium_at(eye.to_array()));
     // The flicker path slides sideways, keeping the greenhouse in view.
     let side = DVec3::new(-dir.z, 0.0, dir.x);
     Ok(Scene {
@@ -336,7 +340,7 @@ pub fn parse(text: &str) -> Result<Scene, String> {
             d.far,
         )
         .map_err(|e| at_line(text, span.start, format!("cameras: {e}")))?;
-        cameras.push(camera);
+        cameras.push(camera.in_medium(world.medium_at(d.eye)));
         paths.push(d.path_to.map(DVec3::from));
     }
     let size = match &file.size {

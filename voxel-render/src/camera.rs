@@ -3,6 +3,7 @@
 //! world coordinates, only chunk origins minus the eye's integer part.
 
 use glam::{DMat4, DVec3, Mat4, Vec3};
+use voxel_core::BlockId;
 
 use crate::{Error, Result};
 
@@ -32,6 +33,11 @@ pub struct Camera {
     pub near: f64,
     /// Distance of the far plane (> near).
     pub far: f64,
+    /// The translucent block type the eye is immersed in (water when diving), `None` in
+    /// air; the game finds it from its world ([`voxel_core::World::medium_at`]). From
+    /// inside a medium, its surfaces are seen from behind and fog of its colour fills the
+    /// way to them.
+    pub medium: Option<BlockId>,
 }
 
 impl Camera {
@@ -43,9 +49,15 @@ impl Camera {
             fov_y_deg,
             near,
             far,
+            medium: None,
         };
         c.validate()?;
         Ok(c)
+    }
+
+    /// The same camera immersed in `medium` (see [`Camera::medium`]).
+    pub fn in_medium(self, medium: Option<BlockId>) -> Self {
+        Self { medium, ..self }
     }
 
     /// A camera at `eye` looking along yaw (radians, 0 = -z, growing towards +x) and pitch
@@ -70,6 +82,7 @@ impl Camera {
             fov_y_deg,
             near,
             far,
+            medium: None,
         };
         c.validate()?;
         Ok(c)

@@ -31,7 +31,7 @@ pub use context::{Capabilities, GpuContext, WANTED_FEATURES, request_device};
 pub use error::{Error, Result};
 pub use oit::{
     BayerSize, OitConfig, OitManager, PeelReport, PeelingSettings, ReferenceReport, ShadingState,
-    SortReport, SortedSettings, StippleSettings, Technique, TechniqueReport, TranslucentFrame,
+    SortReport, StippleSettings, Technique, TechniqueReport, TranslucentFrame,
     TranslucentTechnique, WboitReport, WboitSettings, WeightFit, WeightFunction,
 };
 pub use readback::Image;

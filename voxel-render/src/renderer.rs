@@ -419,14 +419,21 @@ impl Renderer {
         let frustum = Frustum::new(view_proj, camera.eye);
 
         // The technique's CPU work (it may reorder quads) comes before anything borrows
-        // the chunks for drawing. Translucent chunks are drawn farthest first.
-        let far_first: Vec<(ChunkPos, f64)> = self
+        // the chunks for drawing. Translucent chunks are drawn farthest first, by the
+        // integer key that is exact for a grid of equal cubes (`voxel_mesh::order`).
+        let eye = camera.eye.to_array();
+        let mut far_first: Vec<(ChunkPos, f64)> = self
             .chunks
             .visible(MeshKind::Translucent, &frustum)
             .iter()
-            .rev()
             .map(|v| (v.pos, v.distance))
             .collect();
+        far_first.sort_by_cached_key(|&(pos, _)| {
+            (
+                std::cmp::Reverse(voxel_mesh::order::chunk_order_key(pos, eye)),
+                pos,
+            )
+        });
         let positions: Vec<ChunkPos> = far_first.iter().map(|(p, _)| *p).collect();
         let view = FrameView {
             camera,

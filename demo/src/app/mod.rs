@@ -391,9 +391,13 @@ impl Gfx {
         Ok(())
     }
 
+    /// The fly camera, immersed in whatever translucent block holds the eye.
     fn camera(&self) -> Result<Camera, String> {
         let f = &self.input.fly;
-        Camera::from_yaw_pitch(f.eye, f.yaw, f.pitch, 70.0, 0.1, self.far).map_err(|e| chain(&e))
+        let medium = self.remesher.world.medium_at(f.eye.to_array());
+        Camera::from_yaw_pitch(f.eye, f.yaw, f.pitch, 70.0, 0.1, self.far)
+            .map(|c| c.in_medium(medium))
+            .map_err(|e| chain(&e))
     }
 
     fn resize(&mut self, w: u32, h: u32) -> Result<(), String> {

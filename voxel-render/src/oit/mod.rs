@@ -31,7 +31,7 @@ use crate::{Camera, Error, GpuContext, Result};
 
 pub use peeling::{PeelReport, PeelingSettings};
 pub use reference::ReferenceReport;
-pub use sorted::{SortReport, SortedSettings};
+pub use sorted::SortReport;
 pub use stipple::{BayerSize, ShadingState, StippleSettings};
 pub use wboit::weights::{WeightFit, WeightFunction};
 pub use wboit::{WboitReport, WboitSettings};
@@ -183,8 +183,6 @@ pub struct OitConfig {
     pub wboit: WboitSettings,
     /// Stipple.
     pub stipple: StippleSettings,
-    /// The sorted techniques.
-    pub sorted: SortedSettings,
     /// Depth peeling.
     pub peeling: PeelingSettings,
 }
@@ -198,7 +196,6 @@ impl Default for OitConfig {
             // Each technique's settings carry their own reasoned defaults.
             wboit: WboitSettings::default(),
             stipple: StippleSettings::default(),
-            sorted: SortedSettings::default(),
             peeling: PeelingSettings::default(),
         }
     }
@@ -216,8 +213,7 @@ impl OitConfig {
     /// Checks every setting against what the renderer supports.
     pub fn validate(&self) -> Result<()> {
         self.stipple.validate()?;
-        self.peeling.validate()?;
-        self.sorted.validate()
+        self.peeling.validate()
     }
 }
 

@@ -1,17 +1,22 @@
 //! Sorted alpha blending (seed 003's forward pass): translucent chunk meshes drawn back to
-//! front by the distance of their centres from the eye, blended `SrcAlpha,
-//! OneMinusSrcAlpha` into the HDR scene colour, depth tested (nearer or equal: seed 003's
-//! `LessEqual` in our reverse-Z) without depth write.
+//! front, blended `SrcAlpha, OneMinusSrcAlpha` into the HDR scene colour, depth tested
+//! (nearer or equal: seed 003's `LessEqual` in our reverse-Z) without depth write.
 //!
-//! `sorted` draws each chunk's quads in mesher order; `sorted-quads` also sorts the quads
-//! inside each visible chunk back to front on the CPU ([`Sorted::prepare`]
-//! (TranslucentTechnique::prepare)) and rewrites them in that order.
+//! Chunks come farthest first by [`voxel_mesh::order::chunk_order_key`] (exact for a grid of
+//! equal cubes). `sorted` draws each chunk's quads in mesher order, which is wrong wherever
+//! a chunk holds layers that overlap on screen. `sorted-quads` also orders the quads inside
+//! each visible chunk exactly ([`voxel_mesh::order`]): a per-chunk structure is built once
+//! per mesh, and a chunk is re-sorted only when the eye crosses one of its trigger planes
+//! (its region key changes), so a still camera sorts nothing. The order is exact on every
+//! pixel except where quads form a cycle (no order exists; counted in [`SortReport`], those
+//! quads drawn farthest centre first).
 
 use std::collections::HashMap;
 use std::time::Instant;
 
-use glam::DVec3;
 use voxel_core::ChunkPos;
+use voxel_mesh::PackedQuad;
+use voxel_mesh::order::{QuadOrder, RegionKey};
 
 use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
@@ -21,56 +26,42 @@ use crate::oit::{
     TranslucentTechnique,
 };
 use crate::timing::GpuPass;
-use crate::{Error, GpuContext, Result};
+use crate::{GpuContext, Result};
 
-/// Settings of the sorted techniques. Every field has a reasoned default.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SortedSettings {
-    /// Sorted-quads: how far (blocks) the eye may move before a chunk's quads are
-    /// re-sorted.
-    pub resort_distance: f64,
-}
-
-impl Default for SortedSettings {
-    fn default() -> Self {
-        Self {
-            // A quarter block changes the order of few quads, and a sort of a chunk's
-            // translucent quads takes microseconds.
-            resort_distance: 0.25,
-        }
-    }
-}
-
-impl SortedSettings {
-    /// The distance must be a finite number of blocks, 0 or more.
-    pub fn validate(&self) -> Result<()> {
-        if self.resort_distance.is_finite() && self.resort_distance >= 0.0 {
-            Ok(())
-        } else {
-            Err(Error::InvalidSetting(format!(
-                "sorted.resort_distance {}: must be a finite number of blocks, 0 or more",
-                self.resort_distance
-            )))
-        }
-    }
-}
-
-/// What sorting quads cost in the last frame.
+/// What sorting quads did in the last frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SortReport {
-    /// CPU milliseconds spent sorting.
+    /// CPU milliseconds spent building orders and sorting.
     pub ms: f64,
-    /// Chunks whose quads were re-sorted.
+    /// Chunks whose quads were re-sorted (the eye crossed one of their trigger planes, or
+    /// they were remeshed).
     pub chunks_resorted: usize,
+    /// Chunks whose order structure was built (newly visible or remeshed).
+    pub chunks_built: usize,
+    /// Cycles met in the visible chunks (groups of quads no order draws exactly).
+    pub cycles: u32,
+    /// Quads in those cycles.
+    pub quads_in_cycles: u32,
 }
 
-/// The blending pipeline, and for `sorted-quads` the eye each chunk was last sorted for.
+/// One chunk's exact order and what it was last sorted for.
+#[derive(Debug)]
+struct ChunkOrder {
+    generation: u64,
+    order: QuadOrder,
+    /// The region the GPU order is exact for (`None`: sort again on the next frame).
+    sorted_for: Option<RegionKey>,
+    /// Cycles of the last sort.
+    cycles: (u32, u32),
+}
+
+/// The blending pipeline, and for `sorted-quads` each chunk's exact order.
 #[derive(Debug)]
 pub struct Sorted {
     pipeline: wgpu::RenderPipeline,
     sort_quads: bool,
-    /// Per chunk: the generation and the eye its quads were last sorted for.
-    sorted_for: HashMap<ChunkPos, (u64, DVec3)>,
+    orders: HashMap<ChunkPos, ChunkOrder>,
+    scratch: Vec<PackedQuad>,
     report: SortReport,
 }
 
@@ -99,9 +90,60 @@ impl TechniqueKind for Sorted {
         Ok(Self {
             pipeline,
             sort_quads: technique == Technique::SortedQuads,
-            sorted_for: HashMap::new(),
+            orders: HashMap::new(),
+            scratch: Vec::new(),
             report: SortReport::default(),
         })
+    }
+}
+
+impl Sorted {
+    /// Sorts the quads of the chunk at `pos` for `eye` if its region changed (or it was
+    /// remeshed). Returns (built, sorted).
+    fn sort_chunk(
+        &mut self,
+        ctx: &GpuContext,
+        chunks: &mut ChunkStore,
+        pos: ChunkPos,
+        eye: glam::DVec3,
+    ) -> (bool, bool) {
+        let Some(chunk) = chunks.get(pos) else {
+            return (false, false);
+        };
+        let generation = chunk.generation();
+        let built = self
+            .orders
+            .get(&pos)
+            .is_none_or(|o| o.generation != generation);
+        if built {
+            let order = QuadOrder::new(chunk.translucent_quads());
+            self.orders.insert(
+                pos,
+                ChunkOrder {
+                    generation,
+                    order,
+                    sorted_for: None,
+                    cycles: (0, 0),
+                },
+            );
+        }
+        let Some(entry) = self.orders.get_mut(&pos) else {
+            return (built, false);
+        };
+        // The eye in chunk-local blocks, in f64: exact wherever the world is.
+        let o = pos.origin();
+        let local = [0, 1, 2].map(|k| eye[k] - o[k] as f64);
+        let key = entry.order.region_key(local);
+        if entry.sorted_for == Some(key) {
+            return (built, false);
+        }
+        let stats = entry.order.sort_into(local, &mut self.scratch);
+        // Exact for the whole region: sort again only when the key changes; otherwise
+        // (rare) also when the eye moves.
+        entry.sorted_for = stats.is_exact_in_region().then_some(key);
+        entry.cycles = (stats.cycles, stats.quads_in_cycles);
+        chunks.reorder_translucent(ctx, pos, std::mem::take(&mut self.scratch));
+        (built, true)
     }
 }
 
@@ -110,12 +152,12 @@ impl TranslucentTechnique for Sorted {
         Ok(())
     }
 
-    /// Sorted-quads: re-sorts the quads of the visible chunks whose last sort was for an
-    /// eye farther than [`SortedSettings::resort_distance`] away, or that were remeshed.
+    /// Sorted-quads: sorts the visible chunks whose region key changed since their last
+    /// sort, building the order structure of newly visible or remeshed chunks first.
     fn prepare(
         &mut self,
         ctx: &GpuContext,
-        config: &OitConfig,
+        _config: &OitConfig,
         chunks: &mut ChunkStore,
         view: &FrameView<'_>,
     ) -> Result<()> {
@@ -123,37 +165,23 @@ impl TranslucentTechnique for Sorted {
             return Ok(());
         }
         let start = Instant::now();
-        let eye = view.camera.eye;
-        let threshold = config.sorted.resort_distance;
-        let mut n = 0;
+        let mut report = SortReport::default();
         for &pos in view.translucent {
-            let Some(chunk) = chunks.get(pos) else {
-                continue;
-            };
-            let generation = chunk.generation();
-            if self
-                .sorted_for
-                .get(&pos)
-                .is_some_and(|(g, e)| *g == generation && e.distance(eye) <= threshold)
-            {
-                continue;
+            let (built, sorted) = self.sort_chunk(ctx, chunks, pos, view.camera.eye);
+            report.chunks_built += usize::from(built);
+            report.chunks_resorted += usize::from(sorted);
+            if let Some(o) = self.orders.get(&pos) {
+                report.cycles += o.cycles.0;
+                report.quads_in_cycles += o.cycles.1;
             }
-            let mut quads = chunk.translucent_quads().to_vec();
-            let o = pos.origin();
-            let local = eye - DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
-            voxel_mesh::sort::quads_back_to_front(&mut quads, local.as_vec3().to_array());
-            chunks.reorder_translucent(ctx, pos, quads);
-            self.sorted_for.insert(pos, (generation, eye));
-            n += 1;
         }
-        if self.sorted_for.len() > 2 * chunks.len() + 64 {
-            self.sorted_for
-                .retain(|pos, (g, _)| chunks.get(*pos).map(|c| c.generation()) == Some(*g));
+        // Forget chunks that were removed or remeshed since (kept bounded by the store).
+        if self.orders.len() > 2 * chunks.len() + 64 {
+            self.orders
+                .retain(|pos, o| chunks.get(*pos).map(|c| c.generation()) == Some(o.generation));
         }
-        self.report = SortReport {
-            ms: start.elapsed().as_secs_f64() * 1e3,
-            chunks_resorted: n,
-        };
+        report.ms = start.elapsed().as_secs_f64() * 1e3;
+        self.report = report;
         Ok(())
     }
 
