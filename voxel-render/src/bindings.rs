@@ -7,8 +7,15 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::gpu::{self, buffer_entry};
 
-/// WGSL shared by every chunk pipeline: the structs below, vertex pulling and shading.
-pub const COMMON_WGSL: &str = include_str!("shaders/common.wgsl");
+/// WGSL shared by every chunk pipeline: the structs below, vertex pulling and shading,
+/// after the constants it shares with this module.
+pub fn common_wgsl() -> String {
+    gpu::WgslConsts::default()
+        .u32("NO_MEDIUM", NO_MEDIUM)
+        .u32("FLAG_INTERFACE", FLAG_INTERFACE)
+        .finish()
+        + include_str!("shaders/common.wgsl")
+}
 
 /// Per-frame uniforms every pass uses (`Frame` in WGSL).
 #[repr(C)]
@@ -34,9 +41,18 @@ pub struct FrameUniforms {
     pub _pad: f32,
     /// Render target size in pixels.
     pub viewport: [f32; 2],
+    /// Block id of the translucent type the eye is inside, or [`NO_MEDIUM`].
+    pub medium: u32,
     /// Padding to the struct's 16-byte alignment.
-    pub _pad2: [f32; 2],
+    pub _pad2: u32,
 }
+
+/// [`FrameUniforms::medium`] when the eye is in no translucent volume.
+pub const NO_MEDIUM: u32 = u32::MAX;
+
+/// Quad flag (bit 16 of word 1 of a [`voxel_mesh::PackedQuad`]): a translucent face toward
+/// another translucent type (`FLAG_INTERFACE` in WGSL).
+pub const FLAG_INTERFACE: u32 = 1;
 
 /// Per-chunk uniforms (`ChunkInfo` in WGSL).
 #[repr(C)]
@@ -51,7 +67,7 @@ pub struct ChunkUniforms {
 /// Layouts every chunk pipeline is built against.
 #[derive(Debug, Clone)]
 pub struct SharedLayouts {
-    /// Group 0: frame uniforms, block textures, sampler.
+    /// Group 0: frame uniforms, block textures, sampler, the medium's boundary depth.
     pub scene: wgpu::BindGroupLayout,
     /// Group 1: a chunk mesh's quads and the chunk uniform.
     pub chunk: wgpu::BindGroupLayout,
@@ -83,6 +99,7 @@ impl SharedLayouts {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
+                gpu::texture_entry(3, wgpu::TextureSampleType::Depth),
             ],
         );
         let chunk = gpu::layout(
@@ -117,7 +134,7 @@ mod tests {
     /// The Rust structs are laid out exactly as naga lays out the WGSL ones.
     #[test]
     fn structs_match_their_wgsl() {
-        let module = crate::wgsl_layout::parse(COMMON_WGSL);
+        let module = crate::wgsl_layout::parse(&common_wgsl());
         assert_layout::<FrameUniforms>(
             &module,
             "Frame",
@@ -131,6 +148,7 @@ mod tests {
                 field!(FrameUniforms, ambient),
                 field!(FrameUniforms, sky),
                 field!(FrameUniforms, viewport),
+                field!(FrameUniforms, medium),
             ],
         );
         assert_layout::<ChunkUniforms>(

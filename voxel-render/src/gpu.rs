@@ -84,9 +84,46 @@ pub struct ChunkPipeline<'a> {
     pub samples: u32,
 }
 
+/// A translucent chunk pipeline in its two variants: culling back faces (the eye in air),
+/// and drawing both sides (the eye inside a translucent volume, whose surfaces it sees from
+/// behind; see `medium.rs`).
+#[derive(Debug)]
+pub struct SidedPipeline {
+    culled: wgpu::RenderPipeline,
+    two_sided: wgpu::RenderPipeline,
+}
+
+impl SidedPipeline {
+    /// The variant for a frame.
+    pub fn get(&self, two_sided: bool) -> &wgpu::RenderPipeline {
+        if two_sided {
+            &self.two_sided
+        } else {
+            &self.culled
+        }
+    }
+}
+
 impl ChunkPipeline<'_> {
-    /// Creates the pipeline.
+    /// Creates the pipeline (back faces culled).
     pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        self.build_with(device, Some(wgpu::Face::Back))
+    }
+
+    /// Creates the pipeline drawing both sides of every face.
+    pub fn build_two_sided(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        self.build_with(device, None)
+    }
+
+    /// Creates both variants of a translucent pipeline (see [`SidedPipeline`]).
+    pub fn build_sided(&self, device: &wgpu::Device) -> SidedPipeline {
+        SidedPipeline {
+            culled: self.build_with(device, Some(wgpu::Face::Back)),
+            two_sided: self.build_with(device, None),
+        }
+    }
+
+    fn build_with(&self, device: &wgpu::Device, cull_mode: Option<wgpu::Face>) -> wgpu::RenderPipeline {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(self.label),
             bind_group_layouts: self.groups,
@@ -110,9 +147,9 @@ impl ChunkPipeline<'_> {
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 front_face: wgpu::FrontFace::Ccw,
-                // Every face is an entry surface seen from its front: the mesher emits the face
-                // of each side of a boundary, and back faces are culled everywhere.
-                cull_mode: Some(wgpu::Face::Back),
+                // Faces are entry surfaces seen from their front (the mesher emits the face
+                // of each side of a boundary); back faces only count from inside a volume.
+                cull_mode,
                 ..Default::default()
             },
             depth_stencil: Some(wgpu::DepthStencilState {

@@ -7,7 +7,8 @@
 //!
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `camera`,
 //! `readback`, `timing` → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
-//! pipeline binds), `textures` → `chunks` → `oit` (techniques) → `renderer`. A test
+//! pipeline binds), `textures` → `chunks` → `medium` (translucent volumes seen from
+//! inside) → `oit` (techniques) → `renderer`. A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
 mod bindings;
@@ -16,6 +17,7 @@ mod chunks;
 mod context;
 mod error;
 pub mod gpu;
+pub mod medium;
 pub mod oit;
 pub mod readback;
 mod renderer;

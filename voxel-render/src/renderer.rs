@@ -8,11 +8,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glam::Mat4;
-use voxel_core::{BlockRegistry, ChunkPos};
+use voxel_core::{BlockId, BlockRegistry, ChunkPos};
 use voxel_mesh::ChunkMeshes;
 use wgpu::util::DeviceExt;
 
-use crate::bindings::{COMMON_WGSL, FrameUniforms, SharedLayouts};
+use crate::bindings::{FrameUniforms, NO_MEDIUM, SharedLayouts, common_wgsl};
 use crate::chunks::{ChunkStore, Frustum, MeshKind, Visible};
 use crate::error::scoped;
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
@@ -20,6 +20,7 @@ use crate::oit::{
     FrameView, OitConfig, OitManager, Setup, Technique, TechniqueReport, TranslucentFrame,
     WeightFunction,
 };
+use crate::medium::{self, MediumLook, MediumPass};
 use crate::textures::BlockTextures;
 use crate::timing::{GpuPass, GpuTimes, Timer};
 use crate::{Camera, DEPTH_FORMAT, Error, GpuContext, Result, SCENE_FORMAT};
@@ -83,12 +84,28 @@ pub struct FrameStats {
     pub technique: TechniqueReport,
 }
 
-/// The HDR scene colour and depth, and what reads them.
+/// What group 0 binds, apart from the per-size medium boundary.
+#[derive(Debug)]
+struct SceneResources {
+    frame_buffer: wgpu::Buffer,
+    textures: BlockTextures,
+    /// Stands in for the medium boundary in the group of the pass that writes it.
+    no_boundary: Target,
+}
+
+/// The HDR scene colour and depth, the medium boundary, and what reads them.
 #[derive(Debug)]
 struct SceneTargets {
     size: (u32, u32),
     color: Target,
     depth: Target,
+    /// Inside a medium: the depth of its first surface per pixel ([`crate::medium`]).
+    boundary: Target,
+    /// Group 0 of the chunk passes (the boundary readable).
+    scene_group: wgpu::BindGroup,
+    /// Group 0 of the pass that writes the boundary.
+    boundary_scene_group: wgpu::BindGroup,
+    fog_group: wgpu::BindGroup,
     /// MSAA colour and depth, resolved into `color` and `depth`.
     msaa: Option<(Target, Target)>,
     tonemap_group: wgpu::BindGroup,
@@ -113,12 +130,14 @@ pub struct Renderer {
     ctx: GpuContext,
     config: RendererConfig,
     layouts: SharedLayouts,
-    frame_buffer: wgpu::Buffer,
-    scene_group: wgpu::BindGroup,
+    scene: SceneResources,
     chunks: ChunkStore,
     opaque: wgpu::RenderPipeline,
     cutout: wgpu::RenderPipeline,
     post: Post,
+    medium: MediumPass,
+    /// Per block id: its look as a medium (translucent blocks only).
+    looks: Vec<Option<MediumLook>>,
     targets: SceneTargets,
     oit: OitManager,
     timer: Option<Timer>,
@@ -153,26 +172,26 @@ impl Renderer {
     ) -> Result<Self> {
         let device = &ctx.device;
         let layouts = SharedLayouts::new(device);
-        let textures = BlockTextures::new(ctx, registry)?;
-        let frame_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("frame_uniforms"),
-            contents: bytemuck::bytes_of(&FrameUniforms::default()),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
-        let scene_group = gpu::bind_group(
-            device,
-            "scene",
-            &layouts.scene,
-            &[
-                frame_buffer.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&textures.view),
-                wgpu::BindingResource::Sampler(&textures.sampler),
-            ],
-        );
+        let scene = SceneResources {
+            frame_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("frame_uniforms"),
+                contents: bytemuck::bytes_of(&FrameUniforms::default()),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            }),
+            textures: BlockTextures::new(ctx, registry)?,
+            no_boundary: gpu::target(
+                device,
+                "no_medium_boundary",
+                DEPTH_FORMAT,
+                wgpu::TextureUsages::TEXTURE_BINDING,
+                (1, 1),
+            ),
+        };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
         let post = Post::new(device);
+        let medium = MediumPass::new(device, &layouts);
         let size = (config.width, config.height);
-        let targets = SceneTargets::new(ctx, &post, size, config.msaa);
+        let targets = SceneTargets::new(ctx, &post, &layouts, &scene, &medium, size, config.msaa);
         let setup = Setup {
             ctx: ctx.clone(),
             layouts: layouts.clone(),
@@ -188,11 +207,12 @@ impl Renderer {
             ctx: ctx.clone(),
             chunks: ChunkStore::new(layouts.chunk.clone()),
             layouts,
-            frame_buffer,
-            scene_group,
+            scene,
             opaque,
             cutout,
             post,
+            medium,
+            looks: medium::looks(registry),
             targets,
             oit,
             timer: Timer::new(ctx),
@@ -210,7 +230,7 @@ impl Renderer {
         let module = gpu::shader(
             &ctx.device,
             "opaque",
-            &[COMMON_WGSL, include_str!("shaders/opaque.wgsl")],
+            &[&common_wgsl(), include_str!("shaders/opaque.wgsl")],
         );
         let groups = layouts.with(&[]);
         let make = |label, fragment_entry| {
@@ -226,6 +246,18 @@ impl Renderer {
             .build(&ctx.device)
         };
         (make("opaque", "fs_opaque"), make("cutout", "fs_cutout"))
+    }
+
+    fn targets_for(&self, size: (u32, u32), msaa: bool) -> SceneTargets {
+        SceneTargets::new(
+            &self.ctx,
+            &self.post,
+            &self.layouts,
+            &self.scene,
+            &self.medium,
+            size,
+            msaa,
+        )
     }
 
     /// The GPU context.
@@ -329,7 +361,7 @@ impl Renderer {
         let (pipelines, targets) = scoped(&ctx.device, "switching MSAA", || {
             (
                 Self::opaque_pipelines(ctx, &self.layouts, msaa),
-                SceneTargets::new(ctx, &self.post, size, msaa),
+                self.targets_for(size, msaa),
             )
         })?;
         (self.opaque, self.cutout) = pipelines;
@@ -348,7 +380,7 @@ impl Renderer {
         check_size(&self.ctx, width, height)?;
         let ctx = &self.ctx;
         let targets = scoped(&ctx.device, "resizing", || {
-            SceneTargets::new(ctx, &self.post, (width, height), self.config.msaa)
+            self.targets_for((width, height), self.config.msaa)
         })?;
         self.targets = targets;
         self.config.width = width;
@@ -415,7 +447,13 @@ impl Renderer {
         self.post.make_tonemap(&self.ctx, self.config.output_format);
         self.update_fades();
         let (w, h) = self.size();
-        let view_proj = camera.view_proj(f64::from(w) / f64::from(h));
+        let aspect = f64::from(w) / f64::from(h);
+        // No translucent face closer than the near plane's corners (crossing a surface).
+        let camera = &medium::guard(camera, aspect, &self.chunks);
+        let medium = camera
+            .medium
+            .and_then(|b| Some((b, self.looks.get(b.index()).copied().flatten()?)));
+        let view_proj = camera.view_proj(aspect);
         let frustum = Frustum::new(view_proj, camera.eye);
 
         // The technique's CPU work (it may reorder quads) comes before anything borrows
@@ -441,7 +479,7 @@ impl Renderer {
             translucent: &positions,
         };
         self.oit.prepare(&mut self.chunks, &view)?;
-        self.write_frame_uniforms(camera, view_proj);
+        self.write_frame_uniforms(camera, view_proj, medium.map(|(b, _)| b));
 
         let opaque = self.chunks.visible(MeshKind::Opaque, &frustum);
         let cutout = self.chunks.visible(MeshKind::Cutout, &frustum);
@@ -457,17 +495,33 @@ impl Renderer {
             })
             .collect();
         let timer = self.timer.as_ref();
+        let t = &self.targets;
         self.draw_opaque(encoder, &opaque, &cutout, timer);
+        if medium.is_some() {
+            let scene = &t.boundary_scene_group;
+            self.medium
+                .boundary_pass(encoder, &t.depth, &t.boundary, scene, &translucent, timer);
+        }
         self.oit.render(
             encoder,
             &TranslucentFrame {
-                target: &self.targets.color,
-                depth: &self.targets.depth,
-                scene: &self.scene_group,
+                target: &t.color,
+                depth: &t.depth,
+                scene: &t.scene_group,
                 chunks: &translucent,
                 timer,
+                two_sided: medium.is_some(),
             },
         )?;
+        if let Some((_, look)) = &medium {
+            let sun = glam::Vec3::from(self.config.sun_dir).normalize_or(glam::Vec3::Y);
+            let light = self.config.ambient + (1.0 - self.config.ambient) * sun.y.max(0.0);
+            let params = medium::fog_params(look, camera, aspect, [w as f32, h as f32], light);
+            self.ctx
+                .queue
+                .write_buffer(&self.medium.fog_params, 0, bytemuck::bytes_of(&params));
+            self.medium.fog_pass(encoder, &t.color, &t.fog_group, timer);
+        }
         self.tonemap(encoder, output, timer);
         let stats = FrameStats {
             meshes_drawn: [opaque.len(), cutout.len(), translucent.len()],
@@ -550,7 +604,7 @@ impl Renderer {
         self.frame_index = self.frame_index.wrapping_add(1);
     }
 
-    fn write_frame_uniforms(&self, camera: &Camera, view_proj: Mat4) {
+    fn write_frame_uniforms(&self, camera: &Camera, view_proj: Mat4, medium: Option<BlockId>) {
         let (eye_int, eye_frac) = camera.eye_split();
         let sun = glam::Vec3::from(self.config.sun_dir).normalize_or(glam::Vec3::Y);
         let (w, h) = self.size();
@@ -564,11 +618,12 @@ impl Renderer {
             ambient: self.config.ambient,
             sky: self.config.sky,
             viewport: [w as f32, h as f32],
+            medium: medium.map_or(NO_MEDIUM, |b| u32::from(b.0)),
             ..FrameUniforms::default()
         };
         self.ctx
             .queue
-            .write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
+            .write_buffer(&self.scene.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
     }
 
     /// The opaque pass, then the cutout pass; with MSAA the colour resolves at the end of
@@ -616,7 +671,7 @@ impl Renderer {
                 .depth(depth)
                 .record(encoder, timer, |pass| {
                     pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, &self.scene_group, &[]);
+                    pass.set_bind_group(0, &t.scene_group, &[]);
                     for v in list {
                         v.mesh.draw(pass);
                     }
@@ -731,7 +786,15 @@ impl Post {
 }
 
 impl SceneTargets {
-    fn new(ctx: &GpuContext, post: &Post, size: (u32, u32), msaa: bool) -> Self {
+    fn new(
+        ctx: &GpuContext,
+        post: &Post,
+        layouts: &SharedLayouts,
+        scene: &SceneResources,
+        medium: &MediumPass,
+        size: (u32, u32),
+        msaa: bool,
+    ) -> Self {
         use wgpu::TextureUsages as U;
         let device = &ctx.device;
         let target = |label, format, samples, usage| {
@@ -772,6 +835,28 @@ impl SceneTargets {
                 ),
             )
         });
+        let boundary = target(
+            "medium_boundary",
+            DEPTH_FORMAT,
+            1,
+            U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST,
+        );
+        let group = |label, boundary: &Target| {
+            gpu::bind_group(
+                device,
+                label,
+                &layouts.scene,
+                &[
+                    scene.frame_buffer.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&scene.textures.view),
+                    wgpu::BindingResource::Sampler(&scene.textures.sampler),
+                    wgpu::BindingResource::TextureView(&boundary.view),
+                ],
+            )
+        };
+        let scene_group = group("scene", &boundary);
+        let boundary_scene_group = group("scene_writing_boundary", &scene.no_boundary);
+        let fog_group = medium.fog_group(device, &boundary);
         let tonemap_group =
             gpu::texture_group(device, "tonemap", &post.tonemap_layout, &[&color.view]);
         let depth_resolve_group = msaa.as_ref().map(|(_, d)| {
@@ -786,6 +871,10 @@ impl SceneTargets {
             size,
             color,
             depth,
+            boundary,
+            scene_group,
+            boundary_scene_group,
+            fog_group,
             msaa,
             tonemap_group,
             depth_resolve_group,

@@ -23,17 +23,20 @@ pub enum GpuPass {
     Translucent,
     /// The technique's composite(s) into the scene colour.
     Composite,
+    /// With the eye inside a translucent volume: the medium's boundary depth and its fog.
+    Medium,
     /// HDR scene colour to the output.
     Tonemap,
 }
 
 impl GpuPass {
     /// Every pass kind, in frame order.
-    pub const ALL: [GpuPass; 5] = [
+    pub const ALL: [GpuPass; 6] = [
         GpuPass::Opaque,
         GpuPass::Cutout,
         GpuPass::Translucent,
         GpuPass::Composite,
+        GpuPass::Medium,
         GpuPass::Tonemap,
     ];
 
@@ -44,6 +47,7 @@ impl GpuPass {
             GpuPass::Cutout => "cutout",
             GpuPass::Translucent => "translucent",
             GpuPass::Composite => "composite",
+            GpuPass::Medium => "medium",
             GpuPass::Tonemap => "tonemap",
         }
     }
@@ -62,7 +66,7 @@ impl fmt::Display for GpuPass {
 /// Milliseconds of GPU time per [`GpuPass`] of one frame (`None`: no such pass ran).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct GpuTimes {
-    ms: [Option<f64>; 5],
+    ms: [Option<f64>; GpuPass::ALL.len()],
 }
 
 impl GpuTimes {

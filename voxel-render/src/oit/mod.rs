@@ -256,6 +256,9 @@ pub struct TranslucentFrame<'a> {
     pub chunks: &'a [Visible<'a>],
     /// Pass timing, when available.
     pub timer: Option<&'a Timer>,
+    /// The eye is inside a translucent volume: draw both sides of translucent faces
+    /// (the `two_sided` variant of each [`crate::gpu::SidedPipeline`]).
+    pub two_sided: bool,
 }
 
 impl TranslucentFrame<'_> {

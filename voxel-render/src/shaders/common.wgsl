@@ -1,7 +1,8 @@
 // Shared by every chunk pipeline: frame and chunk uniforms (`bindings.rs`, checked equal
 // by a test), vertex pulling of the 8-byte packed quads (voxel-mesh's layout), the shading
 // all passes use (seed 000: Lambert with a sun direction plus ambient, the same for opaque
-// and translucent surfaces), and the dissolve of chunks fading in.
+// and translucent surfaces), the dissolve of chunks fading in, and which translucent
+// fragments count when the eye is inside a translucent volume (`medium.rs`).
 
 struct Frame {
     view_proj: mat4x4<f32>,
@@ -13,7 +14,12 @@ struct Frame {
     ambient: f32,
     sky: vec3<f32>,
     viewport: vec2<f32>,
+    // Block id of the translucent type the eye is inside, or NO_MEDIUM.
+    medium: u32,
 };
+
+// NO_MEDIUM (no medium) and FLAG_INTERFACE (quad flag, word 1 bit 16: a translucent face
+// toward another translucent type) come from `bindings.rs`.
 
 struct ChunkInfo {
     origin: vec3<i32>,
@@ -23,6 +29,9 @@ struct ChunkInfo {
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var block_textures: texture_2d_array<f32>;
 @group(0) @binding(2) var block_sampler: sampler;
+// Inside a medium: per pixel, the depth of the first surface of the medium's volume the
+// eye's ray meets (or the opaque depth when nearer); see `medium.rs`.
+@group(0) @binding(3) var medium_boundary: texture_depth_2d;
 
 @group(1) @binding(0) var<storage, read> quads: array<vec2<u32>>;
 @group(1) @binding(1) var<uniform> chunk: ChunkInfo;
@@ -37,6 +46,8 @@ struct VsOut {
     @location(2) @interpolate(flat) face: u32,
     // Distance from the eye along the view direction (positive).
     @location(3) view_depth: f32,
+    // The quad's flags (word 1, bits 16-31).
+    @location(4) @interpolate(flat) flags: u32,
 };
 
 // Corners of the two triangles of a quad, counter-clockwise seen from the side the normal
@@ -84,6 +95,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     out.clip = frame.view_proj * vec4<f32>(rel, 1.0);
     out.uv = uv;
     out.block = q.y & 0xffffu;
+    out.flags = q.y >> 16u;
     out.face = face;
     // Reverse-Z perspective: clip.w is the view depth.
     out.view_depth = out.clip.w;
@@ -101,11 +113,26 @@ fn light(rgb: vec3<f32>, face: u32) -> vec3<f32> {
     return rgb * (frame.ambient + (1.0 - frame.ambient) * n_dot_l);
 }
 
+// Whether a translucent fragment counts (the model in `medium.rs`): every front face
+// does. A back face (drawn only when the eye is inside a medium) counts when it is a face of
+// the medium's type where it meets air or a cutout block, and it is the first surface of
+// the medium the ray meets: the way out of the eye's own passage through the volume.
+fn counts(in: VsOut, front: bool) -> bool {
+    if front {
+        return true;
+    }
+    return in.block == frame.medium
+        && (in.flags & FLAG_INTERFACE) == 0u
+        && in.clip.z == textureLoad(medium_boundary, vec2<i32>(in.clip.xy), 0);
+}
+
 // The lit colour and opacity of a translucent fragment: what every technique composes.
-// Opacity is the texture's (the block's opacity, or 1 on glass frames) times the chunk's.
-fn translucent_color(in: VsOut) -> vec4<f32> {
+// Opacity is the texture's (the block's opacity, or 1 on glass frames) times the chunk's;
+// 0 for a fragment that does not count.
+fn translucent_color(in: VsOut, front: bool) -> vec4<f32> {
     let a = albedo(in);
-    return vec4<f32>(light(a.rgb, in.face), clamp(a.a * chunk.alpha, 0.0, 1.0));
+    let alpha = select(0.0, clamp(a.a * chunk.alpha, 0.0, 1.0), counts(in, front));
+    return vec4<f32>(light(a.rgb, in.face), alpha);
 }
 
 // Level of the n×n Bayer matrix (n a power of two) at a pixel, over n²: the matrix

@@ -22,7 +22,9 @@
 //! layers (reported when reached). For measurement, not games.
 
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
+use crate::gpu::{
+    self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, SidedPipeline, Target,
+};
 use crate::oit::{
     OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -122,8 +124,8 @@ struct Targets {
 #[derive(Debug)]
 pub struct Peeling {
     mode: PeelMode,
-    peel_front: wgpu::RenderPipeline,
-    peel_back: wgpu::RenderPipeline,
+    peel_front: SidedPipeline,
+    peel_back: SidedPipeline,
     under: wgpu::RenderPipeline,
     over: wgpu::RenderPipeline,
     front_composite: wgpu::RenderPipeline,
@@ -184,7 +186,7 @@ impl TechniqueKind for Peeling {
         let module = gpu::shader(
             device,
             "peel",
-            &[crate::bindings::COMMON_WGSL, include_str!("peel.wgsl")],
+            &[&crate::bindings::common_wgsl(), include_str!("peel.wgsl")],
         );
         let groups = setup.layouts.with(&[&limits_layout]);
         let peel = |label, depth| {
@@ -197,7 +199,7 @@ impl TechniqueKind for Peeling {
                 depth,
                 samples: 1,
             }
-            .build(device)
+            .build_sided(device)
         };
         let blend = |label, fragment_entry, state| {
             FullscreenPipeline {
@@ -313,7 +315,7 @@ impl Peeling {
             ..Pass::new(label, GpuPass::Translucent, &colors).depth(depth)
         };
         pass.record(encoder, frame.timer, |pass| {
-            pass.set_pipeline(pipeline);
+            pass.set_pipeline(pipeline.get(frame.two_sided));
             pass.set_bind_group(2, limits, &[]);
             if let Some(i) = query {
                 pass.begin_occlusion_query(i);

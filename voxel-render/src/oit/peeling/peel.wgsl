@@ -12,12 +12,13 @@
 @group(2) @binding(1) var back_limit: texture_depth_2d;
 
 @fragment
-fn fs_peel(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_peel(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     // Sample first: derivatives need uniform control flow.
-    let c = translucent_color(in);
+    let c = translucent_color(in, front);
     let p = vec2<i32>(in.clip.xy);
     let d = in.clip.z;
-    if !(d < textureLoad(front_limit, p, 0) && d > textureLoad(back_limit, p, 0)) {
+    // A fragment that does not count (alpha 0) is no layer.
+    if !(d < textureLoad(front_limit, p, 0) && d > textureLoad(back_limit, p, 0)) || c.a <= 0.0 {
         discard;
     }
     return c;

@@ -9,8 +9,8 @@
 @group(2) @binding(4) var opaque_depth: texture_depth_2d;
 
 @fragment
-fn fs_abuffer(in: VsOut) {
-    let c = translucent_color(in);
+fn fs_abuffer(in: VsOut, @builtin(front_facing) front: bool) {
+    let c = translucent_color(in, front);
     let p = vec2<u32>(in.clip.xy);
     // The depth test, in the shader: a fragment with storage writes may run them before a
     // late depth test would have dropped it. The scissor keeps fragments in the tile.

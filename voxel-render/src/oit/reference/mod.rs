@@ -23,7 +23,9 @@
 use wgpu::util::DeviceExt;
 
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, WgslConsts};
+use crate::gpu::{
+    self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, SidedPipeline, WgslConsts,
+};
 use crate::oit::{
     OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -99,7 +101,7 @@ fn types_wgsl() -> String {
 /// The build pass's shader.
 pub fn build_wgsl() -> String {
     [
-        crate::bindings::COMMON_WGSL,
+        &crate::bindings::common_wgsl(),
         &types_wgsl(),
         include_str!("abuffer.wgsl"),
     ]
@@ -122,7 +124,7 @@ struct Buffers {
 /// A-buffer resources.
 #[derive(Debug)]
 pub struct Reference {
-    build: wgpu::RenderPipeline,
+    build: SidedPipeline,
     resolve: wgpu::RenderPipeline,
     build_layout: wgpu::BindGroupLayout,
     resolve_layout: wgpu::BindGroupLayout,
@@ -197,7 +199,7 @@ impl TechniqueKind for Reference {
             depth: DepthMode::ReadOnly,
             samples: 1,
         }
-        .build(device);
+        .build_sided(device);
         let resolve = FullscreenPipeline {
             label: "abuffer_resolve",
             source: &resolve_wgsl(),
@@ -363,7 +365,7 @@ impl Reference {
                 .depth(Depth::ReadOnly(&frame.depth.view))
                 .record(encoder, frame.timer, |pass| {
                     pass.set_scissor_rect(x, y, w, h);
-                    pass.set_pipeline(&self.build);
+                    pass.set_pipeline(self.build.get(frame.two_sided));
                     pass.set_bind_group(2, &b.build_group, &dynamic);
                     frame.draw_chunks(pass);
                 });

@@ -20,7 +20,7 @@ use voxel_mesh::order::{QuadOrder, RegionKey};
 
 use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, Pass};
+use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, Pass, SidedPipeline};
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -58,7 +58,7 @@ struct ChunkOrder {
 /// The blending pipeline, and for `sorted-quads` each chunk's exact order.
 #[derive(Debug)]
 pub struct Sorted {
-    pipeline: wgpu::RenderPipeline,
+    pipeline: SidedPipeline,
     sort_quads: bool,
     orders: HashMap<ChunkPos, ChunkOrder>,
     scratch: Vec<PackedQuad>,
@@ -75,7 +75,7 @@ impl TechniqueKind for Sorted {
         let module = gpu::shader(
             device,
             "sorted",
-            &[crate::bindings::COMMON_WGSL, include_str!("sorted.wgsl")],
+            &[&crate::bindings::common_wgsl(), include_str!("sorted.wgsl")],
         );
         let pipeline = ChunkPipeline {
             label: "sorted",
@@ -86,7 +86,7 @@ impl TechniqueKind for Sorted {
             depth: DepthMode::ReadOnlyOrEqual,
             samples: 1,
         }
-        .build(device);
+        .build_sided(device);
         Ok(Self {
             pipeline,
             sort_quads: technique == Technique::SortedQuads,
@@ -195,7 +195,7 @@ impl TranslucentTechnique for Sorted {
         Pass::new("sorted", GpuPass::Translucent, &colors)
             .depth(Depth::ReadOnly(&frame.depth.view))
             .record(encoder, frame.timer, |pass| {
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(self.pipeline.get(frame.two_sided));
                 frame.draw_chunks(pass);
             });
         Ok(())

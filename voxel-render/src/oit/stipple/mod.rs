@@ -15,7 +15,7 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, Pass, WgslConsts};
+use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, Pass, SidedPipeline, WgslConsts};
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TranslucentFrame, TranslucentTechnique,
 };
@@ -80,7 +80,7 @@ pub fn stipple_wgsl() -> String {
         .finish();
     [
         consts.as_str(),
-        crate::bindings::COMMON_WGSL,
+        &crate::bindings::common_wgsl(),
         include_str!("dither.wgsl"),
         include_str!("stipple.wgsl"),
     ]
@@ -90,7 +90,7 @@ pub fn stipple_wgsl() -> String {
 /// The stipple pipeline and its uniform.
 #[derive(Debug)]
 pub struct Stipple {
-    pipeline: wgpu::RenderPipeline,
+    pipeline: SidedPipeline,
     depth_write: bool,
     params: wgpu::Buffer,
     group: wgpu::BindGroup,
@@ -153,7 +153,7 @@ impl TechniqueKind for Stipple {
             },
             samples: 1,
         }
-        .build(device);
+        .build_sided(device);
         Ok(Self {
             pipeline,
             depth_write,
@@ -198,7 +198,7 @@ impl TranslucentTechnique for Stipple {
         Pass::new("stipple", GpuPass::Translucent, &colors)
             .depth(depth)
             .record(encoder, frame.timer, |pass| {
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(self.pipeline.get(frame.two_sided));
                 pass.set_bind_group(2, &self.group, &[]);
                 frame.draw_chunks(pass);
             });

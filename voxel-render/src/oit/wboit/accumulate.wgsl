@@ -13,6 +13,8 @@ struct WboitParams {
     accum_scale: f32,
     // Nearest and farthest view depth of the visible translucent chunks (fitted weight).
     depth_range: vec2<f32>,
+    // Optical depth of a layer of the eye's medium (fitted weight; 0 in air).
+    medium_depth: f32,
     // Per screen tile, the optical depth in front of log-spaced depths (fitted weight).
     optical_depth: array<vec4<f32>, TABLE_VEC4S>,
 };
@@ -31,7 +33,16 @@ fn cube(x: f32) -> f32 {
     return x * x * x;
 }
 
-fn weight(pixel: vec2<f32>, z: f32, depth: f32, a: f32) -> f32 {
+// The eye's medium in front of a fragment: its surface (the way out) dims every fragment
+// behind the first medium surface at the pixel (`medium.rs`).
+fn medium_in_front(pixel: vec2<f32>, frag_z: f32) -> f32 {
+    if frame.medium == NO_MEDIUM || frag_z >= textureLoad(medium_boundary, vec2<i32>(pixel), 0) {
+        return 0.0;
+    }
+    return params.medium_depth;
+}
+
+fn weight(pixel: vec2<f32>, frag_z: f32, z: f32, depth: f32, a: f32) -> f32 {
     let d = abs(depth);
     switch params.weight_fn {
         case WEIGHT_FLAT: {
@@ -56,7 +67,7 @@ fn weight(pixel: vec2<f32>, z: f32, depth: f32, a: f32) -> f32 {
         }
         default: {
             // WEIGHT_FITTED: the estimated transmittance in front of the fragment.
-            return 3e3 * exp(-optical_depth_at(pixel, d));
+            return 3e3 * exp(-optical_depth_at(pixel, d) - medium_in_front(pixel, frag_z));
         }
     }
 }
@@ -91,9 +102,10 @@ fn optical_depth_at(pixel: vec2<f32>, d: f32) -> f32 {
     return min(mix(top, bottom, s.y), MAX_FITTED_DEPTH);
 }
 
-fn accumulation(in: VsOut) -> vec4<f32> {
-    let c = translucent_color(in);
-    let w = weight(in.clip.xy, standard_depth(in.clip.z), in.view_depth, c.a) * params.accum_scale;
+fn accumulation(in: VsOut, front: bool) -> vec4<f32> {
+    let c = translucent_color(in, front);
+    let w = weight(in.clip.xy, in.clip.z, standard_depth(in.clip.z), in.view_depth, c.a)
+        * params.accum_scale;
     return vec4<f32>(c.rgb * c.a, c.a) * w;
 }
 
@@ -104,21 +116,21 @@ struct WboitOut {
 
 // Single pass, two targets (needs independent blend).
 @fragment
-fn fs_accumulate_mrt(in: VsOut) -> WboitOut {
+fn fs_accumulate_mrt(in: VsOut, @builtin(front_facing) front: bool) -> WboitOut {
     var out: WboitOut;
-    out.accumulation = accumulation(in);
+    out.accumulation = accumulation(in, front);
     // α in every channel: the revealage blend multiplies by one minus the source colour.
-    out.revealage = vec4<f32>(translucent_color(in).a);
+    out.revealage = vec4<f32>(translucent_color(in, front).a);
     return out;
 }
 
 // Two passes (seed 002): accumulation first, revealage second.
 @fragment
-fn fs_accumulate(in: VsOut) -> @location(0) vec4<f32> {
-    return accumulation(in);
+fn fs_accumulate(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    return accumulation(in, front);
 }
 
 @fragment
-fn fs_revealage(in: VsOut) -> @location(0) vec4<f32> {
-    return vec4<f32>(translucent_color(in).a);
+fn fs_revealage(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    return vec4<f32>(translucent_color(in, front).a);
 }

@@ -10,7 +10,8 @@
 //! - once per chunk mesh (cached by the technique until the chunk is remeshed), the
 //!   translucent quads are summed up per plane, facing and block: the rectangle around
 //!   those quads, and their area times the block's optical depth `−ln(1 − α)`;
-//! - each frame, every plane that faces the eye (back faces are not drawn) adds, to each of
+//! - each frame, every plane that faces the eye (back faces are not drawn; the surface of
+//!   the eye's medium, seen from behind, is counted per pixel by the shader) adds, to each of
 //!   the `TILES × TILES` screen tiles its projected rectangle overlaps, the optical depth a
 //!   ray through the rectangle crosses (optical area / rectangle area) times the share of
 //!   the tile it covers, in front of the view depths past the rectangle's farthest point.
@@ -75,7 +76,7 @@ impl MeshLayers {
         for q in quads {
             let Some(u) = q.unpack() else { continue };
             let alpha = opacity.get(u.block.index()).copied().unwrap_or(0.0);
-            let depth = (-f64::from(1.0 - alpha.clamp(0.0, 1.0)).ln()).min(MAX_LAYER_DEPTH);
+            let depth = layer_depth(alpha);
             let axis = u.face.axis();
             let [ua, va] = voxel_mesh::UV_AXES[axis];
             let mut min = u.pos.map(f64::from);
@@ -106,8 +107,8 @@ impl MeshLayers {
 
 /// Fits the weight to the meshes in `layers` seen through `view_proj` (camera-relative:
 /// the eye at the origin) from `eye`, with the camera's `near` and `far` planes: the view
-/// depths the meshes span and, for each screen tile, the expected optical depth in front
-/// of [`PROFILE_LEN`] depths spaced evenly in log depth across them.
+/// depths the meshes span and, for each screen tile, the expected optical depth in front of
+/// [`PROFILE_LEN`] depths spaced evenly in log depth across them.
 pub fn fit<'a>(
     layers: impl IntoIterator<Item = &'a MeshLayers>,
     view_proj: Mat4,
@@ -165,7 +166,8 @@ pub fn fit<'a>(
 }
 
 /// The optical depth a ray through the plane's rectangle crosses (its optical area over
-/// its area) when the quads face the eye, else 0 (back faces are not drawn).
+/// its area) when the quads face the eye, else 0 (back faces are not drawn, but for the
+/// medium's, counted per pixel).
 fn crossed_optical_depth(plane: &Plane, eye: DVec3) -> f64 {
     let axis = plane.face.axis();
     if (eye[axis] > plane.lo[axis]) != plane.face.is_positive() || eye[axis] == plane.lo[axis] {
@@ -225,6 +227,13 @@ pub struct WeightFit {
 /// The most optical depth the fitted weight falls by: `e^−12`, 6·10⁻⁶ (the weight must
 /// stay above fp16's smallest numbers once times α·3000).
 pub const MAX_FITTED_DEPTH: f32 = 12.0;
+
+/// The optical depth `−ln(1 − α)` of one layer of opacity `alpha`, at most that of α 0.99
+/// (a fully opaque translucent block would otherwise hide everything behind it for the
+/// weight).
+pub fn layer_depth(alpha: f32) -> f64 {
+    (-f64::from(1.0 - alpha.clamp(0.0, 1.0)).ln()).min(MAX_LAYER_DEPTH)
+}
 
 impl WeightFit {
     /// The optical depth in front of view depth `d` at `screen` (0 to 1, y down):

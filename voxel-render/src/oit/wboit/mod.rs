@@ -38,7 +38,7 @@ use wgpu::util::DeviceExt;
 
 use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, FullscreenPipeline, Pass, Target};
+use crate::gpu::{self, ChunkPipeline, Depth, FullscreenPipeline, Pass, SidedPipeline, Target};
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -105,6 +105,11 @@ pub struct WboitParams {
     pub accum_scale: f32,
     /// Nearest and farthest view depth of the visible translucent chunks (fitted weight).
     pub depth_range: [f32; 2],
+    /// Optical depth of one layer of the eye's medium (fitted weight; 0 in air): it dims
+    /// every fragment behind the medium's surface at its pixel.
+    pub medium_depth: f32,
+    /// Padding (the table is 16-byte aligned).
+    pub _pad: [f32; 3],
     /// Per screen tile, the optical depth in front of log-spaced depths (fitted weight).
     pub optical_depth: [[f32; 4]; TABLE_VEC4S],
 }
@@ -139,7 +144,7 @@ pub fn accumulate_wgsl() -> String {
         .finish();
     [
         consts.as_str(),
-        crate::bindings::COMMON_WGSL,
+        &crate::bindings::common_wgsl(),
         include_str!("accumulate.wgsl"),
     ]
     .concat()
@@ -180,10 +185,10 @@ const REVEAL_CLEAR: wgpu::Color = wgpu::Color {
 
 #[derive(Debug)]
 enum Accumulate {
-    Mrt(wgpu::RenderPipeline),
+    Mrt(SidedPipeline),
     TwoPass {
-        accumulate: wgpu::RenderPipeline,
-        revealage: wgpu::RenderPipeline,
+        accumulate: SidedPipeline,
+        revealage: SidedPipeline,
     },
 }
 
@@ -271,7 +276,7 @@ impl TechniqueKind for Wboit {
                 depth: gpu::DepthMode::ReadOnly,
                 samples: 1,
             }
-            .build(device)
+            .build_sided(device)
         };
         let accumulate = if technique == Technique::WboitTwoPass {
             Accumulate::TwoPass {
@@ -396,6 +401,12 @@ impl TranslucentTechnique for Wboit {
             weight_fn: settings.weight.id(),
             accum_scale: accum_scale(&ctx.caps, settings),
             depth_range: [view.camera.near as f32, view.camera.far as f32],
+            medium_depth: view
+                .camera
+                .medium
+                .and_then(|b| self.block_opacity.get(b.index()))
+                .map_or(0.0, |&a| fit::layer_depth(a) as f32),
+            _pad: [0.0; 3],
             optical_depth: [[0.0; 4]; TABLE_VEC4S],
         };
         if let Some(fit) = &fit {
@@ -423,8 +434,8 @@ impl TranslucentTechnique for Wboit {
         let t = &self.targets;
         let (accum, reveal) = (&t.accumulation.view, &t.revealage.view);
         let depth = Depth::ReadOnly(&frame.depth.view);
-        let draw = |pass: &mut wgpu::RenderPass<'_>, pipeline| {
-            pass.set_pipeline(pipeline);
+        let draw = |pass: &mut wgpu::RenderPass<'_>, pipeline: &SidedPipeline| {
+            pass.set_pipeline(pipeline.get(frame.two_sided));
             pass.set_bind_group(2, &self.params_group, &[]);
             frame.draw_chunks(pass);
         };
@@ -501,6 +512,7 @@ mod tests {
                 field!(WboitParams, weight_fn),
                 field!(WboitParams, accum_scale),
                 field!(WboitParams, depth_range),
+                field!(WboitParams, medium_depth),
                 field!(WboitParams, optical_depth),
             ],
         );

@@ -1,0 +1,330 @@
+//! Translucent volumes seen from inside: under water, inside glass.
+//!
+//! **The model.** Along a view ray, a translucent block type counts once each time the ray
+//! passes through a volume of it. From outside, the ray meets the volume's entry face: a
+//! face seen from its front (the mesher emits every face of a translucent block toward air,
+//! cutout blocks and other translucent types; back faces are culled). From inside the
+//! volume that holds the eye (the camera's [`medium`](crate::Camera::medium)), the eye is
+//! already in it: that passage counts at its exit face, the first surface of the medium's
+//! type the ray meets, seen from behind. Later surfaces of the same type are entries (front
+//! faces, counted) and exits of other passages (back faces, not counted). Where the medium
+//! meets another translucent type, the crossing counts once, at the other type's entry face
+//! (the medium's face there carries the mesher's interface flag and does not count): the
+//! two faces lie at one depth, which depth peeling could not keep apart. With the eye in
+//! air nothing of this applies and every picture is what it was.
+//!
+//! **Fog.** Inside a medium, the way from the eye to the medium's first surface (or to the
+//! opaque surface behind it, whichever is nearer) is filled with fog of the block's colour,
+//! lit like a face turned to the sky: after `d` blocks the picture behind keeps
+//! `(1 − α)^(d / FOG_BLOCKS)` of its light, `α` the block's opacity. So 16 blocks of water
+//! (α 0.7) dim what lies behind as much as one water surface does. The fog goes over the
+//! composited picture, opaque and translucent alike, the same for every technique.
+//!
+//! **How.** With the eye inside a medium, a frame adds two passes: a depth pass over the
+//! visible translucent meshes that keeps, per pixel, the nearest surface of the medium's
+//! type (both sides) in front of the opaque depth; and the fog. The technique draws both
+//! sides of translucent faces (its two-sided pipeline variant) and each fragment asks
+//! `counts()` in `common.wgsl`: front faces count; a back face counts when it is of the
+//! medium's type, not an interface, and at exactly that first depth (positions are
+//! `@invariant`, so the depths are bit-identical). No quad is added: the cost is paid only
+//! under water.
+//!
+//! **Crossing a surface.** The near plane would cut away a translucent face closer to the
+//! eye than it (the surface the eye is passing through), so that a band of the picture
+//! lost it. [`guard`] shrinks the near plane for that frame until the face lies beyond the
+//! near plane's corners, and, when the eye is within [`crate::MIN_NEAR`] of the face, moves
+//! the eye that far off it, to the side its medium says it is on.
+
+use glam::DVec3;
+use voxel_core::{BlockId, BlockRegistry, CHUNK_SIZE, ChunkPos, RenderClass};
+
+use crate::bindings::SharedLayouts;
+use crate::chunks::{ChunkStore, MeshKind, Visible};
+use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
+use crate::timing::{GpuPass, Timer};
+use crate::{Camera, MIN_NEAR};
+
+/// Blocks of a medium that dim what lies behind as much as one layer of it.
+pub const FOG_BLOCKS: f64 = 16.0;
+
+/// What the renderer needs of a block type to treat it as a medium.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MediumLook {
+    /// Linear base colour.
+    pub color: [f32; 3],
+    /// Opacity of one layer.
+    pub opacity: f32,
+}
+
+/// The look of every translucent block type, by block id (`None`: not translucent).
+pub fn looks(registry: &BlockRegistry) -> Vec<Option<MediumLook>> {
+    let linear = |c: u8| {
+        let c = f32::from(c) / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    registry
+        .iter()
+        .map(|(_, def)| {
+            (def.class == RenderClass::Translucent).then(|| MediumLook {
+                color: def.color.map(linear),
+                opacity: def.opacity,
+            })
+        })
+        .collect()
+}
+
+/// The fog pass's uniform (`FogParams` in `medium.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FogParams {
+    /// Lit fog colour, linear.
+    pub color: [f32; 3],
+    /// Optical depth per block: `−ln(1 − α) / FOG_BLOCKS`.
+    pub density: f32,
+    /// `tan` of half the horizontal and vertical field of view.
+    pub tan_half: [f32; 2],
+    /// Near and far plane distances.
+    pub near_far: [f32; 2],
+    /// Render target size in pixels.
+    pub viewport: [f32; 2],
+    /// Padding.
+    pub _pad: [f32; 2],
+}
+
+/// The medium shaders: the boundary pass (after the shared chunk code) and the fog.
+pub fn boundary_wgsl() -> String {
+    crate::bindings::common_wgsl() + include_str!("shaders/medium_boundary.wgsl")
+}
+
+/// The fog pass's shader (after `fullscreen.wgsl`).
+pub const FOG_WGSL: &str = include_str!("shaders/medium_fog.wgsl");
+
+/// The pipelines of the two passes a frame inside a medium adds.
+#[derive(Debug)]
+pub struct MediumPass {
+    boundary: wgpu::RenderPipeline,
+    fog: wgpu::RenderPipeline,
+    /// Group 0 of the fog: the boundary depth and the parameters.
+    pub fog_layout: wgpu::BindGroupLayout,
+    /// The fog's parameters, written each frame inside a medium.
+    pub fog_params: wgpu::Buffer,
+}
+
+impl MediumPass {
+    /// Creates the pipelines.
+    pub fn new(device: &wgpu::Device, layouts: &SharedLayouts) -> Self {
+        let module = gpu::shader(device, "medium_boundary", &[&boundary_wgsl()]);
+        let groups = layouts.with(&[]);
+        // Both sides, nearest kept and written: the depth of the first surface.
+        let boundary = ChunkPipeline {
+            label: "medium_boundary",
+            module: &module,
+            fragment_entry: "fs_boundary",
+            groups: &groups,
+            targets: &[],
+            depth: DepthMode::Write,
+            samples: 1,
+        }
+        .build_two_sided(device);
+        let fog_layout = gpu::layout(
+            device,
+            "medium_fog_layout",
+            &[
+                gpu::texture_entry(0, wgpu::TextureSampleType::Depth),
+                gpu::buffer_entry(
+                    1,
+                    wgpu::ShaderStages::FRAGMENT,
+                    wgpu::BufferBindingType::Uniform,
+                ),
+            ],
+        );
+        let fog = FullscreenPipeline {
+            label: "medium_fog",
+            source: FOG_WGSL,
+            fragment_entry: "fs_fog",
+            groups: &[Some(&fog_layout)],
+            targets: &[gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
+            writes_depth: false,
+            constants: &[],
+        }
+        .build(device);
+        let fog_params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("medium_fog_params"),
+            size: std::mem::size_of::<FogParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self {
+            boundary,
+            fog,
+            fog_layout,
+            fog_params,
+        }
+    }
+
+    /// The fog's bind group over `boundary` (per render size).
+    pub fn fog_group(&self, device: &wgpu::Device, boundary: &Target) -> wgpu::BindGroup {
+        gpu::bind_group(
+            device,
+            "medium_fog",
+            &self.fog_layout,
+            &[
+                wgpu::BindingResource::TextureView(&boundary.view),
+                self.fog_params.as_entire_binding(),
+            ],
+        )
+    }
+
+    /// Writes into `boundary` the depth of the first surface of the medium (the frame's
+    /// `medium`) in front of `opaque_depth`, per pixel. `scene` is group 0 without the
+    /// boundary in it (the pass writes it).
+    #[allow(clippy::too_many_arguments)]
+    pub fn boundary_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        opaque_depth: &Target,
+        boundary: &Target,
+        scene: &wgpu::BindGroup,
+        chunks: &[Visible<'_>],
+        timer: Option<&Timer>,
+    ) {
+        let opaque = &opaque_depth.texture;
+        encoder.copy_texture_to_texture(
+            opaque.as_image_copy(),
+            boundary.texture.as_image_copy(),
+            opaque.size(),
+        );
+        Pass::new("medium_boundary", GpuPass::Medium, &[])
+            .depth(Depth::Load(&boundary.view))
+            .record(encoder, timer, |pass| {
+                pass.set_pipeline(&self.boundary);
+                pass.set_bind_group(0, scene, &[]);
+                for c in chunks {
+                    c.mesh.draw(pass);
+                }
+            });
+    }
+
+    /// Blends the fog over `target` along the way to the boundary.
+    pub fn fog_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &Target,
+        fog_group: &wgpu::BindGroup,
+        timer: Option<&Timer>,
+    ) {
+        let colors = [gpu::load(&target.view)];
+        Pass::new("medium_fog", GpuPass::Medium, &colors).record(encoder, timer, |pass| {
+            pass.set_pipeline(&self.fog);
+            pass.set_bind_group(0, fog_group, &[]);
+            pass.draw(0..3, 0..1);
+        });
+    }
+}
+
+/// The fog of `look` seen with `camera` (already guarded) at `aspect`, lit by `sun` and
+/// `ambient` like a face turned to the sky.
+pub fn fog_params(
+    look: &MediumLook,
+    camera: &Camera,
+    aspect: f64,
+    viewport: [f32; 2],
+    light: f32,
+) -> FogParams {
+    let tan_y = (camera.fov_y_deg.to_radians() / 2.0).tan();
+    let transmit = f64::from(1.0 - look.opacity).max(1e-6);
+    FogParams {
+        color: look.color.map(|c| c * light),
+        density: (-transmit.ln() / FOG_BLOCKS) as f32,
+        tan_half: [(tan_y * aspect) as f32, tan_y as f32],
+        near_far: [camera.near as f32, camera.far as f32],
+        viewport,
+        _pad: [0.0; 2],
+    }
+}
+
+/// How far the corners of the near plane are from the eye, per unit of near distance.
+fn corner_factor(camera: &Camera, aspect: f64) -> f64 {
+    let t = (camera.fov_y_deg.to_radians() / 2.0).tan();
+    (1.0 + t * t * (1.0 + aspect * aspect)).sqrt()
+}
+
+/// The nearest translucent quad to `eye` within `reach`: its distance, its normal axis,
+/// the plane's coordinate and whether its block lies on the plane's low side.
+fn nearest_translucent(
+    chunks: &ChunkStore,
+    eye: DVec3,
+    reach: f64,
+) -> Option<(f64, usize, f64, bool, BlockId)> {
+    let s = CHUNK_SIZE as f64;
+    let lo = ((eye - reach) / s).floor();
+    let hi = ((eye + reach) / s).floor();
+    let mut best: Option<(f64, usize, f64, bool, BlockId)> = None;
+    for cx in lo.x as i64..=hi.x as i64 {
+        for cy in lo.y as i64..=hi.y as i64 {
+            for cz in lo.z as i64..=hi.z as i64 {
+                let [Ok(x), Ok(y), Ok(z)] = [cx, cy, cz].map(i32::try_from) else {
+                    continue;
+                };
+                let pos = ChunkPos::new(x, y, z);
+                let Some(chunk) = chunks.get(pos) else {
+                    continue;
+                };
+                if chunk.mesh(MeshKind::Translucent).is_none() {
+                    continue;
+                }
+                let o = pos.origin().map(|v| v as f64);
+                for q in chunk.translucent_quads() {
+                    let Some(u) = q.unpack() else { continue };
+                    let axis = u.face.axis();
+                    let [ua, va] = voxel_mesh::UV_AXES[axis];
+                    let mut min = u.pos.map(f64::from);
+                    if u.face.is_positive() {
+                        min[axis] += 1.0;
+                    }
+                    let mut max = min;
+                    max[ua] += f64::from(u.size[0]);
+                    max[va] += f64::from(u.size[1]);
+                    let (min, max) = (DVec3::from(min) + DVec3::from(o), DVec3::from(max) + DVec3::from(o));
+                    let d = (eye.clamp(min, max) - eye).length();
+                    if d <= reach && best.is_none_or(|b| d < b.0) {
+                        // A +face's block lies below its plane, a -face's above.
+                        best = Some((d, axis, min[axis], u.face.is_positive(), u.block));
+                    }
+                }
+            }
+        }
+    }
+    best
+}
+
+/// `camera` for this frame, kept from cutting away a translucent face with its near plane
+/// (see the module docs): the near plane shrunk until the nearest translucent face lies
+/// beyond its corners, and an eye within [`MIN_NEAR`] of that face moved off it to the side
+/// of its medium. Unchanged when no translucent face is that close.
+pub fn guard(camera: &Camera, aspect: f64, chunks: &ChunkStore) -> Camera {
+    let corner = corner_factor(camera, aspect);
+    let reach = camera.near * corner;
+    let Some((mut d, axis, plane, block_below, block)) =
+        nearest_translucent(chunks, camera.eye, reach)
+    else {
+        return *camera;
+    };
+    let mut c = *camera;
+    // The closest the eye may be to a face: twice the smallest near plane's corners.
+    let keep = 2.0 * MIN_NEAR * corner;
+    if d < keep {
+        // Which side of the plane: the block's when the eye is inside that block type,
+        // else the other.
+        let inside = camera.medium == Some(block);
+        let up = inside != block_below;
+        c.eye[axis] = plane + if up { keep } else { -keep };
+        d = nearest_translucent(chunks, c.eye, reach).map_or(reach, |n| n.0);
+    }
+    c.near = (0.5 * d / corner).clamp(MIN_NEAR, camera.near);
+    c
+}
