@@ -299,6 +299,54 @@ fn mesher_section(reg: &BlockRegistry, world: &World, cases: &[Case]) {
         "ratio block-mesh greedy_quads / ours = {:.1}x (target >= 10x)",
         bm_us / ours_us
     );
+    uniform_section(reg, ours_us);
+}
+
+/// Ours on uniform chunks: leaves (cutout, every inner face stays) alone and between six
+/// stone neighbours, and stone alone (borders only), next to the terrain figure.
+fn uniform_section(reg: &BlockRegistry, terrain_us: f64) {
+    const ROUNDS: usize = 41;
+    const REPS: usize = 200;
+    let mut ours = Mesher::new(reg);
+    let mut out = ChunkMeshes::default();
+    let leaves = Chunk::uniform(LEAVES);
+    let stone = Chunk::uniform(blocks::STONE);
+    let cases: [(&str, &Chunk, [Option<&Chunk>; 6]); 3] = [
+        ("uniform leaves, no neighbours", &leaves, [None; 6]),
+        (
+            "uniform leaves, six stone neighbours",
+            &leaves,
+            [Some(&stone); 6],
+        ),
+        ("uniform stone, no neighbours", &stone, [None; 6]),
+    ];
+    println!(
+        "\n## uniform chunks (ours, µs per chunk, median of {ROUNDS} rounds of {REPS}; terrain above {terrain_us:.1})"
+    );
+    for (name, chunk, nb) in cases {
+        ours.mesh_into(chunk, nb, &mut out).expect("known blocks");
+        let faces: u32 = [&out.opaque, &out.cutout, &out.translucent]
+            .into_iter()
+            .flatten()
+            .map(|q| q.area())
+            .sum();
+        let quads = out.len();
+        let mut times = Vec::new();
+        for _ in 0..ROUNDS {
+            let t = Instant::now();
+            for _ in 0..REPS {
+                ours.mesh_into(black_box(chunk), black_box(nb), &mut out)
+                    .expect("known blocks");
+                black_box(&out);
+            }
+            times.push(secs(t.elapsed()) / REPS as f64);
+        }
+        println!(
+            "{:<54}{:9.2}   {quads} quads, {faces} unit faces",
+            name,
+            median(times) * 1e6
+        );
+    }
 }
 
 fn storage_and_terrain_section(reg: &BlockRegistry, generator: &TerrainGenerator) {

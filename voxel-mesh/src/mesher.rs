@@ -19,6 +19,13 @@
 //! block type, so merged quads never mix blocks and no per-block comparison is needed. Cost
 //! grows with the number of block types in the chunk, which is small (4 to 9 on terrain).
 //!
+//! Shortcuts, each exact under the rules: an all-air chunk returns at once; an all-opaque
+//! chunk whose six neighbour layers are all opaque returns before any per-type work; a
+//! uniform opaque or translucent chunk hides its own inner faces, so only its six border
+//! layers are meshed. A uniform cutout chunk hides nothing: all 31 inner layers of each
+//! direction are full (one 32×32 quad each), and its border layers are meshed against the
+//! neighbours like any other.
+//!
 //! Greedy merging is applied to all three meshes. For cutout and translucent blocks it is
 //! as correct as for opaque ones: texture coordinates come from world position, so a merged
 //! quad shows the same texels as the unit faces it replaces, and coverage is identical. It
@@ -217,7 +224,10 @@ impl Mesher {
         }
         let full = |rows: &[u32]| rows.iter().all(|&r| r == u32::MAX);
         if full(&s.opaque.by_y) && s.nb_opaque.iter().all(|p| full(p)) {
-            return Ok(()); // fully enclosed: nothing can be seen
+            // Every block is opaque and so is every touching neighbour layer: each face is
+            // against an opaque block. Only an all-opaque chunk gets here; a chunk holding
+            // any cutout or translucent block (uniform leaves included) is meshed below.
+            return Ok(());
         }
 
         for (id, bits) in chunk.palette() {
@@ -248,14 +258,24 @@ impl Mesher {
             };
             let out = out.for_class(class);
             if chunk.as_uniform().is_some() {
-                // A uniform chunk hides all its inner faces: only its borders can show.
+                // One block type everywhere. An opaque or translucent type hides itself, so
+                // only the border layers can show. A cutout type hides nothing: every inner
+                // layer is all faces, one 32×32 quad per layer and direction, exactly what
+                // `mesh_type` would find, without its AND-NOTs and rectangle search.
                 for face in Face::ALL {
-                    let mut rows = nb_hide[face as usize].map(|h| !h);
                     let border = if face.is_positive() {
                         CHUNK_SIZE - 1
                     } else {
                         0
                     };
+                    if class == RenderClass::Cutout {
+                        for l in (0..CHUNK_SIZE).filter(|&l| l != border) {
+                            let mut pos = [0; 3];
+                            pos[face.axis()] = l;
+                            out.push(PackedQuad::new(pos, CHUNK_SIZE, CHUNK_SIZE, face, id));
+                        }
+                    }
+                    let mut rows = nb_hide[face as usize].map(|h| !h);
                     emit_plane(&mut rows, face, border, id, out);
                 }
             } else {
@@ -324,6 +344,7 @@ mod tests {
     use std::collections::BTreeSet;
 
     use super::*;
+    use voxel_core::BlockDef;
     use voxel_core::blocks::*;
 
     /// One visible block face: (block position, face, block), possibly outside the chunk
@@ -362,16 +383,91 @@ mod tests {
         set
     }
 
+    const VOLUME: usize = 32 * 32 * 32;
+
+    /// Every unit face of one chunk as a dense table: for each mesh (opaque, cutout,
+    /// translucent), face direction and block position, the block id plus one (0: no face).
+    /// Much faster to fill and compare than a set, so that the property test can afford
+    /// hundreds of chunks.
+    #[derive(PartialEq, Eq)]
+    struct FaceMap(Vec<u16>);
+
+    impl FaceMap {
+        fn new() -> Self {
+            Self(vec![0; 3 * 6 * VOLUME])
+        }
+
+        /// Records a face of `block`; false if that face was there already.
+        fn insert(&mut self, mesh: usize, face: usize, p: [usize; 3], block: BlockId) -> bool {
+            let slot = &mut self.0[(mesh * 6 + face) * VOLUME + (p[0] * 32 + p[1]) * 32 + p[2]];
+            let was = *slot;
+            *slot = block.0 + 1;
+            was == 0
+        }
+
+        /// Number of unit faces.
+        fn count(&self) -> usize {
+            self.0.iter().filter(|&&v| v != 0).count()
+        }
+
+        /// `None` when equal, else how many faces differ and the first of them.
+        fn diff(&self, want: &Self) -> Option<String> {
+            let mut bad = (0..self.0.len()).filter(|&i| self.0[i] != want.0[i]);
+            let i = bad.next()?;
+            let (mesh, face, p) = (i / (6 * VOLUME), i / VOLUME % 6, i % VOLUME);
+            Some(format!(
+                "{} unit faces differ; first: mesh {mesh} (0 opaque, 1 cutout, 2 translucent), \
+                 {:?} of block ({}, {}, {}): mesher has id+1 = {}, the rules {}",
+                bad.count() + 1,
+                Face::ALL[face],
+                p / 1024,
+                p / 32 % 32,
+                p % 32,
+                self.0[i],
+                want.0[i]
+            ))
+        }
+    }
+
+    /// The unit faces of the three meshes; panics on a face covered twice, or a quad that
+    /// leaves the chunk.
+    fn face_map(m: &ChunkMeshes) -> FaceMap {
+        let mut map = FaceMap::new();
+        for (k, quads) in [&m.opaque, &m.cutout, &m.translucent]
+            .into_iter()
+            .enumerate()
+        {
+            for q in quads {
+                let u = q.unpack().expect("valid quad");
+                let [ua, va] = crate::UV_AXES[u.face.axis()];
+                for i in 0..usize::from(u.size[0]) {
+                    for j in 0..usize::from(u.size[1]) {
+                        let mut p = u.pos.map(usize::from);
+                        p[ua] += i;
+                        p[va] += j;
+                        assert!(p.iter().all(|&c| c < 32), "quad {u:?} leaves the chunk");
+                        assert!(
+                            map.insert(k, u.face as usize, p, u.block),
+                            "face twice: {p:?} {u:?}"
+                        );
+                    }
+                }
+            }
+        }
+        map
+    }
+
     /// The face rules written the slow, obvious way, one block at a time.
-    fn naive(chunk: &Chunk, nb: Neighbours<'_>) -> [BTreeSet<UnitFace>; 3] {
-        let reg = registry();
+    fn naive(reg: &BlockRegistry, chunk: &Chunk, nb: Neighbours<'_>) -> FaceMap {
         let class = |id: BlockId| reg.class(id).expect("known");
+        let dense = chunk.to_dense();
+        let nb_dense = nb.map(|c| c.map(Chunk::to_dense));
         let get = |p: [i64; 3]| -> BlockId {
             let inside = |v: i64| (0..32).contains(&v);
+            let wrap = p.map(|v| v.rem_euclid(32) as usize);
+            let at = |d: &[BlockId]| d[Chunk::dense_index(wrap[0], wrap[1], wrap[2])];
             if p.iter().all(|&v| inside(v)) {
-                return chunk
-                    .get(p[0] as usize, p[1] as usize, p[2] as usize)
-                    .unwrap();
+                return at(&dense);
             }
             let face = Face::ALL
                 .into_iter()
@@ -380,14 +476,13 @@ mod tests {
                     if f.is_positive() { v == 32 } else { v == -1 }
                 })
                 .expect("one step outside");
-            let wrap = p.map(|v| v.rem_euclid(32) as usize);
-            nb[face as usize].map_or(AIR, |c| c.get(wrap[0], wrap[1], wrap[2]).unwrap())
+            nb_dense[face as usize].as_deref().map_or(AIR, at)
         };
-        let mut out: [BTreeSet<UnitFace>; 3] = Default::default();
+        let mut out = FaceMap::new();
         for x in 0..32 {
             for y in 0..32 {
                 for z in 0..32 {
-                    let a = chunk.get(x, y, z).unwrap();
+                    let a = dense[Chunk::dense_index(x, y, z)];
                     let ca = class(a);
                     if ca == RenderClass::Air {
                         continue;
@@ -407,7 +502,7 @@ mod tests {
                                 RenderClass::Translucent => 2,
                                 _ => 0,
                             };
-                            out[k].insert(([x, y, z], face as usize, a.0));
+                            out.insert(k, face as usize, [x, y, z], a);
                         }
                     }
                 }
@@ -416,12 +511,17 @@ mod tests {
         out
     }
 
-    fn faces_of(m: &ChunkMeshes) -> [BTreeSet<UnitFace>; 3] {
-        [
-            unit_faces(&m.opaque),
-            unit_faces(&m.cutout),
-            unit_faces(&m.translucent),
-        ]
+    /// Panics, saying `what` and where, unless `m` holds exactly the faces of the rules.
+    fn assert_rules(
+        m: &ChunkMeshes,
+        reg: &BlockRegistry,
+        chunk: &Chunk,
+        nb: Neighbours<'_>,
+        what: &str,
+    ) {
+        if let Some(d) = face_map(m).diff(&naive(reg, chunk, nb)) {
+            panic!("{what}: {d}");
+        }
     }
 
     fn has(m: &[PackedQuad], pos: [usize; 3], face: Face) -> bool {
@@ -554,7 +654,7 @@ mod tests {
             has(&m.translucent, [4, 31, 4], Face::PosY),
             "water against neighbour glass"
         );
-        assert_eq!(faces_of(&m), naive(&c, nb));
+        assert_rules(&m, &registry(), &c, nb, "borders");
     }
 
     #[test]
@@ -583,7 +683,7 @@ mod tests {
         let m = mesh(&water, nb);
         assert_eq!(m.translucent.len(), 1);
         assert_eq!(m.translucent[0].unpack().unwrap().face, Face::PosY);
-        assert_eq!(faces_of(&m), naive(&water, nb));
+        assert_rules(&m, &registry(), &water, nb, "water");
         // A partly open neighbour layer: faces exactly where it is open.
         let mut holey = Chunk::uniform(STONE);
         holey.fill_box([0, 0, 3], [31, 0, 5], AIR).unwrap();
@@ -595,7 +695,7 @@ mod tests {
             Some(&stone),
             Some(&stone),
         ];
-        assert_eq!(faces_of(&mesh(&stone, nb)), naive(&stone, nb));
+        assert_rules(&mesh(&stone, nb), &registry(), &stone, nb, "holey");
         assert_eq!(unit_faces(&mesh(&stone, nb).opaque).len(), 32 * 3);
     }
 
@@ -635,50 +735,178 @@ mod tests {
     }
 
     #[test]
-    fn random_chunks_match_the_naive_rules_exactly() {
-        let mut s = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+    fn uniform_cutout_chunks_keep_every_inner_face() {
+        // Leaves hide nothing, leaves included (issue 10: the uniform shortcut kept only
+        // the borders, 6 quads alone and none between stone).
         let reg = registry();
-        let mut mesher = Mesher::new(&reg);
-        for round in 0..6 {
-            let mut chunks: Vec<Chunk> = Vec::new();
-            for _ in 0..7 {
-                let mut c = Chunk::default();
-                // Boxes of random blocks give runs to merge; single blocks give noise.
-                for _ in 0..(40 + round * 20) {
-                    let r = next();
-                    let id = BlockId((r % 13) as u16);
-                    let p = [(r >> 8) % 32, (r >> 16) % 32, (r >> 24) % 32].map(|v| v as usize);
-                    let e = [(r >> 32) % 9, (r >> 40) % 9, (r >> 48) % 9].map(|v| v as usize);
-                    let q = [0, 1, 2].map(|i| (p[i] + e[i]).min(31));
-                    c.fill_box(p, q, id).unwrap();
-                }
-                for _ in 0..2000 {
-                    let r = next();
-                    c.set(
-                        (r % 32) as usize,
-                        ((r >> 8) % 32) as usize,
-                        ((r >> 16) % 32) as usize,
-                        BlockId(((r >> 24) % 13) as u16),
-                    )
-                    .unwrap();
-                }
-                chunks.push(c);
-            }
-            let (center, nbs) = chunks.split_first().unwrap();
-            let nb: Neighbours<'_> = std::array::from_fn(|i| (i != round).then(|| &nbs[i]));
-            let m = mesher.mesh(center, nb).unwrap();
-            let faces = faces_of(&m);
-            assert!(
-                faces.iter().all(|f| f.len() > 100),
-                "all three meshes exercised"
-            );
-            assert_eq!(faces, naive(center, nb), "round {round}");
+        let leaves = Chunk::uniform(LEAVES);
+        let m = mesh(&leaves, NONE);
+        assert_eq!(face_map(&m).count(), 6 * 32 * 32 * 32);
+        assert_eq!((m.cutout.len(), m.len()), (6 * 32, 6 * 32));
+        assert_rules(&m, &reg, &leaves, NONE, "leaves alone");
+        // Between stone only the faces against the stone go.
+        let stone = Chunk::uniform(STONE);
+        let m = mesh(&leaves, [Some(&stone); 6]);
+        assert_eq!(face_map(&m).count(), 6 * 31 * 32 * 32);
+        assert_eq!((m.cutout.len(), m.len()), (6 * 31, 6 * 31));
+        assert_rules(&m, &reg, &leaves, [Some(&stone); 6], "leaves in stone");
+        // Leaves beside leaves, water and air: every face.
+        let water = Chunk::uniform(WATER);
+        let nb = [Some(&leaves), Some(&water), None, Some(&leaves), None, None];
+        assert_eq!(face_map(&mesh(&leaves, nb)).count(), 6 * 32 * 32 * 32);
+    }
+
+    /// Deterministic xorshift64 for the property test.
+    struct XorShift(u64);
+
+    impl XorShift {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
         }
+
+        fn below(&mut self, n: usize) -> usize {
+            (self.next() % n as u64) as usize
+        }
+
+        fn pick<T: Copy>(&mut self, v: &[T]) -> T {
+            v[self.below(v.len())]
+        }
+    }
+
+    /// What a chunk slot of a property-test case holds.
+    #[derive(Clone, Copy, Debug)]
+    enum Kind {
+        /// No chunk (a missing neighbour; counts as air).
+        Missing,
+        /// `Chunk::uniform(id)`.
+        Uniform(BlockId),
+        /// Several block types: see [`mixed_chunk`].
+        Mixed,
+    }
+
+    /// A chunk of at least two types from `ids`: a random base, random boxes (runs to
+    /// merge), then 1, 40 or 2000 random single blocks, from nearly uniform to noise; the
+    /// types come from a pool of two to four picks or from all of `ids`.
+    fn mixed_chunk(rng: &mut XorShift, ids: &[BlockId]) -> Chunk {
+        let pool: Vec<BlockId> = if rng.below(3) == 0 {
+            ids.to_vec()
+        } else {
+            (0..2 + rng.below(3)).map(|_| rng.pick(ids)).collect()
+        };
+        let mut c = Chunk::uniform(rng.pick(&pool));
+        for _ in 0..rng.below(30) {
+            let id = rng.pick(&pool);
+            let r = rng.next();
+            let p = [r % 32, (r >> 8) % 32, (r >> 16) % 32].map(|v| v as usize);
+            let e = [(r >> 32) % 12, (r >> 40) % 12, (r >> 48) % 12].map(|v| v as usize);
+            let q = [0, 1, 2].map(|i| (p[i] + e[i]).min(31));
+            c.fill_box(p, q, id).unwrap();
+        }
+        for _ in 0..rng.pick(&[1, 40, 2000]) {
+            let id = rng.pick(&pool);
+            let r = rng.next();
+            let p = [r % 32, (r >> 8) % 32, (r >> 16) % 32].map(|v| v as usize);
+            c.set(p[0], p[1], p[2], id).unwrap();
+        }
+        if let Some(u) = c.as_uniform() {
+            let other = ids.iter().copied().find(|&i| i != u).expect("two ids");
+            let r = rng.next();
+            c.set((r % 32) as usize, ((r >> 8) % 32) as usize, 0, other)
+                .unwrap();
+        }
+        assert!(c.as_uniform().is_none());
+        c
+    }
+
+    /// The property test: every unit face the mesher emits, and no other, is one the
+    /// one-block-at-a-time [`naive`] rules emit, on 264 chunks with their neighbours.
+    ///
+    /// Two registries: the default one (13 blocks, one cutout type) and one with two more
+    /// cutout types, two more translucent types and one more opaque type (18 blocks). For
+    /// each, the centre is in turn uniform of every block of the registry (air, every
+    /// opaque, every cutout, every translucent type) and then mixed (random boxes and
+    /// single blocks, from nearly uniform to noise); each centre meets eight neighbour
+    /// patterns: all missing, all uniform of random blocks, all uniform of the centre's
+    /// block, all uniform opaque (enclosed), all mixed, and three where each of the six
+    /// neighbours is independently missing, uniform of a random block or mixed. The test
+    /// checks that every centre class (air, opaque, cutout, translucent, mixed) met every
+    /// neighbour kind (missing, uniform air, opaque, cutout or translucent, mixed).
+    ///
+    /// The test this replaced drew only mixed centres, so it never met the uniform
+    /// shortcut, and missed that uniform cutout centres lost every inner face (issue 10).
+    #[test]
+    fn random_chunks_match_the_naive_rules_exactly() {
+        let mut extended = registry();
+        for def in [
+            BlockDef::cutout("vines", [40, 110, 30]),
+            BlockDef::cutout("autumn_leaves", [190, 90, 30]),
+            BlockDef::new("tinted_glass", [60, 50, 70], 0.6),
+            BlockDef::new("slime", [110, 200, 90], 0.85),
+            BlockDef::new("basalt", [50, 50, 55], 1.0),
+        ] {
+            extended.register(def).unwrap();
+        }
+        let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
+        let mut covered = BTreeSet::new();
+        let mut cases = 0;
+        for reg in [registry(), extended] {
+            let ids: Vec<BlockId> = reg.iter().map(|(id, _)| id).collect();
+            let class = |id| reg.class(id).unwrap();
+            let opaque: Vec<BlockId> = ids
+                .iter()
+                .copied()
+                .filter(|&id| class(id) == RenderClass::Opaque)
+                .collect();
+            let label = |k: Kind| match k {
+                Kind::Missing => "missing".to_owned(),
+                Kind::Uniform(id) => format!("uniform {:?}", class(id)),
+                Kind::Mixed => "mixed".to_owned(),
+            };
+            let mut mesher = Mesher::new(&reg);
+            let centres = ids.iter().map(|&id| Kind::Uniform(id));
+            for centre_kind in centres.chain([Kind::Mixed]) {
+                for pattern in 0..8 {
+                    let same = match centre_kind {
+                        Kind::Uniform(id) => id,
+                        _ => rng.pick(&ids),
+                    };
+                    let nb_kinds: [Kind; 6] = std::array::from_fn(|_| match pattern {
+                        0 => Kind::Missing,
+                        1 => Kind::Uniform(rng.pick(&ids)),
+                        2 => Kind::Uniform(same),
+                        3 => Kind::Uniform(rng.pick(&opaque)),
+                        4 => Kind::Mixed,
+                        _ => match rng.below(3) {
+                            0 => Kind::Missing,
+                            1 => Kind::Uniform(rng.pick(&ids)),
+                            _ => Kind::Mixed,
+                        },
+                    });
+                    let mut make = |k: Kind| match k {
+                        Kind::Missing => None,
+                        Kind::Uniform(id) => Some(Chunk::uniform(id)),
+                        Kind::Mixed => Some(mixed_chunk(&mut rng, &ids)),
+                    };
+                    let centre = make(centre_kind).expect("a centre");
+                    let nbs = nb_kinds.map(&mut make);
+                    let nb: Neighbours<'_> = std::array::from_fn(|i| nbs[i].as_ref());
+                    let m = mesher.mesh(&centre, nb).unwrap();
+                    let what = format!(
+                        "case {cases}: {} blocks, centre {centre_kind:?}, neighbours {nb_kinds:?}",
+                        reg.len()
+                    );
+                    assert_rules(&m, &reg, &centre, nb, &what);
+                    for k in nb_kinds {
+                        covered.insert((label(centre_kind), label(k)));
+                    }
+                    cases += 1;
+                }
+            }
+        }
+        assert_eq!(cases, (14 + 19) * 8);
+        assert_eq!(covered.len(), 5 * 6, "{covered:?}");
     }
 }
