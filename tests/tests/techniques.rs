@@ -282,24 +282,25 @@ fn new_chunks_fade_in_through_the_stipple_pattern() {
 fn failing_class_scenes() -> Vec<(Scene, bool)> {
     let floor = ([-40, -4, -40], [40, -4, 40], STONE);
     vec![
-        // A chunk-wide water surface with a small glass pillar standing on it, seen from
-        // just above the water in the same chunk (the example).
+        // A chunk-wide water surface with small glass objects just above it (touching, they
+        // would cut the surface into several quads), seen from above the water in the same
+        // chunk (the example).
         (
             scene(
                 "water_and_pillar",
                 box_world(&[
                     floor,
                     ([0, -3, 0], [31, 9, 31], WATER),
-                    ([20, 10, 16], [20, 13, 16], GLASS),
-                    ([8, 10, 24], [9, 11, 25], RED_GLASS),
+                    ([20, 11, 16], [20, 14, 16], GLASS),
+                    ([8, 11, 24], [9, 12, 25], RED_GLASS),
                 ]),
-                [16.5, 11.2, 16.5],
+                [16.5, 13.2, 16.5],
                 [22.0, 10.0, 17.0],
             ),
             true,
         ),
-        // A glass floor and a glass ceiling with coloured glass between them, the eye
-        // inside the room.
+        // A glass floor and a glass ceiling with coloured glass floating between them, the
+        // eye inside the room.
         (
             scene(
                 "floor_and_ceiling",
@@ -307,8 +308,8 @@ fn failing_class_scenes() -> Vec<(Scene, bool)> {
                     floor,
                     ([0, 2, 0], [31, 2, 31], GLASS),
                     ([0, 12, 0], [31, 12, 31], ICE),
-                    ([10, 3, 10], [11, 6, 11], BLUE_GLASS),
-                    ([18, 8, 6], [19, 11, 7], GREEN_GLASS),
+                    ([10, 4, 10], [11, 6, 11], BLUE_GLASS),
+                    ([18, 8, 6], [19, 10, 7], GREEN_GLASS),
                 ]),
                 [15.5, 7.5, 15.5],
                 [10.0, 3.0, 12.0],

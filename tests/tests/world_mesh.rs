@@ -96,13 +96,19 @@ fn border_edit_remeshes_both_chunks_and_matches_a_fresh_mesh() {
             "chunk {pos:?} differs from a fresh mesh"
         );
     }
-    // Glass against water across the border: both faces are there.
-    let glass_faces = meshes[0]
+    // Glass against water across the border: both faces are there, flagged as an
+    // interface.
+    let glass_faces: Vec<_> = meshes[0]
         .1
         .translucent
         .iter()
-        .filter(|q| q.block == u32::from(GLASS.0));
-    assert_eq!(glass_faces.count(), 6);
+        .filter(|q| q.unpack().is_some_and(|u| u.block == GLASS))
+        .collect();
+    assert_eq!(glass_faces.len(), 6);
+    let interfaces = glass_faces
+        .iter()
+        .filter(|q| q.flags() & voxel_mesh::FLAG_INTERFACE != 0);
+    assert_eq!(interfaces.count(), 1, "the face toward the water");
 }
 
 #[test]

@@ -17,7 +17,7 @@ mod world;
 
 pub use bits::greedy_rects;
 pub use mesher::{ChunkMeshes, Mesher, Neighbours};
-pub use quad::{PackedQuad, Quad, UV_AXES};
+pub use quad::{FLAG_INTERFACE, PackedQuad, Quad, UV_AXES};
 pub use world::{mesh_chunks, mesh_dirty};
 
 use voxel_core::BlockId;

@@ -5,7 +5,10 @@
 //! where its neighbour does not hide it.
 //! - An opaque neighbour hides every face.
 //! - A translucent block hides the faces of blocks of its own type (no water-water walls),
-//!   nothing else: water against glass keeps both faces.
+//!   nothing else: water against glass keeps both faces. A translucent face toward another
+//!   translucent type carries [`crate::FLAG_INTERFACE`] (quads never merge across it), so
+//!   that the renderer can tell, seen from inside a volume, where it meets air from where it
+//!   meets another translucent type.
 //! - Air and cutout blocks hide nothing, so cutout faces stay against air, translucent and
 //!   other cutout blocks, leaves against leaves included (the holes of one leaf block show
 //!   the leaves behind it, as in Minecraft's fancy leaves).
@@ -92,6 +95,18 @@ struct Scratch {
     hide: Occupancy,
     /// Opaque blocks of each neighbour's touching layer, in the plane layout of that face.
     nb_opaque: [Plane; 6],
+    /// The chunk's translucent blocks (all types), and each neighbour's touching layer of
+    /// them: where a translucent face is an interface.
+    translucent: Occupancy,
+    nb_translucent: [Plane; 6],
+}
+
+/// Where faces toward other translucent types are (inside the chunk and in the neighbours'
+/// touching layers), for the translucent types, which flag those faces.
+#[derive(Clone, Copy)]
+struct Split<'a> {
+    inside: &'a Occupancy,
+    neighbours: &'a [Plane; 6],
 }
 
 /// Meshes chunks against a block registry. Holds scratch memory: keep one per thread.
@@ -134,13 +149,15 @@ fn or_into(dst: &mut [u32], src: &[u32]) {
     dst.iter_mut().zip(src).for_each(|(d, s)| *d |= s);
 }
 
-/// Emits the rectangles covering the faces in `rows` (layer `layer` of `face`) as quads.
+/// Emits the rectangles covering the faces in `rows` (layer `layer` of `face`) as quads
+/// with `flags`.
 #[inline]
 fn emit_plane(
     rows: &mut Plane,
     face: Face,
     layer: usize,
     block: BlockId,
+    flags: u32,
     out: &mut Vec<PackedQuad>,
 ) {
     greedy_rects(rows, |r, h, b, w| {
@@ -149,8 +166,29 @@ fn emit_plane(
             1 => PackedQuad::new([b, layer, r], h, w, face, block),
             _ => PackedQuad::new([b, r, layer], w, h, face, block),
         };
-        out.push(q);
+        out.push(q.with_flags(flags));
     });
+}
+
+/// Emits the faces in `rows`: those whose neighbour (`next`, the same plane layout) is set
+/// in `interface` flagged, the others not.
+#[inline]
+fn emit_split(
+    rows: &mut Plane,
+    interface: Option<&Plane>,
+    face: Face,
+    layer: usize,
+    block: BlockId,
+    out: &mut Vec<PackedQuad>,
+) {
+    if let Some(next) = interface {
+        let mut flagged: Plane = std::array::from_fn(|r| rows[r] & next[r]);
+        if flagged.iter().any(|&r| r != 0) {
+            rows.iter_mut().zip(&flagged).for_each(|(r, f)| *r &= !f);
+            emit_plane(&mut flagged, face, layer, block, crate::FLAG_INTERFACE, out);
+        }
+    }
+    emit_plane(rows, face, layer, block, 0, out);
 }
 
 const EMPTY_OCCUPANCY: Occupancy = Occupancy {
@@ -167,6 +205,8 @@ impl Mesher {
                 opaque: EMPTY_OCCUPANCY,
                 hide: EMPTY_OCCUPANCY,
                 nb_opaque: [[0; CHUNK_SIZE]; 6],
+                translucent: EMPTY_OCCUPANCY,
+                nb_translucent: [[0; CHUNK_SIZE]; 6],
             }),
         }
     }
@@ -222,6 +262,27 @@ impl Mesher {
                 }
             }
         }
+        // Where translucent faces meet other translucent types (only when the chunk holds
+        // translucent blocks).
+        let is_translucent = |id: BlockId| classes[id.index()] == RenderClass::Translucent;
+        let any_translucent = chunk.palette().any(|(id, _)| is_translucent(id));
+        if any_translucent {
+            s.translucent.by_y.fill(0);
+            s.translucent.by_x.fill(0);
+            for (_, bits) in chunk.palette().filter(|(id, _)| is_translucent(*id)) {
+                or_into(&mut s.translucent.by_y, &bits.by_y);
+                or_into(&mut s.translucent.by_x, &bits.by_x);
+            }
+            for face in Face::ALL {
+                let plane = &mut s.nb_translucent[face as usize];
+                *plane = [0; CHUNK_SIZE];
+                if let Some(n) = neighbours[face as usize] {
+                    for (_, bits) in n.palette().filter(|(id, _)| is_translucent(*id)) {
+                        or_into(plane, &touching_layer(bits, face));
+                    }
+                }
+            }
+        }
         let full = |rows: &[u32]| rows.iter().all(|&r| r == u32::MAX);
         if full(&s.opaque.by_y) && s.nb_opaque.iter().all(|p| full(p)) {
             // Every block is opaque and so is every touching neighbour layer: each face is
@@ -256,6 +317,10 @@ impl Mesher {
             } else {
                 &s.opaque
             };
+            let split = (class == RenderClass::Translucent).then_some(Split {
+                inside: &s.translucent,
+                neighbours: &s.nb_translucent,
+            });
             let out = out.for_class(class);
             if chunk.as_uniform().is_some() {
                 // One block type everywhere. An opaque or translucent type hides itself, so
@@ -276,10 +341,11 @@ impl Mesher {
                         }
                     }
                     let mut rows = nb_hide[face as usize].map(|h| !h);
-                    emit_plane(&mut rows, face, border, id, out);
+                    let interface = split.map(|sp| &sp.neighbours[face as usize]);
+                    emit_split(&mut rows, interface, face, border, id, out);
                 }
             } else {
-                mesh_type(bits, hide, &nb_hide, id, out);
+                mesh_type(bits, hide, &nb_hide, split, id, out);
             }
         }
         Ok(())
@@ -287,20 +353,32 @@ impl Mesher {
 }
 
 /// Emits the visible faces of one block type, hidden where `hide` (inside the chunk) or
-/// `nb_hide` (the neighbours' touching layers) is set. Each face direction is the AND-NOT
-/// of a layer and the next one: x faces on vertical columns (slab x), y faces on rows along
-/// x (layer y), z faces on rows along x again (gathering rows z of every layer y).
+/// `nb_hide` (the neighbours' touching layers) is set, and flagged where `split` says they
+/// meet another translucent type. Each face direction is the AND-NOT of a layer and the
+/// next one: x faces on vertical columns (slab x), y faces on rows along x (layer y), z
+/// faces on rows along x again (gathering rows z of every layer y).
 fn mesh_type(
     m: &Occupancy,
     hide: &Occupancy,
     nb_hide: &[Plane; 6],
+    split: Option<Split<'_>>,
     id: BlockId,
     out: &mut Vec<PackedQuad>,
 ) {
     let empty = |rows: &Plane| rows.iter().all(|&r| r == 0);
-    for (mine, theirs, faces) in [
-        (&m.by_y, &hide.by_y, [Face::PosX, Face::NegX]),
-        (&m.by_x, &hide.by_x, [Face::PosY, Face::NegY]),
+    for (mine, theirs, inter, faces) in [
+        (
+            &m.by_y,
+            &hide.by_y,
+            split.map(|s| &s.inside.by_y),
+            [Face::PosX, Face::NegX],
+        ),
+        (
+            &m.by_x,
+            &hide.by_x,
+            split.map(|s| &s.inside.by_x),
+            [Face::PosY, Face::NegY],
+        ),
     ] {
         for i in 0..CHUNK_SIZE {
             let rows = layer(mine, i);
@@ -308,13 +386,14 @@ fn mesh_type(
                 continue;
             }
             for (face, next) in faces.into_iter().zip([i + 1, i.wrapping_sub(1)]) {
-                let next = if next < CHUNK_SIZE {
-                    layer(theirs, next)
+                let (next, interface) = if next < CHUNK_SIZE {
+                    (layer(theirs, next), inter.map(|t| layer(t, next)))
                 } else {
-                    &nb_hide[face as usize]
+                    let n = split.map(|s| &s.neighbours[face as usize]);
+                    (&nb_hide[face as usize], n)
                 };
                 let mut faces: Plane = std::array::from_fn(|r| rows[r] & !next[r]);
-                emit_plane(&mut faces, face, i, id, out);
+                emit_split(&mut faces, interface, face, i, id, out);
             }
         }
     }
@@ -334,7 +413,16 @@ fn mesh_type(
                 };
                 m.by_x[row_index(y, z)] & !h
             });
-            emit_plane(&mut faces, face, z, id, out);
+            let interface: Option<Plane> = split.map(|s| {
+                std::array::from_fn(|y| {
+                    if next < CHUNK_SIZE {
+                        s.inside.by_x[row_index(y, next)]
+                    } else {
+                        s.neighbours[face as usize][y]
+                    }
+                })
+            });
+            emit_split(&mut faces, interface.as_ref(), face, z, id, out);
         }
     }
 }
@@ -384,9 +472,12 @@ mod tests {
     }
 
     const VOLUME: usize = 32 * 32 * 32;
+    /// Marks an interface face in a [`FaceMap`] (the test registries have far fewer ids).
+    const INTERFACE_BIT: u16 = 1 << 15;
 
     /// Every unit face of one chunk as a dense table: for each mesh (opaque, cutout,
-    /// translucent), face direction and block position, the block id plus one (0: no face).
+    /// translucent), face direction and block position, the block id plus one (0: no face),
+    /// with [`INTERFACE_BIT`] set on a face flagged as an interface.
     /// Much faster to fill and compare than a set, so that the property test can afford
     /// hundreds of chunks.
     #[derive(PartialEq, Eq)]
@@ -397,11 +488,19 @@ mod tests {
             Self(vec![0; 3 * 6 * VOLUME])
         }
 
-        /// Records a face of `block`; false if that face was there already.
-        fn insert(&mut self, mesh: usize, face: usize, p: [usize; 3], block: BlockId) -> bool {
+        /// Records a face of `block` (an interface when `interface`); false if that face
+        /// was there already.
+        fn insert(
+            &mut self,
+            mesh: usize,
+            face: usize,
+            p: [usize; 3],
+            block: BlockId,
+            interface: bool,
+        ) -> bool {
             let slot = &mut self.0[(mesh * 6 + face) * VOLUME + (p[0] * 32 + p[1]) * 32 + p[2]];
             let was = *slot;
-            *slot = block.0 + 1;
+            *slot = (block.0 + 1) | if interface { INTERFACE_BIT } else { 0 };
             was == 0
         }
 
@@ -446,8 +545,9 @@ mod tests {
                         p[ua] += i;
                         p[va] += j;
                         assert!(p.iter().all(|&c| c < 32), "quad {u:?} leaves the chunk");
+                        let interface = q.flags() & crate::FLAG_INTERFACE != 0;
                         assert!(
-                            map.insert(k, u.face as usize, p, u.block),
+                            map.insert(k, u.face as usize, p, u.block, interface),
                             "face twice: {p:?} {u:?}"
                         );
                     }
@@ -502,7 +602,10 @@ mod tests {
                                 RenderClass::Translucent => 2,
                                 _ => 0,
                             };
-                            out.insert(k, face as usize, [x, y, z], a);
+                            // A translucent face toward another translucent type.
+                            let interface = ca == RenderClass::Translucent
+                                && class(b) == RenderClass::Translucent;
+                            out.insert(k, face as usize, [x, y, z], a, interface);
                         }
                     }
                 }

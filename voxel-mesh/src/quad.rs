@@ -11,7 +11,8 @@
 //!         bits 25..28  face     0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z (voxel_core::Face)
 //!         bits 28..32  0        reserved (ambient occlusion)
 //! word 1: bits  0..16  block    BlockId
-//!         bits 16..32  0        reserved (light)
+//!         bit  16      interface: a translucent face toward another translucent type
+//!         bits 17..32  0        reserved (light)
 //! ```
 //!
 //! The face's (U, V) axes are cyclic after the normal axis: +-x → (y, z), +-y → (z, x),
@@ -45,6 +46,11 @@ pub struct Quad {
     pub block: BlockId,
 }
 
+/// Quad flag (word 1, bit 16): a translucent face toward a block of another translucent
+/// type (the renderer counts such a face from behind differently; see
+/// `voxel_render::medium`).
+pub const FLAG_INTERFACE: u32 = 1;
+
 /// The (U, V) axes of faces along each normal axis.
 pub const UV_AXES: [[usize; 2]; 3] = [[1, 2], [2, 0], [0, 1]];
 
@@ -66,6 +72,21 @@ impl PackedQuad {
             geometry,
             block: u32::from(block.0),
         }
+    }
+
+    /// The same quad with `flags` (16 bits) in word 1's bits 16..32.
+    #[inline]
+    pub fn with_flags(self, flags: u32) -> Self {
+        Self {
+            block: (self.block & 0xffff) | flags << 16,
+            ..self
+        }
+    }
+
+    /// The flags in word 1's bits 16..32 ([`FLAG_INTERFACE`]).
+    #[inline]
+    pub fn flags(self) -> u32 {
+        self.block >> 16
     }
 
     /// Packs an unpacked quad.
@@ -147,6 +168,9 @@ mod tests {
                 assert_eq!(p.unpack(), Some(q));
                 assert_eq!(p.geometry >> 28, 0, "reserved bits stay zero");
                 assert_eq!(p.block >> 16, 0, "reserved bits stay zero");
+                let f = p.with_flags(FLAG_INTERFACE);
+                assert_eq!(f.flags(), FLAG_INTERFACE);
+                assert_eq!(f.unpack(), Some(q), "flags leave the fields alone");
                 assert_eq!(p.face_index(), face as usize);
                 assert_eq!(p.area(), u32::from(size[0]) * u32::from(size[1]));
             }

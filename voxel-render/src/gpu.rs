@@ -123,7 +123,11 @@ impl ChunkPipeline<'_> {
         }
     }
 
-    fn build_with(&self, device: &wgpu::Device, cull_mode: Option<wgpu::Face>) -> wgpu::RenderPipeline {
+    fn build_with(
+        &self,
+        device: &wgpu::Device,
+        cull_mode: Option<wgpu::Face>,
+    ) -> wgpu::RenderPipeline {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(self.label),
             bind_group_layouts: self.groups,

@@ -289,7 +289,10 @@ fn nearest_translucent(
                     let mut max = min;
                     max[ua] += f64::from(u.size[0]);
                     max[va] += f64::from(u.size[1]);
-                    let (min, max) = (DVec3::from(min) + DVec3::from(o), DVec3::from(max) + DVec3::from(o));
+                    let (min, max) = (
+                        DVec3::from(min) + DVec3::from(o),
+                        DVec3::from(max) + DVec3::from(o),
+                    );
                     let d = (eye.clamp(min, max) - eye).length();
                     if d <= reach && best.is_none_or(|b| d < b.0) {
                         // A +face's block lies below its plane, a -face's above.

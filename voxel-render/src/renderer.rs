@@ -16,11 +16,11 @@ use crate::bindings::{FrameUniforms, NO_MEDIUM, SharedLayouts, common_wgsl};
 use crate::chunks::{ChunkStore, Frustum, MeshKind, Visible};
 use crate::error::scoped;
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
+use crate::medium::{self, MediumLook, MediumPass};
 use crate::oit::{
     FrameView, OitConfig, OitManager, Setup, Technique, TechniqueReport, TranslucentFrame,
     WeightFunction,
 };
-use crate::medium::{self, MediumLook, MediumPass};
 use crate::textures::BlockTextures;
 use crate::timing::{GpuPass, GpuTimes, Timer};
 use crate::{Camera, DEPTH_FORMAT, Error, GpuContext, Result, SCENE_FORMAT};
