@@ -170,18 +170,22 @@ fn emit_plane(
     });
 }
 
-/// Emits the faces in `rows`: those whose neighbour (`next`, the same plane layout) is set
-/// in `interface` flagged, the others not.
+/// Emits the faces in `rows`: those whose neighbour is set in the plane `interface` gives
+/// (the same layout; asked only when there are faces) flagged, the others not.
 #[inline]
 fn emit_split(
     rows: &mut Plane,
-    interface: Option<&Plane>,
+    interface: Option<impl FnOnce() -> Plane>,
     face: Face,
     layer: usize,
     block: BlockId,
     out: &mut Vec<PackedQuad>,
 ) {
+    if rows.iter().all(|&r| r == 0) {
+        return;
+    }
     if let Some(next) = interface {
+        let next = next();
         let mut flagged: Plane = std::array::from_fn(|r| rows[r] & next[r]);
         if flagged.iter().any(|&r| r != 0) {
             rows.iter_mut().zip(&flagged).for_each(|(r, f)| *r &= !f);
@@ -262,11 +266,20 @@ impl Mesher {
                 }
             }
         }
-        // Where translucent faces meet other translucent types (only when the chunk holds
-        // translucent blocks).
+        // Where translucent faces meet other translucent types: only when the chunk and its
+        // neighbours hold two translucent types or more (terrain with water alone skips it).
         let is_translucent = |id: BlockId| classes[id.index()] == RenderClass::Translucent;
-        let any_translucent = chunk.palette().any(|(id, _)| is_translucent(id));
-        if any_translucent {
+        let mut types = neighbours
+            .iter()
+            .flatten()
+            .chain([&chunk])
+            .flat_map(|c| c.palette())
+            .map(|(id, _)| id)
+            .filter(|&id| is_translucent(id));
+        let interfaces = types
+            .next()
+            .is_some_and(|first| types.any(|id| id != first));
+        if interfaces {
             s.translucent.by_y.fill(0);
             s.translucent.by_x.fill(0);
             for (_, bits) in chunk.palette().filter(|(id, _)| is_translucent(*id)) {
@@ -317,7 +330,7 @@ impl Mesher {
             } else {
                 &s.opaque
             };
-            let split = (class == RenderClass::Translucent).then_some(Split {
+            let split = (interfaces && class == RenderClass::Translucent).then_some(Split {
                 inside: &s.translucent,
                 neighbours: &s.nb_translucent,
             });
@@ -341,7 +354,7 @@ impl Mesher {
                         }
                     }
                     let mut rows = nb_hide[face as usize].map(|h| !h);
-                    let interface = split.map(|sp| &sp.neighbours[face as usize]);
+                    let interface = split.map(|sp| || sp.neighbours[face as usize]);
                     emit_split(&mut rows, interface, face, border, id, out);
                 }
             } else {
@@ -386,13 +399,22 @@ fn mesh_type(
                 continue;
             }
             for (face, next) in faces.into_iter().zip([i + 1, i.wrapping_sub(1)]) {
-                let (next, interface) = if next < CHUNK_SIZE {
-                    (layer(theirs, next), inter.map(|t| layer(t, next)))
+                let inside = next < CHUNK_SIZE;
+                let hidden = if inside {
+                    layer(theirs, next)
                 } else {
-                    let n = split.map(|s| &s.neighbours[face as usize]);
-                    (&nb_hide[face as usize], n)
+                    &nb_hide[face as usize]
                 };
-                let mut faces: Plane = std::array::from_fn(|r| rows[r] & !next[r]);
+                let mut faces: Plane = std::array::from_fn(|r| rows[r] & !hidden[r]);
+                let interface = split.map(|s| {
+                    move || {
+                        if inside {
+                            inter.map_or([0; CHUNK_SIZE], |t| *layer(t, next))
+                        } else {
+                            s.neighbours[face as usize]
+                        }
+                    }
+                });
                 emit_split(&mut faces, interface, face, i, id, out);
             }
         }
@@ -413,16 +435,18 @@ fn mesh_type(
                 };
                 m.by_x[row_index(y, z)] & !h
             });
-            let interface: Option<Plane> = split.map(|s| {
-                std::array::from_fn(|y| {
-                    if next < CHUNK_SIZE {
-                        s.inside.by_x[row_index(y, next)]
-                    } else {
-                        s.neighbours[face as usize][y]
-                    }
-                })
+            let interface = split.map(|s| {
+                move || -> Plane {
+                    std::array::from_fn(|y| {
+                        if next < CHUNK_SIZE {
+                            s.inside.by_x[row_index(y, next)]
+                        } else {
+                            s.neighbours[face as usize][y]
+                        }
+                    })
+                }
             });
-            emit_split(&mut faces, interface.as_ref(), face, z, id, out);
+            emit_split(&mut faces, interface, face, z, id, out);
         }
     }
 }
