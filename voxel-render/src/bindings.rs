@@ -54,7 +54,7 @@ pub const NO_MEDIUM: u32 = u32::MAX;
 /// another translucent type (`FLAG_INTERFACE` in WGSL).
 pub const FLAG_INTERFACE: u32 = 1;
 
-/// Per-chunk uniforms (`ChunkInfo` in WGSL).
+/// A chunk's record in the records array, by slot (`ChunkInfo` in WGSL).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ChunkUniforms {
@@ -69,7 +69,7 @@ pub struct ChunkUniforms {
 pub struct SharedLayouts {
     /// Group 0: frame uniforms, block textures, sampler, the medium's boundary depth.
     pub scene: wgpu::BindGroupLayout,
-    /// Group 1: a chunk mesh's quads and the chunk uniform.
+    /// Group 1: a page of the quad arena and the chunk records.
     pub chunk: wgpu::BindGroupLayout,
 }
 
@@ -107,7 +107,7 @@ impl SharedLayouts {
             "chunk_layout",
             &[
                 buffer_entry(0, S::VERTEX, B::Storage { read_only: true }),
-                buffer_entry(1, S::VERTEX_FRAGMENT, B::Uniform),
+                buffer_entry(1, S::VERTEX, B::Storage { read_only: true }),
             ],
         );
         Self { scene, chunk }

@@ -67,6 +67,16 @@ impl Capabilities {
             .contains(wgpu::DownlevelFlags::INDEPENDENT_BLEND)
     }
 
+    /// Whether chunks can be drawn with `multi_draw_indirect` (indirect execution, and
+    /// indirect draws whose first instance is not zero).
+    pub fn indirect_draws(&self) -> bool {
+        self.downlevel
+            .contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION)
+            && self
+                .features
+                .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
+    }
+
     /// Whether fragment shaders may write storage buffers (the A-buffer reference).
     pub fn fragment_storage(&self) -> bool {
         self.downlevel
@@ -86,7 +96,8 @@ pub struct GpuContext {
 }
 
 /// Optional features the renderer uses when the adapter has them.
-pub const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY;
+pub const WANTED_FEATURES: wgpu::Features =
+    wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::INDIRECT_FIRST_INSTANCE);
 
 impl GpuContext {
     /// Wraps a device the embedding game already owns. `adapter` is the one it came from

@@ -7,10 +7,11 @@
 //!
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `camera`,
 //! `readback`, `timing` → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
-//! pipeline binds), `textures` → `chunks` → `medium` (translucent volumes seen from
+//! pipeline binds), `textures`, `arena` (the quad arena) → `chunks` → `medium` (translucent volumes seen from
 //! inside) → `oit` (techniques) → `renderer`. A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
+pub mod arena;
 mod bindings;
 mod camera;
 mod chunks;
@@ -28,7 +29,9 @@ mod wgsl_layout;
 
 pub use bindings::{ChunkUniforms, FrameUniforms, SharedLayouts};
 pub use camera::{Camera, MAX_FAR, MAX_FOV_DEG, MIN_FOV_DEG, MIN_NEAR, WORLD_EXTENT};
-pub use chunks::{ChunkStore, Frustum, GpuChunk, GpuMesh, MeshKind, Visible};
+pub use chunks::{
+    ChunkStore, DrawCommand, DrawList, DrawMode, FrameDraws, Frustum, GpuChunk, MeshKind, Visible,
+};
 pub use context::{Capabilities, GpuContext, WANTED_FEATURES, request_device};
 pub use error::{Error, Result};
 pub use oit::{
@@ -37,7 +40,7 @@ pub use oit::{
     TranslucentTechnique, WboitReport, WboitSettings, WeightFit, WeightFunction,
 };
 pub use readback::Image;
-pub use renderer::{FrameStats, Renderer, RendererConfig};
+pub use renderer::{ChunkMemory, FrameStats, Renderer, RendererConfig};
 pub use timing::{GpuPass, GpuTimes, Timer};
 
 /// Depth format of every pass: 32-bit float, reverse-Z (1 near, 0 far).

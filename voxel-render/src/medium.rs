@@ -39,7 +39,7 @@ use glam::DVec3;
 use voxel_core::{BlockId, BlockRegistry, CHUNK_SIZE, ChunkPos, RenderClass};
 
 use crate::bindings::SharedLayouts;
-use crate::chunks::{ChunkStore, MeshKind, Visible};
+use crate::chunks::{ChunkStore, DrawList, FrameDraws, MeshKind};
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
 use crate::timing::{GpuPass, Timer};
 use crate::{Camera, MIN_NEAR};
@@ -189,7 +189,8 @@ impl MediumPass {
         opaque_depth: &Target,
         boundary: &Target,
         scene: &wgpu::BindGroup,
-        chunks: &[Visible<'_>],
+        draws: &FrameDraws<'_>,
+        chunks: &DrawList,
         timer: Option<&Timer>,
     ) {
         let opaque = &opaque_depth.texture;
@@ -203,9 +204,7 @@ impl MediumPass {
             .record(encoder, timer, |pass| {
                 pass.set_pipeline(&self.boundary);
                 pass.set_bind_group(0, scene, &[]);
-                for c in chunks {
-                    c.mesh.draw(pass);
-                }
+                draws.draw(chunks, pass);
             });
     }
 

@@ -13,7 +13,9 @@ use voxel_mesh::ChunkMeshes;
 use wgpu::util::DeviceExt;
 
 use crate::bindings::{FrameUniforms, NO_MEDIUM, SharedLayouts, common_wgsl};
-use crate::chunks::{ChunkStore, Frustum, MeshKind, Visible};
+use crate::chunks::{
+    ChunkStore, DrawBuilder, DrawList, DrawMode, FrameDraws, Frustum, MeshKind, Visible,
+};
 use crate::error::scoped;
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
 use crate::medium::{self, MediumLook, MediumPass};
@@ -48,6 +50,10 @@ pub struct RendererConfig {
     pub ambient: f32,
     /// Sky colour (linear). Default a light blue.
     pub sky: [f32; 3],
+    /// How chunk meshes are drawn. Default: indirect (`multi_draw_indirect` per page and
+    /// pass), which costs the CPU next to nothing per chunk; adapters without indirect
+    /// first-instance draws fall back to one draw per mesh (logged).
+    pub draw: DrawMode,
     /// Frames over which a newly uploaded chunk fades in (screen-door dissolve of its
     /// opaque and cutout faces, alpha ramp of its translucent ones). Default 0: off, so
     /// that a picture depends only on the scene; the interactive demo turns it on.
@@ -65,6 +71,7 @@ impl Default for RendererConfig {
             sun_dir: [0.35, 0.85, 0.4],
             ambient: 0.45,
             sky: [0.45, 0.65, 0.9],
+            draw: DrawMode::Indirect,
             fade_in_frames: 0,
         }
     }
@@ -77,11 +84,29 @@ pub struct FrameStats {
     pub meshes_drawn: [usize; 3],
     /// Translucent quads drawn.
     pub translucent_quads: usize,
+    /// Draw calls recorded for the chunks of the opaque, cutout and translucent lists (once
+    /// each: a technique's extra passes repeat them).
+    pub draw_calls: usize,
     /// CPU time spent recording the frame, milliseconds (the technique's preparation
     /// included).
     pub cpu_ms: f64,
     /// What the technique did (its CPU time, sorting, layers, overflow, weight fit).
     pub technique: TechniqueReport,
+}
+
+/// GPU memory of the chunks ([`Renderer::chunk_memory`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ChunkMemory {
+    /// Bytes of the quad arena's pages.
+    pub arena_bytes: u64,
+    /// Of those, bytes holding quads (the rest is free room and fragmentation).
+    pub quad_bytes: u64,
+    /// Bytes of the chunk records (16 per slot, with room to grow).
+    pub record_bytes: u64,
+    /// Pages of the arena.
+    pub pages: usize,
+    /// Free ranges over all pages.
+    pub free_ranges: usize,
 }
 
 /// What group 0 binds, apart from the per-size medium boundary.
@@ -160,6 +185,12 @@ impl Renderer {
             log::warn!("4x MSAA is not supported for the scene formats: rendering without MSAA");
             config.msaa = false;
         }
+        if config.draw == DrawMode::Indirect && !ctx.caps.indirect_draws() {
+            log::warn!(
+                "no indirect draws with a first instance on this adapter: one draw per chunk mesh"
+            );
+            config.draw = DrawMode::PerChunk;
+        }
         scoped(&ctx.device, "creating the renderer", || {
             Self::create(ctx, registry, config)
         })?
@@ -205,7 +236,7 @@ impl Renderer {
         config_with(&mut config.oit, oit.config());
         Ok(Self {
             ctx: ctx.clone(),
-            chunks: ChunkStore::new(layouts.chunk.clone()),
+            chunks: ChunkStore::new(ctx, layouts.chunk.clone()),
             layouts,
             scene,
             opaque,
@@ -328,6 +359,29 @@ impl Renderer {
         config.wboit.weight = weight;
         // Only the weight changed: the configuration stays valid.
         let _ = self.set_oit_config(config);
+    }
+
+    /// Changes how chunk meshes are drawn; indirect draws stay off on an adapter without
+    /// them (logged at creation).
+    pub fn set_draw_mode(&mut self, mode: DrawMode) {
+        self.config.draw = if mode == DrawMode::Indirect && !self.ctx.caps.indirect_draws() {
+            DrawMode::PerChunk
+        } else {
+            mode
+        };
+    }
+
+    /// GPU bytes the chunks take: the quad arena (all pages, and the part holding quads)
+    /// and the chunk records.
+    pub fn chunk_memory(&self) -> ChunkMemory {
+        let (arena, records) = self.chunks.memory();
+        ChunkMemory {
+            arena_bytes: arena.bytes,
+            quad_bytes: arena.used_bytes,
+            record_bytes: records,
+            pages: arena.pages,
+            free_ranges: arena.fragments,
+        }
     }
 
     /// Changes how many frames new chunks take to fade in (0: no fade).
@@ -456,23 +510,16 @@ impl Renderer {
         let view_proj = camera.view_proj(aspect);
         let frustum = Frustum::new(view_proj, camera.eye);
 
-        // The technique's CPU work (it may reorder quads) comes before anything borrows
-        // the chunks for drawing. Translucent chunks are drawn farthest first, by the
-        // integer key that is exact for a grid of equal cubes (`voxel_mesh::order`).
+        // Translucent chunks are drawn farthest first, by the integer key that is exact
+        // for a grid of equal cubes (`voxel_mesh::order`).
         let eye = camera.eye.to_array();
-        let mut far_first: Vec<(ChunkPos, f64)> = self
-            .chunks
-            .visible(MeshKind::Translucent, &frustum)
-            .iter()
-            .map(|v| (v.pos, v.distance))
-            .collect();
-        far_first.sort_by_cached_key(|&(pos, _)| {
-            (
-                std::cmp::Reverse(voxel_mesh::order::chunk_order_key(pos, eye)),
-                pos,
-            )
+        let mut translucent = self.chunks.visible(MeshKind::Translucent, &frustum);
+        translucent.sort_by_cached_key(|v| {
+            let key = voxel_mesh::order::chunk_order_key(v.pos, eye);
+            (std::cmp::Reverse(key), v.pos)
         });
-        let positions: Vec<ChunkPos> = far_first.iter().map(|(p, _)| *p).collect();
+        // The technique's CPU work (it may reorder quads within their places).
+        let positions: Vec<ChunkPos> = translucent.iter().map(|v| v.pos).collect();
         let view = FrameView {
             camera,
             view_proj,
@@ -480,27 +527,45 @@ impl Renderer {
         };
         self.oit.prepare(&mut self.chunks, &view)?;
         self.write_frame_uniforms(camera, view_proj, medium.map(|(b, _)| b));
+        self.chunks.compact(&self.ctx, encoder);
 
-        let opaque = self.chunks.visible(MeshKind::Opaque, &frustum);
-        let cutout = self.chunks.visible(MeshKind::Cutout, &frustum);
-        let translucent: Vec<Visible<'_>> = far_first
-            .iter()
-            .filter_map(|&(pos, distance)| {
-                let mesh = self.chunks.get(pos)?.mesh(MeshKind::Translucent)?;
-                Some(Visible {
-                    pos,
-                    mesh,
-                    distance,
-                })
-            })
-            .collect();
+        // Opaque and cutout meshes front to back (early depth rejection), grouped by page.
+        let near_first = |mut v: Vec<Visible>| {
+            v.sort_by(|a, b| {
+                (a.mesh.page, a.distance)
+                    .partial_cmp(&(b.mesh.page, b.distance))
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            });
+            v
+        };
+        let mut builder = DrawBuilder::default();
+        let lists = [
+            builder.list(&near_first(self.chunks.visible(MeshKind::Opaque, &frustum))),
+            builder.list(&near_first(self.chunks.visible(MeshKind::Cutout, &frustum))),
+            builder.list(&translucent),
+        ];
+        self.chunks.upload_draws(&self.ctx, builder.commands());
+        let draws = FrameDraws {
+            store: &self.chunks,
+            commands: builder.commands(),
+            mode: self.config.draw,
+        };
+        let [opaque, cutout, translucent] = &lists;
+
         let timer = self.timer.as_ref();
         let t = &self.targets;
-        self.draw_opaque(encoder, &opaque, &cutout, timer);
+        self.draw_opaque(encoder, &draws, opaque, cutout, timer);
         if medium.is_some() {
             let scene = &t.boundary_scene_group;
-            self.medium
-                .boundary_pass(encoder, &t.depth, &t.boundary, scene, &translucent, timer);
+            self.medium.boundary_pass(
+                encoder,
+                &t.depth,
+                &t.boundary,
+                scene,
+                &draws,
+                translucent,
+                timer,
+            );
         }
         self.oit.render(
             encoder,
@@ -508,7 +573,8 @@ impl Renderer {
                 target: &t.color,
                 depth: &t.depth,
                 scene: &t.scene_group,
-                chunks: &translucent,
+                draws: &draws,
+                chunks: translucent,
                 timer,
                 two_sided: medium.is_some(),
             },
@@ -524,8 +590,9 @@ impl Renderer {
         }
         self.tonemap(encoder, output, timer);
         let stats = FrameStats {
-            meshes_drawn: [opaque.len(), cutout.len(), translucent.len()],
-            translucent_quads: translucent.iter().map(|v| v.mesh.quads() as usize).sum(),
+            meshes_drawn: lists.each_ref().map(DrawList::meshes),
+            translucent_quads: translucent.quads() as usize,
+            draw_calls: lists.iter().map(|l| l.calls(self.config.draw)).sum(),
             cpu_ms: 0.0,
             technique: TechniqueReport::default(),
         };
@@ -631,8 +698,9 @@ impl Renderer {
     fn draw_opaque(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        opaque: &[Visible<'_>],
-        cutout: &[Visible<'_>],
+        draws: &FrameDraws<'_>,
+        opaque: &DrawList,
+        cutout: &DrawList,
         timer: Option<&Timer>,
     ) {
         let t = &self.targets;
@@ -672,9 +740,7 @@ impl Renderer {
                 .record(encoder, timer, |pass| {
                     pass.set_pipeline(pipeline);
                     pass.set_bind_group(0, &t.scene_group, &[]);
-                    for v in list {
-                        v.mesh.draw(pass);
-                    }
+                    draws.draw(list, pass);
                 });
         }
         if let Some(group) = &t.depth_resolve_group {

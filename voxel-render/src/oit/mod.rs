@@ -23,7 +23,7 @@ use glam::Mat4;
 use voxel_core::ChunkPos;
 
 use crate::bindings::SharedLayouts;
-use crate::chunks::{ChunkStore, Visible};
+use crate::chunks::{ChunkStore, DrawList, FrameDraws};
 use crate::context::Capabilities;
 use crate::gpu::Target;
 use crate::timing::Timer;
@@ -252,8 +252,10 @@ pub struct TranslucentFrame<'a> {
     pub depth: &'a Target,
     /// Group 0: frame uniforms and block textures.
     pub scene: &'a wgpu::BindGroup,
+    /// The frame's draw commands.
+    pub draws: &'a FrameDraws<'a>,
     /// The visible translucent meshes, farthest first.
-    pub chunks: &'a [Visible<'a>],
+    pub chunks: &'a DrawList,
     /// Pass timing, when available.
     pub timer: Option<&'a Timer>,
     /// The eye is inside a translucent volume: draw both sides of translucent faces
@@ -266,9 +268,7 @@ impl TranslucentFrame<'_> {
     /// group 1 set here; the pipeline and groups from 2 on set by the caller).
     pub fn draw_chunks(&self, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_bind_group(0, self.scene, &[]);
-        for c in self.chunks {
-            c.mesh.draw(pass);
-        }
+        self.draws.draw(self.chunks, pass);
     }
 }
 

@@ -33,8 +33,10 @@ struct ChunkInfo {
 // eye's ray meets (or the opaque depth when nearer); see `medium.rs`.
 @group(0) @binding(3) var medium_boundary: texture_depth_2d;
 
+// Group 1: a page of the quad arena, and every chunk's record by slot (the instance
+// index of its draws).
 @group(1) @binding(0) var<storage, read> quads: array<vec2<u32>>;
-@group(1) @binding(1) var<uniform> chunk: ChunkInfo;
+@group(1) @binding(1) var<storage, read> chunks: array<ChunkInfo>;
 
 struct VsOut {
     // Invariant: the same quad gets bit-identical depths in every pipeline, which depth
@@ -48,6 +50,8 @@ struct VsOut {
     @location(3) view_depth: f32,
     // The quad's flags (word 1, bits 16-31).
     @location(4) @interpolate(flat) flags: u32,
+    // The chunk's opacity (fade-in), 1 when settled.
+    @location(5) @interpolate(flat) alpha: f32,
 };
 
 // Corners of the two triangles of a quad, counter-clockwise seen from the side the normal
@@ -66,10 +70,12 @@ const NORMALS = array<vec3<f32>, 6>(
     vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, -1.0),
 );
 
-// Expands vertex `vi` of the quad list: quad vi / 6, corner vi % 6.
+// Expands vertex `vi` of the page's quads (a draw starts at its mesh's first quad times
+// 6): quad vi / 6, corner vi % 6, of the chunk in slot `slot`.
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
+fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -> VsOut {
     let q = quads[vi / 6u];
+    let chunk = chunks[slot];
     let g = q.x;
     let face = min((g >> 25u) & 7u, 5u);
     let size = vec2<f32>(f32(((g >> 15u) & 31u) + 1u), f32(((g >> 20u) & 31u) + 1u));
@@ -96,6 +102,7 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
     out.uv = uv;
     out.block = q.y & 0xffffu;
     out.flags = q.y >> 16u;
+    out.alpha = chunk.alpha;
     out.face = face;
     // Reverse-Z perspective: clip.w is the view depth.
     out.view_depth = out.clip.w;
@@ -131,7 +138,7 @@ fn counts(in: VsOut, front: bool) -> bool {
 // 0 for a fragment that does not count.
 fn translucent_color(in: VsOut, front: bool) -> vec4<f32> {
     let a = albedo(in);
-    let alpha = select(0.0, clamp(a.a * chunk.alpha, 0.0, 1.0), counts(in, front));
+    let alpha = select(0.0, clamp(a.a * in.alpha, 0.0, 1.0), counts(in, front));
     return vec4<f32>(light(a.rgb, in.face), alpha);
 }
 
@@ -149,8 +156,8 @@ fn bayer_level(frag_xy: vec2<f32>, n: u32) -> f32 {
     return f32(level) / f32(n * n);
 }
 
-// Whether a fragment of a chunk fading in (chunk.alpha < 1) is still dissolved away: a
-// 4×4 screen door, so that kept pixels grow in as the chunk's alpha ramps up.
-fn faded_out(frag_xy: vec2<f32>) -> bool {
-    return chunk.alpha < 1.0 && chunk.alpha <= bayer_level(frag_xy, 4u);
+// Whether a fragment of a chunk fading in (alpha < 1) is still dissolved away: a 4×4
+// screen door, so that kept pixels grow in as the chunk's alpha ramps up.
+fn faded_out(in: VsOut) -> bool {
+    return in.alpha < 1.0 && in.alpha <= bayer_level(in.clip.xy, 4u);
 }

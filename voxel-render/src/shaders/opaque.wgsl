@@ -1,10 +1,10 @@
-// Opaque and cutout passes (appended to common.wgsl). A chunk fading in (chunk.alpha < 1)
+// Opaque and cutout passes (appended to common.wgsl). A chunk fading in (alpha < 1)
 // dissolves in through a screen door (`faded_out`).
 
 @fragment
 fn fs_opaque(in: VsOut) -> @location(0) vec4<f32> {
     let a = albedo(in);
-    if faded_out(in.clip.xy) {
+    if faded_out(in) {
         discard;
     }
     return vec4<f32>(light(a.rgb, in.face), 1.0);
@@ -16,7 +16,7 @@ const ALPHA_TEST: f32 = 0.5;
 @fragment
 fn fs_cutout(in: VsOut) -> @location(0) vec4<f32> {
     let a = albedo(in);
-    if a.a < ALPHA_TEST || faded_out(in.clip.xy) {
+    if a.a < ALPHA_TEST || faded_out(in) {
         discard;
     }
     return vec4<f32>(light(a.rgb, in.face), 1.0);

@@ -1,0 +1,380 @@
+//! One quad arena: every chunk mesh lives in a few large storage buffers (*pages*), each
+//! mesh a contiguous run of 8-byte quads, so that whole passes draw from one bind group
+//! with indirect draws instead of one buffer, bind group and draw call per mesh.
+//!
+//! Allocation is first fit over a free list kept in address order; freeing coalesces with
+//! the free neighbours. When no page has room, a new page is added, twice the size of the
+//! last (from [`FIRST_PAGE_QUADS`] up to the adapter's largest storage binding). Waste is
+//! measured, not assumed: [`QuadArena::stats`] reports the bytes held and the bytes in
+//! use. It stays bounded by compaction: [`QuadArena::compact`] moves the meshes of the
+//! emptiest page into the others (a GPU copy) and frees it, which the chunk store runs when
+//! more than half of the arena's bytes are free and a page would be freed.
+
+use std::collections::BTreeMap;
+
+use voxel_mesh::PackedQuad;
+
+/// Quads in the first page: 4 MiB.
+pub const FIRST_PAGE_QUADS: u32 = 1 << 19;
+/// Bytes of one quad.
+pub const QUAD_BYTES: u64 = std::mem::size_of::<PackedQuad>() as u64;
+
+/// A first-fit allocator over `0..capacity` units, with coalescing free lists.
+#[derive(Clone, Debug)]
+pub struct Allocator {
+    capacity: u32,
+    /// Free ranges: start → length, in address order, never adjacent (coalesced).
+    free: BTreeMap<u32, u32>,
+    used: u32,
+}
+
+impl Allocator {
+    /// An empty allocator of `capacity` units.
+    pub fn new(capacity: u32) -> Self {
+        let mut free = BTreeMap::new();
+        if capacity > 0 {
+            free.insert(0, capacity);
+        }
+        Self {
+            capacity,
+            free,
+            used: 0,
+        }
+    }
+
+    /// The lowest-addressed free range of at least `len` units, taken; `None` when no free
+    /// range is that long (or `len` is 0).
+    pub fn alloc(&mut self, len: u32) -> Option<u32> {
+        if len == 0 {
+            return None;
+        }
+        let (&start, &have) = self.free.iter().find(|(_, l)| **l >= len)?;
+        self.free.remove(&start);
+        if have > len {
+            self.free.insert(start + len, have - len);
+        }
+        self.used += len;
+        Some(start)
+    }
+
+    /// Gives back `len` units at `start` (a range [`Allocator::alloc`] returned).
+    pub fn free(&mut self, start: u32, len: u32) {
+        debug_assert!(start + len <= self.capacity);
+        self.used = self.used.saturating_sub(len);
+        let (mut start, mut len) = (start, len);
+        if let Some((&prev, &plen)) = self.free.range(..start).next_back()
+            && prev + plen == start
+        {
+            self.free.remove(&prev);
+            start = prev;
+            len += plen;
+        }
+        if let Some(&nlen) = self.free.get(&(start + len)) {
+            self.free.remove(&(start + len));
+            len += nlen;
+        }
+        self.free.insert(start, len);
+    }
+
+    /// Units in use.
+    pub fn used(&self) -> u32 {
+        self.used
+    }
+
+    /// Units in all.
+    pub fn capacity(&self) -> u32 {
+        self.capacity
+    }
+
+    /// The longest free range.
+    pub fn largest_free(&self) -> u32 {
+        self.free.values().copied().max().unwrap_or(0)
+    }
+
+    /// Number of free ranges (1 when nothing is fragmented).
+    pub fn fragments(&self) -> usize {
+        self.free.len()
+    }
+}
+
+/// Where a mesh lives: a page and a run of quads in it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Alloc {
+    /// The page.
+    pub page: u32,
+    /// First quad in the page.
+    pub offset: u32,
+    /// Number of quads.
+    pub quads: u32,
+}
+
+#[derive(Debug)]
+struct Page {
+    buffer: wgpu::Buffer,
+    alloc: Allocator,
+}
+
+/// What the arena holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ArenaStats {
+    /// Pages.
+    pub pages: usize,
+    /// Bytes of all pages.
+    pub bytes: u64,
+    /// Bytes holding quads.
+    pub used_bytes: u64,
+    /// Free ranges over all pages.
+    pub fragments: usize,
+}
+
+/// The pages and their allocators.
+#[derive(Debug)]
+pub struct QuadArena {
+    pages: Vec<Page>,
+    /// Largest page, in quads (the adapter's storage binding limit).
+    max_page_quads: u32,
+}
+
+impl QuadArena {
+    /// An empty arena whose pages may hold up to `max_binding` bytes.
+    pub fn new(max_binding: u64) -> Self {
+        Self {
+            pages: Vec::new(),
+            max_page_quads: (max_binding / QUAD_BYTES).min(u64::from(u32::MAX)) as u32,
+        }
+    }
+
+    /// Room for `quads` quads; adds a page when none has room. The page list grew when
+    /// the returned flag is true (bind groups over the pages must be remade).
+    pub fn alloc(&mut self, device: &wgpu::Device, quads: u32) -> Option<(Alloc, bool)> {
+        if quads == 0 || quads > self.max_page_quads {
+            return None;
+        }
+        for (i, p) in self.pages.iter_mut().enumerate() {
+            if let Some(offset) = p.alloc.alloc(quads) {
+                return Some((
+                    Alloc {
+                        page: i as u32,
+                        offset,
+                        quads,
+                    },
+                    false,
+                ));
+            }
+        }
+        let last = self
+            .pages
+            .last()
+            .map_or(FIRST_PAGE_QUADS / 2, |p| p.alloc.capacity());
+        let size = last
+            .saturating_mul(2)
+            .max(quads)
+            .max(FIRST_PAGE_QUADS)
+            .min(self.max_page_quads);
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("quad_arena_page"),
+            size: u64::from(size) * QUAD_BYTES,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let mut alloc = Allocator::new(size);
+        let offset = alloc.alloc(quads)?;
+        self.pages.push(Page { buffer, alloc });
+        Some((
+            Alloc {
+                page: self.pages.len() as u32 - 1,
+                offset,
+                quads,
+            },
+            true,
+        ))
+    }
+
+    /// Gives back a mesh's quads.
+    pub fn free(&mut self, a: Alloc) {
+        if let Some(p) = self.pages.get_mut(a.page as usize) {
+            p.alloc.free(a.offset, a.quads);
+        }
+    }
+
+    /// Writes `quads` into `a` (as many as both hold).
+    pub fn write(&self, queue: &wgpu::Queue, a: Alloc, quads: &[PackedQuad]) {
+        if let Some(p) = self.pages.get(a.page as usize) {
+            let n = quads.len().min(a.quads as usize);
+            queue.write_buffer(
+                &p.buffer,
+                u64::from(a.offset) * QUAD_BYTES,
+                bytemuck::cast_slice(&quads[..n]),
+            );
+        }
+    }
+
+    /// The buffer of page `i`.
+    pub fn page(&self, i: usize) -> Option<&wgpu::Buffer> {
+        self.pages.get(i).map(|p| &p.buffer)
+    }
+
+    /// Number of pages.
+    pub fn pages(&self) -> usize {
+        self.pages.len()
+    }
+
+    /// Bytes held and used.
+    pub fn stats(&self) -> ArenaStats {
+        ArenaStats {
+            pages: self.pages.len(),
+            bytes: self.pages.iter().map(|p| p.buffer.size()).sum(),
+            used_bytes: self
+                .pages
+                .iter()
+                .map(|p| u64::from(p.alloc.used()) * QUAD_BYTES)
+                .sum(),
+            fragments: self.pages.iter().map(|p| p.alloc.fragments()).sum(),
+        }
+    }
+
+    /// The page worth compacting away, if any: with more than one page and more than half
+    /// of the arena's bytes free, the page with the fewest quads in use, when the other
+    /// pages have room for them.
+    pub fn page_to_compact(&self) -> Option<u32> {
+        let s = self.stats();
+        if self.pages.len() < 2 || s.used_bytes * 2 >= s.bytes {
+            return None;
+        }
+        let (i, p) = self
+            .pages
+            .iter()
+            .enumerate()
+            .min_by_key(|(_, p)| p.alloc.used())?;
+        let room: u64 = self
+            .pages
+            .iter()
+            .enumerate()
+            .filter(|(j, _)| *j != i)
+            .map(|(_, q)| u64::from(q.alloc.capacity() - q.alloc.used()))
+            .sum();
+        (room >= u64::from(p.alloc.used()) * 2).then_some(i as u32)
+    }
+
+    /// Moves the meshes `moving` (all on page `page`) to other pages with GPU copies
+    /// recorded in `encoder`, then drops the page (the last page takes its index). Returns
+    /// each mesh's new place, in order, and the index change `(from, to)` of the page that
+    /// moved into the dropped one's slot, if any; `None` (nothing changed) when the other
+    /// pages lack room.
+    pub fn compact(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        page: u32,
+        moving: &[Alloc],
+    ) -> Option<(Vec<Alloc>, Option<(u32, u32)>)> {
+        let mut placed = Vec::with_capacity(moving.len());
+        for a in moving {
+            let target = self
+                .pages
+                .iter_mut()
+                .enumerate()
+                .filter(|(j, _)| *j as u32 != page)
+                .find_map(|(j, p)| p.alloc.alloc(a.quads).map(|o| (j, o)));
+            let Some((j, offset)) = target else {
+                // Undo what was placed so far.
+                for b in &placed {
+                    self.free(*b);
+                }
+                return None;
+            };
+            placed.push(Alloc {
+                page: j as u32,
+                offset,
+                quads: a.quads,
+            });
+        }
+        for (from, to) in moving.iter().zip(&placed) {
+            encoder.copy_buffer_to_buffer(
+                &self.pages[page as usize].buffer,
+                u64::from(from.offset) * QUAD_BYTES,
+                &self.pages[to.page as usize].buffer,
+                u64::from(to.offset) * QUAD_BYTES,
+                u64::from(from.quads) * QUAD_BYTES,
+            );
+        }
+        let last = self.pages.len() as u32 - 1;
+        self.pages.swap_remove(page as usize);
+        let renamed = (last != page).then_some((last, page));
+        if let Some((from, to)) = renamed {
+            for a in &mut placed {
+                if a.page == from {
+                    a.page = to;
+                }
+            }
+        }
+        Some((placed, renamed))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A tiny xorshift, so the test needs no dependency and runs the same every time.
+    fn rng(seed: u64) -> impl FnMut() -> u64 {
+        let mut s = seed;
+        move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        }
+    }
+
+    #[test]
+    fn first_fit_reuses_and_coalesces() {
+        let mut a = Allocator::new(100);
+        let x = a.alloc(30).unwrap();
+        let y = a.alloc(30).unwrap();
+        let z = a.alloc(30).unwrap();
+        assert_eq!((x, y, z), (0, 30, 60));
+        assert_eq!(a.alloc(20), None, "10 left");
+        a.free(y, 30);
+        assert_eq!(a.fragments(), 2);
+        assert_eq!(a.alloc(10), Some(30), "the first hole that fits");
+        a.free(30, 10);
+        a.free(x, 30);
+        assert_eq!(a.largest_free(), 60, "0..60 coalesced");
+        a.free(z, 30);
+        assert_eq!(a.fragments(), 1);
+        assert_eq!(a.used(), 0);
+        assert_eq!(a.alloc(100), Some(0));
+        assert_eq!(a.alloc(0), None);
+    }
+
+    #[test]
+    fn random_allocations_never_overlap_and_account_exactly() {
+        let mut next = rng(0x5eed_1234_5678_9abc);
+        let mut a = Allocator::new(10_000);
+        let mut live: Vec<(u32, u32)> = Vec::new();
+        for _ in 0..20_000 {
+            if live.is_empty() || next() % 3 != 0 {
+                let len = (next() % 200 + 1) as u32;
+                if let Some(s) = a.alloc(len) {
+                    assert!(
+                        live.iter().all(|&(t, l)| s + len <= t || t + l <= s),
+                        "overlap at {s}"
+                    );
+                    live.push((s, len));
+                }
+            } else {
+                let i = (next() as usize) % live.len();
+                let (s, l) = live.swap_remove(i);
+                a.free(s, l);
+            }
+            assert_eq!(a.used(), live.iter().map(|l| l.1).sum::<u32>());
+        }
+        for (s, l) in live.drain(..) {
+            a.free(s, l);
+        }
+        assert_eq!(a.fragments(), 1, "everything coalesced back");
+        assert_eq!(a.largest_free(), 10_000);
+    }
+}
