@@ -460,7 +460,7 @@ pub fn describe(w: &WhereItFails) -> String {
         })
         .collect();
     s += if one {
-        " has what few scenes have: "
+        " has these features, each rarer among the other scenes: "
     } else {
         " have more often than the rest: "
     };

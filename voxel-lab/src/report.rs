@@ -490,9 +490,10 @@ fn random_report(s: &mut String, summary: &Summary, d: &Distribution, opts: &Eva
             "every reference is exact".to_owned()
         } else {
             format!(
-                "{} are not (the exact methods disagree by more than {EXACT_AGREEMENT}/255, or the A-buffer capped \
+                "{} {} not (the exact methods disagree by more than {EXACT_AGREEMENT}/255, or the A-buffer capped \
                  pixels visibly): {}{}",
                 d.not_scored.len(),
+                if d.not_scored.len() == 1 { "is" } else { "are" },
                 d.not_scored
                     .iter()
                     .take(20)
