@@ -485,13 +485,16 @@ where
             .margin(8)
             .x_label_area_size(30)
             .y_label_area_size(40)
-            .build_cartesian_2d(0..n, 0.0..1.0)
+            .build_cartesian_2d((0..n).into_segmented(), 0.0..1.0)
             .map_err(err)?;
         chart
             .configure_mesh()
             .disable_x_mesh()
             .x_labels(bins.len().max(1))
-            .x_label_formatter(&|i| bins.get(*i as usize).cloned().unwrap_or_default())
+            .x_label_formatter(&|v| match v {
+                SegmentValue::CenterOf(i) => bins.get(*i as usize).cloned().unwrap_or_default(),
+                _ => String::new(),
+            })
             .y_labels(5)
             .y_label_formatter(&|v| format!("{:.0}%", v * 100.0))
             .x_desc(if i / cols == rows - 1 {
@@ -499,14 +502,20 @@ where
             } else {
                 ""
             })
-            .label_style(("sans-serif", 11))
+            .label_style(("sans-serif", 10))
             .draw()
             .map_err(err)?;
         let c = color(i);
         chart
             .draw_series(counts.iter().enumerate().map(|(b, v)| {
                 let b = b as i32;
-                Rectangle::new([(b, 0.0), (b + 1, *v as f64 / total)], c.filled())
+                Rectangle::new(
+                    [
+                        (SegmentValue::Exact(b), 0.0),
+                        (SegmentValue::Exact(b + 1), *v as f64 / total),
+                    ],
+                    c.filled(),
+                )
             }))
             .map_err(err)?;
     }
