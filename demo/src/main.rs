@@ -63,6 +63,29 @@ fn size(s: &str) -> Result<(u32, u32), String> {
     Ok((side(w)?, side(h)?))
 }
 
+/// A number of random scenes: 1 to [`voxel_lab::random::MAX_SCENES`].
+fn random_count(s: &str) -> Result<usize, String> {
+    let max = voxel_lab::random::MAX_SCENES;
+    let t = s.trim();
+    if !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit()) {
+        // Too many digits for a usize is still "too many", not "not a number".
+        return match t.parse::<usize>() {
+            Ok(n) => voxel_lab::random::RandomSet::new(n, 0).map(|r| r.count),
+            Err(_) => Err(voxel_lab::random::too_many(t)),
+        };
+    }
+    Err(format!(
+        "{s:?} is not a number of scenes: a whole number from 1 to {max}"
+    ))
+}
+
+/// A seed: any whole number from 0 to 2^64 - 1.
+fn random_seed(s: &str) -> Result<u64, String> {
+    s.trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a seed: a whole number from 0 to {}", u64::MAX))
+}
+
 fn technique(s: &str) -> Result<Technique, String> {
     Technique::from_name(s).map_err(|e| e.to_string())
 }
@@ -171,6 +194,15 @@ struct EvalArgs {
     /// Scene files or folders (default: the suite in scenes/).
     #[arg(long, num_args = 1..)]
     scenes: Vec<PathBuf>,
+    /// Random scenes instead of scene files: N scenes (1 to 100000) drawn from --seed;
+    /// writes distribution.json, scenes.json, worst/<technique>.toml and distribution
+    /// charts besides the usual files (no heat maps per scene).
+    #[arg(long, value_name = "N", value_parser = random_count, conflicts_with = "scenes", allow_negative_numbers = true)]
+    random: Option<usize>,
+    /// Seed of the random scenes (0 to 2^64-1; default 1): the same N and seed give the
+    /// same scenes on every machine.
+    #[arg(long, value_name = "S", value_parser = random_seed, requires = "random", allow_negative_numbers = true)]
+    seed: Option<u64>,
     /// Techniques: all, or a comma-separated list.
     #[arg(long, num_args = 1.., value_delimiter = ',', default_value = "all")]
     techniques: Vec<String>,
@@ -482,8 +514,16 @@ fn names<T: Copy>(
 /// charts, heat maps, stability sweeps and report.
 fn eval(a: EvalArgs) -> Result<(), String> {
     writable_dir(&a.out)?;
+    let random = a
+        .random
+        .map(|n| voxel_lab::random::RandomSet::new(n, a.seed.unwrap_or(1)))
+        .transpose()?;
     let opts = EvalOptions {
-        scenes: scene_paths(&a.scenes)?,
+        scenes: if random.is_some() {
+            Vec::new()
+        } else {
+            scene_paths(&a.scenes)?
+        },
         techniques: names(&a.techniques, &Technique::ALL, false, technique)
             .map_err(|e| format!("--techniques: {e}"))?,
         weights: names(&a.weights, &WeightFunction::ALL, true, weight)
@@ -500,12 +540,13 @@ fn eval(a: EvalArgs) -> Result<(), String> {
             .collect::<Vec<_>>()
             .join(" "),
         heatmap_width: a.heatmap_width,
+        random,
     };
     let ctx = headless::context()?;
     eprintln!(
         "adapter: {}; {} scenes x {} techniques + {} weights",
         ctx.caps.adapter_name,
-        opts.scenes.len(),
+        random.map_or(opts.scenes.len(), |r| r.count),
         opts.techniques.len(),
         opts.weights.len()
     );
@@ -577,6 +618,7 @@ fn showcase(a: ShowcaseArgs) -> Result<(), String> {
         sweep_points: 0,
         command: "demo showcase".into(),
         heatmap_width: Some(240),
+        random: None,
     };
     let summary = voxel_lab::evaluate(&ctx, &opts)?;
     println!(

@@ -112,3 +112,53 @@ fn help_comes_from_clap_for_every_command() {
         "{text}"
     );
 }
+
+#[test]
+fn bad_random_draws_are_refused_before_rendering() {
+    fails_saying(
+        &["eval", "--random", "0", "--out", "x"],
+        &["--random", "at least 1 scene"],
+    );
+    fails_saying(
+        &["eval", "--random", "100001", "--out", "x"],
+        &["--random", "100001", "at most 100000"],
+    );
+    fails_saying(
+        &["eval", "--random", "99999999999999999999999", "--out", "x"],
+        &[
+            "--random",
+            "99999999999999999999999 random scenes",
+            "at most 100000",
+        ],
+    );
+    fails_saying(
+        &["eval", "--random", "ten", "--out", "x"],
+        &["--random", "\"ten\"", "not a number of scenes"],
+    );
+    fails_saying(&["eval", "--random", "-3", "--out", "x"], &["--random"]);
+    fails_saying(
+        &["eval", "--random", "5", "--seed", "abc", "--out", "x"],
+        &["--seed", "\"abc\"", "not a seed"],
+    );
+    fails_saying(
+        &["eval", "--random", "5", "--seed", "-1", "--out", "x"],
+        &["--seed", "\"-1\"", "not a seed"],
+    );
+    fails_saying(
+        &[
+            "eval",
+            "--random",
+            "5",
+            "--seed",
+            "18446744073709551616",
+            "--out",
+            "x",
+        ],
+        &["--seed", "not a seed", "18446744073709551615"],
+    );
+    fails_saying(&["eval", "--seed", "3", "--out", "x"], &["--random"]);
+    fails_saying(
+        &["eval", "--random", "3", "--scenes", "scenes", "--out", "x"],
+        &["--random", "--scenes", "cannot be used with"],
+    );
+}

@@ -16,12 +16,14 @@ const RENDER: &[&str] = &[
 /// voxel-lab, bottom up: the model, then the runs, then the report (its lib.rs docs).
 const LAB: &[&str] = &[
     "progress",
+    "random",
     "summary",
     "metrics",
     "scene",
     "headless",
     "eval",
     "stability",
+    "distribution",
     "charts",
     "report",
 ];

@@ -30,6 +30,7 @@ fn small_eval_of_the_suite() {
         sweep_points: 2,
         command: "cargo test -p tests --test lab".into(),
         heatmap_width: Some(48),
+        random: None,
     };
 
     let summary = voxel_lab::evaluate(&ctx, &opts).unwrap();

@@ -357,6 +357,171 @@ where
     root.present().map_err(err)
 }
 
+/// A technique's spread: p10, median and p90 of its time (x) and of its error (y).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Spread {
+    /// Legend text.
+    pub name: String,
+    /// p10, p50, p90 of the x value.
+    pub x: [f64; 3],
+    /// p10, p50, p90 of the y value.
+    pub y: [f64; 3],
+}
+
+/// Speed against accuracy over a distribution of scenes: per technique a marker at the
+/// medians and bars (whiskers) from p10 to p90 of each. Log axes; FLIP below
+/// [`FLIP_FLOOR`] is drawn there. Writes `path.png` and `path.svg`.
+pub fn speed_vs_accuracy_spread(
+    path: &Path,
+    title: &str,
+    spreads: &[Spread],
+) -> Result<(), String> {
+    fonts();
+    spread_body(
+        BitMapBackend::new(&path.with_extension("png"), (1000, 640)).into_drawing_area(),
+        title,
+        spreads,
+    )?;
+    draw_svg(&path.with_extension("svg"), (1000, 640), |root| {
+        spread_body(root, title, spreads)
+    })
+}
+
+fn spread_body<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    spreads: &[Spread],
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let fy = |y: f64| y.max(FLIP_FLOOR);
+    let (x0, x1) = range(spreads.iter().flat_map(|s| s.x), true);
+    let (_, y1) = range(spreads.iter().flat_map(|s| s.y.map(fy)), true);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d((x0..x1).log_scale(), (FLIP_FLOOR / 1.5..y1).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("GPU ms per frame for the translucent work (log; bars p10 to p90, marker at the median)")
+        .y_desc("mean FLIP against the exact reference (log; 0 drawn at 1e-4)")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    for (i, s) in spreads.iter().enumerate() {
+        let c = color(i);
+        let (mx, my) = (s.x[1], fy(s.y[1]));
+        let style = c.stroke_width(3);
+        chart
+            .draw_series([
+                PathElement::new(vec![(s.x[0], my), (s.x[2], my)], style),
+                PathElement::new(vec![(mx, fy(s.y[0])), (mx, fy(s.y[2]))], style),
+            ])
+            .map_err(err)?;
+        chart
+            .draw_series([Circle::new((mx, my), 7, c.filled())])
+            .map_err(err)?
+            .label(s.name.clone())
+            .legend(move |(x, y)| Circle::new((x, y), 6, c.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)
+}
+
+/// Histograms as small multiples: one panel per series, one bar per bin (`bins` labels
+/// them), heights as shares of the series' total. Writes `path.png` and `path.svg`.
+pub fn histograms(
+    path: &Path,
+    title: &str,
+    bins: &[String],
+    series: &[(String, Vec<usize>)],
+) -> Result<(), String> {
+    fonts();
+    let cols = 3usize;
+    let rows = series.len().div_ceil(cols).max(1);
+    let size = (1100, 60 + 260 * rows as u32);
+    histogram_body(
+        BitMapBackend::new(&path.with_extension("png"), size).into_drawing_area(),
+        title,
+        bins,
+        series,
+        (rows, cols),
+    )?;
+    draw_svg(&path.with_extension("svg"), size, |root| {
+        histogram_body(root, title, bins, series, (rows, cols))
+    })
+}
+
+fn histogram_body<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    bins: &[String],
+    series: &[(String, Vec<usize>)],
+    (rows, cols): (usize, usize),
+) -> Result<(), String>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let root = root.titled(title, ("sans-serif", 22)).map_err(err)?;
+    let panels = root.split_evenly((rows, cols));
+    let n = bins.len().max(1) as i32;
+    for (i, ((name, counts), area)) in series.iter().zip(panels.iter()).enumerate() {
+        let total = counts.iter().sum::<usize>().max(1) as f64;
+        let mut chart = ChartBuilder::on(area)
+            .caption(name, ("sans-serif", 16))
+            .margin(8)
+            .x_label_area_size(30)
+            .y_label_area_size(40)
+            .build_cartesian_2d((0..n).into_segmented(), 0.0..1.0)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .x_labels(bins.len().max(1))
+            .x_label_formatter(&|v| match v {
+                SegmentValue::CenterOf(i) => bins.get(*i as usize).cloned().unwrap_or_default(),
+                _ => String::new(),
+            })
+            .y_labels(5)
+            .y_label_formatter(&|v| format!("{:.0}%", v * 100.0))
+            .x_desc(if i / cols == rows - 1 {
+                "largest error (1/255)"
+            } else {
+                ""
+            })
+            .label_style(("sans-serif", 10))
+            .draw()
+            .map_err(err)?;
+        let c = color(i);
+        chart
+            .draw_series(counts.iter().enumerate().map(|(b, v)| {
+                let b = b as i32;
+                Rectangle::new(
+                    [
+                        (SegmentValue::Exact(b), 0.0),
+                        (SegmentValue::Exact(b + 1), *v as f64 / total),
+                    ],
+                    c.filled(),
+                )
+            }))
+            .map_err(err)?;
+    }
+    root.present().map_err(err)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -386,6 +551,23 @@ mod tests {
             points: vec![(0.5, 0.1), (2.0, 0.05)],
         }];
         speed_vs_accuracy(&dir.join("sva"), "t", &s, &s).unwrap();
+        speed_vs_accuracy_spread(
+            &dir.join("spread"),
+            "t",
+            &[Spread {
+                name: "a".into(),
+                x: [0.5, 1.0, 2.0],
+                y: [0.0, 0.01, 0.1],
+            }],
+        )
+        .unwrap();
+        histograms(
+            &dir.join("hist"),
+            "t",
+            &["0".into(), "1".into()],
+            &[("a".into(), vec![3, 1]), ("b".into(), vec![0, 4])],
+        )
+        .unwrap();
         sweep(&dir.join("sweep"), "t", "x", true, &s).unwrap();
         bars(
             &dir.join("bars"),
@@ -401,6 +583,10 @@ mod tests {
             "sweep.svg",
             "bars.png",
             "bars.svg",
+            "spread.png",
+            "spread.svg",
+            "hist.png",
+            "hist.svg",
         ] {
             let len = std::fs::metadata(dir.join(f)).unwrap().len();
             assert!(len > 1000, "{f}: {len} bytes");

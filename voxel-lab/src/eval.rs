@@ -12,7 +12,9 @@ use crate::headless::{Offscreen, renderer_for};
 use crate::metrics::{self, Metrics, thumbnail};
 use crate::progress::Progress;
 use crate::scene::Scene;
-use crate::summary::{EXACT_AGREEMENT, EvalOptions, Record, ReferenceCheck, Summary};
+use crate::summary::{
+    EXACT_AGREEMENT, EvalOptions, Record, ReferenceCheck, SceneFeatures, Summary,
+};
 
 /// A renderer for measurements, sized `size`.
 pub fn make_renderer(
@@ -189,30 +191,35 @@ fn runs(opts: &EvalOptions) -> Vec<(String, OitConfig)> {
     runs
 }
 
-/// Measures every run of `opts` on the scene at `path` against its reference; saves the
-/// reference picture and one heat map per run under `out/heatmaps/`.
+/// Output size when neither the command nor the scene gives one.
+pub const DEFAULT_SIZE: (u32, u32) = (640, 360);
+
+/// Measures every run of `opts` on `scene` (named `stem`) against its reference; with
+/// `heatmaps`, saves the reference picture and one heat map per run under
+/// `out/heatmaps/`.
 fn scene_records(
     ctx: &GpuContext,
     opts: &EvalOptions,
-    path: &Path,
+    stem: &str,
+    scene: &Scene,
+    heatmaps: bool,
     progress: &mut Progress,
 ) -> Result<(Vec<Record>, ReferenceCheck), String> {
-    let stem = path
-        .file_stem()
-        .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
-    let scene = Scene::load(path)?;
-    let size = opts.size.or(scene.size).unwrap_or((640, 360));
-    let mut renderer = make_renderer(ctx, &scene, size)?;
+    let stem = stem.to_owned();
+    let size = opts.size.or(scene.size).unwrap_or(DEFAULT_SIZE);
+    let mut renderer = make_renderer(ctx, scene, size)?;
     let target = Offscreen::new(ctx, size.0, size.1);
     let camera = scene.cameras[0];
-    let heatmaps = opts.out.join("heatmaps");
+    let dir = opts.out.join("heatmaps");
 
     progress.step(&format!("{stem}: exact references"));
     let reference = reference(ctx, &mut renderer, &target, &camera, &stem)?;
-    save(
-        &thumbnail(&reference.image, opts.heatmap_width),
-        &heatmaps.join(format!("{stem}__reference.png")),
-    )?;
+    if heatmaps {
+        save(
+            &thumbnail(&reference.image, opts.heatmap_width),
+            &dir.join(format!("{stem}__reference.png")),
+        )?;
+    }
 
     let mut records = Vec::new();
     for (name, config) in runs(opts) {
@@ -227,8 +234,13 @@ fn scene_records(
             opts.frames,
         )?;
         let (metrics, heat) = metrics::compare(&reference.image, &m.image);
-        let file = format!("{stem}__{}.png", name.replace('/', "_"));
-        save(&thumbnail(&heat, opts.heatmap_width), &heatmaps.join(&file))?;
+        let heatmap = if heatmaps {
+            let file = format!("{stem}__{}.png", name.replace('/', "_"));
+            save(&thumbnail(&heat, opts.heatmap_width), &dir.join(&file))?;
+            format!("heatmaps/{file}")
+        } else {
+            String::new()
+        };
         let Metrics {
             rmse,
             psnr,
@@ -255,7 +267,9 @@ fn scene_records(
             lost_fragments: report.reference.map(|r| r.lost_fragments),
             capped_pixels: report.reference.map(|r| r.capped_pixels),
             reference_exact: reference.check.exact,
-            heatmap: format!("heatmaps/{file}"),
+            sort_cycles: report.sort.map(|s| s.cycles),
+            quads_in_cycles: report.sort.map(|s| s.quads_in_cycles),
+            heatmap,
         });
     }
     Ok((records, reference.check))
@@ -267,13 +281,39 @@ fn save(image: &Image, path: &Path) -> Result<(), String> {
 
 /// Measures every scene of `opts` with every technique against its reference.
 pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary, String> {
-    let dir = opts.out.join("heatmaps");
+    let dir = if opts.random.is_some() {
+        opts.out.clone()
+    } else {
+        opts.out.join("heatmaps")
+    };
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let mut progress = Progress::new(opts.scenes.len() * (runs(opts).len() + 1));
+    let count = opts.random.map_or(opts.scenes.len(), |r| r.count);
+    let mut progress = Progress::new(count * (runs(opts).len() + 1));
     let mut records = Vec::new();
     let mut checks = Vec::new();
-    for path in &opts.scenes {
-        let (r, check) = scene_records(ctx, opts, path, &mut progress)?;
+    let mut features = Vec::new();
+    for i in 0..count {
+        let (r, check) = match opts.random {
+            Some(set) => {
+                // Parsed from its text like a scene file, so that the text replays it.
+                let generated = set.scene(i, opts.size.unwrap_or(DEFAULT_SIZE));
+                let scene = crate::scene::parse(&generated.text)
+                    .map_err(|e| format!("{}:{e}", generated.name))?;
+                features.push(SceneFeatures {
+                    scene: generated.name.clone(),
+                    features: generated.features,
+                });
+                scene_records(ctx, opts, &generated.name, &scene, false, &mut progress)?
+            }
+            None => {
+                let path = &opts.scenes[i];
+                let stem = path
+                    .file_stem()
+                    .map_or("scene".into(), |s| s.to_string_lossy().into_owned());
+                let scene = Scene::load(path)?;
+                scene_records(ctx, opts, &stem, &scene, true, &mut progress)?
+            }
+        };
         if !check.exact {
             log::warn!(
                 "{}: the exact methods disagree by {}/255 (or the A-buffer capped pixels): its errors are not scored",
@@ -289,5 +329,6 @@ pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary, String
         adapter: ctx.caps.adapter_name.clone(),
         records,
         reference_checks: checks,
+        features,
     })
 }

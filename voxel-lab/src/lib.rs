@@ -3,17 +3,21 @@
 //! It has no window: the demo's window and the integration tests both build on it.
 //!
 //! Modules depend on each other one way:
-//! - the model: [`scene`], [`headless`], [`metrics`], [`summary`], [`progress`];
+//! - the model: [`progress`], [`random`] (random scenes as scene-file text), [`summary`],
+//!   [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the
 //!   reference), [`stability`] (sweeps and flicker);
-//! - the report, which reads what the runs produced: [`charts`], [`report`];
+//! - the report, which reads what the runs produced: [`distribution`] (errors over random
+//!   scenes, where each technique fails), [`charts`], [`report`];
 //! - [`evaluate`] here, which runs everything and writes every file.
 
 pub mod charts;
+pub mod distribution;
 pub mod eval;
 pub mod headless;
 pub mod metrics;
 pub mod progress;
+pub mod random;
 pub mod report;
 pub mod scene;
 pub mod stability;
@@ -34,7 +38,9 @@ pub fn chain(e: &dyn std::error::Error) -> String {
 
 /// Runs the evaluation `opts` asks for and writes every file into `opts.out`:
 /// `summary.json`, `reference_checks.json`, heat maps, the speed-against-accuracy chart,
-/// the stability sweeps (when asked) and `report.md`.
+/// the stability sweeps (when asked) and `report.md`. On random scenes
+/// ([`EvalOptions::random`]) no heat maps, but `distribution.json`, `scenes.json`,
+/// `worst/` and the distribution charts.
 pub fn evaluate(ctx: &voxel_render::GpuContext, opts: &EvalOptions) -> Result<Summary, String> {
     let out = &opts.out;
     let summary = eval::run_suite(ctx, opts)?;
@@ -43,7 +49,18 @@ pub fn evaluate(ctx: &voxel_render::GpuContext, opts: &EvalOptions) -> Result<Su
         &out.join("reference_checks.json"),
         &summary.reference_checks,
     )?;
-    report::chart(out, &summary, opts)?;
+    let distribution = opts
+        .random
+        .map(|set| (set, distribution::compute(&summary, set)));
+    match &distribution {
+        Some((set, d)) => {
+            summary::write_json(&out.join("distribution.json"), d)?;
+            summary::write_json(&out.join("scenes.json"), &d.scenes)?;
+            distribution::write_worst(out, *set, d, opts)?;
+            report::random_charts(out, &summary, d, opts)?;
+        }
+        None => report::chart(out, &summary, opts)?,
+    }
     let stability = if opts.stability {
         let st = stability::run(ctx, opts)?;
         report::stability_charts(out, &st)?;
@@ -51,6 +68,12 @@ pub fn evaluate(ctx: &voxel_render::GpuContext, opts: &EvalOptions) -> Result<Su
     } else {
         None
     };
-    report::write(out, &summary, stability.as_ref(), opts)?;
+    report::write(
+        out,
+        &summary,
+        distribution.as_ref().map(|(_, d)| d),
+        stability.as_ref(),
+        opts,
+    )?;
     Ok(summary)
 }

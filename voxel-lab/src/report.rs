@@ -3,9 +3,10 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::charts::{self, Series};
+use crate::charts::{self, Series, Spread};
+use crate::distribution::{self, Distribution, ERROR_BINS, bin_label};
 use crate::stability::Stability;
-use crate::summary::{EvalOptions, Record, Summary, is_real_time};
+use crate::summary::{EXACT_AGREEMENT, EvalOptions, Record, Summary, is_real_time};
 
 fn ms(v: Option<f64>) -> String {
     v.map_or("n/a".into(), |v| format!("{v:.3}"))
@@ -42,6 +43,10 @@ fn ranking<'a>(summary: &'a Summary, scene: &str) -> Vec<&'a Record> {
 /// The speed-against-accuracy chart. `opaque-only` (draws no translucency, costs nothing)
 /// stays out of it.
 pub fn chart(out: &Path, summary: &Summary, opts: &EvalOptions) -> Result<(), String> {
+    chart_to(&out.join("speed_vs_accuracy"), summary, opts)
+}
+
+fn chart_to(path: &Path, summary: &Summary, opts: &EvalOptions) -> Result<(), String> {
     let names: Vec<String> = summary
         .main_techniques()
         .into_iter()
@@ -75,14 +80,64 @@ pub fn chart(out: &Path, summary: &Summary, opts: &EvalOptions) -> Result<(), St
         .collect();
     let (w, h) = opts.size.unwrap_or((640, 360));
     charts::speed_vs_accuracy(
-        &out.join("speed_vs_accuracy"),
+        path,
         &format!(
             "Speed vs accuracy, {} scenes, {w}x{h}, {}",
-            opts.scenes.len(),
+            summary.reference_checks.len(),
             summary.adapter
         ),
         &per_scene,
         &means,
+    )
+}
+
+/// The charts of a random evaluation: `speed_vs_accuracy` (per technique the p10–p90
+/// range of time and of error around the medians), `speed_vs_accuracy_scenes` (every
+/// scene a point) and `max_abs_err_histogram` (small multiples).
+pub fn random_charts(
+    out: &Path,
+    summary: &Summary,
+    dist: &Distribution,
+    opts: &EvalOptions,
+) -> Result<(), String> {
+    let main = summary.main_techniques();
+    let spreads: Vec<Spread> = dist
+        .techniques
+        .iter()
+        .filter(|t| main.contains(&t.technique) && t.technique != "opaque-only")
+        .filter_map(|t| {
+            let g = t.gpu_ms?;
+            Some(Spread {
+                name: t.technique.clone(),
+                x: [g.p10, g.p50, g.p90],
+                y: [t.flip_mean.p10, t.flip_mean.p50, t.flip_mean.p90],
+            })
+        })
+        .collect();
+    charts::speed_vs_accuracy_spread(
+        &out.join("speed_vs_accuracy"),
+        &format!(
+            "Speed vs accuracy, {} random scenes (seed {}), {}x{}, {}",
+            dist.count, dist.seed, dist.width, dist.height, summary.adapter
+        ),
+        &spreads,
+    )?;
+    chart_to(&out.join("speed_vs_accuracy_scenes"), summary, opts)?;
+    let bins: Vec<String> = (0..ERROR_BINS.len()).map(bin_label).collect();
+    let series: Vec<(String, Vec<usize>)> = dist
+        .techniques
+        .iter()
+        .filter(|t| main.contains(&t.technique) && t.technique != "reference")
+        .map(|t| (t.technique.clone(), t.histogram.clone()))
+        .collect();
+    charts::histograms(
+        &out.join("max_abs_err_histogram"),
+        &format!(
+            "Largest channel error per scene, share of the {} scored random scenes",
+            dist.scored
+        ),
+        &bins,
+        &series,
     )
 }
 
@@ -125,10 +180,19 @@ pub fn stability_charts(out: &Path, st: &Stability) -> Result<(), String> {
 pub fn write(
     out: &Path,
     summary: &Summary,
+    distribution: Option<&Distribution>,
     stability: Option<&Stability>,
     opts: &EvalOptions,
 ) -> Result<(), String> {
     let mut s = String::new();
+    if let Some(d) = distribution {
+        random_report(&mut s, summary, d, opts);
+        if let Some(st) = stability {
+            stability_section(&mut s, st);
+        }
+        return std::fs::write(out.join("report.md"), s)
+            .map_err(|e| format!("{}: {e}", out.display()));
+    }
     header(&mut s, summary, opts);
     suite_means(&mut s, summary);
     winners(&mut s, summary);
@@ -398,5 +462,197 @@ fn stability_section(s: &mut String, st: &Stability) {
             let _ = writeln!(s, "| {t} | {e:.3} |");
         }
         let _ = writeln!(s);
+    }
+}
+
+/// The report of a random evaluation: the distribution table, the charts, where each
+/// technique fails, the scenes' features, the worst scenes and the reference checks.
+fn random_report(s: &mut String, summary: &Summary, d: &Distribution, opts: &EvalOptions) {
+    let _ = writeln!(
+        s,
+        "# Transparency techniques on {} random scenes\n",
+        d.count
+    );
+    let _ = writeln!(
+        s,
+        "Made by `{}` on **{}**, {}×{} pixels, median of {} timed frames after {} warm-up frames: {} scenes drawn \
+         from seed {} by the lab's generator (`voxel_lab::random`), each parsed from its own scene file text.\n",
+        opts.command, summary.adapter, d.width, d.height, opts.frames, opts.warmup, d.count, d.seed
+    );
+    let _ = writeln!(
+        s,
+        "Errors are measured against the exact reference (an A-buffer), checked on every scene against the second exact \
+         method (peeling until a pass writes nothing). **{} of {} scenes are scored**; {}. Something translucent is in \
+         view in {} scenes: the reference equals `opaque-only` in {} ({:.1} %).\n",
+        d.scored,
+        d.count,
+        if d.not_scored.is_empty() {
+            "every reference is exact".to_owned()
+        } else {
+            format!(
+                "{} {} not (the exact methods disagree by more than {EXACT_AGREEMENT}/255, or the A-buffer capped \
+                 pixels visibly): {}{}",
+                d.not_scored.len(),
+                if d.not_scored.len() == 1 { "is" } else { "are" },
+                d.not_scored
+                    .iter()
+                    .take(20)
+                    .cloned()
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                if d.not_scored.len() > 20 { ", …" } else { "" }
+            )
+        },
+        d.count - d.translucent_not_in_view,
+        d.translucent_not_in_view,
+        d.translucent_not_in_view_share * 100.0
+    );
+    let _ = writeln!(s, "![speed against accuracy](speed_vs_accuracy.png)\n");
+    let _ = writeln!(s, "## Error distribution\n");
+    distribution_table(s, d, &summary.main_techniques());
+    let weights = summary.weight_runs();
+    if !weights.is_empty() {
+        let _ = writeln!(s, "\nThe same `wboit-mrt` pass with each WBOIT weight:\n");
+        distribution_table(s, d, &weights);
+    }
+    let _ = writeln!(
+        s,
+        "\nPercentiles are nearest-rank over the scored scenes; *exact* is the share of scenes within 1/255 on every \
+         pixel; GPU ms over the scenes where the technique drew something. Every technique's worst scene is in \
+         `worst/` ([below](#worst-scenes)).\n"
+    );
+    let _ = writeln!(s, "![largest error histogram](max_abs_err_histogram.png)\n");
+    let _ = writeln!(s, "## Where each technique fails\n");
+    let _ = writeln!(
+        s,
+        "For each technique, its worst decile of scenes (largest error, then highest mean FLIP; only scenes where it is \
+         off by more than 1/255) against all scored scenes: a feature is named when at least {:.0} % of the worst scenes have it and it \
+         is at least {} times as common among them as among all.\n",
+        distribution::MIN_WORST_SHARE * 100.0,
+        distribution::MIN_LIFT
+    );
+    for w in &d.where_it_fails {
+        let _ = writeln!(s, "### {}\n\n{}\n", w.technique, distribution::describe(w));
+    }
+    let _ = writeln!(s, "## The scenes\n");
+    let _ = writeln!(
+        s,
+        "What the {} scenes hold (the generator's design is in `voxel-lab/src/random.rs`; the last two rows are measured):\n",
+        d.count
+    );
+    let _ = writeln!(s, "| feature | scenes | share |\n|---|---|---|");
+    for f in &d.features {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.1} % |",
+            f.feature,
+            f.scenes,
+            f.share * 100.0
+        );
+    }
+    let _ = writeln!(s, "\n## Worst scenes\n");
+    let _ = writeln!(
+        s,
+        "Each file replays its scene exactly: `demo eval --scenes worst/<technique>.toml --frames {} --warmup {}` \
+         renders the same picture with the same error (heat maps included).\n",
+        opts.frames, opts.warmup
+    );
+    let _ = writeln!(
+        s,
+        "| technique | worst scene | FLIP | max err (1/255) | file |\n|---|---|---|---|---|"
+    );
+    for t in &d.techniques {
+        if t.technique == "reference" {
+            continue;
+        }
+        let file = distribution::worst_file(&t.technique);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.4} | {} | [{file}]({file}) |",
+            t.technique, t.worst_scene, t.worst_flip, t.worst_max_abs_err
+        );
+    }
+    let _ = writeln!(s, "\n## Reference cross-check\n");
+    let worst = summary
+        .reference_checks
+        .iter()
+        .max_by_key(|c| c.max_abs_err)
+        .map_or((String::new(), 0), |c| (c.scene.clone(), c.max_abs_err));
+    let capped = summary
+        .reference_checks
+        .iter()
+        .filter(|c| c.capped_visible_pixels > 0)
+        .count();
+    let lost: u64 = summary
+        .reference_checks
+        .iter()
+        .map(|c| c.lost_fragments)
+        .sum();
+    let _ = writeln!(
+        s,
+        "The exact methods differ by {}/255 at most ({}); the A-buffer lost {lost} fragments and capped pixels visibly \
+         in {capped} scenes. Depth complexity: up to {} layers.\n",
+        worst.1,
+        worst.0,
+        summary
+            .reference_checks
+            .iter()
+            .map(|c| c.depth_complexity)
+            .max()
+            .unwrap_or(0)
+    );
+    let bad: Vec<_> = summary
+        .reference_checks
+        .iter()
+        .filter(|c| !c.exact)
+        .collect();
+    if !bad.is_empty() {
+        let _ = writeln!(
+            s,
+            "| scene (not scored; in `worst/not-exact/`) | A-buffer vs peeling (1/255) | lost fragments | capped (visibly) | depth complexity |\n|---|---|---|---|---|"
+        );
+        for c in bad {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} ({}) | {} |",
+                c.scene,
+                c.max_abs_err,
+                c.lost_fragments,
+                c.capped_pixels,
+                c.capped_visible_pixels,
+                c.depth_complexity
+            );
+        }
+    }
+}
+
+/// The distribution table of `runs`.
+fn distribution_table(s: &mut String, d: &Distribution, runs: &[String]) {
+    let _ = writeln!(
+        s,
+        "| technique | scenes | FLIP p50 | p90 | p99 | max | max err p50 | p90 | p99 | max | exact | NaN px | GPU ms p50 (p10–p90) |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for t in d.techniques.iter().filter(|t| runs.contains(&t.technique)) {
+        let (f, e) = (t.flip_mean, t.max_abs_err);
+        let gpu = t.gpu_ms.map_or("n/a".to_owned(), |g| {
+            format!("{:.3} ({:.3}–{:.3})", g.p50, g.p10, g.p90)
+        });
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} | {} | {} | {} | {:.0} % | {} | {gpu} |",
+            t.technique,
+            t.n,
+            f.p50,
+            f.p90,
+            f.p99,
+            f.max,
+            e.p50,
+            e.p90,
+            e.p99,
+            e.max,
+            t.exact_share * 100.0,
+            t.nan_px
+        );
     }
 }

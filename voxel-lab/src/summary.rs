@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 use voxel_render::{Technique, WeightFunction};
 
+use crate::random::{Features, RandomSet};
+
 /// The two exact methods must agree within this many 1/255 levels on every channel for a
 /// scene's reference to count as exact (rounding of two different blend orders and of
 /// the A-buffer's half-float colours stays within it).
@@ -40,6 +42,10 @@ pub struct EvalOptions {
     /// Width of the saved heat maps and reference pictures (downscaled, to keep results
     /// small); `None`: full size.
     pub heatmap_width: Option<u32>,
+    /// Random scenes instead of `scenes` (`demo eval --random N --seed S`): no heat maps
+    /// per scene; `distribution.json`, `scenes.json`, `worst/` and the distribution
+    /// charts besides the usual files.
+    pub random: Option<RandomSet>,
 }
 
 /// One scene × technique measurement (the keys of `summary.json`).
@@ -81,7 +87,13 @@ pub struct Record {
     /// Whether the scene's reference is exact ([`ReferenceCheck::exact`]); the errors of
     /// a scene whose reference is not are not scored in means and charts.
     pub reference_exact: bool,
-    /// The FLIP heat map, relative to the output folder.
+    /// `sorted-quads`: cycles in the visible chunks' quad orders (groups of quads no
+    /// order draws exactly); 0 means its order is exact.
+    pub sort_cycles: Option<u32>,
+    /// `sorted-quads`: quads in those cycles.
+    pub quads_in_cycles: Option<u32>,
+    /// The FLIP heat map, relative to the output folder (empty when not saved: random
+    /// scenes save none).
     pub heatmap: String,
 }
 
@@ -114,6 +126,17 @@ pub struct Summary {
     pub records: Vec<Record>,
     /// The exact methods' agreement per scene.
     pub reference_checks: Vec<ReferenceCheck>,
+    /// Random scenes: what each holds, in scene order (empty for scene files).
+    pub features: Vec<SceneFeatures>,
+}
+
+/// What a random scene holds.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneFeatures {
+    /// Scene name (`random-SEED-INDEX`).
+    pub scene: String,
+    /// Its features.
+    pub features: Features,
 }
 
 /// A technique's means over the scenes whose reference is exact.
