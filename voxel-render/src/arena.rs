@@ -259,16 +259,14 @@ impl QuadArena {
     }
 
     /// Moves the meshes `moving` (all on page `page`) to other pages with GPU copies
-    /// recorded in `encoder`, then drops the page (the last page takes its index). Returns
-    /// each mesh's new place, in order, and the index change `(from, to)` of the page that
-    /// moved into the dropped one's slot, if any; `None` (nothing changed) when the other
-    /// pages lack room.
+    /// recorded in `encoder`, then drops the page (the last page takes its index). `None`
+    /// (nothing changed) when the other pages lack room.
     pub fn compact(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         page: u32,
         moving: &[Alloc],
-    ) -> Option<(Vec<Alloc>, Option<(u32, u32)>)> {
+    ) -> Option<Compacted> {
         let mut placed = Vec::with_capacity(moving.len());
         for a in moving {
             let target = self
@@ -309,8 +307,17 @@ impl QuadArena {
                 }
             }
         }
-        Some((placed, renamed))
+        Some(Compacted { placed, renamed })
     }
+}
+
+/// What [`QuadArena::compact`] did.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Compacted {
+    /// The new place of each mesh moved, in the order given.
+    pub placed: Vec<Alloc>,
+    /// The page that took the freed page's index: `(old index, new index)`.
+    pub renamed: Option<(u32, u32)>,
 }
 
 #[cfg(test)]
@@ -355,7 +362,7 @@ mod tests {
         let mut a = Allocator::new(10_000);
         let mut live: Vec<(u32, u32)> = Vec::new();
         for _ in 0..20_000 {
-            if live.is_empty() || next() % 3 != 0 {
+            if live.is_empty() || !next().is_multiple_of(3) {
                 let len = (next() % 200 + 1) as u32;
                 if let Some(s) = a.alloc(len) {
                     assert!(

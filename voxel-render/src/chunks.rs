@@ -351,10 +351,7 @@ impl ChunkStore {
                 s
             }
             None => {
-                let s = self
-                    .free_slots
-                    .pop()
-                    .unwrap_or_else(|| self.slots.len() as u32);
+                let s = self.free_slots.pop().unwrap_or(self.slots.len() as u32);
                 if s as usize == self.slots.len() {
                     self.slots.push(None);
                 }
@@ -516,7 +513,9 @@ impl ChunkStore {
             })
             .collect();
         let allocs: Vec<Alloc> = moving.iter().map(|m| m.2).collect();
-        let Some((placed, renamed)) = self.arena.compact(encoder, page, &allocs) else {
+        let Some(crate::arena::Compacted { placed, renamed }) =
+            self.arena.compact(encoder, page, &allocs)
+        else {
             return false;
         };
         for ((s, k, _), to) in moving.iter().zip(placed) {
