@@ -252,17 +252,27 @@ fn corner_factor(camera: &Camera, aspect: f64) -> f64 {
     (1.0 + t * t * (1.0 + aspect * aspect)).sqrt()
 }
 
-/// The nearest translucent quad to `eye` within `reach`: its distance, its normal axis,
-/// the plane's coordinate and whether its block lies on the plane's low side.
-fn nearest_translucent(
-    chunks: &ChunkStore,
-    eye: DVec3,
-    reach: f64,
-) -> Option<(f64, usize, f64, bool, BlockId)> {
+/// A translucent quad's plane near the eye.
+#[derive(Clone, Copy, Debug)]
+struct NearFace {
+    /// Distance from the eye to the quad.
+    distance: f64,
+    /// The plane's normal axis.
+    axis: usize,
+    /// The plane's coordinate on that axis.
+    plane: f64,
+    /// Whether the quad's block lies on the plane's low side (a + face).
+    block_below: bool,
+    /// The quad's block.
+    block: BlockId,
+}
+
+/// The translucent quads within `reach` of `eye`.
+fn translucent_near(chunks: &ChunkStore, eye: DVec3, reach: f64) -> Vec<NearFace> {
     let s = CHUNK_SIZE as f64;
     let lo = ((eye - reach) / s).floor();
     let hi = ((eye + reach) / s).floor();
-    let mut best: Option<(f64, usize, f64, bool, BlockId)> = None;
+    let mut near = Vec::new();
     for cx in lo.x as i64..=hi.x as i64 {
         for cy in lo.y as i64..=hi.y as i64 {
             for cz in lo.z as i64..=hi.z as i64 {
@@ -292,41 +302,65 @@ fn nearest_translucent(
                         DVec3::from(min) + DVec3::from(o),
                         DVec3::from(max) + DVec3::from(o),
                     );
-                    let d = (eye.clamp(min, max) - eye).length();
-                    if d <= reach && best.is_none_or(|b| d < b.0) {
+                    let distance = (eye.clamp(min, max) - eye).length();
+                    if distance <= reach {
                         // A +face's block lies below its plane, a -face's above.
-                        best = Some((d, axis, min[axis], u.face.is_positive(), u.block));
+                        near.push(NearFace {
+                            distance,
+                            axis,
+                            plane: min[axis],
+                            block_below: u.face.is_positive(),
+                            block: u.block,
+                        });
                     }
                 }
             }
         }
     }
-    best
+    near
 }
 
 /// `camera` for this frame, kept from cutting away a translucent face with its near plane
 /// (see the module docs): the near plane shrunk until the nearest translucent face lies
-/// beyond its corners, and an eye within [`MIN_NEAR`] of that face moved off it to the side
-/// of its medium. Unchanged when no translucent face is that close.
+/// beyond its corners, and an eye within [`MIN_NEAR`] of faces moved off each of their
+/// planes (off both at an edge, all three at a corner) to the side of its medium.
+/// Unchanged when no translucent face is that close. The result does not depend on the
+/// order the quads are stored in (sorting rewrites it).
 pub fn guard(camera: &Camera, aspect: f64, chunks: &ChunkStore) -> Camera {
     let corner = corner_factor(camera, aspect);
     let reach = camera.near * corner;
-    let Some((mut d, axis, plane, block_below, block)) =
-        nearest_translucent(chunks, camera.eye, reach)
-    else {
+    let mut near = translucent_near(chunks, camera.eye, reach);
+    if near.is_empty() {
         return *camera;
-    };
+    }
     let mut c = *camera;
     // The closest the eye may be to a face: twice the smallest near plane's corners.
     let keep = 2.0 * MIN_NEAR * corner;
-    if d < keep {
-        // Which side of the plane: the block's when the eye is inside that block type,
-        // else the other.
-        let inside = camera.medium == Some(block);
-        let up = inside != block_below;
-        c.eye[axis] = plane + if up { keep } else { -keep };
-        d = nearest_translucent(chunks, c.eye, reach).map_or(reach, |n| n.0);
+    // One move per axis; where faces disagree (never, when the medium is the block at the
+    // eye), the same one wins whatever their order.
+    near.sort_by(|a, b| {
+        (a.axis, a.block_below, a.block.index())
+            .cmp(&(b.axis, b.block_below, b.block.index()))
+            .then(a.plane.total_cmp(&b.plane))
+    });
+    let mut moved = [false; 3];
+    for f in near.iter().filter(|f| f.distance < keep) {
+        if !std::mem::replace(&mut moved[f.axis], true) {
+            // Which side of the plane: the block's when the eye is inside that block
+            // type, else the other.
+            let inside = camera.medium == Some(f.block);
+            let up = inside != f.block_below;
+            c.eye[f.axis] = f.plane + if up { keep } else { -keep };
+        }
     }
+    let d = if moved.contains(&true) {
+        translucent_near(chunks, c.eye, reach)
+            .iter()
+            .map(|f| f.distance)
+            .fold(reach, f64::min)
+    } else {
+        near.iter().map(|f| f.distance).fold(reach, f64::min)
+    };
     c.near = (0.5 * d / corner).clamp(MIN_NEAR, camera.near);
     c
 }
