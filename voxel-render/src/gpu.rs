@@ -58,9 +58,6 @@ pub enum DepthMode {
     Write,
     /// Reverse-Z test, no write: blended translucent passes.
     ReadOnly,
-    /// Reverse-Z test, nearer or equal, no write: the sorted baseline (seed 003's LessEqual
-    /// in a standard depth range).
-    ReadOnlyOrEqual,
     /// Keep the farthest fragment and write it: back-layer peeling.
     WriteFarthest,
 }
@@ -136,7 +133,6 @@ impl ChunkPipeline<'_> {
         let (write, compare) = match self.depth {
             DepthMode::Write => (true, wgpu::CompareFunction::Greater),
             DepthMode::ReadOnly => (false, wgpu::CompareFunction::Greater),
-            DepthMode::ReadOnlyOrEqual => (false, wgpu::CompareFunction::GreaterEqual),
             DepthMode::WriteFarthest => (true, wgpu::CompareFunction::Less),
         };
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {

@@ -10,6 +10,8 @@
 
 @fragment
 fn fs_abuffer(in: VsOut, @builtin(front_facing) front: bool) {
+    // Derivatives first, while every invocation of the quad still runs.
+    let slope = vec2<f32>(dpdx(in.clip.z), dpdy(in.clip.z));
     let c = translucent_color(in, front);
     let p = vec2<u32>(in.clip.xy);
     // The depth test, in the shader: a fragment with storage writes may run them before a
@@ -23,5 +25,6 @@ fn fs_abuffer(in: VsOut, @builtin(front_facing) front: bool) {
     }
     nodes[index].color = vec2<u32>(pack2x16float(c.rg), pack2x16float(c.ba));
     nodes[index].depth = in.clip.z;
+    nodes[index].slope = slope;
     nodes[index].next = atomicExchange(&heads[head_index(p)], index + 1u);
 }

@@ -33,8 +33,8 @@ use crate::oit::{
 use crate::timing::GpuPass;
 use crate::{Error, GpuContext, Result, readback};
 
-/// Bytes per node: colour (4 halves), depth, next.
-pub const NODE_BYTES: u64 = 16;
+/// Bytes per node (`Node`).
+pub const NODE_BYTES: u64 = std::mem::size_of::<Node>() as u64;
 /// Initial pool: nodes per pixel.
 pub const INITIAL_NODES_PER_PIXEL: u64 = 4;
 /// Most tiles per axis before giving up on fitting a frame.
@@ -62,6 +62,20 @@ impl ReferenceReport {
     pub fn exact(&self) -> bool {
         self.lost_fragments == 0 && self.capped_visible_pixels == 0
     }
+}
+
+/// One fragment of a pixel's list (`Node` in `types.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Node {
+    /// Colour and alpha as four halves.
+    pub color: [u32; 2],
+    /// Reverse-Z depth.
+    pub depth: f32,
+    /// Index + 1 of the next node; 0 ends the list.
+    pub next: u32,
+    /// The depth's screen-space gradient, which orders fragments of equal depth.
+    pub slope: [f32; 2],
 }
 
 /// The counters read back per tile (`Counters` in `types.wgsl`).
@@ -522,6 +536,16 @@ mod tests {
     #[test]
     fn shared_structs_match_their_wgsl() {
         let build = parse(&build_wgsl());
+        assert_layout::<Node>(
+            &build,
+            "Node",
+            &[
+                field!(Node, color),
+                field!(Node, depth),
+                field!(Node, next),
+                field!(Node, slope),
+            ],
+        );
         assert_layout::<Counters>(
             &build,
             "Counters",

@@ -11,11 +11,25 @@ fn tie_key(c: vec2<u32>) -> u32 {
     return c.x ^ (c.y * 2654435761u);
 }
 
-// Whether fragment a (depth, colour) lies in front of fragment b. Fragments at exactly the
-// same depth (two faces meeting on an edge through the pixel centre) are ordered by their
-// colour bits, so that the order does not depend on which won the race to the list.
-fn in_front(da: f32, ca: vec2<u32>, db: f32, cb: vec2<u32>) -> bool {
-    return da > db || (da == db && tie_key(ca) > tie_key(cb));
+// Whether fragment a lies in front of fragment b. Two fragments of the same depth are two
+// faces meeting on an edge through the pixel centre. The rasterizer gives such a pixel to
+// a triangle only when the edge is a top or left one (the top-left rule): the triangle lies
+// to the right of the edge, or below it when the edge is flat. Both faces contain the edge,
+// so their gradients differ across it only: the one in front just inside (larger
+// reverse-Z depth) has the larger slope to the right, or down for a flat edge. The colour
+// bits order what is left, so that the order never depends on which won the race to the
+// list.
+fn in_front(a: Node, b: Node) -> bool {
+    if a.depth != b.depth {
+        return a.depth > b.depth;
+    }
+    if a.slope.x != b.slope.x {
+        return a.slope.x > b.slope.x;
+    }
+    if a.slope.y != b.slope.y {
+        return a.slope.y > b.slope.y;
+    }
+    return tie_key(a.color) > tie_key(b.color);
 }
 
 @fragment
@@ -28,30 +42,27 @@ fn fs_resolve(in: FullscreenOut) -> @location(0) vec4<f32> {
     // The nearest MAX_LAYERS fragments, nearest (largest reverse-Z depth) first, by
     // insertion while walking the list; a farther fragment than all kept ones of a full
     // list is dropped, a nearer one replaces the farthest kept.
-    var depth: array<f32, MAX_LAYERS>;
-    var color: array<vec2<u32>, MAX_LAYERS>;
+    var kept: array<Node, MAX_LAYERS>;
     var n = 0u;
     var total = 0u;
     while next != 0u {
         let node = nodes[next - 1u];
         next = node.next;
         total += 1u;
-        if n == MAX_LAYERS && !in_front(node.depth, node.color, depth[n - 1u], color[n - 1u]) {
+        if n == MAX_LAYERS && !in_front(node, kept[n - 1u]) {
             continue;
         }
         var i = min(n, MAX_LAYERS - 1u);
-        while i > 0u && in_front(node.depth, node.color, depth[i - 1u], color[i - 1u]) {
-            depth[i] = depth[i - 1u];
-            color[i] = color[i - 1u];
+        while i > 0u && in_front(node, kept[i - 1u]) {
+            kept[i] = kept[i - 1u];
             i -= 1u;
         }
-        depth[i] = node.depth;
-        color[i] = node.color;
+        kept[i] = node;
         n = min(n + 1u, MAX_LAYERS);
     }
     var acc = vec4<f32>(0.0);
     for (var i = 0u; i < n; i += 1u) {
-        let c = vec4<f32>(unpack2x16float(color[i].x), unpack2x16float(color[i].y));
+        let c = vec4<f32>(unpack2x16float(kept[i].color.x), unpack2x16float(kept[i].color.y));
         acc += (1.0 - acc.a) * vec4<f32>(c.rgb * c.a, c.a);
     }
     if total > MAX_LAYERS {

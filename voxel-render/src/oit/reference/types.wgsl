@@ -7,6 +7,8 @@ struct Node {
     depth: f32,
     // Index + 1 of the next node of the pixel; 0 ends the list.
     next: u32,
+    // The depth's screen-space gradient (dpdx, dpdy): orders fragments of equal depth.
+    slope: vec2<f32>,
 };
 
 // Read back after every tile (`Counters` in mod.rs, checked equal by a test).

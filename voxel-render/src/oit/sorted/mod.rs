@@ -1,6 +1,8 @@
 //! Sorted alpha blending (seed 003's forward pass): translucent chunk meshes drawn back to
 //! front, blended `SrcAlpha, OneMinusSrcAlpha` into the HDR scene colour, depth tested
-//! (nearer or equal: seed 003's `LessEqual` in our reverse-Z) without depth write.
+//! without depth write. The test is strictly nearer (reverse-Z `Greater`), not seed 003's
+//! nearer-or-equal: a translucent face exactly at the opaque depth (an edge on an opaque
+//! silhouette) is hidden, as in every other technique and the reference.
 //!
 //! Chunks come farthest first by [`voxel_mesh::order::chunk_order_key`] (exact for a grid of
 //! equal cubes). `sorted` draws each chunk's quads in mesher order, which is wrong wherever
@@ -83,7 +85,7 @@ impl TechniqueKind for Sorted {
             fragment_entry: "fs_sorted",
             groups: &setup.layouts.with(&[]),
             targets: &[gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
-            depth: DepthMode::ReadOnlyOrEqual,
+            depth: DepthMode::ReadOnly,
             samples: 1,
         }
         .build_sided(device);
