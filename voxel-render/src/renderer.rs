@@ -500,6 +500,8 @@ impl Renderer {
         let start = Instant::now();
         self.post.make_tonemap(&self.ctx, self.config.output_format);
         self.update_fades();
+        // Before any list of this frame takes the meshes' places.
+        self.chunks.compact(&self.ctx, encoder);
         let (w, h) = self.size();
         let aspect = f64::from(w) / f64::from(h);
         // No translucent face closer than the near plane's corners (crossing a surface).
@@ -527,7 +529,6 @@ impl Renderer {
         };
         self.oit.prepare(&mut self.chunks, &view)?;
         self.write_frame_uniforms(camera, view_proj, medium.map(|(b, _)| b));
-        self.chunks.compact(&self.ctx, encoder);
 
         // Opaque and cutout meshes front to back (early depth rejection), grouped by page.
         let near_first = |mut v: Vec<Visible>| {
