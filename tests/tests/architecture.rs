@@ -17,6 +17,7 @@ const RENDER: &[&str] = &[
 const LAB: &[&str] = &[
     "progress",
     "random",
+    "edges",
     "summary",
     "metrics",
     "scene",

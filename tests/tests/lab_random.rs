@@ -1,6 +1,7 @@
 //! The lab on random scenes in CI: a small draw (40 scenes at 96×54, one timed frame),
 //! asserting from it that nothing turns NaN, that the two exact methods agree on every
-//! scene, that `sorted-quads` is exact wherever its quad order has no cycle, that the
+//! scene, that `sorted-quads` is exact wherever its quad order has no cycle (off the
+//! pixels on quad edges, where sub-pixel snapping decides: rare), that the
 //! default WBOIT weight has the lowest median FLIP of all weights, and that a worst scene
 //! written to `worst/` replays with the same error.
 //!
@@ -180,22 +181,37 @@ fn sorted_quads_is_exact_without_cycles() {
         without_cycle.len() >= COUNT / 2,
         "most scenes have no quad cycle"
     );
+    // Off quad edges, where the order alone decides the colour (`voxel_lab::edges`).
     let findings: Vec<(String, String)> = without_cycle
         .iter()
-        .filter(|r| r.max_abs_err > 1)
+        .filter(|r| r.max_abs_err_off_edges.unwrap() > 1)
         .map(|r| {
             (
                 r.scene.clone(),
                 format!(
-                    "sorted-quads off by {}/255 (FLIP {:.4}, {} pixels) with no cycle in its quad order",
+                    "sorted-quads off by {}/255 away from quad edges ({}/255 over all, FLIP {:.4}, {} pixels, {} on edges) with no cycle in its quad order",
+                    r.max_abs_err_off_edges.unwrap(),
                     r.max_abs_err,
                     r.flip_mean,
-                    (r.frac_bad_px * f64::from(r.width * r.height)).round()
+                    (r.frac_bad_px * f64::from(r.width * r.height)).round(),
+                    r.edge_px.unwrap()
                 ),
             )
         })
         .collect();
-    no_findings("sorted-quads within 1/255", &findings, summary);
+    // On edges: single pixels where sub-pixel snapping decides, rare.
+    let edge_px: u32 = without_cycle.iter().map(|r| r.edge_px.unwrap()).sum();
+    let px = without_cycle.len() as u32 * SIZE.0 * SIZE.1;
+    eprintln!("sorted-quads without cycles: {edge_px} edge pixels off of {px}");
+    assert!(
+        edge_px * 10_000 <= px,
+        "{edge_px} edge pixels off of {px}: more than 1 in 10000"
+    );
+    no_findings(
+        "sorted-quads within 1/255 off quad edges",
+        &findings,
+        summary,
+    );
 }
 
 #[test]

@@ -89,6 +89,9 @@ pub struct TechniqueDistribution {
     pub max_abs_err: Percentiles,
     /// Share of scored scenes within 1/255 everywhere.
     pub exact_share: f64,
+    /// `sorted-quads`: share of scored scenes within 1/255 off the quad edges
+    /// ([`crate::edges`]).
+    pub exact_off_edges_share: Option<f64>,
     /// NaN/inf pixels over all scenes (scored or not).
     pub nan_px: usize,
     /// GPU ms of the translucent work, over the scored scenes where it drew something
@@ -336,6 +339,11 @@ fn technique(summary: &Summary, t: &str) -> Option<TechniqueDistribution> {
         flip_mean: Percentiles::of(&flip)?,
         max_abs_err: Percentiles::of(&err)?,
         exact_share: rs.iter().filter(|r| r.max_abs_err <= 1).count() as f64 / rs.len() as f64,
+        exact_off_edges_share: rs
+            .iter()
+            .map(|r| r.max_abs_err_off_edges.map(|e| e <= 1))
+            .collect::<Option<Vec<bool>>>()
+            .map(|e| e.iter().filter(|x| **x).count() as f64 / rs.len() as f64),
         nan_px: summary
             .records
             .iter()

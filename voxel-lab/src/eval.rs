@@ -8,6 +8,7 @@ use voxel_render::{
     WeightFunction,
 };
 
+use crate::edges::{self, Edges};
 use crate::headless::{Offscreen, renderer_for};
 use crate::metrics::{self, Metrics, thumbnail};
 use crate::progress::Progress;
@@ -222,6 +223,7 @@ fn scene_records(
     }
 
     let mut records = Vec::new();
+    let mut quad_edges = None;
     for (name, config) in runs(opts) {
         progress.step(&format!("{stem}: {name}"));
         let m = measure(
@@ -249,6 +251,11 @@ fn scene_records(
             frac_bad_px,
         } = metrics;
         let report = &m.stats.technique;
+        // An exact order's error off the quad edges (sub-pixel snapping decides the rest).
+        let off_edges = report.sort.map(|_| {
+            let e = quad_edges.get_or_insert_with(|| Edges::new(&scene.world, &camera, size));
+            edges::error_off_edges(e, &reference.image, &m.image)
+        });
         records.push(Record {
             scene: stem.clone(),
             technique: name,
@@ -269,6 +276,8 @@ fn scene_records(
             reference_exact: reference.check.exact,
             sort_cycles: report.sort.map(|s| s.cycles),
             quads_in_cycles: report.sort.map(|s| s.quads_in_cycles),
+            max_abs_err_off_edges: off_edges.map(|e| e.0),
+            edge_px: off_edges.map(|e| e.1),
             heatmap,
         });
     }

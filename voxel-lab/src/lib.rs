@@ -3,8 +3,8 @@
 //! It has no window: the demo's window and the integration tests both build on it.
 //!
 //! Modules depend on each other one way:
-//! - the model: [`progress`], [`random`] (random scenes as scene-file text), [`summary`],
-//!   [`metrics`], [`scene`], [`headless`];
+//! - the model: [`progress`], [`random`] (random scenes as scene-file text), [`edges`]
+//!   (which pixels lie on quad edges), [`summary`], [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the
 //!   reference), [`stability`] (sweeps and flicker);
 //! - the report, which reads what the runs produced: [`distribution`] (errors over random
@@ -13,6 +13,7 @@
 
 pub mod charts;
 pub mod distribution;
+pub mod edges;
 pub mod eval;
 pub mod headless;
 pub mod metrics;

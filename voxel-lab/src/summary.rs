@@ -92,6 +92,11 @@ pub struct Record {
     pub sort_cycles: Option<u32>,
     /// `sorted-quads`: quads in those cycles.
     pub quads_in_cycles: Option<u32>,
+    /// `sorted-quads`: the largest channel error over the pixels off translucent quad
+    /// edges ([`crate::edges`]), where the order alone decides the colour.
+    pub max_abs_err_off_edges: Option<u32>,
+    /// `sorted-quads`: pixels off by more than 1/255 that lie on a quad edge.
+    pub edge_px: Option<u32>,
     /// The FLIP heat map, relative to the output folder (empty when not saved: random
     /// scenes save none).
     pub heatmap: String,
