@@ -127,7 +127,8 @@ struct Packed {
 enum Storage {
     Uniform(BlockId),
     Masks(Vec<Entry>),
-    Packed(Packed),
+    /// Boxed, so that a chunk stays three words (uniform chunks are common).
+    Packed(Box<Packed>),
 }
 
 /// 32×32×32 blocks. See the module docs for the storage forms.
@@ -193,9 +194,10 @@ fn index_word(planes: &[ColumnMask], k: usize, w: usize) -> u32 {
 }
 
 /// Writes into `out` the set of blocks whose palette index is `k`, in the layout of
-/// `planes` (the stored column planes, or their transposes for the row layout).
+/// `planes` (the stored column planes, or their transposes for the row layout): one AND of
+/// plane `j` or its complement per bit `j` of `k`, in one vectorised pass when there are
+/// at most four planes (16 types).
 fn decode_index(planes: &[ColumnMask], k: usize, out: &mut ColumnMask) {
-    /// `B` known at compile time: one pass, `B` XOR-ANDs per word, vectorised.
     fn fixed<const B: usize>(planes: &[ColumnMask; B], k: usize, out: &mut ColumnMask) {
         let inv: [u32; B] = std::array::from_fn(|j| inverter(k, j));
         for (w, o) in out.iter_mut().enumerate() {
@@ -223,28 +225,63 @@ fn decode_index(planes: &[ColumnMask], k: usize, out: &mut ColumnMask) {
     }
 }
 
+/// A block type's masks in a [`MaskBuffer`].
+type Built = (BlockId, Box<Occupancy>);
+
+/// One step of a bit-matrix transpose, on rows `a` and `b` that are `J` rows apart: bit
+/// `c + J` of `a` and bit `c` of `b` change places for every column `c` selected by `m`
+/// (those whose bit `J` is clear).
+#[inline(always)]
+fn swap_bits<const J: u32>(a: &mut u32, b: &mut u32, m: u32) {
+    let t = ((*a >> J) ^ *b) & m;
+    *a ^= t << J;
+    *b ^= t;
+}
+
 /// Transposes, for all 32 values of z at once, the 32×32 bit matrix whose row `x` is word
-/// `x * 32 + z` (bits y) into rows `y` at words `y * 32 + z` (bits x): turns a mask in the
-/// `by_y` layout into the same set in the `by_x` layout, in place. The classic recursive
-/// block swap (halves, quarters, ... of the matrix), where each row operation runs over
-/// the 32 values of z, contiguous in memory, so that it vectorises.
-fn transpose_layout(p: &mut ColumnMask) {
-    fn level<const J: usize>(rows: &mut [[u32; CHUNK_SIZE]], m: u32) {
-        for k in (0..CHUNK_SIZE).filter(|k| k & J == 0) {
-            let (lo, hi) = rows.split_at_mut(k + J);
-            for (a, b) in lo[k].iter_mut().zip(hi[0].iter_mut()) {
-                let t = ((*a >> J) ^ *b) & m;
-                *a ^= t << J;
-                *b ^= t;
+/// `x * 32 + z` (bits y) of `src` into rows `y` at words `y * 32 + z` (bits x) of `dst`:
+/// turns a mask in the `by_y` layout into the same set in the `by_x` layout.
+///
+/// The classic recursive block swap (halves, quarters, ... of the matrix: five steps, one
+/// per bit of the row index), where each row operation runs over the 32 values of z,
+/// contiguous in memory, so that it vectorises. Two passes over memory: the first does the
+/// steps of row bits 4, 3 and 2 on groups of 8 rows held in registers, the second those of
+/// bits 1 and 0 on groups of 4 rows.
+fn transpose_layout_into(src: &ColumnMask, dst: &mut ColumnMask) {
+    let (s, _) = src.as_chunks::<CHUNK_SIZE>();
+    let (d, _) = dst.as_chunks_mut::<CHUNK_SIZE>();
+    for base in 0..4 {
+        for z in 0..CHUNK_SIZE {
+            let mut v: [u32; 8] = std::array::from_fn(|i| s[base + 4 * i][z]);
+            let [v0, v1, v2, v3, v4, v5, v6, v7] = &mut v;
+            swap_bits::<16>(v0, v4, 0x0000_ffff);
+            swap_bits::<16>(v1, v5, 0x0000_ffff);
+            swap_bits::<16>(v2, v6, 0x0000_ffff);
+            swap_bits::<16>(v3, v7, 0x0000_ffff);
+            swap_bits::<8>(v0, v2, 0x00ff_00ff);
+            swap_bits::<8>(v1, v3, 0x00ff_00ff);
+            swap_bits::<8>(v4, v6, 0x00ff_00ff);
+            swap_bits::<8>(v5, v7, 0x00ff_00ff);
+            swap_bits::<4>(v0, v1, 0x0f0f_0f0f);
+            swap_bits::<4>(v2, v3, 0x0f0f_0f0f);
+            swap_bits::<4>(v4, v5, 0x0f0f_0f0f);
+            swap_bits::<4>(v6, v7, 0x0f0f_0f0f);
+            for (i, v) in v.into_iter().enumerate() {
+                d[base + 4 * i][z] = v;
             }
         }
     }
-    let (rows, _) = p.as_chunks_mut::<CHUNK_SIZE>();
-    level::<16>(rows, 0x0000_ffff);
-    level::<8>(rows, 0x00ff_00ff);
-    level::<4>(rows, 0x0f0f_0f0f);
-    level::<2>(rows, 0x3333_3333);
-    level::<1>(rows, 0x5555_5555);
+    for group in d.chunks_exact_mut(4) {
+        let [r0, r1, r2, r3] = group else {
+            continue;
+        };
+        for (((a, b), c), e) in r0.iter_mut().zip(r1.iter_mut()).zip(r2.iter_mut()).zip(r3) {
+            swap_bits::<2>(a, c, 0x3333_3333);
+            swap_bits::<2>(b, e, 0x3333_3333);
+            swap_bits::<1>(a, b, 0x5555_5555);
+            swap_bits::<1>(c, e, 0x5555_5555);
+        }
+    }
 }
 
 /// Transposes one 32×32 bit matrix: bit `j` of row `i` becomes bit `i` of row `j`.
@@ -312,10 +349,12 @@ fn side_index(side: Face) -> usize {
 #[derive(Clone, Debug, Default)]
 pub struct MaskBuffer {
     /// The first `len` entries are valid; the others keep their allocation.
-    entries: Vec<(BlockId, Box<Occupancy>)>,
+    entries: Vec<Built>,
     len: usize,
     /// A packed chunk's planes, transposed to the row layout.
     rows: Vec<ColumnMask>,
+    /// The palette index of each entry, for a packed chunk.
+    codes: Vec<usize>,
 }
 
 impl MaskBuffer {
@@ -386,28 +425,50 @@ impl Packed {
         }
     }
 
-    /// The planes transposed to the row layout.
+    /// The planes transposed to the row layout, into `rows` (resized to fit).
     fn transposed_into(&self, rows: &mut Vec<ColumnMask>) {
-        rows.clear();
-        rows.extend_from_slice(&self.planes);
-        rows.iter_mut().for_each(transpose_layout);
+        rows.resize(self.planes.len(), [0; CHUNK_AREA]);
+        for (src, dst) in self.planes.iter().zip(rows.iter_mut()) {
+            transpose_layout_into(src, dst);
+        }
+    }
+
+    /// The masks of the palette entries that `want` selects, into `out`.
+    fn build_masks(&self, out: &mut MaskBuffer, mut want: impl FnMut(BlockId) -> bool) {
+        out.clear();
+        out.codes.clear();
+        for (k, s) in self.palette.iter().enumerate() {
+            if want(s.id) {
+                out.push(s.id);
+                out.codes.push(k);
+            }
+        }
+        if out.is_empty() {
+            return;
+        }
+        self.transposed_into(&mut out.rows);
+        let MaskBuffer {
+            entries,
+            len,
+            rows,
+            codes,
+        } = out;
+        for (&k, (_, m)) in codes.iter().zip(&mut entries[..*len]) {
+            decode_index(&self.planes, k, &mut m.by_y);
+            decode_index(rows, k, &mut m.by_x);
+        }
     }
 
     fn to_entries(&self) -> Vec<Entry> {
-        let mut rows = Vec::new();
-        self.transposed_into(&mut rows);
-        self.palette
-            .iter()
-            .enumerate()
-            .map(|(k, s)| {
-                let mut bits = Box::new(EMPTY);
-                decode_index(&self.planes, k, &mut bits.by_y);
-                decode_index(&rows, k, &mut bits.by_x);
-                Entry {
-                    id: s.id,
-                    count: s.count,
-                    bits,
-                }
+        let mut buf = MaskBuffer::new();
+        self.build_masks(&mut buf, |_| true);
+        buf.entries
+            .into_iter()
+            .zip(&self.palette)
+            .map(|((id, bits), s)| Entry {
+                id,
+                count: s.count,
+                bits,
             })
             .collect()
     }
@@ -643,7 +704,7 @@ impl Chunk {
     /// chunk stays as it is.
     pub fn pack(&mut self) {
         if let Storage::Masks(entries) = &self.storage {
-            self.storage = Storage::Packed(Packed::from_entries(entries));
+            self.storage = Storage::Packed(Box::new(Packed::from_entries(entries)));
         }
     }
 
@@ -714,22 +775,7 @@ impl Chunk {
                     out.push(e.id).clone_from(&e.bits);
                 }
             }
-            Storage::Packed(p) => {
-                let wanted = p.palette.iter().filter(|s| want(s.id)).count();
-                if wanted == 0 {
-                    return;
-                }
-                let mut rows = std::mem::take(&mut out.rows);
-                p.transposed_into(&mut rows);
-                for (k, s) in p.palette.iter().enumerate() {
-                    if want(s.id) {
-                        let m = out.push(s.id);
-                        decode_index(&p.planes, k, &mut m.by_y);
-                        decode_index(&rows, k, &mut m.by_x);
-                    }
-                }
-                out.rows = rows;
-            }
+            Storage::Packed(p) => p.build_masks(out, want),
         }
     }
 
@@ -744,30 +790,51 @@ impl Chunk {
         buf.entries.into_iter().next().map(|(_, m)| Cow::Owned(*m))
     }
 
-    /// For each block type present (air included, in palette order), its blocks in the
-    /// layer on `side` of the chunk (x = 31 for [`Face::PosX`], x = 0 for [`Face::NegX`],
-    /// ...), into `out` (replacing what it held), in any form. Layout of a layer: for an x
-    /// side row z bits y, for a y side row z bits x (a layer of [`Occupancy::by_x`]), for
-    /// a z side row y bits x. A packed chunk extracts the layer of each bit plane once and
-    /// decodes the types from those: no masks are built.
-    pub fn side_layers(&self, side: Face, out: &mut Vec<(BlockId, LayerMask)>) {
+    /// For each block type present that `want` selects (in palette order), its blocks in
+    /// the layer on `side` of the chunk (x = 31 for [`Face::PosX`], x = 0 for
+    /// [`Face::NegX`], ...), into `out` (replacing what it held), in any form. Layout of a
+    /// layer: for an x side row z bits y, for a y side row z bits x (a layer of
+    /// [`Occupancy::by_x`]), for a z side row y bits x. A packed chunk extracts the layer of
+    /// each bit plane once and decodes the types from those: no masks are built.
+    pub fn side_layers(
+        &self,
+        side: Face,
+        out: &mut Vec<(BlockId, LayerMask)>,
+        mut want: impl FnMut(BlockId) -> bool,
+    ) {
         out.clear();
         match &self.storage {
-            Storage::Uniform(id) => out.push((*id, [u32::MAX; CHUNK_SIZE])),
-            Storage::Masks(entries) => {
-                out.extend(entries.iter().map(|e| (e.id, side_layer(&e.bits, side))));
+            Storage::Uniform(id) => {
+                if want(*id) {
+                    out.push((*id, [u32::MAX; CHUNK_SIZE]));
+                }
             }
+            Storage::Masks(entries) => out.extend(
+                entries
+                    .iter()
+                    .filter(|e| want(e.id))
+                    .map(|e| (e.id, side_layer(&e.bits, side))),
+            ),
             Storage::Packed(p) => {
-                let layers: Vec<LayerMask> =
-                    p.planes.iter().map(|q| plane_side_layer(q, side)).collect();
-                out.extend(p.palette.iter().enumerate().map(|(k, s)| {
-                    let mut m = [u32::MAX; CHUNK_SIZE];
-                    for (j, l) in layers.iter().enumerate() {
-                        let inv = inverter(k, j);
-                        m.iter_mut().zip(l).for_each(|(m, l)| *m &= l ^ inv);
+                if !p.palette.iter().any(|s| want(s.id)) {
+                    return;
+                }
+                // At most 16 planes: ids are 16 bits.
+                let mut layers = [[0; CHUNK_SIZE]; 16];
+                for (l, q) in layers.iter_mut().zip(&p.planes) {
+                    *l = plane_side_layer(q, side);
+                }
+                let layers = &layers[..p.planes.len()];
+                for (k, s) in p.palette.iter().enumerate() {
+                    if want(s.id) {
+                        let mut m = [u32::MAX; CHUNK_SIZE];
+                        for (j, l) in layers.iter().enumerate() {
+                            let inv = inverter(k, j);
+                            m.iter_mut().zip(l).for_each(|(m, l)| *m &= l ^ inv);
+                        }
+                        out.push((s.id, m));
                     }
-                    (s.id, m)
-                }));
+                }
             }
         }
     }
@@ -797,7 +864,8 @@ impl Chunk {
                         + entries.len() * std::mem::size_of::<Occupancy>()
                 }
                 Storage::Packed(p) => {
-                    p.palette.capacity() * std::mem::size_of::<Slot>()
+                    std::mem::size_of::<Packed>()
+                        + p.palette.capacity() * std::mem::size_of::<Slot>()
                         + p.planes.capacity() * std::mem::size_of::<ColumnMask>()
                 }
             }
@@ -1077,8 +1145,8 @@ mod tests {
     fn the_layout_transpose_turns_columns_into_rows() {
         let c = varied_chunk(7, 6);
         for (_, m) in c.stored_masks().unwrap() {
-            let mut t = m.by_y;
-            transpose_layout(&mut t);
+            let mut t = [0; CHUNK_AREA];
+            transpose_layout_into(&m.by_y, &mut t);
             assert_eq!(t, m.by_x);
         }
         let mut a: LayerMask = std::array::from_fn(|i| (i as u32).wrapping_mul(0x9e37_79b9));
@@ -1093,8 +1161,19 @@ mod tests {
 
     #[test]
     fn pack_and_unpack_keep_every_block() {
-        for (seed, types) in [(1, 1), (2, 2), (3, 3), (4, 4), (5, 7), (6, 8), (7, 12)] {
+        // Up to 21 types: five planes, past the vectorised decoding of up to four.
+        for (seed, types) in [
+            (1, 1),
+            (2, 2),
+            (3, 3),
+            (4, 4),
+            (5, 7),
+            (6, 8),
+            (7, 12),
+            (8, 20),
+        ] {
             let c = varied_chunk(seed, types);
+            assert!(types < 20 || c.palette_len() > 16, "five planes");
             let mut p = c.clone();
             p.pack();
             assert!(p.is_packed() || c.as_uniform().is_some());
@@ -1132,7 +1211,18 @@ mod tests {
 
     #[test]
     fn built_masks_and_side_layers_agree_across_forms() {
-        let c = varied_chunk(11, 9);
+        for types in [9, 20] {
+            let c = varied_chunk(11, types);
+            assert!(
+                c.palette_len() > 8 + 8 * usize::from(types > 9),
+                "more planes than 3, 4"
+            );
+            built_masks_and_side_layers_agree(&c);
+        }
+    }
+
+    fn built_masks_and_side_layers_agree(c: &Chunk) {
+        let c = c.clone();
         let mut p = c.clone();
         p.pack();
         assert!(p.stored_masks().is_none());
@@ -1156,8 +1246,11 @@ mod tests {
         let dense = c.to_dense();
         let (mut a, mut b) = (Vec::new(), Vec::new());
         for side in Face::ALL {
-            c.side_layers(side, &mut a);
-            p.side_layers(side, &mut b);
+            c.side_layers(side, &mut a, |_| true);
+            p.side_layers(side, &mut b, |_| true);
+            let mut no_air = Vec::new();
+            p.side_layers(side, &mut no_air, |id| id != AIR);
+            assert_eq!(no_air.len() + 1, a.len());
             assert_eq!(a, b, "{side:?}");
             let l = side_index(side);
             for (id, rows) in &a {
@@ -1174,7 +1267,7 @@ mod tests {
                 }
             }
         }
-        Chunk::uniform(WATER).side_layers(Face::NegY, &mut a);
+        Chunk::uniform(WATER).side_layers(Face::NegY, &mut a, |_| true);
         assert_eq!(a, vec![(WATER, [u32::MAX; 32])]);
     }
 

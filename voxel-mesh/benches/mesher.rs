@@ -327,22 +327,18 @@ fn mesher_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[C
         "ratio block-mesh greedy_quads / ours = {:.1}x (target >= 10x)",
         bm_us / ours_us
     );
-    packed_section(reg, world, packed, cases, ours_us, packed_us);
     uniform_section(reg, ours_us);
+    packed_section(reg, world, packed, cases);
 }
 
-/// What meshing a packed chunk costs, part by part, on the same cases: building the masks
-/// of its non-air types (what the mesher does first for a packed centre), and the
+/// What meshing a packed chunk costs, part by part, on the same cases and in rounds of
+/// their own (the peers' sweeps through memory make the section above slower for every
+/// mesher): building the masks of its non-air types (what the mesher does first for a
+/// packed centre), meshes with the centre and the neighbours in each form, and the
 /// alternative where the caller unpacks the chunk, meshes it and packs it again.
-fn packed_section(
-    reg: &BlockRegistry,
-    world: &World,
-    packed: &World,
-    cases: &[Case],
-    masks_us: f64,
-    packed_us: f64,
-) {
+fn packed_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[Case]) {
     const ROUNDS: usize = 41;
+    const METHODS: usize = 5;
     let mut ours = Mesher::new(reg);
     let mut out = ChunkMeshes::default();
     let mut buf = MaskBuffer::new();
@@ -352,47 +348,52 @@ fn packed_section(
         .map(|c| packed.chunk(c.pos).expect("generated").clone())
         .collect();
     let n = cases.len() as f64;
-    let mut times: [Vec<f64>; 3] = Default::default();
+    let mut times: [Vec<f64>; METHODS] = Default::default();
     for round in 0..ROUNDS {
-        for k in 0..3 {
-            let method = (round + k) % 3;
+        for k in 0..METHODS {
+            let method = (round + k) % METHODS;
             let t = Instant::now();
             for (c, chunk) in cases.iter().zip(&mut chunks) {
-                match method {
+                let (centre, nb) = match method {
                     0 => {
                         black_box(&*chunk).build_masks(&mut buf, not_air);
                         black_box(&buf);
+                        continue;
                     }
-                    1 => {
+                    4 => {
                         chunk.unpack();
                         ours.mesh_into(black_box(&*chunk), packed.neighbours(c.pos), &mut out)
                             .expect("known blocks");
                         chunk.pack();
                         black_box(&out);
+                        continue;
                     }
-                    _ => {
-                        // The neighbours' touching layers alone: masks for the centre.
-                        let chunk = world.chunk(c.pos).expect("generated");
-                        ours.mesh_into(black_box(chunk), packed.neighbours(c.pos), &mut out)
-                            .expect("known blocks");
-                        black_box(&out);
-                    }
-                }
+                    1 => (packed, packed),
+                    2 => (world, packed),
+                    _ => (world, world),
+                };
+                let chunk = centre.chunk(c.pos).expect("generated");
+                ours.mesh_into(black_box(chunk), nb.neighbours(c.pos), &mut out)
+                    .expect("known blocks");
+                black_box(&out);
             }
             times[method].push(secs(t.elapsed()) / n);
         }
     }
-    let [t_build, t_unpack, t_nb] = times.map(|t| median(t) * 1e6);
+    let [t_build, t_packed, t_nb, t_masks, t_unpack] = times.map(|t| median(t) * 1e6);
     let types: usize = chunks.iter().map(Chunk::palette_len).sum();
     println!(
-        "\n## packed chunks (the same chunks, {:.1} types each; µs per chunk, median of {ROUNDS} rounds)",
+        "\n## packed chunks (the same chunks, {:.1} types each; µs per chunk, median of {ROUNDS} interleaved rounds without the peers)",
         types as f64 / n
     );
     println!("build the masks of a packed chunk (non-air types, both layouts) {t_build:6.1}");
-    println!("mesh, chunk in mask form + 6 packed neighbours              {t_nb:10.1}");
-    println!("mesh, chunk and neighbours packed (from above)              {packed_us:10.1}");
-    println!("mesh, chunk and neighbours in mask form (from above)        {masks_us:10.1}");
-    println!("alternative: the caller unpacks, meshes, packs again        {t_unpack:10.1}");
+    println!("mesh, chunk and neighbours in mask form                    {t_masks:11.1}");
+    println!("mesh, chunk in mask form, neighbours packed                {t_nb:11.1}");
+    println!(
+        "mesh, chunk and neighbours packed (masks built)            {t_packed:11.1}   {:+.1} over the mask form",
+        t_packed - t_masks
+    );
+    println!("alternative: the caller unpacks, meshes, packs again       {t_unpack:11.1}");
 }
 
 /// Ours on uniform chunks: leaves (cutout, every inner face stays) alone and between six

@@ -15,8 +15,13 @@
 //! - Across a chunk border the neighbour chunk decides; a missing neighbour counts as air,
 //!   so the edge of a loaded area is closed by faces rather than left with holes.
 //!
-//! The algorithm works on the chunk's storage directly: every block type present has its
-//! blocks as bits, in vertical columns and in rows along x ([`Occupancy`]). For each type,
+//! The algorithm works on bit masks: every block type present has its blocks as bits, in
+//! vertical columns and in rows along x ([`Occupancy`]). A chunk in mask form stores exactly
+//! these and is meshed from its storage directly; for a packed chunk (the compact resident
+//! form, see [`Chunk::pack`]) the mesher first builds the masks of its non-air
+//! types into its own scratch memory ([`Chunk::build_masks`], a few µs), and of a
+//! neighbour it reads only the touching layer ([`Chunk::side_layers`]), in any form. The
+//! quads are the same whatever the forms of the chunk and its neighbours. For each type,
 //! the visible faces of a layer are one AND-NOT between its rows and the "hides me" rows of
 //! the next layer; they are then covered with rectangles by [`greedy_rects`]. Bits are per
 //! block type, so merged quads never mix blocks and no per-block comparison is needed. Cost
@@ -268,7 +273,10 @@ impl Mesher {
             let layers = &mut s.nb_layers[face as usize];
             layers.clear();
             if let Some(n) = neighbours[face as usize] {
-                n.side_layers(face.opposite(), layers);
+                // Only opaque and translucent blocks hide anything.
+                n.side_layers(face.opposite(), layers, |id| {
+                    is_opaque(id) || is_translucent(id)
+                });
             }
         }
         let nb_union = |layers: &[(BlockId, Plane)], keep: &dyn Fn(BlockId) -> bool| -> Plane {
@@ -999,6 +1007,11 @@ mod tests {
     /// neighbours is independently missing, uniform of a random block or mixed. The test
     /// checks that every centre class (air, opaque, cutout, translucent, mixed) met every
     /// neighbour kind (missing, uniform air, opaque, cutout or translucent, mixed).
+    ///
+    /// Storage forms: each mixed chunk (centre or neighbour) is packed or left in mask form
+    /// at random, and every case is meshed again with each mixed chunk in the other form,
+    /// which must give the same quads; the test checks that every centre form (uniform,
+    /// masks, packed) met every neighbour form (missing, uniform, masks, packed).
     ///
     /// The test this replaced drew only mixed centres, so it never met the uniform
     /// shortcut, and missed that uniform cutout centres lost every inner face (issue 10).
