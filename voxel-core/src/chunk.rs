@@ -16,37 +16,63 @@
 //! streamer packs a chunk once it has been meshed ([`crate::World::pack_chunk`],
 //! [`crate::World::pack_all`]).
 //!
-//! Why two forms (measured by `cargo bench -p voxel-mesh --bench mesher`, sections "mesher"
-//! and "storage"; figures of one run on the 2-core development machine):
+//! Why two forms. Figures from one run of `cargo bench -p voxel-mesh --bench mesher`
+//! (results/mesher-bench.txt) on the shared 2-core development machine, whose load made
+//! every time in it some 25-35% slower than in the previous recorded run; compare ratios
+//! within the run:
 //! - The binary mesher works on exactly the masks, so a remesh of a chunk in mask form needs
-//!   no pass over 32 768 block ids (building masks from a `u16` per block costs more than
-//!   twice our whole mesh). Two layouts make every face direction a pair of adjacent rows
-//!   ANDed together: x faces from the vertical columns, y and z faces from the rows along x.
+//!   no pass over 32 768 block ids (building masks from a `u16` per block costs 78.9 µs,
+//!   more than twice our whole mesh). Two layouts make every face direction a pair of
+//!   adjacent rows ANDed together: x faces from the vertical columns, y and z faces from the
+//!   rows along x. From the mask form, ours takes 34.4 µs a chunk against 43.3 µs for
+//!   binary-greedy-meshing's `fast_mesh`: 0.795× (target ≤ 0.8; 0.74 in the previous
+//!   recorded run, on a quieter machine, with the same mask-form code path).
 //! - But the masks cost 8 KiB per block type present: 76.5 MiB for the benchmark's
-//!   2048-chunk world, 4.25× a packed-index palette (18.0 MiB), about a quarter of a
-//!   gigabyte at a 32-chunk view distance. The packed form costs 18.3 MiB there, 1.02× the
-//!   packed-index figure (the rest is the palette with its counts and the chunk header).
-//! - The mesher takes packed chunks as they are: for a packed centre it builds the masks of
-//!   the non-air types into its own scratch memory (`b` in-place bit-matrix transposes turn
-//!   the planes into the row layout, then each type is `b` ANDs per word in each layout);
-//!   for a packed neighbour it only extracts the touching layer ([`Chunk::side_layers`]).
-//!   MEASURED_FIGURES
-//! - Alternatives measured: unpacking the centre before meshing (allocating and filling a
-//!   mask form, air included) instead of decoding into the mesher's scratch, and decoding
-//!   each type's column masks and then transposing each type (`n` transposes instead of
-//!   `b`); both are slower (ALTERNATIVE_FIGURES). A packed index with
+//!   2048-chunk world, 4.2× a packed-index palette (18.0 MiB), about a quarter of a
+//!   gigabyte at a 32-chunk view distance. The packed form costs 18.2 MiB there, 1.01× the
+//!   packed-index figure (target ≤ 2×; the rest is the palette with its counts and a small
+//!   header); the masks take 4.21× that and a `u16` per block 5.90×. Packing a chunk takes
+//!   2.4 µs, unpacking it 7.2 µs (allocation included); packing the whole world 4 ms on two
+//!   threads.
+//! - The mesher takes packed chunks as they are. For a packed centre it builds the masks of
+//!   the non-air types into its own scratch memory ([`Chunk::build_masks`]): `b` bit-matrix
+//!   transposes (two vectorised passes each, all 32 slabs at once) turn the planes into the
+//!   row layout, then each type is `b` XOR-ANDs per word in each layout: 4.5 µs for the
+//!   benchmark's chunks (7.5 types). Of a packed neighbour it reads only the touching layer
+//!   ([`Chunk::side_layers`]: the layer of each plane, then the types from those), no
+//!   slower than from mask-form neighbours (27.5 against 28.3 µs a mesh). A chunk and its
+//!   neighbours all packed mesh in 37.7 µs in the rounds shared with binary-greedy-meshing:
+//!   0.872× its time, above the 0.8 target that the mask form meets. In rounds of their own (no peer sweeping the caches) the gap is
+//!   smaller, 30.4 against 28.3 µs, likely because the 12 KiB of a packed centre come in
+//!   from memory where the stored masks are ten times that.
+//! - So the design is: chunks are generated in mask form and meshed from it (the bulk of
+//!   all meshing, at the mask form's speed), then packed by the streamer; what stays
+//!   resident is packed. A later remesh of a packed chunk (an edit in it or on a
+//!   neighbour's border) pays the mask build, about a tenth of a mesh; a caller that edits
+//!   a chunk over and over can keep it in mask form ([`Chunk::unpack`]) while it is hot.
+//! - Alternatives measured (the last two with a throwaway harness, minimum over 2 s of
+//!   32-chunk passes): the caller unpacking the centre, meshing it and packing it again
+//!   takes 35.1 µs against 30.4 µs for meshing it packed (unpacking allocates and decodes
+//!   air too); decoding each type's column masks and transposing each type (`n` transposes
+//!   instead of `b`) builds the masks in 4.0-4.3 µs against 3.7 µs; decoding all codes at
+//!   once through a tree of ANDs shared between codes (about two per code and word instead
+//!   of `b`) is slower, 3.7 µs against 2.2 µs for the decode alone, because on SSE2 it is
+//!   bound by loads and stores of the tree, not by the ANDs. A packed index with
 //!   power-of-two widths (1, 2, 4 or 8 bits, so that no index straddles a word) would cost
 //!   up to a third more memory (5 to 8 types need 4 bits instead of 3) for a decode that the
-//!   bit planes already make cheap.
+//!   bit planes already make cheap; storing the planes in both layouts would spare the
+//!   transposes but cost just over 2× the packed-index palette.
 //!
 //! Edits work in every form. An edit of a packed chunk edits the packed data and the chunk
-//! stays packed: a write is `b` word updates per column touched, a new type may add a plane,
-//! and a type whose last block goes is dropped (its index reused, the planes narrowed when
-//! they can be). Converting to masks on edit would multiply the chunk's memory by four for
-//! as long as nobody packs it again, and nothing is gained: the remesh that follows an edit
-//! decodes what it needs anyway. An edit of a uniform chunk gives the mask form, as in
-//! terrain generation (pack again afterwards). [`Chunk::get`] on a packed chunk reads `b`
-//! bits; in mask form it scans the palette.
+//! stays packed: a write is `b` word updates per column touched (plus a count update per
+//! palette entry), a new type may add a plane, and a type whose last block goes is dropped
+//! (the last entry takes its index, the planes narrow when they can). Converting to masks
+//! on edit would make that chunk's next remeshes a few µs cheaper but multiply its memory
+//! by four until someone packs it again; that trade is left to the caller ([`Chunk::unpack`],
+//! [`crate::World::unpack_chunk`]), so that memory never grows behind a streamer's back. An
+//! edit of a uniform chunk gives the mask form, as in terrain generation (pack it
+//! afterwards). [`Chunk::get`] on a packed chunk reads `b` bits (6.5 ns at random); in mask
+//! form it scans the palette (7.4 ns).
 
 use std::borrow::Cow;
 
