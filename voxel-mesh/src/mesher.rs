@@ -905,6 +905,13 @@ mod tests {
             mesher.mesh(&ok, [Some(&c), None, None, None, None, None]),
             Err(Error::UnknownBlock(BlockId(40)))
         );
+        c.pack();
+        assert!(c.is_packed());
+        assert_eq!(mesher.mesh(&c, NONE), Err(Error::UnknownBlock(BlockId(40))));
+        assert_eq!(
+            mesher.mesh(&ok, [None, None, None, None, None, Some(&c)]),
+            Err(Error::UnknownBlock(BlockId(40)))
+        );
     }
 
     #[test]
