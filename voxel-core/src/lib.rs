@@ -11,7 +11,8 @@ mod world;
 
 pub use block::{BlockDef, BlockId, BlockRegistry, RenderClass, blocks};
 pub use chunk::{
-    CHUNK_AREA, CHUNK_SIZE, CHUNK_VOLUME, Chunk, ColumnMask, Occupancy, column_index, row_index,
+    CHUNK_AREA, CHUNK_SIZE, CHUNK_VOLUME, Chunk, ColumnMask, LayerMask, MaskBuffer, Occupancy,
+    column_index, row_index,
 };
 pub use error::{Error, Result};
 pub use terrain::{Site, SiteKind, TerrainConfig, TerrainGenerator};

@@ -4,6 +4,8 @@
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
+use rayon::prelude::*;
+
 use crate::{BlockId, BlockRegistry, CHUNK_SIZE, Chunk, Error, Result};
 
 /// The six face directions, in the order used everywhere (mesher, quads, neighbours).
@@ -300,6 +302,30 @@ impl World {
         self.chunks.get(&pos)
     }
 
+    /// Converts the chunk at `pos` to the compact packed form (see [`Chunk::pack`]), e.g.
+    /// once a streamer has meshed it. Blocks do not change, so nothing becomes dirty.
+    /// Returns whether a chunk is loaded there.
+    pub fn pack_chunk(&mut self, pos: ChunkPos) -> bool {
+        self.chunks.get_mut(&pos).map(Chunk::pack).is_some()
+    }
+
+    /// Converts the chunk at `pos` to the mask form (see [`Chunk::unpack`]), e.g. for a chunk
+    /// about to be edited and remeshed often. Returns whether a chunk is loaded there.
+    pub fn unpack_chunk(&mut self, pos: ChunkPos) -> bool {
+        self.chunks.get_mut(&pos).map(Chunk::unpack).is_some()
+    }
+
+    /// Packs every loaded chunk, in parallel.
+    pub fn pack_all(&mut self) {
+        self.chunks.par_iter_mut().for_each(|(_, c)| c.pack());
+    }
+
+    /// Heap and inline bytes of the loaded chunks ([`Chunk::memory_bytes`] summed; the map
+    /// itself not counted).
+    pub fn chunk_memory_bytes(&self) -> usize {
+        self.chunks.values().map(Chunk::memory_bytes).sum()
+    }
+
     /// The six neighbours of `pos` in [`Face`] order; `None` where not loaded.
     pub fn neighbours(&self, pos: ChunkPos) -> [Option<&Chunk>; 6] {
         Face::ALL.map(|f| pos.neighbour(f).and_then(|n| self.chunks.get(&n)))
@@ -486,6 +512,44 @@ mod tests {
             b.len(),
             "empty boxes and air in missing chunks load nothing"
         );
+    }
+
+    #[test]
+    fn packed_chunks_read_and_edit_like_any_other() {
+        let mut w = world();
+        w.fill_box(WorldPos::new(-3, -3, -3), WorldPos::new(40, 2, 4), STONE)
+            .unwrap();
+        w.set_block(WorldPos::new(0, 0, 0), WATER).unwrap();
+        let before: Vec<_> = {
+            let mut v: Vec<_> = w.iter().map(|(p, c)| (p, c.to_dense())).collect();
+            v.sort_by_key(|(p, _)| *p);
+            v
+        };
+        let mask_bytes = w.chunk_memory_bytes();
+        w.take_dirty();
+        w.pack_all();
+        assert!(w.dirty().is_empty(), "packing changes no block");
+        assert!(
+            w.iter()
+                .all(|(_, c)| c.is_packed() || c.as_uniform().is_some())
+        );
+        assert!(w.chunk_memory_bytes() * 3 < mask_bytes);
+        for (p, dense) in &before {
+            assert_eq!(&w.chunk(*p).unwrap().to_dense(), dense);
+        }
+        assert_eq!(w.get_block(WorldPos::new(0, 0, 0)), WATER);
+        assert_eq!(w.get_block(WorldPos::new(-1, -1, -1)), STONE);
+        assert_eq!(w.set_block(WorldPos::new(1, 1, 1), GLASS).unwrap(), STONE);
+        let c = ChunkPos::new(0, 0, 0);
+        assert!(w.chunk(c).unwrap().is_packed(), "an edit keeps the form");
+        w.chunk(c).unwrap().check_invariants().unwrap();
+        assert!(w.unpack_chunk(c));
+        assert!(!w.chunk(c).unwrap().is_packed());
+        assert_eq!(w.get_block(WorldPos::new(1, 1, 1)), GLASS);
+        assert!(w.pack_chunk(c));
+        assert!(w.chunk(c).unwrap().is_packed());
+        assert!(!w.pack_chunk(ChunkPos::new(9, 9, 9)));
+        assert!(!w.unpack_chunk(ChunkPos::new(9, 9, 9)));
     }
 
     #[test]

@@ -8,6 +8,12 @@
 //! opaque/transparent column masks its `fast_mesh` expects a chunk to maintain), outside the
 //! timed region. Ours is timed from our chunk storage and the six neighbour chunks, with all
 //! neighbour lookups inside the timed region, and it produces three meshes instead of one.
+//!
+//! Ours is timed twice in the same rounds: from the mask form (the mesher's input, as
+//! stored), and from the packed form (the compact resident form: the mesher builds the
+//! centre's masks into its scratch memory and reads the neighbours' touching layers from
+//! their bit planes). The storage section reports the memory of both forms against a
+//! packed-index palette, and the cost of converting between them.
 
 use std::collections::BTreeSet;
 use std::hint::black_box;
@@ -21,8 +27,8 @@ use block_mesh::{
 };
 use voxel_core::blocks::{GLASS, LEAVES, WATER};
 use voxel_core::{
-    BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Face, RenderClass, TerrainConfig,
-    TerrainGenerator, World, blocks,
+    BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Face, MaskBuffer, RenderClass,
+    TerrainConfig, TerrainGenerator, World, blocks,
 };
 use voxel_mesh::{ChunkMeshes, Mesher, mesh_chunks};
 
@@ -182,11 +188,13 @@ fn main() {
         has(GLASS) > 0 && has(LEAVES) > 0,
         "bench chunks must hold glass and leaves"
     );
-    mesher_section(&reg, &world, &cases);
+    let mut packed = world.clone();
+    packed.pack_all();
+    mesher_section(&reg, &world, &packed, &cases);
     storage_and_terrain_section(&reg, &generator);
 }
 
-fn mesher_section(reg: &BlockRegistry, world: &World, cases: &[Case]) {
+fn mesher_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[Case]) {
     let mut ours = Mesher::new(reg);
     let mut out = ChunkMeshes::default();
     let mut theirs = Bgm::new();
@@ -200,6 +208,14 @@ fn mesher_section(reg: &BlockRegistry, world: &World, cases: &[Case]) {
         ours.mesh_into(chunk, world.neighbours(c.pos), &mut out)
             .expect("known blocks");
         q_ours += out.len();
+        let from_masks = out.clone();
+        ours.mesh_into(
+            packed.chunk(c.pos).expect("generated"),
+            packed.neighbours(c.pos),
+            &mut out,
+        )
+        .expect("known blocks");
+        assert_eq!(out, from_masks, "packed chunks mesh like mask chunks");
         q_split[0] += out.opaque.len();
         q_split[1] += out.cutout.len();
         q_split[2] += out.translucent.len();
@@ -233,12 +249,12 @@ fn mesher_section(reg: &BlockRegistry, world: &World, cases: &[Case]) {
         .filter(|(_, d)| matches!(d.class, RenderClass::Cutout | RenderClass::Translucent))
         .map(|(id, _)| id.0)
         .collect();
-    let mut times: [Vec<f64>; 4] = Default::default();
+    let mut times: [Vec<f64>; 5] = Default::default();
     for round in 0..ROUNDS {
         // The order rotates every round, so that no mesher always runs cold right after
         // another one's sweep through memory.
-        for k in 0..4 {
-            let method = (round + k) % 4;
+        for k in 0..5 {
+            let method = (round + k) % 5;
             // block-mesh is ~20× slower: a third of the rounds is plenty.
             if method == 3 && round % 3 != 0 {
                 continue;
@@ -249,6 +265,12 @@ fn mesher_section(reg: &BlockRegistry, world: &World, cases: &[Case]) {
                     0 => {
                         let chunk = world.chunk(c.pos).expect("generated");
                         ours.mesh_into(black_box(chunk), world.neighbours(c.pos), &mut out)
+                            .expect("known blocks");
+                        black_box(&out);
+                    }
+                    4 => {
+                        let chunk = packed.chunk(c.pos).expect("generated");
+                        ours.mesh_into(black_box(chunk), packed.neighbours(c.pos), &mut out)
                             .expect("known blocks");
                         black_box(&out);
                     }
@@ -283,23 +305,95 @@ fn mesher_section(reg: &BlockRegistry, world: &World, cases: &[Case]) {
             times[method].push(secs(t.elapsed()) / n);
         }
     }
-    let [t_ours, t_bgm_fast, t_bgm_mesh, t_bm] = times;
+    let [t_ours, t_bgm_fast, t_bgm_mesh, t_bm, t_packed] = times;
     let us = |v: Vec<f64>| median(v) * 1e6;
     let (ours_us, fast_us, mesh_us, bm_us) = (us(t_ours), us(t_bgm_fast), us(t_bgm_mesh), us(t_bm));
+    let packed_us = us(t_packed);
     println!("\n## mesher (µs per 32^3 chunk, median of {ROUNDS} interleaved rounds)");
     println!("ours (three meshes, from chunk storage + 6 neighbours) {ours_us:9.1}");
     println!("binary-greedy-meshing 0.5 fast_mesh (input prepared)  {fast_us:9.1}");
     println!("binary-greedy-meshing 0.5 mesh (BTreeSet transparents) {mesh_us:8.1}");
     println!("block-mesh 0.2 greedy_quads                           {bm_us:9.1}");
+    println!("ours, packed chunk + 6 packed neighbours (masks built) {packed_us:9.1}");
     println!(
         "ratio ours / binary-greedy-meshing fast_mesh = {:.3} (target <= 0.8)",
         ours_us / fast_us
+    );
+    println!(
+        "ratio ours packed / binary-greedy-meshing fast_mesh = {:.3}",
+        packed_us / fast_us
     );
     println!(
         "ratio block-mesh greedy_quads / ours = {:.1}x (target >= 10x)",
         bm_us / ours_us
     );
     uniform_section(reg, ours_us);
+    packed_section(reg, world, packed, cases);
+}
+
+/// What meshing a packed chunk costs, part by part, on the same cases and in rounds of
+/// their own (the peers' sweeps through memory make the section above slower for every
+/// mesher): building the masks of its non-air types (what the mesher does first for a
+/// packed centre), meshes with the centre and the neighbours in each form, and the
+/// alternative where the caller unpacks the chunk, meshes it and packs it again.
+fn packed_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[Case]) {
+    const ROUNDS: usize = 41;
+    const METHODS: usize = 5;
+    let mut ours = Mesher::new(reg);
+    let mut out = ChunkMeshes::default();
+    let mut buf = MaskBuffer::new();
+    let not_air = |id: BlockId| reg.class(id).is_ok_and(|c| c != RenderClass::Air);
+    let mut chunks: Vec<Chunk> = cases
+        .iter()
+        .map(|c| packed.chunk(c.pos).expect("generated").clone())
+        .collect();
+    let n = cases.len() as f64;
+    let mut times: [Vec<f64>; METHODS] = Default::default();
+    for round in 0..ROUNDS {
+        for k in 0..METHODS {
+            let method = (round + k) % METHODS;
+            let t = Instant::now();
+            for (c, chunk) in cases.iter().zip(&mut chunks) {
+                let (centre, nb) = match method {
+                    0 => {
+                        black_box(&*chunk).build_masks(&mut buf, not_air);
+                        black_box(&buf);
+                        continue;
+                    }
+                    4 => {
+                        chunk.unpack();
+                        ours.mesh_into(black_box(&*chunk), packed.neighbours(c.pos), &mut out)
+                            .expect("known blocks");
+                        chunk.pack();
+                        black_box(&out);
+                        continue;
+                    }
+                    1 => (packed, packed),
+                    2 => (world, packed),
+                    _ => (world, world),
+                };
+                let chunk = centre.chunk(c.pos).expect("generated");
+                ours.mesh_into(black_box(chunk), nb.neighbours(c.pos), &mut out)
+                    .expect("known blocks");
+                black_box(&out);
+            }
+            times[method].push(secs(t.elapsed()) / n);
+        }
+    }
+    let [t_build, t_packed, t_nb, t_masks, t_unpack] = times.map(|t| median(t) * 1e6);
+    let types: usize = chunks.iter().map(Chunk::palette_len).sum();
+    println!(
+        "\n## packed chunks (the same chunks, {:.1} types each; µs per chunk, median of {ROUNDS} interleaved rounds without the peers)",
+        types as f64 / n
+    );
+    println!("build the masks of a packed chunk (non-air types, both layouts) {t_build:6.1}");
+    println!("mesh, chunk and neighbours in mask form                    {t_masks:11.1}");
+    println!("mesh, chunk in mask form, neighbours packed                {t_nb:11.1}");
+    println!(
+        "mesh, chunk and neighbours packed (masks built)            {t_packed:11.1}   {:+.1} over the mask form",
+        t_packed - t_masks
+    );
+    println!("alternative: the caller unpacks, meshes, packs again       {t_unpack:11.1}");
 }
 
 /// Ours on uniform chunks: leaves (cutout, every inner face stays) alone and between six
@@ -448,12 +542,62 @@ fn storage_section(world: &World) {
         mib(dense),
         mib(packed)
     );
+    // The resident form: the same world, every chunk packed.
+    let mut compact_world = world.clone();
+    let t = Instant::now();
+    compact_world.pack_all();
+    let t_pack_all = secs(t.elapsed());
+    let compact = compact_world.chunk_memory_bytes();
+    println!(
+        "memory, packed (ours, the resident form) {:.1} MiB = {:.2}x the packed-index palette (target <= 2); bitmask palette {:.2}x and u16 per block {:.2}x of it",
+        mib(compact),
+        compact as f64 / packed as f64,
+        ours as f64 / compact as f64,
+        dense as f64 / compact as f64
+    );
+
+    // Converting between the forms, on mixed chunks of the world (they leave the caches:
+    // 256 chunks in mask form are 15 MiB).
+    let originals: Vec<Chunk> = mixed.iter().take(256).map(|c| (**c).clone()).collect();
+    let (mut t_pack, mut t_unpack) = (vec![], vec![]);
+    for _ in 0..9 {
+        let mut v = originals.clone();
+        let t = Instant::now();
+        for c in &mut v {
+            black_box(&mut *c).pack();
+        }
+        t_pack.push(secs(t.elapsed()) / v.len() as f64);
+        let t = Instant::now();
+        for c in &mut v {
+            black_box(&mut *c).unpack();
+        }
+        t_unpack.push(secs(t.elapsed()) / v.len() as f64);
+        black_box(&v);
+    }
+    println!(
+        "pack (masks -> packed) {:.1} µs, unpack (packed -> masks) {:.1} µs per mixed chunk (median of 9 x {}); pack_all of the world, {} threads: {:.0} ms",
+        median(t_pack) * 1e6,
+        median(t_unpack) * 1e6,
+        originals.len(),
+        rayon::current_num_threads(),
+        t_pack_all * 1e3
+    );
 
     // What a u16 store would pay on every remesh: building the per-type masks we keep.
     let sample: Vec<Vec<BlockId>> = mixed.iter().take(64).map(|c| c.to_dense()).collect();
     let mut t_masks = vec![];
     let mut t_get_dense = vec![];
     let mut t_get_ours = vec![];
+    let mut t_get_packed = vec![];
+    let packed_sample: Vec<Chunk> = mixed
+        .iter()
+        .take(sample.len())
+        .map(|c| {
+            let mut c = (**c).clone();
+            c.pack();
+            c
+        })
+        .collect();
     let lookups: Vec<(usize, usize, usize)> = (0..4096u64)
         .map(|i| {
             let h = i.wrapping_mul(0x9e37_79b9_7f4a_7c15);
@@ -501,6 +645,16 @@ fn storage_section(world: &World) {
         }
         black_box(acc);
         t_get_ours.push(secs(t.elapsed()) / (sample.len() * lookups.len()) as f64);
+
+        let t = Instant::now();
+        let mut acc = 0u32;
+        for c in &packed_sample {
+            for &(x, y, z) in &lookups {
+                acc = acc.wrapping_add(u32::from(c.get(x, y, z).map_or(0, |b| b.0)));
+            }
+        }
+        black_box(acc);
+        t_get_packed.push(secs(t.elapsed()) / (sample.len() * lookups.len()) as f64);
     }
     println!(
         "building per-type masks from u16 per block: {:.1} µs per chunk (paid on every remesh by a u16 store)",
@@ -511,5 +665,6 @@ fn storage_section(world: &World) {
         median(t_get_dense) * 1e9,
         median(t_get_ours) * 1e9
     );
+    println!("random get, packed: {:.1} ns", median(t_get_packed) * 1e9);
     let _ = blocks::AIR;
 }

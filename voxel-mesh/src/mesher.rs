@@ -15,8 +15,13 @@
 //! - Across a chunk border the neighbour chunk decides; a missing neighbour counts as air,
 //!   so the edge of a loaded area is closed by faces rather than left with holes.
 //!
-//! The algorithm works on the chunk's storage directly: every block type present has its
-//! blocks as bits, in vertical columns and in rows along x ([`Occupancy`]). For each type,
+//! The algorithm works on bit masks: every block type present has its blocks as bits, in
+//! vertical columns and in rows along x ([`Occupancy`]). A chunk in mask form stores exactly
+//! these and is meshed from its storage directly; for a packed chunk (the compact resident
+//! form, see [`Chunk::pack`]) the mesher first builds the masks of its non-air
+//! types into its own scratch memory ([`Chunk::build_masks`], a few µs), and of a
+//! neighbour it reads only the touching layer ([`Chunk::side_layers`]), in any form. The
+//! quads are the same whatever the forms of the chunk and its neighbours. For each type,
 //! the visible faces of a layer are one AND-NOT between its rows and the "hides me" rows of
 //! the next layer; they are then covered with rectangles by [`greedy_rects`]. Bits are per
 //! block type, so merged quads never mix blocks and no per-block comparison is needed. Cost
@@ -36,7 +41,7 @@
 //! depth peeling are per pixel and do not care.
 
 use voxel_core::{
-    BlockId, BlockRegistry, CHUNK_AREA, CHUNK_SIZE, Chunk, ColumnMask, Face, Occupancy,
+    BlockId, BlockRegistry, CHUNK_AREA, CHUNK_SIZE, Chunk, ColumnMask, Face, MaskBuffer, Occupancy,
     RenderClass, row_index,
 };
 
@@ -99,6 +104,8 @@ struct Scratch {
     /// them: where a translucent face is an interface.
     translucent: Occupancy,
     nb_translucent: [Plane; 6],
+    /// Each neighbour's touching layer, per block type.
+    nb_layers: [Vec<(BlockId, Plane)>; 6],
 }
 
 /// Where faces toward other translucent types are (inside the chunk and in the neighbours'
@@ -114,6 +121,8 @@ struct Split<'a> {
 pub struct Mesher {
     classes: Vec<RenderClass>,
     s: Box<Scratch>,
+    /// A packed centre's masks.
+    built: MaskBuffer,
 }
 
 impl std::fmt::Debug for Mesher {
@@ -129,20 +138,6 @@ impl std::fmt::Debug for Mesher {
 fn layer(mask: &ColumnMask, i: usize) -> &Plane {
     let rows = &mask[i * CHUNK_SIZE..(i + 1) * CHUNK_SIZE];
     rows.try_into().unwrap_or(&[0; CHUNK_SIZE])
-}
-
-/// The layer of `bits` that touches a chunk across `face`, in that face's plane layout:
-/// rows z bits y for x faces, rows z bits x for y faces, rows y bits x for z faces.
-fn touching_layer(bits: &Occupancy, face: Face) -> Plane {
-    let last = CHUNK_SIZE - 1;
-    match face {
-        Face::PosX => *layer(&bits.by_y, 0),
-        Face::NegX => *layer(&bits.by_y, last),
-        Face::PosY => *layer(&bits.by_x, 0),
-        Face::NegY => *layer(&bits.by_x, last),
-        Face::PosZ => std::array::from_fn(|y| bits.by_x[row_index(y, 0)]),
-        Face::NegZ => std::array::from_fn(|y| bits.by_x[row_index(y, last)]),
-    }
 }
 
 fn or_into(dst: &mut [u32], src: &[u32]) {
@@ -211,7 +206,9 @@ impl Mesher {
                 nb_opaque: [[0; CHUNK_SIZE]; 6],
                 translucent: EMPTY_OCCUPANCY,
                 nb_translucent: [[0; CHUNK_SIZE]; 6],
+                nb_layers: Default::default(),
             }),
+            built: MaskBuffer::new(),
         }
     }
 
@@ -230,7 +227,10 @@ impl Mesher {
     }
 
     /// Meshes `chunk` into `out`, reusing its allocations. Fails if the chunk or a
-    /// neighbour holds a block id the registry does not know.
+    /// neighbour holds a block id the registry does not know. The chunk and its neighbours
+    /// may each be in any storage form (uniform, masks or packed): a packed centre has the
+    /// masks of its non-air types built into this mesher's scratch memory, a packed
+    /// neighbour gives only its touching layer.
     pub fn mesh_into(
         &mut self,
         chunk: &Chunk,
@@ -246,29 +246,59 @@ impl Mesher {
         if chunk.as_uniform() == Some(BlockId::AIR) {
             return Ok(());
         }
-        let classes = &self.classes;
-        let is_opaque = |id: BlockId| classes[id.index()] == RenderClass::Opaque;
-        let s = &mut *self.s;
+        let Self { classes, s, built } = self;
+        let classes = &*classes;
+        let s = &mut **s;
+        let class = |id: BlockId| classes[id.index()];
+        let is_opaque = |id: BlockId| class(id) == RenderClass::Opaque;
+        let is_translucent = |id: BlockId| class(id) == RenderClass::Translucent;
+
+        // The centre's masks: stored, or built from the packed form (air is never meshed
+        // and hides nothing, so it is left out).
+        built.clear();
+        if chunk.is_packed() {
+            chunk.build_masks(built, |id| class(id) != RenderClass::Air);
+        }
+        let built = &*built;
+        let entries = || {
+            chunk
+                .stored_masks()
+                .into_iter()
+                .flatten()
+                .chain(built.iter())
+        };
+
+        // Each neighbour's touching layer, per block type.
+        for face in Face::ALL {
+            let layers = &mut s.nb_layers[face as usize];
+            layers.clear();
+            if let Some(n) = neighbours[face as usize] {
+                // Only opaque and translucent blocks hide anything.
+                n.side_layers(face.opposite(), layers, |id| {
+                    is_opaque(id) || is_translucent(id)
+                });
+            }
+        }
+        let nb_union = |layers: &[(BlockId, Plane)], keep: &dyn Fn(BlockId) -> bool| -> Plane {
+            let mut plane = [0; CHUNK_SIZE];
+            for (_, rows) in layers.iter().filter(|(id, _)| keep(*id)) {
+                or_into(&mut plane, rows);
+            }
+            plane
+        };
 
         // What hides our faces: our opaque blocks and the neighbours' touching layers.
         s.opaque.by_y.fill(0);
         s.opaque.by_x.fill(0);
-        for (_, bits) in chunk.palette().filter(|(id, _)| is_opaque(*id)) {
+        for (_, bits) in entries().filter(|(id, _)| is_opaque(*id)) {
             or_into(&mut s.opaque.by_y, &bits.by_y);
             or_into(&mut s.opaque.by_x, &bits.by_x);
         }
         for face in Face::ALL {
-            let plane = &mut s.nb_opaque[face as usize];
-            *plane = [0; CHUNK_SIZE];
-            if let Some(n) = neighbours[face as usize] {
-                for (_, bits) in n.palette().filter(|(id, _)| is_opaque(*id)) {
-                    or_into(plane, &touching_layer(bits, face));
-                }
-            }
+            s.nb_opaque[face as usize] = nb_union(&s.nb_layers[face as usize], &is_opaque);
         }
         // Where translucent faces meet other translucent types: only when the chunk and its
         // neighbours hold two translucent types or more (terrain with water alone skips it).
-        let is_translucent = |id: BlockId| classes[id.index()] == RenderClass::Translucent;
         let mut types = neighbours
             .iter()
             .flatten()
@@ -282,18 +312,13 @@ impl Mesher {
         if interfaces {
             s.translucent.by_y.fill(0);
             s.translucent.by_x.fill(0);
-            for (_, bits) in chunk.palette().filter(|(id, _)| is_translucent(*id)) {
+            for (_, bits) in entries().filter(|(id, _)| is_translucent(*id)) {
                 or_into(&mut s.translucent.by_y, &bits.by_y);
                 or_into(&mut s.translucent.by_x, &bits.by_x);
             }
             for face in Face::ALL {
-                let plane = &mut s.nb_translucent[face as usize];
-                *plane = [0; CHUNK_SIZE];
-                if let Some(n) = neighbours[face as usize] {
-                    for (_, bits) in n.palette().filter(|(id, _)| is_translucent(*id)) {
-                        or_into(plane, &touching_layer(bits, face));
-                    }
-                }
+                s.nb_translucent[face as usize] =
+                    nb_union(&s.nb_layers[face as usize], &is_translucent);
             }
         }
         let full = |rows: &[u32]| rows.iter().all(|&r| r == u32::MAX);
@@ -304,12 +329,11 @@ impl Mesher {
             return Ok(());
         }
 
-        for (id, bits) in chunk.palette() {
-            let class = self.classes[id.index()];
+        for (id, bits) in entries() {
+            let class = class(id);
             if class == RenderClass::Air {
                 continue;
             }
-            let s = &mut *self.s;
             let mut nb_hide = s.nb_opaque;
             let hide = if class == RenderClass::Translucent {
                 // Blocks of the same type hide too, inside the chunk and across borders.
@@ -322,8 +346,9 @@ impl Mesher {
                         .for_each(|(h, (o, m))| *h = o | m);
                 }
                 for face in Face::ALL {
-                    if let Some(same) = neighbours[face as usize].and_then(|n| n.occupancy(id)) {
-                        or_into(&mut nb_hide[face as usize], &touching_layer(same, face));
+                    let layers = &s.nb_layers[face as usize];
+                    if let Some((_, same)) = layers.iter().find(|(i, _)| *i == id) {
+                        or_into(&mut nb_hide[face as usize], same);
                     }
                 }
                 &s.hide
@@ -467,10 +492,31 @@ mod tests {
         BlockRegistry::default()
     }
 
+    /// Meshes `chunk` as it is, and again in each of the 2^7 combinations of storage forms
+    /// (masks or packed) of the centre and the six neighbours, checking that every
+    /// combination gives the same quads.
     fn mesh(chunk: &Chunk, nb: Neighbours<'_>) -> ChunkMeshes {
-        Mesher::new(&registry())
-            .mesh(chunk, nb)
-            .expect("known blocks")
+        let mut mesher = Mesher::new(&registry());
+        let m = mesher.mesh(chunk, nb).expect("known blocks");
+        let forms = |c: &Chunk| {
+            let (mut masks, mut packed) = (c.clone(), c.clone());
+            masks.unpack();
+            packed.pack();
+            [masks, packed]
+        };
+        let centre = forms(chunk);
+        let nbs = nb.map(|n| n.map(forms));
+        for combo in 0..1 << 7 {
+            let pick = |slot: usize| combo >> slot & 1;
+            let nb: Neighbours<'_> =
+                std::array::from_fn(|i| nbs[i].as_ref().map(|f| &f[pick(i + 1)]));
+            let other = mesher.mesh(&centre[pick(0)], nb).expect("known blocks");
+            assert!(
+                same_quads(&m, &other),
+                "forms {combo:#09b} mesh differently"
+            );
+        }
+        m
     }
 
     /// Every unit face covered by `quads`; panics on a face covered twice.
@@ -859,6 +905,13 @@ mod tests {
             mesher.mesh(&ok, [Some(&c), None, None, None, None, None]),
             Err(Error::UnknownBlock(BlockId(40)))
         );
+        c.pack();
+        assert!(c.is_packed());
+        assert_eq!(mesher.mesh(&c, NONE), Err(Error::UnknownBlock(BlockId(40))));
+        assert_eq!(
+            mesher.mesh(&ok, [None, None, None, None, None, Some(&c)]),
+            Err(Error::UnknownBlock(BlockId(40)))
+        );
     }
 
     #[test]
@@ -962,6 +1015,11 @@ mod tests {
     /// checks that every centre class (air, opaque, cutout, translucent, mixed) met every
     /// neighbour kind (missing, uniform air, opaque, cutout or translucent, mixed).
     ///
+    /// Storage forms: each mixed chunk (centre or neighbour) is packed or left in mask form
+    /// at random, and every case is meshed again with each mixed chunk in the other form,
+    /// which must give the same quads; the test checks that every centre form (uniform,
+    /// masks, packed) met every neighbour form (missing, uniform, masks, packed).
+    ///
     /// The test this replaced drew only mixed centres, so it never met the uniform
     /// shortcut, and missed that uniform cutout centres lost every inner face (issue 10).
     #[test]
@@ -978,6 +1036,8 @@ mod tests {
         }
         let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
         let mut covered = BTreeSet::new();
+        let mut forms = BTreeSet::new();
+        let mut forms_rng = XorShift(0x2545_f491_4f6c_dd1d);
         let mut cases = 0;
         for reg in [registry(), extended] {
             let ids: Vec<BlockId> = reg.iter().map(|(id, _)| id).collect();
@@ -1012,22 +1072,55 @@ mod tests {
                             _ => Kind::Mixed,
                         },
                     });
+                    // A mixed chunk is packed or left in mask form at random (its own
+                    // stream, so that the chunks drawn stay those of the test before forms).
                     let mut make = |k: Kind| match k {
                         Kind::Missing => None,
                         Kind::Uniform(id) => Some(Chunk::uniform(id)),
-                        Kind::Mixed => Some(mixed_chunk(&mut rng, &ids)),
+                        Kind::Mixed => {
+                            let mut c = mixed_chunk(&mut rng, &ids);
+                            if forms_rng.below(2) == 0 {
+                                c.pack();
+                            }
+                            Some(c)
+                        }
                     };
                     let centre = make(centre_kind).expect("a centre");
                     let nbs = nb_kinds.map(&mut make);
                     let nb: Neighbours<'_> = std::array::from_fn(|i| nbs[i].as_ref());
                     let m = mesher.mesh(&centre, nb).unwrap();
                     let what = format!(
-                        "case {cases}: {} blocks, centre {centre_kind:?}, neighbours {nb_kinds:?}",
-                        reg.len()
+                        "case {cases}: {} blocks, centre {centre_kind:?} {}, neighbours {nb_kinds:?} {:?}",
+                        reg.len(),
+                        form(Some(&centre)),
+                        nbs.each_ref().map(|c| form(c.as_ref()))
                     );
                     assert_rules(&m, &reg, &centre, nb, &what);
+                    // The same chunks with every mixed one in the other form: the same quads.
+                    let flip = |c: &Chunk| {
+                        let mut c = c.clone();
+                        if c.is_packed() {
+                            c.unpack();
+                        } else {
+                            c.pack();
+                        }
+                        c
+                    };
+                    let centre2 = flip(&centre);
+                    let nbs2 = nbs.each_ref().map(|c| c.as_ref().map(flip));
+                    let nb2: Neighbours<'_> = std::array::from_fn(|i| nbs2[i].as_ref());
+                    let m2 = mesher.mesh(&centre2, nb2).unwrap();
+                    assert!(
+                        same_quads(&m, &m2),
+                        "{what}: the other forms mesh differently"
+                    );
                     for k in nb_kinds {
                         covered.insert((label(centre_kind), label(k)));
+                    }
+                    for (c, n) in [(&centre, &nbs), (&centre2, &nbs2)] {
+                        for n in n {
+                            forms.insert((form(Some(c)), form(n.as_ref())));
+                        }
                     }
                     cases += 1;
                 }
@@ -1035,5 +1128,32 @@ mod tests {
         }
         assert_eq!(cases, (14 + 19) * 8);
         assert_eq!(covered.len(), 5 * 6, "{covered:?}");
+        assert_eq!(forms.len(), 3 * 4, "{forms:?}");
+    }
+
+    /// The storage form of a chunk slot, for the property test's coverage.
+    fn form(c: Option<&Chunk>) -> &'static str {
+        match c {
+            None => "missing",
+            Some(c) if c.as_uniform().is_some() => "uniform",
+            Some(c) if c.is_packed() => "packed",
+            Some(_) => "masks",
+        }
+    }
+
+    /// Whether two meshes hold the same quads, in any order.
+    fn same_quads(a: &ChunkMeshes, b: &ChunkMeshes) -> bool {
+        let sorted = |v: &[PackedQuad]| {
+            let mut v: Vec<_> = v.iter().map(|q| (q.geometry, q.block)).collect();
+            v.sort_unstable();
+            v
+        };
+        [
+            (&a.opaque, &b.opaque),
+            (&a.cutout, &b.cutout),
+            (&a.translucent, &b.translucent),
+        ]
+        .into_iter()
+        .all(|(x, y)| sorted(x) == sorted(y))
     }
 }

@@ -1,6 +1,6 @@
 //! Our face area against a peer: block-mesh's `visible_block_faces` (one quad per visible
 //! face) on the same opaque-only voxels must cover exactly the area our greedy quads cover,
-//! direction by direction.
+//! direction by direction, whatever the storage forms of the chunk and its neighbours.
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
@@ -95,14 +95,27 @@ fn peer_faces(c: &Chunk, nb: Neighbours<'_>) -> [usize; 6] {
     [g(3), g(0), g(4), g(1), g(5), g(2)]
 }
 
+/// Our unit-face count per direction, the same with the chunk and its neighbours as they
+/// are, all packed, and only the neighbours packed.
 fn our_faces(mesher: &mut Mesher, c: &Chunk, nb: Neighbours<'_>) -> [usize; 6] {
-    let m = mesher.mesh(c, nb).unwrap();
-    assert!(m.cutout.is_empty() && m.translucent.is_empty());
-    let mut area = [0; 6];
-    for q in &m.opaque {
-        area[q.face_index()] += q.area() as usize;
-    }
-    area
+    let packed = |c: &Chunk| {
+        let mut c = c.clone();
+        c.pack();
+        c
+    };
+    let (pc, pnb) = (packed(c), nb.map(|n| n.map(packed)));
+    let pnb: Neighbours<'_> = std::array::from_fn(|i| pnb[i].as_ref());
+    let areas = [(c, nb), (&pc, pnb), (c, pnb)].map(|(c, nb)| {
+        let m = mesher.mesh(c, nb).unwrap();
+        assert!(m.cutout.is_empty() && m.translucent.is_empty());
+        let mut area = [0; 6];
+        for q in &m.opaque {
+            area[q.face_index()] += q.area() as usize;
+        }
+        area
+    });
+    assert!(areas.iter().all(|a| *a == areas[0]), "{areas:?}");
+    areas[0]
 }
 
 #[test]
