@@ -142,11 +142,13 @@ impl ChunkPos {
     }
 }
 
-/// A sparse world of chunks over one block registry.
+/// A sparse world of chunks over one block registry. Chunks are shared (`Arc`): cloning a
+/// world, or handing a chunk to a meshing job ([`World::shared`]), copies no blocks; an
+/// edit copies a chunk only while someone else still holds it.
 #[derive(Debug, Clone)]
 pub struct World {
     registry: Arc<BlockRegistry>,
-    chunks: HashMap<ChunkPos, Chunk>,
+    chunks: HashMap<ChunkPos, Arc<Chunk>>,
     dirty: HashSet<ChunkPos>,
 }
 
@@ -198,7 +200,7 @@ impl World {
         if id == BlockId::AIR && !self.chunks.contains_key(&c) {
             return Ok(BlockId::AIR);
         }
-        let old = self.chunks.entry(c).or_default().set(x, y, z, id)?;
+        let old = Arc::make_mut(self.chunks.entry(c).or_default()).set(x, y, z, id)?;
         if old != id {
             self.dirty.insert(c);
             let last = CHUNK_SIZE - 1;
@@ -252,7 +254,7 @@ impl World {
                     if id == BlockId::AIR && !self.chunks.contains_key(&pos) {
                         continue;
                     }
-                    self.chunks.entry(pos).or_default().fill_box(
+                    Arc::make_mut(self.chunks.entry(pos).or_default()).fill_box(
                         [lo[0], lo[1], lo[2]],
                         [hi[0], hi[1], hi[2]],
                         id,
@@ -275,13 +277,16 @@ impl World {
             return Err(Error::UnknownBlock(id, self.registry.len()));
         }
         self.mark_with_neighbours(pos);
-        Ok(self.chunks.insert(pos, chunk))
+        Ok(self
+            .chunks
+            .insert(pos, Arc::new(chunk))
+            .map(Arc::unwrap_or_clone))
     }
 
     /// Unloads a chunk; it and its loaded neighbours become dirty (the mesher then returns
     /// empty meshes for it).
     pub fn remove_chunk(&mut self, pos: ChunkPos) -> Option<Chunk> {
-        let old = self.chunks.remove(&pos);
+        let old = self.chunks.remove(&pos).map(Arc::unwrap_or_clone);
         if old.is_some() {
             self.mark_with_neighbours(pos);
         }
@@ -299,41 +304,67 @@ impl World {
 
     /// The chunk at `pos`, if loaded.
     pub fn chunk(&self, pos: ChunkPos) -> Option<&Chunk> {
-        self.chunks.get(&pos)
+        self.chunks.get(&pos).map(|c| &**c)
+    }
+
+    /// The chunk at `pos` as a shared handle (for a job on another thread), if loaded.
+    pub fn shared(&self, pos: ChunkPos) -> Option<Arc<Chunk>> {
+        self.chunks.get(&pos).cloned()
+    }
+
+    /// Puts `chunk` at `pos` in place of `expected` (the same blocks in another form, say
+    /// packed by a meshing job), if the chunk there is still exactly `expected`: an edit or
+    /// a replacement since wins. Nothing becomes dirty. Returns whether it was replaced.
+    pub fn replace_shared(&mut self, pos: ChunkPos, expected: &Arc<Chunk>, chunk: Chunk) -> bool {
+        match self.chunks.get_mut(&pos) {
+            Some(c) if Arc::ptr_eq(c, expected) => {
+                *c = Arc::new(chunk);
+                true
+            }
+            _ => false,
+        }
     }
 
     /// Converts the chunk at `pos` to the compact packed form (see [`Chunk::pack`]), e.g.
     /// once a streamer has meshed it. Blocks do not change, so nothing becomes dirty.
     /// Returns whether a chunk is loaded there.
     pub fn pack_chunk(&mut self, pos: ChunkPos) -> bool {
-        self.chunks.get_mut(&pos).map(Chunk::pack).is_some()
+        self.chunks
+            .get_mut(&pos)
+            .map(|c| Arc::make_mut(c).pack())
+            .is_some()
     }
 
     /// Converts the chunk at `pos` to the mask form (see [`Chunk::unpack`]), e.g. for a chunk
     /// about to be edited and remeshed often. Returns whether a chunk is loaded there.
     pub fn unpack_chunk(&mut self, pos: ChunkPos) -> bool {
-        self.chunks.get_mut(&pos).map(Chunk::unpack).is_some()
+        self.chunks
+            .get_mut(&pos)
+            .map(|c| Arc::make_mut(c).unpack())
+            .is_some()
     }
 
     /// Packs every loaded chunk, in parallel.
     pub fn pack_all(&mut self) {
-        self.chunks.par_iter_mut().for_each(|(_, c)| c.pack());
+        self.chunks
+            .par_iter_mut()
+            .for_each(|(_, c)| Arc::make_mut(c).pack());
     }
 
     /// Heap and inline bytes of the loaded chunks ([`Chunk::memory_bytes`] summed; the map
     /// itself not counted).
     pub fn chunk_memory_bytes(&self) -> usize {
-        self.chunks.values().map(Chunk::memory_bytes).sum()
+        self.chunks.values().map(|c| c.memory_bytes()).sum()
     }
 
     /// The six neighbours of `pos` in [`Face`] order; `None` where not loaded.
     pub fn neighbours(&self, pos: ChunkPos) -> [Option<&Chunk>; 6] {
-        Face::ALL.map(|f| pos.neighbour(f).and_then(|n| self.chunks.get(&n)))
+        Face::ALL.map(|f| pos.neighbour(f).and_then(|n| self.chunk(n)))
     }
 
     /// All loaded chunks, in no particular order.
     pub fn iter(&self) -> impl Iterator<Item = (ChunkPos, &Chunk)> {
-        self.chunks.iter().map(|(p, c)| (*p, c))
+        self.chunks.iter().map(|(p, c)| (*p, &**c))
     }
 
     /// Number of loaded chunks.
