@@ -162,3 +162,77 @@ fn bad_random_draws_are_refused_before_rendering() {
         &["--random", "--scenes", "cannot be used with"],
     );
 }
+
+#[test]
+fn bad_stream_runs_are_refused_before_rendering() {
+    fails_saying(
+        &[
+            "stream",
+            "--view-distance",
+            "0",
+            "--frames",
+            "5",
+            "--out",
+            "x",
+        ],
+        &["--view-distance", "0"],
+    );
+    fails_saying(
+        &[
+            "stream",
+            "--view-distance",
+            "65",
+            "--frames",
+            "5",
+            "--out",
+            "x",
+        ],
+        &["--view-distance", "65", "1..=64"],
+    );
+    fails_saying(
+        &[
+            "stream",
+            "--view-distance",
+            "4",
+            "--frames",
+            "0",
+            "--out",
+            "x",
+        ],
+        &["--frames", "0"],
+    );
+    for speed in ["NaN", "-1", "2000", "inf"] {
+        fails_saying(
+            &[
+                "stream",
+                "--view-distance",
+                "4",
+                "--frames",
+                "5",
+                "--speed",
+                speed,
+                "--out",
+                "x",
+            ],
+            &["--speed", "0 to 1024"],
+        );
+    }
+    fails_saying(
+        &[
+            "stream",
+            "--view-distance",
+            "4",
+            "--frames",
+            "5",
+            "--draw",
+            "bindless",
+            "--out",
+            "x",
+        ],
+        &["--draw", "bindless", "indirect or per-chunk"],
+    );
+    fails_saying(
+        &["stream", "--frames", "5", "--out", "x"],
+        &["--view-distance"],
+    );
+}

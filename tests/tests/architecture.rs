@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 /// voxel-render, bottom up (its lib.rs docs give the same order).
 const RENDER: &[&str] = &[
     "error", "context", "camera", "readback", "timing", "gpu", "bindings", "textures", "arena",
-    "chunks", "medium", "oit", "renderer",
+    "chunks", "medium", "oit", "renderer", "stream",
 ];
 
 /// voxel-lab, bottom up: the model, then the runs, then the report (its lib.rs docs).
@@ -27,6 +27,7 @@ const LAB: &[&str] = &[
     "distribution",
     "charts",
     "report",
+    "stream",
 ];
 
 /// The module each item re-exported by lib.rs (`pub use module::{A, B};`) comes from.

@@ -897,6 +897,18 @@ impl Chunk {
             }
     }
 
+    /// The bytes a packed-index palette would take for these blocks: the baseline resident
+    /// storage is measured against. A uniform chunk is the chunk value alone; a mixed one
+    /// has `ceil(log2 k)` bits per block for its `k` types and a `u16` per palette entry.
+    pub fn packed_index_bytes(&self) -> usize {
+        let k = self.palette_len();
+        if self.as_uniform().is_some() || k < 2 {
+            return std::mem::size_of::<Self>();
+        }
+        let bits = (usize::BITS - (k - 1).leading_zeros()) as usize;
+        CHUNK_VOLUME * bits / 8 + k * 2
+    }
+
     /// The chunk as one id per block, indexed by [`Chunk::dense_index`]. For tools, tests
     /// and peer meshers that want a dense array.
     pub fn to_dense(&self) -> Vec<BlockId> {

@@ -357,6 +357,12 @@ impl World {
         self.chunks.values().map(|c| c.memory_bytes()).sum()
     }
 
+    /// What the loaded chunks would take as packed-index palettes
+    /// ([`Chunk::packed_index_bytes`] summed): the baseline of [`World::chunk_memory_bytes`].
+    pub fn packed_index_bytes(&self) -> usize {
+        self.chunks.values().map(|c| c.packed_index_bytes()).sum()
+    }
+
     /// The six neighbours of `pos` in [`Face`] order; `None` where not loaded.
     pub fn neighbours(&self, pos: ChunkPos) -> [Option<&Chunk>; 6] {
         Face::ALL.map(|f| pos.neighbour(f).and_then(|n| self.chunk(n)))

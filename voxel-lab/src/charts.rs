@@ -209,23 +209,42 @@ pub fn sweep(
     log_x: bool,
     series: &[Series],
 ) -> Result<(), String> {
+    line_chart(
+        path,
+        title,
+        (x_desc, "mean FLIP against the exact reference"),
+        log_x,
+        series,
+    )
+}
+
+/// Any quantity against another, one line per series (points marked when there are few).
+/// Writes `path.png` and `path.svg`.
+pub fn line_chart(
+    path: &Path,
+    title: &str,
+    (x_desc, y_desc): (&str, &str),
+    log_x: bool,
+    series: &[Series],
+) -> Result<(), String> {
     fonts();
+    let axes = (x_desc, y_desc);
     lines(
         BitMapBackend::new(&path.with_extension("png"), (900, 560)).into_drawing_area(),
         title,
-        x_desc,
+        axes,
         log_x,
         series,
     )?;
     draw_svg(&path.with_extension("svg"), (900, 560), |root| {
-        lines(root, title, x_desc, log_x, series)
+        lines(root, title, axes, log_x, series)
     })
 }
 
 fn lines<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
-    x_desc: &str,
+    (x_desc, y_desc): (&str, &str),
     log_x: bool,
     series: &[Series],
 ) -> Result<(), String>
@@ -251,7 +270,7 @@ where
             chart
                 .configure_mesh()
                 .x_desc(x_desc)
-                .y_desc("mean FLIP against the exact reference")
+                .y_desc(y_desc)
                 .label_style(("sans-serif", 14))
                 .draw()
                 .map_err(err)?;
@@ -264,9 +283,11 @@ where
                     .legend(move |(x, y)| {
                         PathElement::new(vec![(x - 10, y), (x + 10, y)], c.stroke_width(2))
                     });
-                chart
-                    .draw_series(s.points.iter().map(move |&p| Circle::new(p, 3, c.filled())))
-                    .map_err(err)?;
+                if s.points.len() <= 100 {
+                    chart
+                        .draw_series(s.points.iter().map(move |&p| Circle::new(p, 3, c.filled())))
+                        .map_err(err)?;
+                }
             }
             chart
                 .configure_series_labels()

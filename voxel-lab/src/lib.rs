@@ -9,7 +9,8 @@
 //!   reference), [`stability`] (sweeps and flicker);
 //! - the report, which reads what the runs produced: [`distribution`] (errors over random
 //!   scenes, where each technique fails), [`charts`], [`report`];
-//! - [`evaluate`] here, which runs everything and writes every file.
+//! - [`evaluate`] here, which runs everything and writes every file;
+//! - [`stream`]: the streaming flight (`demo stream`), which draws its own chart.
 
 pub mod charts;
 pub mod distribution;
@@ -22,6 +23,7 @@ pub mod random;
 pub mod report;
 pub mod scene;
 pub mod stability;
+pub mod stream;
 pub mod summary;
 
 pub use summary::{EvalOptions, Summary};

@@ -512,14 +512,12 @@ fn storage_section(world: &World) {
         ours += c.memory_bytes();
         let k = c.palette_len();
         sizes[k.min(19)] += 1;
+        packed += c.packed_index_bytes();
         if c.as_uniform().is_some() {
             uniform += 1;
             dense += std::mem::size_of::<Chunk>();
-            packed += std::mem::size_of::<Chunk>();
         } else {
             dense += 32 * 32 * 32 * 2;
-            let bits = usize::BITS - (k - 1).leading_zeros();
-            packed += 32 * 32 * 32 * bits as usize / 8 + k * 2;
         }
     }
     let mixed: Vec<&&Chunk> = chunks.iter().filter(|c| c.as_uniform().is_none()).collect();

@@ -435,6 +435,11 @@ impl ChunkStore {
         (self.arena.stats(), self.infos.size())
     }
 
+    /// Bytes of the indirect command buffer.
+    pub fn indirect_bytes(&self) -> u64 {
+        self.indirect.size()
+    }
+
     /// Rewrites a chunk's translucent quads in a new order (the same quads: a permutation
     /// of [`GpuChunk::translucent_quads`]), for sorting. The generation stays.
     pub fn reorder_translucent(&mut self, ctx: &GpuContext, pos: ChunkPos, quads: Vec<PackedQuad>) {

@@ -32,6 +32,9 @@ pub enum Error {
         /// The names that exist, comma-separated.
         known: String,
     },
+    /// A block or world error (an unknown block id, a chunk outside the world).
+    #[error("world")]
+    World(#[from] voxel_core::Error),
     /// A setting outside what the renderer supports (the message names the setting and
     /// the allowed range).
     #[error("invalid setting: {0}")]

@@ -4,11 +4,13 @@
 //! - [`Renderer`]: chunks on the GPU and the passes of a frame; [`Camera`] to look with.
 //! - [`oit`]: the transparency techniques behind [`OitManager`], one folder each.
 //! - [`Image`] and [`readback`]: pictures back to the CPU, PNG files.
+//! - [`ChunkStreamer`]: the chunks around a moving eye, generated, meshed and uploaded on
+//!   rayon's workers.
 //!
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `camera`,
 //! `readback`, `timing` → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
 //! pipeline binds), `textures`, `arena` (the quad arena) → `chunks` → `medium` (translucent volumes seen from
-//! inside) → `oit` (techniques) → `renderer`. A test
+//! inside) → `oit` (techniques) → `renderer` → `stream` (chunks loaded around a moving eye). A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
 pub mod arena;
@@ -22,6 +24,7 @@ pub mod medium;
 pub mod oit;
 pub mod readback;
 mod renderer;
+pub mod stream;
 pub mod textures;
 mod timing;
 #[cfg(test)]
@@ -41,6 +44,9 @@ pub use oit::{
 };
 pub use readback::Image;
 pub use renderer::{ChunkMemory, FrameStats, Renderer, RendererConfig};
+pub use stream::{
+    ChunkSink, ChunkSource, ChunkStreamer, MAX_VIEW_DISTANCE, StreamConfig, StreamFrame,
+};
 pub use timing::{GpuPass, GpuTimes, Timer};
 
 /// Depth format of every pass: 32-bit float, reverse-Z (1 near, 0 far).

@@ -103,6 +103,8 @@ pub struct ChunkMemory {
     pub quad_bytes: u64,
     /// Bytes of the chunk records (16 per slot, with room to grow).
     pub record_bytes: u64,
+    /// Bytes of the indirect draw commands (16 per mesh drawn, with room to grow).
+    pub indirect_bytes: u64,
     /// Pages of the arena.
     pub pages: usize,
     /// Free ranges over all pages.
@@ -379,6 +381,7 @@ impl Renderer {
             arena_bytes: arena.bytes,
             quad_bytes: arena.used_bytes,
             record_bytes: records,
+            indirect_bytes: self.chunks.indirect_bytes(),
             pages: arena.pages,
             free_ranges: arena.fragments,
         }

@@ -1,0 +1,126 @@
+//! Streaming on the GPU: what the streamer uploads draws exactly like the same chunks
+//! meshed at once from a whole world, before and after an edit, for every draw path; and
+//! after streaming away and back (the arena reusing freed room) the picture is the same.
+
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, WorldPos, blocks};
+use voxel_render::{
+    Camera, ChunkStreamer, DrawMode, Renderer, RendererConfig, StreamConfig, Technique,
+};
+
+const SIZE: (u32, u32) = (240, 135);
+
+fn generator() -> TerrainGenerator {
+    TerrainGenerator::new(TerrainConfig::default())
+}
+
+fn renderer(ctx: &voxel_render::GpuContext, draw: DrawMode) -> Renderer {
+    let mut config = RendererConfig {
+        width: SIZE.0,
+        height: SIZE.1,
+        draw,
+        ..RendererConfig::default()
+    };
+    config.oit.technique = Technique::SortedQuads;
+    Renderer::new(ctx, &BlockRegistry::default(), config).unwrap()
+}
+
+fn settle(s: &mut ChunkStreamer, eye: DVec3, r: &mut Renderer) {
+    for _ in 0..100_000 {
+        let f = s.update(eye, r).unwrap();
+        assert!(f.failed.is_empty(), "{:?}", f.failed);
+        if s.is_idle() {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(300));
+    }
+    panic!("the streamer never settled: {s:?}");
+}
+
+/// The chunks the streamer drew, meshed at once from a world that holds them and every
+/// chunk the streamer holds (their neighbours), into a fresh renderer.
+fn whole(ctx: &voxel_render::GpuContext, s: &ChunkStreamer, draw: DrawMode) -> Renderer {
+    let mut r = renderer(ctx, draw);
+    let drawn: Vec<ChunkPos> = s.uploaded().collect();
+    for (pos, m) in voxel_mesh::mesh_chunks(s.world(), &drawn).unwrap() {
+        r.upload_chunk(pos, &m).unwrap();
+    }
+    r
+}
+
+#[test]
+fn streamed_chunks_draw_like_the_whole_world() {
+    let Some(ctx) = tests::gpu() else { return };
+    let out = tests::out_dir("stream");
+    let g = generator();
+    let eye = DVec3::new(0.5, g.height_at(0, 0) as f64 + 30.0, 0.5);
+    let camera = Camera::from_yaw_pitch(eye, 0.6, -0.35, 70.0, 0.1, 400.0).unwrap();
+    for draw in [DrawMode::Indirect, DrawMode::PerChunk] {
+        let config = StreamConfig {
+            view_distance: 3,
+            vertical_distance: 2,
+            ..StreamConfig::default()
+        };
+        let registry = Arc::new(BlockRegistry::default());
+        let mut s = ChunkStreamer::new(registry, g.clone(), config).unwrap();
+        let mut streamed = renderer(&ctx, draw);
+        settle(&mut s, eye, &mut streamed);
+        assert!(s.uploaded().count() > 20, "the terrain is drawn");
+        let a = tests::frame(&ctx, &mut streamed, &camera);
+        let b = tests::frame(&ctx, &mut whole(&ctx, &s, draw), &camera);
+        assert!(tests::distinct_colours(&a) > 50, "a real picture");
+        tests::assert_close(&format!("streamed_{}", draw.name()), &a, &b, 0);
+        a.save_png(&out.join(format!("streamed_{}.png", draw.name())))
+            .unwrap();
+
+        // An edit: a glass wall in front of the eye, across a chunk border.
+        let ground = g.height_at(20, 0) as i32;
+        for y in ground..ground + 8 {
+            for z in -4..4 {
+                s.set_block(WorldPos::new(31, y, z), blocks::GLASS).unwrap();
+                s.set_block(WorldPos::new(32, y, z), blocks::RED_GLASS)
+                    .unwrap();
+            }
+        }
+        settle(&mut s, eye, &mut streamed);
+        let look = Camera::look_at(
+            eye,
+            DVec3::new(32.0, ground as f64 + 3.0, 0.0),
+            70.0,
+            0.1,
+            400.0,
+        )
+        .unwrap();
+        let a = tests::frame(&ctx, &mut streamed, &look);
+        let b = tests::frame(&ctx, &mut whole(&ctx, &s, draw), &look);
+        tests::assert_close(&format!("edited_{}", draw.name()), &a, &b, 0);
+    }
+}
+
+#[test]
+fn streaming_away_and_back_draws_the_same() {
+    let Some(ctx) = tests::gpu() else { return };
+    let g = generator();
+    let eye = DVec3::new(0.5, g.height_at(0, 0) as f64 + 30.0, 0.5);
+    let camera = Camera::from_yaw_pitch(eye, 2.0, -0.3, 70.0, 0.1, 400.0).unwrap();
+    let config = StreamConfig {
+        view_distance: 3,
+        vertical_distance: 2,
+        max_unloads: 16,
+        ..StreamConfig::default()
+    };
+    let mut s = ChunkStreamer::new(Arc::new(BlockRegistry::default()), g, config).unwrap();
+    let mut r = renderer(&ctx, DrawMode::Indirect);
+    settle(&mut s, eye, &mut r);
+    let before = tests::frame(&ctx, &mut r, &camera);
+    // Far enough that everything unloads (its quads freed), then back: the arena reuses
+    // freed room for the new meshes.
+    settle(&mut s, eye + DVec3::X * 32.0 * 40.0, &mut r);
+    settle(&mut s, eye, &mut r);
+    let after = tests::frame(&ctx, &mut r, &camera);
+    tests::assert_close("away_and_back", &after, &before, 0);
+}
