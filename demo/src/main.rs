@@ -152,9 +152,10 @@ struct WindowArgs {
     /// Technique to start with.
     #[arg(long, value_parser = technique, default_value = "wboit-mrt")]
     technique: Technique,
-    /// Chunks of terrain around the start, each way (1 to 16).
-    #[arg(long, value_parser = clap::value_parser!(i32).range(1..=16), default_value_t = voxel_lab::scene::DEFAULT_RADIUS)]
-    view_distance: i32,
+    /// Chunks of terrain loaded around the eye, each way (1 to 32); they stream in as
+    /// the camera flies.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(demo::app::MAX_VIEW_DISTANCE)), default_value_t = 8)]
+    view_distance: u32,
     /// Start with the error map against the reference on.
     #[arg(long)]
     heatmap: bool,

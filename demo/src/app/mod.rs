@@ -1,7 +1,8 @@
-//! The interactive demo: a winit window with a wgpu surface, generated terrain drawn by the
-//! voxel renderer, an egui side panel to switch techniques and settings, a fly camera,
-//! block edits remeshed in the background, live GPU timings and a live error map against
-//! the exact reference.
+//! The interactive demo: a winit window with a wgpu surface, generated terrain streamed
+//! around the eye (a [`ChunkStreamer`]: chunks generated, meshed and uploaded in the
+//! background, up to 32 chunks of view distance) and drawn by the voxel renderer, an egui
+//! side panel to switch techniques and settings, a fly camera, block edits remeshed in the
+//! background, live GPU timings and a live error map against the exact reference.
 //!
 //! A frame is drawn into an sRGB offscreen target (the scene, then the panel), which is
 //! blitted to the surface: one picture for the window and for screenshots.
@@ -11,19 +12,18 @@ mod panel;
 mod post;
 mod raycast;
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, Sender, channel};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use glam::DVec3;
-use voxel_core::{BlockId, ChunkPos, RenderClass, World};
+use voxel_core::{BlockId, BlockRegistry, ChunkPos, RenderClass, TerrainConfig, TerrainGenerator};
 use voxel_lab::{chain, scene};
-use voxel_mesh::{ChunkMeshes, Mesher};
+use voxel_mesh::ChunkMeshes;
 use voxel_render::{
-    Camera, FrameStats, GpuContext, GpuTimes, Image, OitConfig, Renderer, RendererConfig,
-    Technique, readback,
+    Camera, ChunkSink, ChunkStreamer, FrameStats, GpuContext, GpuTimes, Image, OitConfig, Renderer,
+    RendererConfig, StreamConfig, StreamFrame, Technique, readback,
 };
 use winit::application::ApplicationHandler;
 use winit::event::{DeviceEvent, ElementState, MouseButton, WindowEvent};
@@ -44,8 +44,8 @@ pub struct DemoOptions {
     pub size: (u32, u32),
     /// Initial technique.
     pub technique: Technique,
-    /// Chunks of terrain around the start, each way.
-    pub view_distance: i32,
+    /// Chunks of terrain loaded around the eye, each way (1 to [`MAX_VIEW_DISTANCE`]).
+    pub view_distance: u32,
     /// Scripted: quit after this many frames (per technique with `cycle`).
     pub frames: Option<u64>,
     /// Scripted: save the last frame (with the panel) here.
@@ -67,7 +67,7 @@ impl Default for DemoOptions {
             seed: 1,
             size: (1280, 720),
             technique: Technique::WboitMrt,
-            view_distance: scene::DEFAULT_RADIUS,
+            view_distance: 8,
             frames: None,
             screenshot: None,
             cycle: None,
@@ -77,6 +77,9 @@ impl Default for DemoOptions {
         }
     }
 }
+
+/// The demo's largest view distance, in chunks (the streamer's own limit is higher).
+pub const MAX_VIEW_DISTANCE: u32 = 32;
 
 /// Whether a window can be opened: an X11 or Wayland display is named in the environment.
 pub fn have_display() -> bool {
@@ -224,7 +227,7 @@ struct Settings {
     msaa: bool,
     fade_in_frames: u32,
     seed: u32,
-    view_distance: i32,
+    view_distance: u32,
     heatmap: bool,
     place: BlockId,
 }
@@ -244,17 +247,55 @@ struct PanelFrame {
     view_x: u32,
 }
 
-type MeshResult = (ChunkPos, u64, Result<ChunkMeshes, String>);
+/// The streamed world: the chunks around the eye, generated and meshed on the streamer's
+/// pool and uploaded by the frames (within a budget): no frame waits for a mesh.
+struct Streaming {
+    streamer: ChunkStreamer,
+    /// What the last update did, for the panel.
+    last: StreamFrame,
+}
 
-/// The world and its background remeshing: edited chunks are meshed on rayon's pool and
-/// uploaded by the frame that receives them, so that no frame waits for a mesh.
-struct Remesher {
-    world: World,
-    tx: Sender<MeshResult>,
-    rx: Receiver<MeshResult>,
-    /// The latest job per chunk: older results are dropped.
-    generation: HashMap<ChunkPos, u64>,
-    pending: usize,
+/// The renderer, and the reference beside it when the error map is on: both get every
+/// chunk.
+struct Sinks<'a> {
+    renderer: &'a mut Renderer,
+    reference: Option<&'a mut Renderer>,
+}
+
+impl ChunkSink for Sinks<'_> {
+    fn upload(&mut self, pos: ChunkPos, meshes: &ChunkMeshes) -> voxel_render::Result<()> {
+        self.renderer.upload_chunk(pos, meshes)?;
+        if let Some(r) = self.reference.as_deref_mut() {
+            r.upload_chunk(pos, meshes)?;
+        }
+        Ok(())
+    }
+
+    fn remove(&mut self, pos: ChunkPos) {
+        self.renderer.remove_chunk(pos);
+        if let Some(r) = self.reference.as_deref_mut() {
+            r.remove_chunk(pos);
+        }
+    }
+}
+
+/// A streamer of `seed`'s terrain with `view_distance` chunks each way (4 up and down).
+fn streamer(seed: u32, view_distance: u32) -> Result<ChunkStreamer, String> {
+    let generator = TerrainGenerator::new(TerrainConfig {
+        seed,
+        ..TerrainConfig::default()
+    });
+    let config = StreamConfig {
+        view_distance,
+        vertical_distance: 4,
+        ..StreamConfig::default()
+    };
+    ChunkStreamer::new(Arc::new(BlockRegistry::default()), generator, config).map_err(|e| chain(&e))
+}
+
+/// The far plane for a view distance: its chunks and a little more.
+fn far_plane(view_distance: u32) -> f64 {
+    (f64::from(view_distance) * 32.0 * 1.5).max(200.0)
 }
 
 /// What the panel shows about the last frames.
@@ -283,7 +324,7 @@ struct Gfx {
     post: Post,
     frames: Frames,
     ui: Ui,
-    remesher: Remesher,
+    streaming: Streaming,
     input: Input,
     far: f64,
     settings: Settings,
@@ -296,8 +337,9 @@ struct Gfx {
 impl Gfx {
     fn new(window: Arc<Window>, opts: DemoOptions) -> Result<Self, String> {
         let (display, ctx) = Display::new(window)?;
-        let scene = scene::default_scene_with_radius(opts.seed, opts.view_distance)?;
-        let cam = scene.cameras[0];
+        // The default view of the seed (its world is only the few chunks around it).
+        let cam = scene::default_scene_with_radius(opts.seed, 1)?.cameras[0];
+        let view_distance = opts.view_distance.clamp(1, MAX_VIEW_DISTANCE);
         let (yaw, pitch) = cam.yaw_pitch();
         let settings = Settings {
             oit: OitConfig::with(opts.technique),
@@ -306,7 +348,7 @@ impl Gfx {
             // shows the settled picture from its first frame instead.
             fade_in_frames: if opts.frames.is_some() { 0 } else { 20 },
             seed: opts.seed,
-            view_distance: opts.view_distance,
+            view_distance,
             heatmap: opts.heatmap,
             place: voxel_core::blocks::GLASS,
         };
@@ -320,7 +362,7 @@ impl Gfx {
             ..RendererConfig::default()
         };
         let renderer =
-            Renderer::new(&ctx, scene.world.registry(), config).map_err(|e| chain(&e))?;
+            Renderer::new(&ctx, &BlockRegistry::default(), config).map_err(|e| chain(&e))?;
         let post = Post::new(&ctx.device, display.config.format);
         let frames = Frames::new(&ctx.device, &post, w, h, 0);
         let ui = Ui::new(&display.window, &ctx);
@@ -329,7 +371,6 @@ impl Gfx {
         } else {
             Vec::new()
         };
-        let (tx, rx) = channel();
         let mut g = Self {
             display,
             ctx,
@@ -338,12 +379,9 @@ impl Gfx {
             post,
             frames,
             ui,
-            remesher: Remesher {
-                world: scene.world,
-                tx,
-                rx,
-                generation: HashMap::new(),
-                pending: 0,
+            streaming: Streaming {
+                streamer: streamer(opts.seed, view_distance)?,
+                last: StreamFrame::default(),
             },
             input: Input {
                 fly: Fly {
@@ -357,7 +395,7 @@ impl Gfx {
                 dragged: 0.0,
                 ctrl: false,
             },
-            far: cam.far,
+            far: far_plane(view_distance),
             applied: settings.clone(),
             settings,
             status: Status::default(),
@@ -371,30 +409,55 @@ impl Gfx {
         if let Some(t) = g.script.cycle.first() {
             g.settings.oit.technique = *t;
         }
-        // The first meshes: all at once, in parallel (a start-up cost, not a frame hitch).
-        g.upload_all()?;
+        // A scripted run (a test, a screenshot) starts from the loaded view distance; an
+        // interactive one watches the chunks stream in.
+        if g.script.opts.frames.is_some() {
+            g.load_all(Duration::from_secs(120))?;
+        }
         Ok(g)
     }
 
-    /// Every chunk of the world meshed and uploaded, to the renderer and the reference.
-    fn upload_all(&mut self) -> Result<(), String> {
-        let world = &mut self.remesher.world;
-        let positions: Vec<ChunkPos> = world.iter().map(|(p, _)| p).collect();
-        world.take_dirty();
-        let meshes = voxel_mesh::mesh_chunks(world, &positions).map_err(|e| e.to_string())?;
-        for r in std::iter::once(&mut self.renderer).chain(self.reference.as_mut()) {
-            r.clear_chunks();
-            for (pos, m) in &meshes {
-                r.upload_chunk(*pos, m).map_err(|e| chain(&e))?;
-            }
+    /// Streams one frame's worth around the eye into the renderer (and the reference).
+    fn stream(&mut self) -> Result<(), String> {
+        let eye = self.input.fly.eye;
+        let mut sinks = Sinks {
+            renderer: &mut self.renderer,
+            reference: self.reference.as_mut(),
+        };
+        let frame = self
+            .streaming
+            .streamer
+            .update(eye, &mut sinks)
+            .map_err(|e| chain(&e))?;
+        if let Some((pos, why)) = frame.failed.first() {
+            self.status.message = format!("chunk {pos:?}: {why}");
         }
+        self.streaming.last = frame;
         Ok(())
+    }
+
+    /// Streams until everything within the view distance is drawn (or `limit` passes).
+    fn load_all(&mut self, limit: Duration) -> Result<(), String> {
+        let start = Instant::now();
+        loop {
+            self.stream()?;
+            if self.streaming.streamer.is_idle() {
+                return Ok(());
+            }
+            if start.elapsed() > limit {
+                return Err(format!(
+                    "the view distance did not load in {} s",
+                    limit.as_secs()
+                ));
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
     }
 
     /// The fly camera, immersed in whatever translucent block holds the eye.
     fn camera(&self) -> Result<Camera, String> {
         let f = &self.input.fly;
-        let medium = self.remesher.world.medium_at(f.eye.to_array());
+        let medium = self.streaming.streamer.world().medium_at(f.eye.to_array());
         Camera::from_yaw_pitch(f.eye, f.yaw, f.pitch, 70.0, 0.1, self.far)
             .map(|c| c.in_medium(medium))
             .map_err(|e| chain(&e))
@@ -491,7 +554,7 @@ impl Gfx {
         let dir = Camera::from_yaw_pitch(DVec3::ZERO, f.yaw, f.pitch, 70.0, 0.1, 10.0)
             .map(|c| c.forward)
             .unwrap_or(DVec3::NEG_Z);
-        let world = &mut self.remesher.world;
+        let world = self.streaming.streamer.world();
         let registry = world.registry().clone();
         let solid = |p| {
             registry
@@ -507,9 +570,8 @@ impl Gfx {
         } else {
             (hit, BlockId::AIR)
         };
-        match world.set_block(pos, id) {
-            Ok(_) => self.remesher.schedule(),
-            Err(e) => self.status.message = e.to_string(),
+        if let Err(e) = self.streaming.streamer.set_block(pos, id) {
+            self.status.message = chain(&e);
         }
     }
 
@@ -554,19 +616,25 @@ impl Gfx {
     fn apply_settings(&mut self) -> Result<(), String> {
         let s = self.settings.clone();
         let a = self.applied.clone();
-        if s.seed != a.seed || s.view_distance != a.view_distance {
-            let scene = scene::default_scene_with_radius(s.seed, s.view_distance)?;
-            self.remesher.world = scene.world;
-            self.remesher.generation.clear();
-            self.far = (f64::from(s.view_distance) * 32.0 * 1.8).max(200.0);
-            if s.seed != a.seed {
-                let (yaw, pitch) = scene.cameras[0].yaw_pitch();
-                self.input.fly.eye = scene.cameras[0].eye;
-                self.input.fly.yaw = yaw;
-                self.input.fly.pitch = pitch;
+        if s.seed != a.seed {
+            // Another world: start it over at its default view.
+            let cam = scene::default_scene_with_radius(s.seed, 1)?.cameras[0];
+            let (yaw, pitch) = cam.yaw_pitch();
+            self.input.fly.eye = cam.eye;
+            self.input.fly.yaw = yaw;
+            self.input.fly.pitch = pitch;
+            self.streaming.streamer = streamer(s.seed, s.view_distance)?;
+            self.renderer.clear_chunks();
+            if let Some(r) = &mut self.reference {
+                r.clear_chunks();
             }
-            self.upload_all()?;
+        } else if s.view_distance != a.view_distance {
+            self.streaming
+                .streamer
+                .set_view_distance(s.view_distance)
+                .map_err(|e| chain(&e))?;
         }
+        self.far = far_plane(s.view_distance);
         if s.oit != a.oit {
             self.renderer
                 .set_oit_config(s.oit.clone())
@@ -597,9 +665,11 @@ impl Gfx {
             oit: OitConfig::with(Technique::Reference),
             ..RendererConfig::default()
         };
-        let world = &self.remesher.world;
+        let streamer = &self.streaming.streamer;
+        let world = streamer.world();
         let mut r = Renderer::new(&self.ctx, world.registry(), config).map_err(|e| chain(&e))?;
-        let positions: Vec<ChunkPos> = world.iter().map(|(p, _)| p).collect();
+        // What the renderer draws, meshed at once (the same meshes the streamer made).
+        let positions: Vec<ChunkPos> = streamer.uploaded().collect();
         for (pos, m) in voxel_mesh::mesh_chunks(world, &positions).map_err(|e| e.to_string())? {
             r.upload_chunk(pos, &m).map_err(|e| chain(&e))?;
         }
@@ -647,13 +717,8 @@ impl Gfx {
 
     fn frame(&mut self) -> Result<Flow, String> {
         let dt = self.tick();
-        if let Some(message) = self
-            .remesher
-            .receive(&mut self.renderer, self.reference.as_mut())
-        {
-            self.status.message = message;
-        }
         self.fly(dt);
+        self.stream()?;
         self.scripted_events()?;
         let panel = self.run_panel();
         self.apply_settings()?;
@@ -753,7 +818,7 @@ impl Gfx {
             return Ok(Flow::Continue);
         };
         // Edits are remeshed in the background: let them land before the last frame.
-        if self.status.frame_index < frames || self.remesher.pending > 0 {
+        if self.status.frame_index < frames || !self.streaming.streamer.is_idle() {
             return Ok(Flow::Continue);
         }
         if let Some(dir) = self.script.opts.cycle.clone() {
@@ -792,63 +857,5 @@ impl Gfx {
         .map_err(|e| chain(&e))?;
         self.status.message = format!("saved {}", path.display());
         Ok(())
-    }
-}
-
-impl Remesher {
-    /// Remeshes the dirty chunks on rayon's pool; results come back through a channel and
-    /// are uploaded by the frame that receives them: editing never stalls a frame.
-    fn schedule(&mut self) {
-        for pos in self.world.take_dirty() {
-            let generation = self.generation.entry(pos).or_insert(0);
-            *generation += 1;
-            let generation = *generation;
-            let chunk = self.world.chunk(pos).cloned();
-            let neighbours: [Option<voxel_core::Chunk>; 6] =
-                self.world.neighbours(pos).map(|c| c.cloned());
-            let registry = self.world.registry().clone();
-            let tx = self.tx.clone();
-            self.pending += 1;
-            rayon::spawn(move || {
-                let meshes = match &chunk {
-                    Some(c) => {
-                        let nb: [Option<&voxel_core::Chunk>; 6] =
-                            std::array::from_fn(|i| neighbours[i].as_ref());
-                        Mesher::new(&registry)
-                            .mesh(c, nb)
-                            .map_err(|e| e.to_string())
-                    }
-                    None => Ok(ChunkMeshes::default()),
-                };
-                let _ = tx.send((pos, generation, meshes));
-            });
-        }
-    }
-
-    /// Uploads the meshes that came back; returns an error to show, if any.
-    fn receive(
-        &mut self,
-        renderer: &mut Renderer,
-        mut reference: Option<&mut Renderer>,
-    ) -> Option<String> {
-        let mut message = None;
-        while let Ok((pos, generation, meshes)) = self.rx.try_recv() {
-            self.pending = self.pending.saturating_sub(1);
-            // A later edit of the same chunk has a newer job in flight: skip this one.
-            if self.generation.get(&pos) != Some(&generation) {
-                continue;
-            }
-            let uploaded = meshes.and_then(|m| {
-                renderer.upload_chunk(pos, &m).map_err(|e| chain(&e))?;
-                if let Some(r) = reference.as_deref_mut() {
-                    r.upload_chunk(pos, &m).map_err(|e| chain(&e))?;
-                }
-                Ok(())
-            });
-            if let Err(e) = uploaded {
-                message = Some(e);
-            }
-        }
-        message
     }
 }

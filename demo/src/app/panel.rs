@@ -186,8 +186,11 @@ impl Gfx {
             ui.label("Seed");
             ui.add(egui::DragValue::new(&mut s.seed));
         });
-        ui.add(egui::Slider::new(&mut s.view_distance, 2..=10).text("view distance (chunks)"));
-        let registry = self.remesher.world.registry().clone();
+        ui.add(
+            egui::Slider::new(&mut s.view_distance, 1..=super::MAX_VIEW_DISTANCE)
+                .text("view distance (chunks)"),
+        );
+        let registry = self.streaming.streamer.world().registry().clone();
         egui::ComboBox::from_label("block to place")
             .selected_text(registry.get(s.place).map_or("?", |d| d.name.as_str()))
             .show_ui(ui, |ui| {
@@ -214,6 +217,18 @@ impl Gfx {
             st.meshes_drawn[0], st.meshes_drawn[1], st.meshes_drawn[2]
         ));
         ui.label(format!("translucent quads: {}", st.translucent_quads));
+        let streamer = &self.streaming.streamer;
+        let last = &self.streaming.last;
+        let memory = self.renderer.chunk_memory();
+        ui.label(format!(
+            "streaming: {} chunks held ({:.1} MiB), {} on the GPU ({:.1} MiB of quads), {} jobs, {} uploads",
+            streamer.world().len(),
+            streamer.memory_bytes() as f64 / f64::from(1 << 20),
+            self.renderer.chunks().len(),
+            memory.quad_bytes as f64 / f64::from(1 << 20),
+            last.jobs,
+            last.uploads
+        ));
         let report = &st.technique;
         if let Some(sort) = report.sort {
             ui.label(format!(
