@@ -74,6 +74,10 @@ struct StreamArgs {
     /// Terrain seed.
     #[arg(long, default_value_t = 1)]
     seed: u32,
+    /// At this frame the eye jumps 10 000 chunks away and flies on (bad-input check of
+    /// the streamer: it drops and reloads within its per-frame budgets).
+    #[arg(long, value_name = "FRAME")]
+    teleport_at: Option<usize>,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
@@ -614,6 +618,7 @@ fn stream(a: StreamArgs) -> Result<(), String> {
         draw: a.draw,
         size: a.size,
         seed: a.seed,
+        teleport_at: a.teleport_at,
         out: a.out.clone(),
     };
     opts.validate()?;
@@ -652,6 +657,17 @@ fn stream(a: StreamArgs) -> Result<(), String> {
         r.chunk_storage_bytes as f64 / r.packed_index_bytes.max(1) as f64,
         a.out.join("stream.json").display()
     );
+    if let Some(t) = r.teleport {
+        println!(
+            "teleport at frame {}: reloaded in {} frames; longest frame after it {:.3} ms (streamer {:.3} ms), at most {} unloads per frame",
+            t.frame,
+            t.frames_to_reload
+                .map_or("more than the remaining".to_owned(), |n| n.to_string()),
+            t.max_cpu_ms,
+            t.max_stream_ms,
+            t.max_unloads
+        );
+    }
     Ok(())
 }
 

@@ -41,9 +41,14 @@ pub struct StreamOptions {
     pub size: (u32, u32),
     /// Terrain seed.
     pub seed: u32,
+    /// At this frame the eye jumps 10 000 chunks (along +z) and flies on from there.
+    pub teleport_at: Option<usize>,
     /// Output folder.
     pub out: PathBuf,
 }
+
+/// How far a teleport jumps, in chunks.
+pub const TELEPORT_CHUNKS: f64 = 10_000.0;
 
 impl Default for StreamOptions {
     fn default() -> Self {
@@ -55,6 +60,7 @@ impl Default for StreamOptions {
             draw: DrawMode::Indirect,
             size: (640, 360),
             seed: 1,
+            teleport_at: None,
             out: PathBuf::from("stream-out"),
         }
     }
@@ -77,6 +83,14 @@ impl StreamOptions {
         }
         if self.frames == 0 {
             return Err("--frames must be at least 1".into());
+        }
+        if let Some(t) = self.teleport_at
+            && t >= self.frames
+        {
+            return Err(format!(
+                "--teleport-at {t}: it must be a frame of the flight (0 to {})",
+                self.frames - 1
+            ));
         }
         if !(self.speed.is_finite() && (0.0..=1024.0).contains(&self.speed)) {
             return Err(format!(
@@ -137,6 +151,8 @@ pub struct StreamFrameRecord {
     pub unloads: usize,
     /// Chunks drawn (with at least one mesh in view).
     pub chunks_drawn: usize,
+    /// Whether the streamer had everything within the view distance drawn.
+    pub idle: bool,
     /// Draw calls recorded.
     pub draw_calls: usize,
 }
@@ -196,6 +212,24 @@ pub struct StreamReport {
     pub hitches: usize,
     /// Chunks the streamer could not mesh or upload.
     pub failed: usize,
+    /// With a teleport: what followed it.
+    pub teleport: Option<TeleportReport>,
+}
+
+/// What followed a teleport of [`TELEPORT_CHUNKS`].
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct TeleportReport {
+    /// The frame of the jump.
+    pub frame: usize,
+    /// Frames until the new view distance was drawn and the old one gone (`null`: not
+    /// within the flight).
+    pub frames_to_reload: Option<usize>,
+    /// The longest frame from the jump on (CPU ms).
+    pub max_cpu_ms: f64,
+    /// The longest streamer update from the jump on (CPU ms).
+    pub max_stream_ms: f64,
+    /// The most chunks unloaded in one frame.
+    pub max_unloads: usize,
 }
 
 /// Resident set size of this process, from `/proc/self/statm` (Linux).
@@ -213,7 +247,11 @@ fn camera_at(
     frame: usize,
 ) -> Result<Camera, String> {
     let y = generator.height_at(0, 0) as f64 + 40.0;
-    let eye = DVec3::new(0.5 + opts.speed * frame as f64, y, 0.5);
+    let z = match opts.teleport_at {
+        Some(t) if frame >= t => TELEPORT_CHUNKS * 32.0,
+        _ => 0.0,
+    };
+    let eye = DVec3::new(0.5 + opts.speed * frame as f64, y, 0.5 + z);
     let far = (f64::from(opts.view_distance) * 32.0 * 1.5).max(200.0);
     Camera::from_yaw_pitch(eye, std::f64::consts::FRAC_PI_2, -0.25, 70.0, 0.1, far)
         .map_err(|e| crate::chain(&e))
@@ -299,6 +337,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
             uploads: f.uploads,
             unloads: f.unloads,
             chunks_drawn: stats.meshes_drawn.iter().copied().max().unwrap_or(0),
+            idle: streamer.is_idle(),
             draw_calls: stats.draw_calls,
         });
         progress.step(&format!("frame {i}"));
@@ -338,6 +377,16 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
         rss_bytes: rss_bytes(),
         hitches: cpu.iter().filter(|&&c| c > 2.0 * cpu_spread.p50).count(),
         failed,
+        teleport: opts.teleport_at.map(|t| {
+            let after = &records[t..];
+            TeleportReport {
+                frame: t,
+                frames_to_reload: after.iter().position(|r| r.idle).map(|n| n + 1),
+                max_cpu_ms: after.iter().map(|r| r.cpu_ms).fold(0.0, f64::max),
+                max_stream_ms: after.iter().map(|r| r.stream_ms).fold(0.0, f64::max),
+                max_unloads: after.iter().map(|r| r.unloads).max().unwrap_or(0),
+            }
+        }),
     };
     write_json(&opts.out.join("stream.json"), &report)?;
     write_json(&opts.out.join("frames.json"), &records)?;
@@ -407,6 +456,10 @@ mod tests {
             },
             StreamOptions {
                 speed: -1.0,
+                ..ok.clone()
+            },
+            StreamOptions {
+                teleport_at: Some(600),
                 ..ok.clone()
             },
         ] {

@@ -118,7 +118,7 @@ impl Default for StreamConfig {
             hysteresis: 2,
             upload_budget_bytes: 1 << 20,
             threads: 0,
-            max_jobs: 16,
+            max_jobs: 64,
             max_unloads: 256,
             scan_budget: 2048,
         }
