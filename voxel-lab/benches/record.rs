@@ -16,17 +16,15 @@
 
 use std::fmt::Write as _;
 use std::path::Path;
-use std::time::Instant;
 use std::sync::Arc;
+use std::time::Instant;
 
 use glam::DVec3;
 use rayon::prelude::*;
 use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, World};
 use voxel_lab::headless::{self, Offscreen};
 use voxel_mesh::mesh_chunks;
-use voxel_render::{
-    Camera, DrawMode, FrameStats, GpuContext, Renderer, RendererConfig, Technique,
-};
+use voxel_render::{Camera, DrawMode, FrameStats, GpuContext, Renderer, RendererConfig, Technique};
 
 const WARMUP: usize = 4;
 /// Frames measured per mode (RECORD_FRAMES overrides, for profiling).
