@@ -5,11 +5,19 @@
 //! `first_instance` = its slot), issued with `multi_draw_indirect` per page, or one direct
 //! draw per mesh where the adapter lacks indirect first-instance draws (logged).
 //!
+//! A frame finds its visible meshes in one pass ([`ChunkStore::cull`]): chunks are grouped
+//! into regions of [`REGION_CHUNKS`] (Sodium's 8 × 4 × 8), whose box is tested first, so that
+//! a region outside the frustum costs one test and one wholly inside costs none per chunk;
+//! only the chunks of regions the frustum's planes cut are tested one by one. The result is
+//! exactly what testing every chunk finds ([`ChunkStore::visible`]), in the same draw
+//! order once sorted.
+//!
 //! Each upload of a chunk gets a new *generation* number, so that what a technique derives
 //! from a chunk's quads (a sort structure, a summary of its layers) can be cached by
 //! position and generation and recomputed only when the chunk is remeshed.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Mat4, Vec3, Vec4};
@@ -20,6 +28,55 @@ use crate::GpuContext;
 use crate::arena::{Alloc, ArenaStats, QuadArena};
 use crate::bindings::ChunkUniforms;
 use crate::gpu;
+
+/// A fast hasher for small keys of integers (chunk positions): a multiply-rotate per word
+/// and a final mix, instead of SipHash (the store and the techniques look chunks up by
+/// position every frame; nothing here needs resistance to chosen keys).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PosHasher(u64);
+
+impl PosHasher {
+    const K: u64 = 0x9e37_79b9_7f4a_7c15;
+
+    fn add(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(26) ^ word).wrapping_mul(Self::K);
+    }
+}
+
+impl Hasher for PosHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.add(u64::from(b));
+        }
+    }
+
+    fn write_u32(&mut self, v: u32) {
+        self.add(u64::from(v));
+    }
+
+    fn write_i32(&mut self, v: i32) {
+        self.add(u64::from(v as u32));
+    }
+
+    fn write_u64(&mut self, v: u64) {
+        self.add(v);
+    }
+
+    fn write_usize(&mut self, v: usize) {
+        self.add(v as u64);
+    }
+
+    fn finish(&self) -> u64 {
+        // The table takes its bucket from the low bits and its tag from the high ones: mix
+        // both.
+        let h = self.0 ^ (self.0 >> 32);
+        let h = h.wrapping_mul(0xd6e8_feb8_6659_fd93);
+        h ^ (h >> 29)
+    }
+}
+
+/// A hash map keyed by chunk position (or another small integer key), with [`PosHasher`].
+pub type PosMap<K, V> = HashMap<K, V, BuildHasherDefault<PosHasher>>;
 
 /// Which of a chunk's three meshes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -198,35 +255,228 @@ pub struct DrawBuilder {
 }
 
 impl DrawBuilder {
-    /// A list drawing `visible`, in order.
-    pub fn list(&mut self, visible: &[Visible]) -> DrawList {
+    /// A list drawing `meshes` (slot and place of each, as [`Culled::meshes`] gives them),
+    /// in order.
+    pub fn list(&mut self, meshes: impl IntoIterator<Item = (u32, Alloc)>) -> DrawList {
         let mut list = DrawList::default();
-        for v in visible {
+        for (slot, mesh) in meshes {
             let index = self.commands.len() as u32;
             self.commands.push(DrawCommand {
-                vertex_count: v.mesh.quads * 6,
+                vertex_count: mesh.quads * 6,
                 instance_count: 1,
-                first_vertex: v.mesh.offset * 6,
-                first_instance: v.slot,
+                first_vertex: mesh.offset * 6,
+                first_instance: slot,
             });
             match list.runs.last_mut() {
-                Some(r) if r.page == v.mesh.page => r.count += 1,
+                Some(r) if r.page == mesh.page => r.count += 1,
                 _ => list.runs.push(Run {
-                    page: v.mesh.page,
+                    page: mesh.page,
                     first: index,
                     count: 1,
                 }),
             }
             list.meshes += 1;
-            list.quads += u64::from(v.mesh.quads);
+            list.quads += u64::from(mesh.quads);
         }
         list
+    }
+
+    /// Forgets the commands (keeping their room), for the next frame.
+    pub fn clear(&mut self) {
+        self.commands.clear();
     }
 
     /// The commands of every list, to be uploaded with [`ChunkStore::upload_draws`].
     pub fn commands(&self) -> &[DrawCommand] {
         &self.commands
     }
+}
+
+/// Chunks per region along x, y and z: 8 × 4 × 8 (Sodium's), 256 × 128 × 256 blocks. A
+/// frame tests a region's box before the chunks in it.
+pub const REGION_CHUNKS: [i32; 3] = [8, 4, 8];
+
+/// What culling needs of a chunk, kept with the other chunks of its region.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Member {
+    pos: ChunkPos,
+    slot: u32,
+    meshes: [Option<Alloc>; 3],
+}
+
+/// The chunks of one region.
+#[derive(Debug)]
+struct Region {
+    /// Region coordinates (chunk coordinates divided by [`REGION_CHUNKS`], rounded down).
+    key: [i32; 3],
+    /// Block coordinates of the region's lowest corner.
+    origin: [i64; 3],
+    members: Vec<Member>,
+}
+
+/// Where a slot's member is: its region and its index there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Place {
+    region: u32,
+    index: u32,
+}
+
+/// The chunks grouped by region (CPU only: what [`ChunkStore::cull`] walks).
+#[derive(Debug, Default)]
+struct Regions {
+    regions: Vec<Region>,
+    by_key: PosMap<[i32; 3], u32>,
+    /// Per slot, where its member is (`None`: no chunk in the slot).
+    places: Vec<Option<Place>>,
+}
+
+impl Regions {
+    fn key(pos: ChunkPos) -> [i32; 3] {
+        [
+            pos.x.div_euclid(REGION_CHUNKS[0]),
+            pos.y.div_euclid(REGION_CHUNKS[1]),
+            pos.z.div_euclid(REGION_CHUNKS[2]),
+        ]
+    }
+
+    /// Adds the chunk of `slot`, or updates its meshes (the position of a slot never
+    /// changes while it is held).
+    fn set(&mut self, slot: u32, pos: ChunkPos, meshes: [Option<Alloc>; 3]) {
+        let s = slot as usize;
+        if s >= self.places.len() {
+            self.places.resize(s + 1, None);
+        }
+        if let Some(p) = self.places[s] {
+            let m = &mut self.regions[p.region as usize].members[p.index as usize];
+            if m.pos == pos {
+                m.meshes = meshes;
+                return;
+            }
+            self.remove(slot);
+        }
+        let key = Self::key(pos);
+        let region = *self.by_key.entry(key).or_insert_with(|| {
+            let n = CHUNK_SIZE as i64;
+            self.regions.push(Region {
+                key,
+                origin: [0, 1, 2].map(|k| i64::from(key[k]) * i64::from(REGION_CHUNKS[k]) * n),
+                members: Vec::new(),
+            });
+            self.regions.len() as u32 - 1
+        });
+        let members = &mut self.regions[region as usize].members;
+        self.places[s] = Some(Place {
+            region,
+            index: members.len() as u32,
+        });
+        members.push(Member { pos, slot, meshes });
+    }
+
+    /// Removes the chunk of `slot` (an empty region goes with it).
+    fn remove(&mut self, slot: u32) {
+        let Some(p) = self.places.get_mut(slot as usize).and_then(Option::take) else {
+            return;
+        };
+        let members = &mut self.regions[p.region as usize].members;
+        members.swap_remove(p.index as usize);
+        if let Some(moved) = members.get(p.index as usize) {
+            self.places[moved.slot as usize] = Some(p);
+        }
+        if !members.is_empty() {
+            return;
+        }
+        // The last region takes the empty one's index.
+        let gone = self.regions.swap_remove(p.region as usize);
+        self.by_key.remove(&gone.key);
+        if let Some(r) = self.regions.get(p.region as usize) {
+            self.by_key.insert(r.key, p.region);
+            for m in &r.members {
+                if let Some(place) = self.places[m.slot as usize].as_mut() {
+                    place.region = p.region;
+                }
+            }
+        }
+    }
+
+    /// Calls `visit` with every chunk whose box is not wholly outside one of the frustum's
+    /// planes, and its distance ([`Frustum::chunk_distance`]: the same chunks, the same
+    /// numbers), region by region.
+    fn cull(&self, frustum: &Frustum, mut visit: impl FnMut(&Member, f64)) {
+        let size = REGION_CHUNKS.map(|c| i64::from(c) * CHUNK_SIZE as i64);
+        for r in &self.regions {
+            match frustum.region_cover(r.origin, size) {
+                Cover::Outside => {}
+                Cover::Inside => {
+                    for m in &r.members {
+                        visit(m, frustum.centre_distance(m.pos));
+                    }
+                }
+                Cover::Partial => {
+                    for m in &r.members {
+                        if let Some(d) = frustum.chunk_distance(m.pos) {
+                            visit(m, d);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A visible opaque or cutout mesh in a frame's list: its sort key (page, distance, slot;
+/// see [`Culled`]) and where it lives.
+#[derive(Clone, Copy, Debug)]
+struct NearEntry {
+    key: u128,
+    mesh: Alloc,
+}
+
+/// A visible translucent mesh in a frame's list.
+#[derive(Clone, Copy, Debug)]
+struct FarEntry {
+    /// [`voxel_mesh::order::chunk_order_key`].
+    key: u128,
+    pos: ChunkPos,
+    slot: u32,
+    mesh: Alloc,
+}
+
+/// One frame's visible meshes of every kind, from [`ChunkStore::cull`], in draw order:
+/// opaque and cutout meshes by page, then front to back (early depth rejection; equal
+/// distances by slot), translucent ones farthest first by
+/// [`voxel_mesh::order::chunk_order_key`] (equal keys by position). The same meshes in the
+/// same order as sorting [`ChunkStore::visible`]'s lists so. Keep one between frames: its
+/// vectors keep their room.
+#[derive(Debug, Default)]
+pub struct Culled {
+    near: [Vec<NearEntry>; 2],
+    far: Vec<FarEntry>,
+    positions: Vec<ChunkPos>,
+}
+
+impl Culled {
+    /// The meshes of `kind` in draw order: (slot, place).
+    pub fn meshes(&self, kind: MeshKind) -> impl Iterator<Item = (u32, Alloc)> + '_ {
+        let (near, far): (&[NearEntry], &[FarEntry]) = match kind {
+            MeshKind::Opaque => (&self.near[0], &[]),
+            MeshKind::Cutout => (&self.near[1], &[]),
+            MeshKind::Translucent => (&[], &self.far),
+        };
+        near.iter()
+            .map(|e| (e.key as u32, e.mesh))
+            .chain(far.iter().map(|e| (e.slot, e.mesh)))
+    }
+
+    /// The positions of the visible translucent meshes, farthest first.
+    pub fn translucent_positions(&self) -> &[ChunkPos] {
+        &self.positions
+    }
+}
+
+/// The sort key of a near-first list: page, then distance, then slot; the distance (never
+/// negative: its bits order like the number) in the middle.
+fn near_key(page: u32, distance: f64, slot: u32) -> u128 {
+    (u128::from(page) << 96) | (u128::from(distance.to_bits()) << 32) | u128::from(slot)
 }
 
 /// All chunks on the GPU.
@@ -241,7 +491,9 @@ pub struct ChunkStore {
     groups: Vec<wgpu::BindGroup>,
     slots: Vec<Option<GpuChunk>>,
     free_slots: Vec<u32>,
-    by_pos: HashMap<ChunkPos, u32>,
+    by_pos: PosMap<ChunkPos, u32>,
+    /// The chunks by region, for culling.
+    regions: Regions,
     indirect: wgpu::Buffer,
     next_generation: u64,
 }
@@ -263,7 +515,8 @@ impl ChunkStore {
             groups: Vec::new(),
             slots: Vec::new(),
             free_slots: Vec::new(),
-            by_pos: HashMap::new(),
+            by_pos: PosMap::default(),
+            regions: Regions::default(),
             indirect,
             next_generation: 1,
         }
@@ -376,6 +629,7 @@ impl ChunkStore {
         }
         let origin = pos.origin().map(|v| v as i32);
         self.write_info(ctx, slot, ChunkUniforms { origin, alpha: 1.0 });
+        self.regions.set(slot, pos, allocs);
         self.slots[slot as usize] = Some(GpuChunk {
             pos,
             meshes: allocs,
@@ -397,6 +651,7 @@ impl ChunkStore {
     pub fn remove(&mut self, pos: ChunkPos) {
         if let Some(slot) = self.by_pos.remove(&pos) {
             self.free_meshes(slot);
+            self.regions.remove(slot);
             self.free_slots.push(slot);
         }
     }
@@ -486,6 +741,46 @@ impl ChunkStore {
             .collect()
     }
 
+    /// Finds the visible meshes of every kind in one pass over the regions (see the module
+    /// docs) and puts them in draw order into `out` (see [`Culled`]): the meshes
+    /// [`ChunkStore::visible`] finds for each kind.
+    pub fn cull(&self, frustum: &Frustum, out: &mut Culled) {
+        for list in &mut out.near {
+            list.clear();
+        }
+        out.far.clear();
+        out.positions.clear();
+        let eye = frustum.eye.to_array();
+        let [opaque, cutout] = &mut out.near;
+        let far = &mut out.far;
+        self.regions.cull(frustum, |m, distance| {
+            for (list, mesh) in [(&mut *opaque, m.meshes[0]), (&mut *cutout, m.meshes[1])] {
+                if let Some(mesh) = mesh {
+                    list.push(NearEntry {
+                        key: near_key(mesh.page, distance, m.slot),
+                        mesh,
+                    });
+                }
+            }
+            if let Some(mesh) = m.meshes[2] {
+                far.push(FarEntry {
+                    key: voxel_mesh::order::chunk_order_key(m.pos, eye),
+                    pos: m.pos,
+                    slot: m.slot,
+                    mesh,
+                });
+            }
+        });
+        // Every key is unique (it holds the slot, or the position): an unstable sort gives
+        // the one order.
+        for list in &mut out.near {
+            list.sort_unstable_by_key(|e| e.key);
+        }
+        out.far
+            .sort_unstable_by(|a, b| b.key.cmp(&a.key).then(a.pos.cmp(&b.pos)));
+        out.positions.extend(out.far.iter().map(|e| e.pos));
+    }
+
     /// Uploads a frame's draw commands to the indirect buffer (growing it when needed).
     pub fn upload_draws(&mut self, ctx: &GpuContext, commands: &[DrawCommand]) {
         let bytes = std::mem::size_of_val(commands) as u64;
@@ -537,6 +832,11 @@ impl ChunkStore {
                 }
             }
         }
+        for (s, c) in self.slots.iter().enumerate() {
+            if let Some(c) = c {
+                self.regions.set(s as u32, c.pos, c.meshes);
+            }
+        }
         self.remake_groups(&ctx.device);
         true
     }
@@ -573,8 +873,7 @@ impl Frustum {
     /// wholly outside one plane.
     pub fn chunk_distance(&self, pos: ChunkPos) -> Option<f64> {
         let s = CHUNK_SIZE as f64;
-        let o = pos.origin();
-        let min = DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64) - self.eye;
+        let min = self.relative(pos);
         let lo = min.as_vec3();
         let hi = (min + DVec3::splat(s)).as_vec3();
         for p in &self.planes {
@@ -585,8 +884,65 @@ impl Frustum {
                 return None;
             }
         }
-        Some((min + DVec3::splat(s / 2.0)).length())
+        Some(self.centre_distance(pos))
     }
+
+    /// The chunk's lowest corner relative to the eye.
+    fn relative(&self, pos: ChunkPos) -> DVec3 {
+        let o = pos.origin();
+        DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64) - self.eye
+    }
+
+    /// Distance from the eye to the chunk's centre (the number
+    /// [`Frustum::chunk_distance`] gives).
+    fn centre_distance(&self, pos: ChunkPos) -> f64 {
+        (self.relative(pos) + DVec3::splat(CHUNK_SIZE as f64 / 2.0)).length()
+    }
+
+    /// Where the box from block `origin` of `size` blocks lies: wholly outside one plane,
+    /// wholly inside all of them, or neither, decided only where the decision holds for
+    /// [`Frustum::chunk_distance`]'s test of every chunk in the box despite rounding. That
+    /// test rounds the box corners to f32 and sums three products and the plane's offset
+    /// in f32: at most about 3.2·10⁻⁷ of `S` = Σ|nᵢ|·|corner coordinateᵢ| + |w| off the
+    /// exact value, and so is this one's. A chunk's exact value lies between this box's
+    /// nearest and farthest exact values, so with a margin of 4·10⁻⁶·`S` (over ten times
+    /// both errors) "outside" and "inside" here are what the chunk test finds too; closer
+    /// calls are [`Cover::Partial`], left to the chunk test.
+    fn region_cover(&self, origin: [i64; 3], size: [i64; 3]) -> Cover {
+        let min = DVec3::new(origin[0] as f64, origin[1] as f64, origin[2] as f64) - self.eye;
+        let max = min + DVec3::new(size[0] as f64, size[1] as f64, size[2] as f64);
+        let (lo, hi) = (min.as_vec3(), max.as_vec3());
+        let reach = lo.abs().max(hi.abs());
+        let mut inside = true;
+        for p in &self.planes {
+            let n = p.truncate();
+            let positive = n.cmpge(Vec3::ZERO);
+            let margin = 4e-6 * (n.abs().dot(reach) + p.w.abs());
+            let far = Vec3::select(positive, hi, lo);
+            if n.dot(far) + p.w < -margin {
+                return Cover::Outside;
+            }
+            let near = Vec3::select(positive, lo, hi);
+            // NaN counts as "not sure".
+            inside &= n.dot(near) + p.w > margin;
+        }
+        if inside {
+            Cover::Inside
+        } else {
+            Cover::Partial
+        }
+    }
+}
+
+/// Where a region's box lies against the frustum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Cover {
+    /// Wholly outside one plane: none of its chunks is visible.
+    Outside,
+    /// Wholly inside every plane: all of its chunks are.
+    Inside,
+    /// Cut by a plane (or too close to call): test its chunks one by one.
+    Partial,
 }
 
 #[cfg(test)]
@@ -625,5 +981,139 @@ mod tests {
             f.chunk_distance(ChunkPos::new(0, 0, 3)).is_some(),
             "the eye's own chunk"
         );
+    }
+
+    /// A tiny xorshift, so the tests need no dependency and run the same every time.
+    fn rng(seed: u64) -> impl FnMut() -> u64 {
+        let mut s = seed;
+        move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        }
+    }
+
+    fn mesh(page: u32, offset: u32) -> Option<Alloc> {
+        Some(Alloc {
+            page,
+            offset,
+            quads: 1,
+        })
+    }
+
+    /// Every place points at its slot's member, every region is non-empty and found by its
+    /// key, and the members are exactly the chunks held.
+    fn check_bookkeeping(regions: &Regions, held: &[Option<ChunkPos>]) {
+        let mut members = 0;
+        for (i, r) in regions.regions.iter().enumerate() {
+            assert!(!r.members.is_empty(), "empty region {:?} kept", r.key);
+            assert_eq!(regions.by_key.get(&r.key), Some(&(i as u32)));
+            for (j, m) in r.members.iter().enumerate() {
+                assert_eq!(Regions::key(m.pos), r.key);
+                let place = Place {
+                    region: i as u32,
+                    index: j as u32,
+                };
+                assert_eq!(regions.places[m.slot as usize], Some(place));
+                assert_eq!(held[m.slot as usize], Some(m.pos));
+                members += 1;
+            }
+        }
+        assert_eq!(regions.by_key.len(), regions.regions.len());
+        assert_eq!(members, held.iter().flatten().count());
+    }
+
+    #[test]
+    fn regions_follow_uploads_and_removals() {
+        let mut next = rng(0x0dd_ba11_5eed);
+        let mut regions = Regions::default();
+        let mut held: Vec<Option<ChunkPos>> = vec![None; 600];
+        for step in 0..6000 {
+            let slot = (next() % held.len() as u64) as u32;
+            if next() % 3 == 0 {
+                regions.remove(slot);
+                held[slot as usize] = None;
+            } else {
+                let c = |n: u64| (n % 40) as i32 - 20;
+                let pos = held[slot as usize]
+                    .filter(|_| next() % 2 == 0)
+                    .unwrap_or_else(|| ChunkPos::new(c(next()), c(next()) / 4, c(next())));
+                regions.set(slot, pos, [mesh(0, step), None, mesh(1, step)]);
+                held[slot as usize] = Some(pos);
+            }
+            if step % 500 == 0 {
+                check_bookkeeping(&regions, &held);
+            }
+        }
+        check_bookkeeping(&regions, &held);
+        for slot in 0..held.len() as u32 {
+            regions.remove(slot);
+        }
+        check_bookkeeping(&regions, &[]);
+        assert!(regions.regions.is_empty());
+    }
+
+    #[test]
+    fn region_culling_finds_what_testing_every_chunk_finds() {
+        let mut next = rng(0x5eed_cafe_f00d);
+        let mut unit = move || (next() % 1_000_000) as f64 / 1e6;
+        let mut covers = [0usize; 3];
+        for scene in 0..24 {
+            // Around the origin, and far out (where f32 corners round to 1/8 block and more).
+            let centre = match scene % 3 {
+                0 => [0, 0, 0],
+                1 => [31_250, -40, -31_250],
+                _ => [60_000_000, 100, -60_000_000],
+            };
+            let mut regions = Regions::default();
+            let mut held = Vec::new();
+            for slot in 0..2500u32 {
+                let c = |u: f64, r: f64| (u * 2.0 * r - r).floor() as i32;
+                let pos = ChunkPos::new(
+                    centre[0] + c(unit(), 40.0),
+                    centre[1] + c(unit(), 6.0),
+                    centre[2] + c(unit(), 40.0),
+                );
+                if regions.by_key.contains_key(&Regions::key(pos)) && unit() < 0.05 {
+                    continue;
+                }
+                regions.set(slot, pos, [mesh(0, slot), None, None]);
+                held.push((slot, pos));
+            }
+            for _ in 0..40 {
+                let s = CHUNK_SIZE as f64;
+                let eye = DVec3::new(
+                    (f64::from(centre[0]) + unit() * 60.0 - 30.0) * s,
+                    (f64::from(centre[1]) + unit() * 8.0 - 4.0) * s,
+                    (f64::from(centre[2]) + unit() * 60.0 - 30.0) * s,
+                );
+                let far = [50.0, 500.0, 5000.0, crate::MAX_FAR][(unit() * 4.0) as usize];
+                let cam = Camera::from_yaw_pitch(
+                    eye,
+                    unit() * 7.0,
+                    unit() * 3.0 - 1.5,
+                    10.0 + unit() * 150.0,
+                    crate::MIN_NEAR + unit(),
+                    far,
+                )
+                .unwrap();
+                let f = Frustum::new(cam.view_proj(0.5 + unit() * 2.0), cam.eye);
+                let size = REGION_CHUNKS.map(|c| i64::from(c) * CHUNK_SIZE as i64);
+                for r in &regions.regions {
+                    covers[f.region_cover(r.origin, size) as usize] += 1;
+                }
+                let mut found = Vec::new();
+                regions.cull(&f, |m, d| found.push((m.slot, m.pos, d.to_bits())));
+                found.sort_unstable();
+                let every: Vec<_> = held
+                    .iter()
+                    .filter_map(|&(slot, pos)| Some((slot, pos, f.chunk_distance(pos)?.to_bits())))
+                    .collect();
+                assert_eq!(found, every, "eye {eye:?}");
+            }
+        }
+        // Every kind of region was met.
+        assert!(covers.iter().all(|&n| n > 100), "{covers:?}");
     }
 }

@@ -14,7 +14,7 @@ use wgpu::util::DeviceExt;
 
 use crate::bindings::{FrameUniforms, NO_MEDIUM, SharedLayouts, common_wgsl};
 use crate::chunks::{
-    ChunkStore, DrawBuilder, DrawList, DrawMode, FrameDraws, Frustum, MeshKind, Visible,
+    ChunkStore, Culled, DrawBuilder, DrawList, DrawMode, FrameDraws, Frustum, MeshKind, PosMap,
 };
 use crate::error::scoped;
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
@@ -170,7 +170,11 @@ pub struct Renderer {
     timer: Option<Timer>,
     frame_index: u32,
     /// Chunks fading in, with the frame they appeared.
-    fading: HashMap<ChunkPos, u32>,
+    fading: PosMap<ChunkPos, u32>,
+    /// The last frame's visible meshes (kept for the room of its lists).
+    culled: Culled,
+    /// The last frame's draw commands (likewise).
+    builder: DrawBuilder,
 }
 
 impl Renderer {
@@ -250,7 +254,9 @@ impl Renderer {
             oit,
             timer: Timer::new(ctx),
             frame_index: 0,
-            fading: HashMap::new(),
+            fading: PosMap::default(),
+            culled: Culled::default(),
+            builder: DrawBuilder::default(),
             config,
         })
     }
@@ -515,43 +521,31 @@ impl Renderer {
         let view_proj = camera.view_proj(aspect);
         let frustum = Frustum::new(view_proj, camera.eye);
 
-        // Translucent chunks are drawn farthest first, by the integer key that is exact
-        // for a grid of equal cubes (`voxel_mesh::order`).
-        let eye = camera.eye.to_array();
-        let mut translucent = self.chunks.visible(MeshKind::Translucent, &frustum);
-        translucent.sort_by_cached_key(|v| {
-            let key = voxel_mesh::order::chunk_order_key(v.pos, eye);
-            (std::cmp::Reverse(key), v.pos)
-        });
+        // One pass over the chunks finds the visible meshes of every kind, in draw order:
+        // translucent chunks farthest first, by the integer key that is exact for a grid of
+        // equal cubes (`voxel_mesh::order`); opaque and cutout meshes grouped by page, front
+        // to back (early depth rejection).
+        self.chunks.cull(&frustum, &mut self.culled);
         // The technique's CPU work (it may reorder quads within their places).
-        let positions: Vec<ChunkPos> = translucent.iter().map(|v| v.pos).collect();
         let view = FrameView {
             camera,
             view_proj,
-            translucent: &positions,
+            translucent: self.culled.translucent_positions(),
         };
         self.oit.prepare(&mut self.chunks, &view)?;
         self.write_frame_uniforms(camera, view_proj, medium.map(|(b, _)| b));
 
-        // Opaque and cutout meshes front to back (early depth rejection), grouped by page.
-        let near_first = |mut v: Vec<Visible>| {
-            v.sort_by(|a, b| {
-                (a.mesh.page, a.distance)
-                    .partial_cmp(&(b.mesh.page, b.distance))
-                    .unwrap_or(std::cmp::Ordering::Equal)
-            });
-            v
-        };
-        let mut builder = DrawBuilder::default();
-        let lists = [
-            builder.list(&near_first(self.chunks.visible(MeshKind::Opaque, &frustum))),
-            builder.list(&near_first(self.chunks.visible(MeshKind::Cutout, &frustum))),
-            builder.list(&translucent),
-        ];
-        self.chunks.upload_draws(&self.ctx, builder.commands());
+        let builder = &mut self.builder;
+        builder.clear();
+        let lists = [MeshKind::Opaque, MeshKind::Cutout, MeshKind::Translucent]
+            .map(|kind| builder.list(self.culled.meshes(kind)));
+        // Per-chunk draws read the commands on the CPU.
+        if self.config.draw == DrawMode::Indirect {
+            self.chunks.upload_draws(&self.ctx, self.builder.commands());
+        }
         let draws = FrameDraws {
             store: &self.chunks,
-            commands: builder.commands(),
+            commands: self.builder.commands(),
             mode: self.config.draw,
         };
         let [opaque, cutout, translucent] = &lists;

@@ -13,14 +13,13 @@
 //! pixel except where quads form a cycle (no order exists; counted in [`SortReport`], those
 //! quads drawn farthest centre first).
 
-use std::collections::HashMap;
 use std::time::Instant;
 
 use voxel_core::ChunkPos;
 use voxel_mesh::PackedQuad;
 use voxel_mesh::order::{QuadOrder, RegionKey};
 
-use crate::chunks::ChunkStore;
+use crate::chunks::{ChunkStore, PosMap};
 use crate::context::Capabilities;
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, Pass, SidedPipeline};
 use crate::oit::{
@@ -62,7 +61,7 @@ struct ChunkOrder {
 pub struct Sorted {
     pipeline: SidedPipeline,
     sort_quads: bool,
-    orders: HashMap<ChunkPos, ChunkOrder>,
+    orders: PosMap<ChunkPos, ChunkOrder>,
     scratch: Vec<PackedQuad>,
     report: SortReport,
 }
@@ -92,7 +91,7 @@ impl TechniqueKind for Sorted {
         Ok(Self {
             pipeline,
             sort_quads: technique == Technique::SortedQuads,
-            orders: HashMap::new(),
+            orders: PosMap::default(),
             scratch: Vec::new(),
             report: SortReport::default(),
         })

@@ -185,7 +185,10 @@ fn projection(plane: &Plane, view_proj: Mat4, eye: DVec3) -> ([Vec2; 2], [f32; 2
     let (lo, hi) = ((plane.lo - eye).as_vec3(), (plane.hi - eye).as_vec3());
     let (mut min, mut max) = (Vec2::splat(f32::INFINITY), Vec2::NEG_INFINITY);
     let (mut near, mut far) = (f32::INFINITY, f32::NEG_INFINITY);
-    for i in 0..8 {
+    // The rectangle is flat along its face's axis: the corners that differ only there are
+    // the same point, so four of the eight give every number.
+    let flat = 1 << plane.face.axis();
+    for i in (0..8).filter(|i| i & flat == 0) {
         let corner = Vec3::new(
             if i & 1 == 0 { lo.x } else { hi.x },
             if i & 2 == 0 { lo.y } else { hi.y },

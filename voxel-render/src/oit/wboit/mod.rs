@@ -30,13 +30,11 @@
 pub mod fit;
 pub mod weights;
 
-use std::collections::HashMap;
-
 use bytemuck::{Pod, Zeroable};
 use voxel_core::ChunkPos;
 use wgpu::util::DeviceExt;
 
-use crate::chunks::ChunkStore;
+use crate::chunks::{ChunkStore, PosMap};
 use crate::context::Capabilities;
 use crate::gpu::{self, ChunkPipeline, Depth, FullscreenPipeline, Pass, SidedPipeline, Target};
 use crate::oit::{
@@ -212,7 +210,7 @@ pub struct Wboit {
     params_group: wgpu::BindGroup,
     block_opacity: std::sync::Arc<[f32]>,
     /// Per chunk: the generation summed up and its layers.
-    layers: HashMap<ChunkPos, (u64, MeshLayers)>,
+    layers: PosMap<ChunkPos, (u64, MeshLayers)>,
     report: Option<WboitReport>,
 }
 
@@ -312,7 +310,7 @@ impl TechniqueKind for Wboit {
             params,
             params_group,
             block_opacity: setup.block_opacity.clone(),
-            layers: HashMap::new(),
+            layers: PosMap::default(),
             report: None,
         })
     }
