@@ -189,7 +189,11 @@ fn main() -> Result<(), String> {
     let runs = [8, 16, 24, 32]
         .map(|vd| (vd, Technique::WboitMrt))
         .into_iter()
-        .chain([(16, Technique::SortedQuads)])
+        .chain([
+            (16, Technique::SortedQuads),
+            (32, Technique::SortedQuads),
+            (32, Technique::Sorted),
+        ])
         .filter(|(vd, _)| only.as_ref().is_none_or(|o| o.contains(vd)));
     for (vd, technique) in runs {
         let r = measure(&ctx, vd, technique)?;

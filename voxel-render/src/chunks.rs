@@ -1031,13 +1031,13 @@ mod tests {
         let mut held: Vec<Option<ChunkPos>> = vec![None; 600];
         for step in 0..6000 {
             let slot = (next() % held.len() as u64) as u32;
-            if next() % 3 == 0 {
+            if next().is_multiple_of(3) {
                 regions.remove(slot);
                 held[slot as usize] = None;
             } else {
                 let c = |n: u64| (n % 40) as i32 - 20;
                 let pos = held[slot as usize]
-                    .filter(|_| next() % 2 == 0)
+                    .filter(|_| next().is_multiple_of(2))
                     .unwrap_or_else(|| ChunkPos::new(c(next()), c(next()) / 4, c(next())));
                 regions.set(slot, pos, [mesh(0, step), None, mesh(1, step)]);
                 held[slot as usize] = Some(pos);

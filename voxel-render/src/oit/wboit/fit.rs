@@ -152,11 +152,20 @@ pub fn fit<'a>(
                 let t0 = Vec2::new(tx as f32, ty as f32) / tiles;
                 let size = (hi.min(t0 + 1.0 / tiles) - lo.max(t0)).max(Vec2::ZERO) * tiles;
                 let tau = tau * size.x * size.y;
-                let tile = (ty as usize * TILES + tx as usize) * PROFILE_LEN;
-                for p in &mut optical_depth[tile + behind..tile + PROFILE_LEN] {
-                    *p += tau;
+                // Added where the depths behind it start; the running sums below carry it
+                // to the depths past (one add per tile instead of one per depth).
+                if behind < PROFILE_LEN {
+                    optical_depth[(ty as usize * TILES + tx as usize) * PROFILE_LEN + behind] +=
+                        tau;
                 }
             }
+        }
+    }
+    for profile in optical_depth.chunks_exact_mut(PROFILE_LEN) {
+        let mut sum = 0.0;
+        for p in profile {
+            sum += *p;
+            *p = sum;
         }
     }
     WeightFit {
