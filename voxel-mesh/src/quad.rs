@@ -46,6 +46,23 @@ pub struct Quad {
     pub block: BlockId,
 }
 
+impl Quad {
+    /// The face's rectangle in block coordinates of its chunk: lowest and highest corner
+    /// (equal along the face's axis, which is one past the block on positive faces).
+    pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
+        let axis = self.face.axis();
+        let [ua, va] = UV_AXES[axis];
+        let mut min = self.pos.map(f64::from);
+        if self.face.is_positive() {
+            min[axis] += 1.0;
+        }
+        let mut max = min;
+        max[ua] += f64::from(self.size[0]);
+        max[va] += f64::from(self.size[1]);
+        (min, max)
+    }
+}
+
 /// Quad flag (word 1, bit 16): a translucent face toward a block of another translucent
 /// type (the renderer counts such a face from behind differently; see
 /// `voxel_render::medium`).

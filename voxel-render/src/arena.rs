@@ -347,11 +347,12 @@ pub struct Compacted {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    /// A tiny xorshift, so the test needs no dependency and runs the same every time.
-    fn rng(seed: u64) -> impl FnMut() -> u64 {
+    /// A tiny xorshift, so the tests (here and in `chunks`) need no dependency and run the
+    /// same every time.
+    pub(crate) fn rng(seed: u64) -> impl FnMut() -> u64 {
         let mut s = seed;
         move || {
             s ^= s << 13;

@@ -949,6 +949,7 @@ enum Cover {
 mod tests {
     use super::*;
     use crate::Camera;
+    use crate::arena::tests::rng;
 
     #[test]
     fn frustum_keeps_chunks_in_view_and_drops_the_rest() {
@@ -981,17 +982,6 @@ mod tests {
             f.chunk_distance(ChunkPos::new(0, 0, 3)).is_some(),
             "the eye's own chunk"
         );
-    }
-
-    /// A tiny xorshift, so the tests need no dependency and run the same every time.
-    fn rng(seed: u64) -> impl FnMut() -> u64 {
-        let mut s = seed;
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        }
     }
 
     fn mesh(page: u32, offset: u32) -> Option<Alloc> {

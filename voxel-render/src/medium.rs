@@ -290,14 +290,7 @@ fn translucent_near(chunks: &ChunkStore, eye: DVec3, reach: f64) -> Vec<NearFace
                 for q in chunk.translucent_quads() {
                     let Some(u) = q.unpack() else { continue };
                     let axis = u.face.axis();
-                    let [ua, va] = voxel_mesh::UV_AXES[axis];
-                    let mut min = u.pos.map(f64::from);
-                    if u.face.is_positive() {
-                        min[axis] += 1.0;
-                    }
-                    let mut max = min;
-                    max[ua] += f64::from(u.size[0]);
-                    max[va] += f64::from(u.size[1]);
+                    let (min, max) = u.bounds();
                     let (min, max) = (
                         DVec3::from(min) + DVec3::from(o),
                         DVec3::from(max) + DVec3::from(o),

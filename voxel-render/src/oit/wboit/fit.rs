@@ -78,14 +78,7 @@ impl MeshLayers {
             let alpha = opacity.get(u.block.index()).copied().unwrap_or(0.0);
             let depth = layer_depth(alpha);
             let axis = u.face.axis();
-            let [ua, va] = voxel_mesh::UV_AXES[axis];
-            let mut min = u.pos.map(f64::from);
-            if u.face.is_positive() {
-                min[axis] += 1.0;
-            }
-            let mut max = min;
-            max[ua] += f64::from(u.size[0]);
-            max[va] += f64::from(u.size[1]);
+            let (min, max) = u.bounds();
             let (lo, hi) = (origin + DVec3::from(min), origin + DVec3::from(max));
             let area = f64::from(q.area());
             let key = (u.face as usize, min[axis] as u8, u.block.0);
