@@ -251,9 +251,12 @@ fn scene_records(
             frac_bad_px,
         } = metrics;
         let report = &m.stats.technique;
-        // An exact order's error off the quad edges (sub-pixel snapping decides the rest).
+        // An exact order's error off the quad edges (sub-pixel snapping decides the rest),
+        // seen from where the renderer drew (an eye on a face plane is moved off it).
         let off_edges = report.sort.map(|_| {
-            let e = quad_edges.get_or_insert_with(|| Edges::new(&scene.world, &camera, size));
+            let e = quad_edges.get_or_insert_with(|| {
+                Edges::new(&scene.world, &renderer.drawn_camera(&camera), size)
+            });
             edges::error_off_edges(e, &reference.image, &m.image)
         });
         records.push(Record {

@@ -641,17 +641,38 @@ fn distribution_table(s: &mut String, d: &Distribution, runs: &[String]) {
             format!("{:.3} ({:.3}–{:.3})", g.p50, g.p10, g.p90)
         });
         let exact = match t.exact_off_edges_share {
-            Some(e) => format!(
-                "{:.0} % ({:.0} % off edges)",
-                t.exact_share * 100.0,
-                e * 100.0
-            ),
-            None => format!("{:.0} %", t.exact_share * 100.0),
+            Some(e) => format!("{} ({} off edges)", share(t.exact_share), share(e)),
+            None => share(t.exact_share),
         };
         let _ = writeln!(
             s,
             "| {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {} | {} | {} | {} | {exact} | {} | {gpu} |",
             t.technique, t.n, f.p50, f.p90, f.p99, f.max, e.p50, e.p90, e.p99, e.max, t.nan_px
         );
+    }
+}
+
+/// A share as a percentage: whole numbers, except that a share short of all (or above
+/// none) never rounds to 100 % (or 0 %).
+fn share(x: f64) -> String {
+    let p = x * 100.0;
+    if (p.round() == 100.0 && x < 1.0) || (p.round() == 0.0 && x > 0.0) {
+        format!("{p:.1} %")
+    } else {
+        format!("{p:.0} %")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::share;
+
+    #[test]
+    fn shares_short_of_all_or_above_none_never_round_to_it() {
+        assert_eq!(share(1.0), "100 %");
+        assert_eq!(share(296.0 / 297.0), "99.7 %");
+        assert_eq!(share(0.5), "50 %");
+        assert_eq!(share(0.001), "0.1 %");
+        assert_eq!(share(0.0), "0 %");
     }
 }

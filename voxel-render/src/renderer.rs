@@ -513,8 +513,7 @@ impl Renderer {
         self.chunks.compact(&self.ctx, encoder);
         let (w, h) = self.size();
         let aspect = f64::from(w) / f64::from(h);
-        // No translucent face closer than the near plane's corners (crossing a surface).
-        let camera = &medium::guard(camera, aspect, &self.chunks);
+        let camera = &self.drawn_camera(camera);
         let medium = camera
             .medium
             .and_then(|b| Some((b, self.looks.get(b.index()).copied().flatten()?)));
@@ -602,6 +601,16 @@ impl Renderer {
             technique: self.oit.report(),
             ..stats
         })
+    }
+
+    /// The camera a frame of `camera` is drawn with: no translucent face closer than the
+    /// near plane's corners (the near plane shrinks for the frame), and an eye within
+    /// [`crate::MIN_NEAR`] of a translucent face moved off it to its medium's side
+    /// ([`medium::guard`]). Tools that reason about the picture's geometry (the lab's quad
+    /// edges) use this one.
+    pub fn drawn_camera(&self, camera: &Camera) -> Camera {
+        let (w, h) = self.size();
+        medium::guard(camera, f64::from(w) / f64::from(h), &self.chunks)
     }
 
     /// Renders one frame into `output` and submits it (for tools and tests).
