@@ -1026,6 +1026,17 @@ mod tests {
     use super::*;
     use crate::blocks::*;
 
+    /// A tiny xorshift, so the tests need no dependency and run the same every time.
+    fn xorshift(seed: u64) -> impl FnMut() -> u64 {
+        let mut s = seed;
+        move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        }
+    }
+
     #[test]
     fn set_and_get_round_trip() {
         let mut c = Chunk::default();
@@ -1089,14 +1100,7 @@ mod tests {
 
     #[test]
     fn random_edits_match_a_dense_model() {
-        // A tiny xorshift so the test needs no dependency and is the same on every run.
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+        let mut next = xorshift(0x2545_f491_4f6c_dd1d);
         let mut c = Chunk::default();
         let mut model = vec![AIR; CHUNK_VOLUME];
         for step in 0..20_000 {
@@ -1125,13 +1129,7 @@ mod tests {
     /// A chunk of several types from a seed: boxes, columns and single blocks of up to
     /// `types` ids (1..=types), on air.
     fn varied_chunk(seed: u64, types: u16) -> Chunk {
-        let mut s = seed | 1;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+        let mut next = xorshift(seed | 1);
         let mut c = Chunk::default();
         for step in 0..400 {
             let r = next();
@@ -1347,13 +1345,7 @@ mod tests {
 
     #[test]
     fn random_edits_of_packed_chunks_match_a_dense_model() {
-        let mut s = 0x1234_5678_9abc_def1u64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s
-        };
+        let mut next = xorshift(0x1234_5678_9abc_def1);
         let mut c = varied_chunk(99, 6);
         let mut model = c.to_dense();
         c.pack();

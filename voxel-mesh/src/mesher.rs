@@ -519,23 +519,31 @@ mod tests {
         m
     }
 
+    /// The blocks whose faces quad `u` covers; panics on a quad that leaves the chunk.
+    fn covered_blocks(u: crate::Quad) -> impl Iterator<Item = [usize; 3]> {
+        let [ua, va] = crate::UV_AXES[u.face.axis()];
+        let (w, h) = (usize::from(u.size[0]), usize::from(u.size[1]));
+        (0..w).flat_map(move |i| {
+            (0..h).map(move |j| {
+                let mut p = u.pos.map(usize::from);
+                p[ua] += i;
+                p[va] += j;
+                assert!(p.iter().all(|&c| c < 32), "quad {u:?} leaves the chunk");
+                p
+            })
+        })
+    }
+
     /// Every unit face covered by `quads`; panics on a face covered twice.
     fn unit_faces(quads: &[PackedQuad]) -> BTreeSet<UnitFace> {
         let mut set = BTreeSet::new();
         for q in quads {
             let u = q.unpack().expect("valid quad");
-            let [ua, va] = crate::UV_AXES[u.face.axis()];
-            for i in 0..usize::from(u.size[0]) {
-                for j in 0..usize::from(u.size[1]) {
-                    let mut p = u.pos.map(usize::from);
-                    p[ua] += i;
-                    p[va] += j;
-                    assert!(p.iter().all(|&c| c < 32), "quad {u:?} leaves the chunk");
-                    assert!(
-                        set.insert((p, u.face as usize, u.block.0)),
-                        "face twice: {p:?} {u:?}"
-                    );
-                }
+            for p in covered_blocks(u) {
+                assert!(
+                    set.insert((p, u.face as usize, u.block.0)),
+                    "face twice: {p:?} {u:?}"
+                );
             }
         }
         set
@@ -608,19 +616,12 @@ mod tests {
         {
             for q in quads {
                 let u = q.unpack().expect("valid quad");
-                let [ua, va] = crate::UV_AXES[u.face.axis()];
-                for i in 0..usize::from(u.size[0]) {
-                    for j in 0..usize::from(u.size[1]) {
-                        let mut p = u.pos.map(usize::from);
-                        p[ua] += i;
-                        p[va] += j;
-                        assert!(p.iter().all(|&c| c < 32), "quad {u:?} leaves the chunk");
-                        let interface = q.flags() & crate::FLAG_INTERFACE != 0;
-                        assert!(
-                            map.insert(k, u.face as usize, p, u.block, interface),
-                            "face twice: {p:?} {u:?}"
-                        );
-                    }
+                let interface = q.flags() & crate::FLAG_INTERFACE != 0;
+                for p in covered_blocks(u) {
+                    assert!(
+                        map.insert(k, u.face as usize, p, u.block, interface),
+                        "face twice: {p:?} {u:?}"
+                    );
                 }
             }
         }
