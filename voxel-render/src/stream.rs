@@ -201,6 +201,12 @@ struct Slot {
 }
 
 impl Slot {
+    /// Whether the job of `version` that leaves the slot in `state` is still the one it
+    /// waits for (a stale job counts for nothing).
+    fn awaits(&self, version: u32, state: State) -> bool {
+        self.version == version && self.state == state
+    }
+
     fn has_blocks(&self) -> bool {
         self.state != State::Generating
     }
@@ -528,12 +534,13 @@ impl ChunkStreamer {
                     version,
                     chunk,
                 } => {
-                    let Some(slot) = self.slots.get_mut(&pos) else {
+                    let Some(slot) = self
+                        .slots
+                        .get_mut(&pos)
+                        .filter(|s| s.awaits(version, State::Generating))
+                    else {
                         continue;
                     };
-                    if slot.version != version || slot.state != State::Generating {
-                        continue;
-                    }
                     slot.state = State::Generated;
                     frame.generated += 1;
                     if chunk.as_uniform() != Some(BlockId::AIR) {
@@ -547,12 +554,13 @@ impl ChunkStreamer {
                     meshes,
                     packed,
                 } => {
-                    let Some(slot) = self.slots.get_mut(&pos) else {
+                    let Some(slot) = self
+                        .slots
+                        .get_mut(&pos)
+                        .filter(|s| s.awaits(version, State::Meshing))
+                    else {
                         continue;
                     };
-                    if slot.version != version || slot.state != State::Meshing {
-                        continue;
-                    }
                     frame.meshed += 1;
                     if let Some((sent, chunk)) = packed {
                         self.world.replace_shared(pos, &sent, chunk);
@@ -823,12 +831,13 @@ impl ChunkStreamer {
                 break;
             }
             let Some(r) = self.ready.pop() else { break };
-            let Some(slot) = self.slots.get_mut(&r.pos) else {
+            let Some(slot) = self
+                .slots
+                .get_mut(&r.pos)
+                .filter(|s| s.awaits(r.version, State::Ready))
+            else {
                 continue;
             };
-            if slot.version != r.version || slot.state != State::Ready {
-                continue;
-            }
             slot.state = State::Meshed;
             if r.meshes.is_empty() {
                 if slot.uploaded {
