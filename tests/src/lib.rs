@@ -62,13 +62,18 @@ pub fn render(
     width: u32,
     height: u32,
 ) -> Image {
+    render_with(ctx, scene, technique_config(technique, width, height))
+}
+
+/// The default renderer settings with `technique`, drawing `width` × `height` pixels.
+pub fn technique_config(technique: Technique, width: u32, height: u32) -> RendererConfig {
     let mut config = RendererConfig {
         width,
         height,
         ..RendererConfig::default()
     };
     config.oit.technique = technique;
-    render_with(ctx, scene, config)
+    config
 }
 
 /// Renders `scene`'s first camera with `config`.

@@ -5,32 +5,27 @@
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use voxel_render::{RendererConfig, Technique};
+use voxel_render::Technique;
 
 use tests::*;
-
-fn config(technique: Technique, w: u32, h: u32) -> RendererConfig {
-    let mut c = RendererConfig {
-        width: w,
-        height: h,
-        ..RendererConfig::default()
-    };
-    c.oit.technique = technique;
-    c
-}
 
 #[test]
 fn the_exact_methods_agree_on_200_dense_sheets() {
     let Some(ctx) = gpu() else { return };
     for n in [64, 200] {
         let scene = dense_sheets(n, 0.99);
-        let mut r = renderer_for(&ctx, &scene, config(Technique::Reference, 96, 64)).unwrap();
+        let mut r =
+            renderer_for(&ctx, &scene, technique_config(Technique::Reference, 96, 64)).unwrap();
         let target = Offscreen::new(&ctx, 96, 64);
         let stats = r
             .render_and_submit(&target.view, &scene.cameras[0])
             .unwrap();
         let a = target.read(&ctx).unwrap();
-        let p = render_with(&ctx, &scene, config(Technique::PeelReference, 96, 64));
+        let p = render_with(
+            &ctx,
+            &scene,
+            technique_config(Technique::PeelReference, 96, 64),
+        );
         eprintln!(
             "{n}: {:?} diff {:?}",
             stats.technique.reference,
@@ -48,7 +43,7 @@ fn a_render_size_above_the_adapter_limit_is_an_error() {
     let e = voxel_render::Renderer::new(
         &ctx,
         scene.world.registry(),
-        config(Technique::WboitMrt, limit + 1, 64),
+        technique_config(Technique::WboitMrt, limit + 1, 64),
     )
     .unwrap_err();
     assert!(matches!(e, voxel_render::Error::TooLarge { .. }), "{e:?}");
@@ -58,7 +53,7 @@ fn a_render_size_above_the_adapter_limit_is_an_error() {
         "{msg}"
     );
 
-    let mut r = renderer_for(&ctx, &scene, config(Technique::WboitMrt, 64, 48)).unwrap();
+    let mut r = renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, 64, 48)).unwrap();
     let e = r.resize(64, limit + 1).unwrap_err();
     assert!(e.to_string().contains("render height"), "{e}");
     assert_eq!(r.size(), (64, 48), "a failed resize changes nothing");
@@ -72,7 +67,7 @@ fn a_render_size_above_the_adapter_limit_is_an_error() {
 fn an_output_of_another_size_or_format_is_an_error() {
     let Some(ctx) = gpu() else { return };
     let scene = dense_sheets(2, 0.5);
-    let mut r = renderer_for(&ctx, &scene, config(Technique::WboitMrt, 64, 48)).unwrap();
+    let mut r = renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, 64, 48)).unwrap();
     let cam = scene.cameras[0];
     let small = Offscreen::new(&ctx, 32, 48);
     let e = r.render_and_submit(&small.view, &cam).unwrap_err();
@@ -99,7 +94,12 @@ fn an_output_of_another_size_or_format_is_an_error() {
 fn peel_layers_beyond_the_limit_are_an_error_not_a_hang() {
     let Some(ctx) = gpu() else { return };
     let scene = dense_sheets(2, 0.5);
-    let mut r = renderer_for(&ctx, &scene, config(Technique::DepthPeeling, 64, 48)).unwrap();
+    let mut r = renderer_for(
+        &ctx,
+        &scene,
+        technique_config(Technique::DepthPeeling, 64, 48),
+    )
+    .unwrap();
     for layers in [u32::MAX, 8194, 513 * 2, 3, 0] {
         let mut c = r.config().oit.clone();
         c.peeling.layers = layers;
@@ -121,7 +121,7 @@ fn peel_layers_beyond_the_limit_are_an_error_not_a_hang() {
 fn config_tells_the_truth_after_every_setter() {
     let Some(ctx) = gpu() else { return };
     let scene = dense_sheets(2, 0.5);
-    let mut r = renderer_for(&ctx, &scene, config(Technique::WboitMrt, 64, 48)).unwrap();
+    let mut r = renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, 64, 48)).unwrap();
     r.set_technique(Technique::Stipple);
     assert_eq!(r.config().oit.technique, Technique::Stipple);
     r.set_weight(voxel_render::WeightFunction::McGuire8);
@@ -140,7 +140,12 @@ fn the_a_buffer_tiles_its_head_pointers_when_they_exceed_a_storage_binding() {
         return;
     };
     let scene = dense_sheets(6, 0.4);
-    let mut r = renderer_for(&ctx, &scene, config(Technique::Reference, 160, 120)).unwrap();
+    let mut r = renderer_for(
+        &ctx,
+        &scene,
+        technique_config(Technique::Reference, 160, 120),
+    )
+    .unwrap();
     let target = Offscreen::new(&ctx, 160, 120);
     let stats = r
         .render_and_submit(&target.view, &scene.cameras[0])
@@ -149,7 +154,11 @@ fn the_a_buffer_tiles_its_head_pointers_when_they_exceed_a_storage_binding() {
     assert!(report.tiles >= 2, "{report:?}");
     assert!(report.exact(), "{report:?}");
     let a = target.read(&ctx).unwrap();
-    let p = render_with(&ctx, &scene, config(Technique::PeelReference, 160, 120));
+    let p = render_with(
+        &ctx,
+        &scene,
+        technique_config(Technique::PeelReference, 160, 120),
+    );
     assert_close("abuffer_tiled_heads", &a, &p, 2);
 }
 
@@ -157,7 +166,7 @@ fn the_a_buffer_tiles_its_head_pointers_when_they_exceed_a_storage_binding() {
 fn chunks_and_eyes_outside_the_i32_world_are_errors() {
     let Some(ctx) = gpu() else { return };
     let scene = dense_sheets(2, 0.5);
-    let mut r = renderer_for(&ctx, &scene, config(Technique::WboitMrt, 64, 48)).unwrap();
+    let mut r = renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, 64, 48)).unwrap();
     let meshes = voxel_mesh::ChunkMeshes {
         opaque: vec![voxel_mesh::PackedQuad::new(
             [0, 0, 0],
@@ -205,9 +214,18 @@ fn the_nearest_near_plane_still_shows_the_floor() {
         .unwrap();
         Scene::new("floor", world.clone(), cam)
     };
-    let sky = render_with(&ctx, &make(0.1), config(Technique::WboitMrt, 64, 48)).pixel(32, 2);
+    let sky = render_with(
+        &ctx,
+        &make(0.1),
+        technique_config(Technique::WboitMrt, 64, 48),
+    )
+    .pixel(32, 2);
     for near in [0.1, voxel_render::MIN_NEAR] {
-        let img = render_with(&ctx, &make(near), config(Technique::WboitMrt, 64, 48));
+        let img = render_with(
+            &ctx,
+            &make(near),
+            technique_config(Technique::WboitMrt, 64, 48),
+        );
         let floor = img.pixel(32, 46);
         assert_ne!(floor, sky, "near {near}: the floor vanished");
     }
@@ -221,7 +239,12 @@ fn hundreds_of_timed_passes_keep_every_pass_timed() {
     }
     // Peeling 100 layers to convergence records 200+ timed passes in one frame.
     let scene = dense_sheets(100, 0.3);
-    let mut r = renderer_for(&ctx, &scene, config(Technique::PeelReference, 48, 32)).unwrap();
+    let mut r = renderer_for(
+        &ctx,
+        &scene,
+        technique_config(Technique::PeelReference, 48, 32),
+    )
+    .unwrap();
     frame(&ctx, &mut r, &scene.cameras[0]);
     let times = r.gpu_times_blocking();
     use voxel_render::GpuPass;

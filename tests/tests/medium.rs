@@ -14,13 +14,7 @@ const W: u32 = 160;
 const H: u32 = 96;
 
 fn config(technique: Technique) -> RendererConfig {
-    let mut c = RendererConfig {
-        width: W,
-        height: H,
-        ..RendererConfig::default()
-    };
-    c.oit.technique = technique;
-    c
+    technique_config(technique, W, H)
 }
 
 /// A sea (surface at y = 1) over sand and a stone pillar through it, with a glass block

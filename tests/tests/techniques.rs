@@ -13,13 +13,7 @@ const W: u32 = 256;
 const H: u32 = 160;
 
 fn config(technique: Technique) -> RendererConfig {
-    let mut c = RendererConfig {
-        width: W,
-        height: H,
-        ..RendererConfig::default()
-    };
-    c.oit.technique = technique;
-    c
+    technique_config(technique, W, H)
 }
 
 /// Six parallel sheets of six different translucent blocks, facing the camera, at
