@@ -9,8 +9,8 @@
 //! into regions of [`REGION_CHUNKS`] (Sodium's 8 × 4 × 8), whose box is tested first, so that
 //! a region outside the frustum costs one test and one wholly inside costs none per chunk;
 //! only the chunks of regions the frustum's planes cut are tested one by one. The result is
-//! exactly what testing every chunk finds ([`ChunkStore::visible`]), in the same draw
-//! order once sorted.
+//! exactly what testing every chunk with [`Frustum::chunk_distance`] finds (a randomized
+//! test).
 //!
 //! Each upload of a chunk gets a new *generation* number, so that what a technique derives
 //! from a chunk's quads (a sort structure, a summary of its layers) can be cached by
@@ -137,19 +137,6 @@ impl GpuChunk {
     pub fn generation(&self) -> u64 {
         self.generation
     }
-}
-
-/// A visible chunk mesh, with the view distance of the chunk's centre.
-#[derive(Clone, Copy, Debug)]
-pub struct Visible {
-    /// Where the chunk is.
-    pub pos: ChunkPos,
-    /// Its slot (the instance index its draws carry).
-    pub slot: u32,
-    /// Where the mesh lives.
-    pub mesh: Alloc,
-    /// Distance from the eye to the chunk's centre.
-    pub distance: f64,
 }
 
 /// One draw command, as `multi_draw_indirect` reads it.
@@ -444,9 +431,8 @@ struct FarEntry {
 /// One frame's visible meshes of every kind, from [`ChunkStore::cull`], in draw order:
 /// opaque and cutout meshes by page, then front to back (early depth rejection; equal
 /// distances by slot), translucent ones farthest first by
-/// [`voxel_mesh::order::chunk_order_key`] (equal keys by position). The same meshes in the
-/// same order as sorting [`ChunkStore::visible`]'s lists so. Keep one between frames: its
-/// vectors keep their room.
+/// [`voxel_mesh::order::chunk_order_key`] (equal keys by position). Keep one between
+/// frames: its vectors keep their room.
 #[derive(Debug, Default)]
 pub struct Culled {
     near: [Vec<NearEntry>; 2],
@@ -723,27 +709,9 @@ impl ChunkStore {
         }
     }
 
-    /// The meshes of `kind` of the chunks inside the view frustum, in no particular order.
-    pub fn visible(&self, kind: MeshKind, frustum: &Frustum) -> Vec<Visible> {
-        self.slots
-            .iter()
-            .enumerate()
-            .filter_map(|(slot, c)| {
-                let c = c.as_ref()?;
-                let mesh = c.meshes[kind as usize]?;
-                frustum.chunk_distance(c.pos).map(|distance| Visible {
-                    pos: c.pos,
-                    slot: slot as u32,
-                    mesh,
-                    distance,
-                })
-            })
-            .collect()
-    }
-
     /// Finds the visible meshes of every kind in one pass over the regions (see the module
-    /// docs) and puts them in draw order into `out` (see [`Culled`]): the meshes
-    /// [`ChunkStore::visible`] finds for each kind.
+    /// docs) and puts them in draw order into `out` (see [`Culled`]): the meshes of every
+    /// chunk whose box [`Frustum::chunk_distance`] does not put outside the frustum.
     pub fn cull(&self, frustum: &Frustum, out: &mut Culled) {
         for list in &mut out.near {
             list.clear();

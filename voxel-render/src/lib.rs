@@ -34,7 +34,7 @@ pub use bindings::{ChunkUniforms, FrameUniforms, SharedLayouts};
 pub use camera::{Camera, MAX_FAR, MAX_FOV_DEG, MIN_FOV_DEG, MIN_NEAR, WORLD_EXTENT};
 pub use chunks::{
     ChunkStore, Culled, DrawCommand, DrawList, DrawMode, FrameDraws, Frustum, GpuChunk, MeshKind,
-    REGION_CHUNKS, Visible,
+    REGION_CHUNKS,
 };
 pub use context::{Capabilities, GpuContext, WANTED_FEATURES, request_device};
 pub use error::{Error, Result};
