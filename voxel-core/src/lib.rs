@@ -16,4 +16,4 @@ pub use chunk::{
 };
 pub use error::{Error, Result};
 pub use terrain::{Site, SiteKind, TerrainConfig, TerrainGenerator};
-pub use world::{ChunkPos, Face, World, WorldPos};
+pub use world::{ChunkPos, Face, Neighbourhood, World, WorldPos, touched_neighbours};
