@@ -226,6 +226,12 @@ struct RenderArgs {
     /// 4x MSAA for the opaque and cutout passes.
     #[arg(long)]
     msaa: bool,
+    /// Ambient-occlusion strength, 0 (off) to 1.
+    #[arg(long, default_value_t = 1.0)]
+    ao_strength: f32,
+    /// Every block one flat colour (what the lab compares with its CPU ray march).
+    #[arg(long)]
+    flat_textures: bool,
     /// Timed frames (after one untimed); the medians are printed.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1)]
     frames: u32,
@@ -406,6 +412,8 @@ fn render(a: RenderArgs) -> Result<(), String> {
         width,
         height,
         msaa: a.msaa,
+        ao_strength: a.ao_strength,
+        flat_textures: a.flat_textures,
         ..RendererConfig::default()
     };
     config.oit.technique = a.technique;
