@@ -18,6 +18,7 @@ const LAB: &[&str] = &[
     "progress",
     "random",
     "edges",
+    "raymarch",
     "summary",
     "metrics",
     "scene",

@@ -4,7 +4,8 @@
 //!
 //! Modules depend on each other one way:
 //! - the model: [`progress`], [`random`] (random scenes as scene-file text), [`edges`]
-//!   (which pixels lie on quad edges), [`summary`], [`metrics`], [`scene`], [`headless`];
+//!   (which pixels lie on quad edges), [`raymarch`] (the CPU ray-march reference),
+//!   [`summary`], [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the
 //!   reference), [`stability`] (sweeps and flicker);
 //! - the report, which reads what the runs produced: [`distribution`] (errors over random
@@ -20,6 +21,7 @@ pub mod headless;
 pub mod metrics;
 pub mod progress;
 pub mod random;
+pub mod raymarch;
 pub mod report;
 pub mod scene;
 pub mod stability;
