@@ -178,6 +178,9 @@ struct WindowArgs {
     /// Scripted: halve the window, get a zero size, restore it (frames 1 to 3).
     #[arg(long, requires = "frames")]
     resize: bool,
+    /// A scene file or a MagicaVoxel .vox model to show instead of generated terrain.
+    #[arg(long)]
+    scene: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -214,7 +217,7 @@ struct RenderArgs {
     /// Layers of dual depth peeling (even, 2 to 512).
     #[arg(long)]
     layers: Option<u32>,
-    /// Scene file (default: the generated default scene).
+    /// Scene file or MagicaVoxel .vox model (default: the generated default scene).
     #[arg(long)]
     scene: Option<PathBuf>,
     /// Picture size.
@@ -236,7 +239,8 @@ struct RenderArgs {
 
 #[derive(Args, Debug)]
 struct EvalArgs {
-    /// Scene files or folders (default: the suite in scenes/).
+    /// Scene files (.toml), MagicaVoxel models (.vox) or folders of them (default: the
+    /// suite in scenes/).
     #[arg(long, num_args = 1..)]
     scenes: Vec<PathBuf>,
     /// Random scenes instead of scene files: N scenes (1 to 100000) drawn from --seed;
@@ -684,6 +688,8 @@ fn window(a: WindowArgs) -> Result<(), String> {
         heatmap: a.heatmap,
         edit: a.edit,
         resize: a.resize,
+        // Read before the window opens: a broken file is an error, not an empty window.
+        scene: a.scene.as_deref().map(scene::Scene::load).transpose()?,
     })
 }
 
