@@ -40,6 +40,25 @@ enum Command {
     /// Flies over generated terrain with chunk streaming; writes stream.json (CPU and GPU
     /// time per frame, uploads, memory), frames.json and a chart of CPU ms per frame.
     Stream(StreamArgs),
+    /// One scene (a scene file or a .vox model) under every technique: each picture, its
+    /// FLIP error map against the reference, and gallery.png with all of them.
+    Gallery(GalleryArgs),
+}
+
+#[derive(Args, Debug)]
+struct GalleryArgs {
+    /// Scene file or MagicaVoxel .vox model.
+    #[arg(long)]
+    scene: PathBuf,
+    /// Picture size of each technique.
+    #[arg(long, value_parser = size, default_value = "480x270")]
+    size: (u32, u32),
+    /// Tiles per row of gallery.png.
+    #[arg(long, default_value_t = 3)]
+    columns: usize,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 /// How chunk meshes are drawn: `indirect` or `per-chunk`.
@@ -304,6 +323,7 @@ fn main() {
         Some(Command::Render(a)) => render(a),
         Some(Command::Eval(a)) => eval(a),
         Some(Command::Stream(a)) => stream(a),
+        Some(Command::Gallery(a)) => gallery(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e}");
@@ -672,6 +692,26 @@ fn stream(a: StreamArgs) -> Result<(), String> {
             t.max_unloads
         );
     }
+    Ok(())
+}
+
+/// Renders one scene with every technique and writes the pictures, error maps and sheet.
+fn gallery(a: GalleryArgs) -> Result<(), String> {
+    writable_dir(&a.out)?;
+    let scene = scene::Scene::load(&a.scene)?;
+    let ctx = headless::context()?;
+    println!("adapter: {}; scene: {}", ctx.caps.adapter_name, scene.name);
+    let entries = voxel_lab::gallery::render(&ctx, &scene, a.size)?;
+    voxel_lab::gallery::write(&a.out, &entries, a.columns)?;
+    for e in &entries {
+        println!(
+            "{:<16} FLIP {:.4}  max error {}/255",
+            e.technique.name(),
+            e.metrics.flip_mean,
+            e.metrics.max_abs_err
+        );
+    }
+    println!("wrote {}", a.out.join("gallery.png").display());
     Ok(())
 }
 

@@ -275,7 +275,10 @@ fn the_window_opens_a_vox_model() {
     assert!(distinct(&v) > 100, "{} colours", distinct(&v));
     // The harbour, not terrain: its red sail and lighthouse bands (200+ red, little else),
     // which generated terrain does not hold, and sky around it.
-    let red = v.iter().filter(|p| p[0] > 150 && p[1] < 90 && p[2] < 90).count();
+    let red = v
+        .iter()
+        .filter(|p| p[0] > 150 && p[1] < 90 && p[2] < 90)
+        .count();
     assert!(red > 50, "{red} red pixels");
     let top_left_sky = v[0];
     assert!(
