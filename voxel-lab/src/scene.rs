@@ -699,6 +699,49 @@ path_to = [3.0, 1.0, 10.0]
     }
 
     #[test]
+    fn the_framing_camera_shows_the_whole_box_tightly() {
+        for (min, max) in [
+            ([0, 0, 0], [0, 0, 0]),
+            ([0, 0, 0], [63, 23, 55]),
+            ([-40, 5, 7], [300, 9, 12]),
+            ([0, 0, 0], [3, 200, 3]),
+        ] {
+            let (lo, hi) = (
+                WorldPos::new(min[0], min[1], min[2]),
+                WorldPos::new(max[0], max[1], max[2]),
+            );
+            let (cam, path_to) = framing_camera(lo, hi).unwrap();
+            // The renderer's own projection, square: every corner inside, one near an edge.
+            let vp = cam.view_proj(1.0);
+            let mut widest = 0.0f32;
+            for k in 0..8 {
+                let pick =
+                    |bit: i32, a: i32, b: i32| f64::from(if k & bit == 0 { a } else { b + 1 });
+                let c = DVec3::new(
+                    pick(1, min[0], max[0]),
+                    pick(2, min[1], max[1]),
+                    pick(4, min[2], max[2]),
+                ) - cam.eye;
+                let p = vp * c.as_vec3().extend(1.0);
+                let ndc = p.truncate() / p.w;
+                assert!(p.w > 0.0 && ndc.z > 0.0 && ndc.z < 1.0, "{min:?}: {ndc}");
+                assert!(ndc.x.abs() <= 0.93 && ndc.y.abs() <= 0.93, "{min:?}: {ndc}");
+                widest = widest.max(ndc.x.abs()).max(ndc.y.abs());
+            }
+            assert!(widest > 0.85, "{min:?}..{max:?}: framed loosely ({widest})");
+            // From above, and the flicker path stays as far from the box.
+            assert!(cam.forward.y < -0.5);
+            let centre = DVec3::new(
+                f64::from(min[0] + max[0] + 1),
+                f64::from(min[1] + max[1] + 1),
+                f64::from(min[2] + max[2] + 1),
+            ) * 0.5;
+            let (a, b) = ((cam.eye - centre).length(), (path_to - centre).length());
+            assert!((a - b).abs() < 1e-6 * a);
+        }
+    }
+
+    #[test]
     fn an_unknown_block_names_the_line_and_lists_the_known_ones() {
         let bad = GOOD.replace("block = \"smoky_glass\"", "block = \"lava\"");
         let e = parse(&bad).unwrap_err();
