@@ -29,6 +29,7 @@ const LAB: &[&str] = &[
     "charts",
     "report",
     "stream",
+    "gallery",
 ];
 
 /// The module each item re-exported by lib.rs (`pub use module::{A, B};`) comes from.

@@ -11,12 +11,14 @@
 //! - the report, which reads what the runs produced: [`distribution`] (errors over random
 //!   scenes, where each technique fails), [`charts`], [`report`];
 //! - [`evaluate`] here, which runs everything and writes every file;
-//! - [`stream`]: the streaming flight (`demo stream`), which draws its own chart.
+//! - [`stream`]: the streaming flight (`demo stream`), which draws its own chart;
+//! - [`gallery`]: one scene under every technique with its error maps (`demo gallery`).
 
 pub mod charts;
 pub mod distribution;
 pub mod edges;
 pub mod eval;
+pub mod gallery;
 pub mod headless;
 pub mod metrics;
 pub mod progress;
