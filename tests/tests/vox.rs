@@ -483,11 +483,11 @@ fn the_lab_evaluates_the_vox_scenes_and_the_exact_references_agree() {
     let summary = voxel_lab::evaluate(&ctx, &opts).unwrap();
     assert_eq!(summary.reference_checks.len(), scenes.len());
     for c in &summary.reference_checks {
-        // Exact as the lab counts it: within EXACT_AGREEMENT (2/255), nothing lost.
+        // Exact as the lab counts it (the CPU ray march agrees with the A-buffer off
+        // geometric edges, no crack, nothing lost), and the two GPU methods agree within
+        // 2/255 (rounding of two blend orders and of the A-buffer's half floats).
         assert!(
-            c.exact
-                && c.max_abs_err <= voxel_lab::summary::EXACT_AGREEMENT
-                && c.lost_fragments == 0,
+            c.exact && c.max_abs_err <= 2 && c.lost_fragments == 0,
             "{}: the exact methods differ by {}/255 ({c:?})",
             c.scene,
             c.max_abs_err
