@@ -896,7 +896,7 @@ impl RayMarcher {
     /// Compares a ray-marched picture (of `camera`, the renderer's drawn camera, with
     /// `shading`) with a GPU picture of the same scene, and with the GPU's opaque depth
     /// (reverse-Z, 0 where nothing opaque was drawn) for cracks. A pixel whose colours
-    /// differ by more than 1/255 is marched again at 16 points around its centre at
+    /// differ by more than 1/255 is marched again at 96 points around its centre within
     /// [`EDGE_RADIUS_PX`]: if one meets other surfaces or ends on another block's face, an
     /// edge passes there (a face's edge, where faces the eye cannot see may touch the
     /// visible one at the same depth) and the pixel is on an edge; otherwise it counts as
@@ -917,12 +917,15 @@ impl RayMarcher {
         let w = width as usize;
         let projection = &Projection::new(camera, width, height);
         let light = &Light::new(self, camera, shading);
-        // The 16 rays around a pixel's centre at the edge radius.
+        // Rays around a pixel's centre within the edge radius: 32 angles on circles of a
+        // quarter, half and the whole radius, dense enough to meet the thin sliver of a
+        // face seen at a grazing angle.
         let ring = |i: usize| {
             let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
-            (0..16).map(move |k| {
-                let angle = f64::from(k) * std::f64::consts::TAU / 16.0;
-                let (dx, dy) = (angle.cos() * EDGE_RADIUS_PX, angle.sin() * EDGE_RADIUS_PX);
+            (0..96).map(move |k| {
+                let angle = f64::from(k % 32) * std::f64::consts::TAU / 32.0;
+                let radius = EDGE_RADIUS_PX * f64::from(1 << (k / 32)) / 4.0;
+                let (dx, dy) = (angle.cos() * radius, angle.sin() * radius);
                 self.march(
                     camera.eye,
                     projection.dir(x + dx, y + dy),

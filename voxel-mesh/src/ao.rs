@@ -63,6 +63,12 @@ impl Pad {
         })
     }
 
+    /// An empty shell: no occluder anywhere (the planes are left as they were; only the
+    /// flags that say whether a plane holds any are read first).
+    pub(crate) fn clear(&mut self) {
+        self.any = [[false; P]; 3];
+    }
+
     /// Fills the shell: `opaque` are the chunk's opaque blocks, `faces` each face
     /// neighbour's touching layer of opaque blocks (in the layouts of
     /// [`voxel_core::Chunk::side_layers`]), and the edge and corner neighbours are read from

@@ -445,13 +445,25 @@ impl Mesher {
             return Ok(());
         }
         if options.ambient_occlusion {
-            pad.fill(
-                &s.opaque,
-                &s.nb_opaque,
-                &neighbourhood,
-                &is_opaque,
-                edge_layers,
-            );
+            // Nothing opaque anywhere around: no face is occluded, no shell to fill.
+            let any_opaque = s.opaque.by_y.iter().any(|&r| r != 0)
+                || s.nb_opaque.iter().flatten().any(|&r| r != 0)
+                || Neighbourhood::OFFSETS[6..].iter().any(|&d| {
+                    neighbourhood
+                        .get(d)
+                        .is_some_and(|c| c.palette().any(|(id, _)| is_opaque(id)))
+                });
+            if any_opaque {
+                pad.fill(
+                    &s.opaque,
+                    &s.nb_opaque,
+                    &neighbourhood,
+                    &is_opaque,
+                    edge_layers,
+                );
+            } else {
+                pad.clear();
+            }
         }
 
         for (id, bits) in entries() {
@@ -503,7 +515,18 @@ impl Mesher {
                     };
                     if class == RenderClass::Cutout {
                         for l in (0..CHUNK_SIZE).filter(|&l| l != border) {
-                            emit_plane(&mut [u32::MAX; CHUNK_SIZE], face, l, id, 0, &mut sink);
+                            let shaded = sink
+                                .ao
+                                .as_ref()
+                                .is_some_and(|(pad, _)| pad.occluders(face, l).is_some());
+                            if shaded {
+                                emit_plane(&mut [u32::MAX; CHUNK_SIZE], face, l, id, 0, &mut sink);
+                            } else {
+                                let mut pos = [0; 3];
+                                pos[face.axis()] = l;
+                                let full = PackedQuad::new(pos, CHUNK_SIZE, CHUNK_SIZE, face, id);
+                                sink.out.push(full);
+                            }
                         }
                     }
                     let mut rows = nb_hide[face as usize].map(|h| !h);

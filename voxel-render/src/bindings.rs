@@ -15,6 +15,7 @@ pub fn common_wgsl() -> String {
         .u32("FLAG_INTERFACE", FLAG_INTERFACE)
         .f32("AO_DEPTH", AO_DEPTH)
         .f32("OPAQUE_EXPANSION_PX", OPAQUE_EXPANSION_PX)
+        .f32("MAX_GROWTH", MAX_GROWTH)
         .finish()
         + include_str!("shaders/common.wgsl")
 }
@@ -24,8 +25,8 @@ pub fn common_wgsl() -> String {
 /// corner (value 0) keeps 45 % of its light, about Minecraft's smooth lighting.
 pub const AO_DEPTH: f32 = 0.55;
 
-/// Opaque quads grow by this many pixels at each vertex (along the quad's own
-/// plane, scaled with the vertex's distance), so that the T-junctions of greedy-merged
+/// Opaque quads grow by this many pixels at each vertex (along the quad's own plane, as far
+/// as it takes to move the vertex that far on screen along each of the quad's axes), so that the T-junctions of greedy-merged
 /// quads leave no crack: the rasteriser snaps the vertex in the middle of another quad's
 /// edge to its sub-pixel grid independently of that edge, which can leave a sliver no
 /// quad covers. An eighth of a pixel is several times the snapping error (1/256 px with 8
@@ -35,6 +36,10 @@ pub const AO_DEPTH: f32 = 0.55;
 /// twice), nor cutout ones (leaves keep their inner faces, which would poke out along the
 /// seams of the faces in front).
 pub const OPAQUE_EXPANSION_PX: f32 = 1.0 / 64.0;
+
+/// The most an opaque quad grows along an axis, in blocks: a quad seen edge-on would need to
+/// grow without bound to move a vertex by [`OPAQUE_EXPANSION_PX`] on screen.
+pub const MAX_GROWTH: f32 = 1.0 / 16.0;
 
 /// The tonemap's shoulder (`shaders/tonemap.wgsl`): values up to it pass unchanged.
 pub const TONEMAP_SHOULDER: f32 = 0.8;
@@ -67,10 +72,6 @@ pub struct FrameUniforms {
     pub medium: u32,
     /// Ambient-occlusion strength, 0 (off) to 1.
     pub ao_strength: f32,
-    /// World size of one pixel at unit view depth: `2 tan(fov_y / 2) / height`.
-    pub pixel_size: f32,
-    /// Padding to the struct's 16-byte alignment.
-    pub _pad2: [f32; 3],
 }
 
 /// [`FrameUniforms::medium`] when the eye is in no translucent volume.
@@ -176,7 +177,6 @@ mod tests {
                 field!(FrameUniforms, viewport),
                 field!(FrameUniforms, medium),
                 field!(FrameUniforms, ao_strength),
-                field!(FrameUniforms, pixel_size),
             ],
         );
         let tonemap = include_str!("shaders/tonemap.wgsl");

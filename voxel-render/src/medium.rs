@@ -27,7 +27,10 @@
 //! `counts()` in `common.wgsl`: front faces count; a back face counts when it is of the
 //! medium's type, not an interface, and at exactly that first depth (positions are
 //! `@invariant`, so the depths are bit-identical). No quad is added: the cost is paid only
-//! under water.
+//! under water. A face of the medium toward a cutout block lies in the plane of that block's
+//! face; where the cutout texel is solid the boundary pass leaves the tie to the opaque
+//! surface (within 1/16384 of its depth), as an opaque block hides the medium's face: the
+//! passage ends there, fogged; through a hole in the texel the face is the way out.
 //!
 //! **Crossing a surface.** The near plane would cut away a translucent face closer to the
 //! eye than it (the surface the eye is passing through), so that a band of the picture

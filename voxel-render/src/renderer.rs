@@ -126,8 +126,6 @@ pub struct ChunkMemory {
 struct SceneResources {
     frame_buffer: wgpu::Buffer,
     textures: BlockTextures,
-    /// Stands in for the medium boundary in the group of the pass that writes it.
-    no_boundary: Target,
 }
 
 /// The HDR scene colour and depth, the medium boundary, and what reads them.
@@ -227,13 +225,6 @@ impl Renderer {
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             }),
             textures: BlockTextures::new(ctx, registry, config.flat_textures)?,
-            no_boundary: gpu::target(
-                device,
-                "no_medium_boundary",
-                DEPTH_FORMAT,
-                wgpu::TextureUsages::TEXTURE_BINDING,
-                (1, 1),
-            ),
         };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
         let post = Post::new(device);
@@ -724,7 +715,6 @@ impl Renderer {
             viewport: [w as f32, h as f32],
             medium: medium.map_or(NO_MEDIUM, |b| u32::from(b.0)),
             ao_strength: self.config.ao_strength,
-            pixel_size: (2.0 * (camera.fov_y_deg.to_radians() / 2.0).tan() / f64::from(h)) as f32,
             ..FrameUniforms::default()
         };
         self.ctx
@@ -971,7 +961,9 @@ impl SceneTargets {
             )
         };
         let scene_group = group("scene", &boundary);
-        let boundary_scene_group = group("scene_writing_boundary", &scene.no_boundary);
+        // The pass writing the boundary reads the opaque depth in its place (ties with
+        // cutout faces, `shaders/medium_boundary.wgsl`).
+        let boundary_scene_group = group("scene_writing_boundary", &depth);
         let fog_group = medium.fog_group(device, &boundary);
         let tonemap_group =
             gpu::texture_group(device, "tonemap", &post.tonemap_layout, &[&color.view]);

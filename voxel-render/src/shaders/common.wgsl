@@ -19,8 +19,6 @@ struct Frame {
     medium: u32,
     // Ambient-occlusion strength, 0 (off) to 1.
     ao_strength: f32,
-    // World size of one pixel at unit view depth.
-    pixel_size: f32,
 };
 
 // NO_MEDIUM (no medium) and FLAG_INTERFACE (quad flag, word 1 bit 16: a translucent face
@@ -136,9 +134,19 @@ fn quad_vertex(vi: u32, slot: u32, grow: bool) -> VsOut {
     var out: VsOut;
     out.clip = frame.view_proj * vec4<f32>(rel, 1.0);
     out.shade = corner_shade(q, corner);
-    if grow {
-        let grown = (corner * 2.0 - 1.0)
-            * (OPAQUE_EXPANSION_PX * frame.pixel_size * max(out.clip.w, 0.0));
+    if grow && out.clip.w > 0.0 {
+        // So far along U and V (outward) that the vertex moves OPAQUE_EXPANSION_PX pixels
+        // on screen along each, at most MAX_GROWTH blocks (a quad seen edge-on).
+        let outward = corner * 2.0 - 1.0;
+        var du = vec3<f32>(0.0);
+        du[u_axis] = outward.x;
+        var dv = vec3<f32>(0.0);
+        dv[v_axis] = outward.y;
+        let rate = vec2<f32>(
+            screen_rate(out.clip, frame.view_proj * vec4<f32>(du, 0.0)),
+            screen_rate(out.clip, frame.view_proj * vec4<f32>(dv, 0.0)),
+        );
+        let grown = outward * min(vec2<f32>(OPAQUE_EXPANSION_PX) / max(rate, vec2<f32>(1e-6)), vec2<f32>(MAX_GROWTH));
         var offset = vec3<f32>(0.0);
         offset[u_axis] = grown.x;
         offset[v_axis] = grown.y;
@@ -167,6 +175,13 @@ fn quad_vertex(vi: u32, slot: u32, grow: bool) -> VsOut {
     // Reverse-Z perspective: clip.w is the view depth.
     out.view_depth = out.clip.w;
     return out;
+}
+
+// Pixels per block that a vertex at `clip` moves on screen along the clip-space direction
+// `d` (the derivative of the projected position).
+fn screen_rate(clip: vec4<f32>, d: vec4<f32>) -> f32 {
+    let w = clip.w;
+    return length((d.xy * w - clip.xy * d.w) / (w * w) * frame.viewport * 0.5);
 }
 
 // Translucent quads (every technique, the medium boundary): exactly as meshed.
