@@ -4,7 +4,8 @@
 //!
 //! Modules depend on each other one way:
 //! - the model: [`progress`], [`random`] (random scenes as scene-file text), [`edges`]
-//!   (which pixels lie on quad edges), [`raymarch`] (the CPU ray-march reference),
+//!   (which pixels lie on quad edges), [`content`] (a game's particles and entities),
+//!   [`raymarch`] (the CPU ray-march reference),
 //!   [`summary`], [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the
 //!   reference), [`stability`] (sweeps and flicker);
@@ -15,6 +16,7 @@
 //! - [`gallery`]: one scene under every technique with its error maps (`demo gallery`).
 
 pub mod charts;
+pub mod content;
 pub mod distribution;
 pub mod edges;
 pub mod eval;

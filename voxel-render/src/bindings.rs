@@ -17,8 +17,12 @@ pub fn common_wgsl() -> String {
         .f32("OPAQUE_EXPANSION_PX", OPAQUE_EXPANSION_PX)
         .f32("MAX_GROWTH", MAX_GROWTH)
         .finish()
+        + FRAME_WGSL
         + include_str!("shaders/common.wgsl")
 }
+
+/// The `Frame` struct (what [`FrameUniforms`] is in WGSL).
+pub const FRAME_WGSL: &str = include_str!("shaders/frame.wgsl");
 
 /// How much ambient occlusion darkens at full strength: a vertex of AO value `v` (0 to 3,
 /// `voxel_mesh::ao`) gets brightness `1 − strength · AO_DEPTH · (3 − v) / 3`, so an inner

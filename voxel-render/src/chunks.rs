@@ -117,6 +117,8 @@ pub struct GpuChunk {
     /// The translucent quads in their current GPU order, kept for techniques that derive
     /// something from them (sorting, the fitted WBOIT weight).
     translucent: Vec<PackedQuad>,
+    /// The box of the translucent quads, chunk-local blocks (min, max).
+    translucent_bounds: Option<([f64; 3], [f64; 3])>,
     /// Changes with every upload of the chunk.
     generation: u64,
 }
@@ -132,11 +134,36 @@ impl GpuChunk {
         &self.translucent
     }
 
+    /// The box the translucent quads span, in world blocks (min, max).
+    pub fn translucent_bounds(&self) -> Option<([f64; 3], [f64; 3])> {
+        let o = self.pos.origin().map(|v| v as f64);
+        self.translucent_bounds.map(|(lo, hi)| {
+            (
+                [0, 1, 2].map(|a| lo[a] + o[a]),
+                [0, 1, 2].map(|a| hi[a] + o[a]),
+            )
+        })
+    }
+
     /// A number that changes with every upload (remesh) of this chunk, never repeated by
     /// the store.
     pub fn generation(&self) -> u64 {
         self.generation
     }
+}
+
+/// The box a set of quads spans, chunk-local blocks.
+fn quad_bounds(quads: &[PackedQuad]) -> Option<([f64; 3], [f64; 3])> {
+    quads
+        .iter()
+        .filter_map(|q| q.unpack())
+        .map(|q| q.bounds())
+        .reduce(|(lo, hi), (a, b)| {
+            (
+                [0, 1, 2].map(|k| lo[k].min(a[k])),
+                [0, 1, 2].map(|k| hi[k].max(b[k])),
+            )
+        })
 }
 
 /// One draw command, as `multi_draw_indirect` reads it.
@@ -209,7 +236,31 @@ pub struct FrameDraws<'a> {
 impl FrameDraws<'_> {
     /// Records the draws of `list` (pipeline and group 0 already set; group 1 set here).
     pub fn draw(&self, list: &DrawList, pass: &mut wgpu::RenderPass<'_>) {
+        self.draw_range(list, 0..list.meshes, pass);
+    }
+
+    /// Records the draws of meshes `range` of `list` (in its order), like [`Self::draw`].
+    pub fn draw_range(
+        &self,
+        list: &DrawList,
+        range: std::ops::Range<usize>,
+        pass: &mut wgpu::RenderPass<'_>,
+    ) {
+        let Some(base) = list.runs.first().map(|r| r.first as usize) else {
+            return;
+        };
+        let (lo, hi) = (base + range.start, base + range.end.min(list.meshes));
         for run in &list.runs {
+            let (first, end) = (run.first as usize, (run.first + run.count) as usize);
+            let (a, b) = (first.max(lo), end.min(hi));
+            if a >= b {
+                continue;
+            }
+            let run = &Run {
+                page: run.page,
+                first: a as u32,
+                count: (b - a) as u32,
+            };
             let Some(group) = self.store.groups.get(run.page as usize) else {
                 continue;
             };
@@ -620,6 +671,7 @@ impl ChunkStore {
             pos,
             meshes: allocs,
             translucent: meshes.translucent.clone(),
+            translucent_bounds: quad_bounds(&meshes.translucent),
             generation: self.next_generation,
         });
         self.next_generation += 1;

@@ -62,6 +62,22 @@ pub enum DepthMode {
     WriteFarthest,
 }
 
+/// The depth state of `mode` (format [`DEPTH_FORMAT`], reverse-Z).
+pub fn depth_state(mode: DepthMode) -> wgpu::DepthStencilState {
+    let (write, compare) = match mode {
+        DepthMode::Write => (true, wgpu::CompareFunction::Greater),
+        DepthMode::ReadOnly => (false, wgpu::CompareFunction::Greater),
+        DepthMode::WriteFarthest => (true, wgpu::CompareFunction::Less),
+    };
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(write),
+        depth_compare: Some(compare),
+        stencil: wgpu::StencilState::default(),
+        bias: wgpu::DepthBiasState::default(),
+    }
+}
+
 /// A pipeline that draws chunk quads with `common.wgsl`'s vertex pulling (`vs_main`, or
 /// `vs_solid` for opaque quads).
 #[derive(Debug)]
@@ -138,11 +154,6 @@ impl ChunkPipeline<'_> {
             bind_group_layouts: self.groups,
             immediate_size: 0,
         });
-        let (write, compare) = match self.depth {
-            DepthMode::Write => (true, wgpu::CompareFunction::Greater),
-            DepthMode::ReadOnly => (false, wgpu::CompareFunction::Greater),
-            DepthMode::WriteFarthest => (true, wgpu::CompareFunction::Less),
-        };
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(self.label),
             layout: Some(&layout),
@@ -160,13 +171,7 @@ impl ChunkPipeline<'_> {
                 cull_mode,
                 ..Default::default()
             },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(write),
-                depth_compare: Some(compare),
-                stencil: wgpu::StencilState::default(),
-                bias: wgpu::DepthBiasState::default(),
-            }),
+            depth_stencil: Some(depth_state(self.depth)),
             multisample: wgpu::MultisampleState {
                 count: self.samples,
                 ..Default::default()

@@ -10,7 +10,7 @@
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `camera`,
 //! `readback`, `timing` → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
 //! pipeline binds), `textures`, `arena` (the quad arena) → `chunks` → `medium` (translucent volumes seen from
-//! inside) → `oit` (techniques) → `renderer` → `stream` (chunks loaded around a moving eye). A test
+//! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` → `stream` (chunks loaded around a moving eye). A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
 pub mod arena;
@@ -24,6 +24,7 @@ pub mod medium;
 pub mod oit;
 pub mod readback;
 mod renderer;
+pub mod stages;
 pub mod stream;
 pub mod textures;
 mod timing;
@@ -45,6 +46,10 @@ pub use oit::{
 };
 pub use readback::Image;
 pub use renderer::{ChunkMemory, FrameStats, Renderer, RendererConfig};
+pub use stages::{
+    DEPTH_COMPARE, GameFrame, GameStages, NoGame, OIT_GROUP, Stages, TranslucentContract,
+    TranslucentObject, TranslucentVariant,
+};
 pub use stream::{
     ChunkSink, ChunkSource, ChunkStreamer, MAX_VIEW_DISTANCE, StreamConfig, StreamFrame,
 };

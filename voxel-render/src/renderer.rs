@@ -23,6 +23,7 @@ use crate::oit::{
     FrameView, OitConfig, OitManager, Setup, Technique, TechniqueReport, TranslucentFrame,
     WeightFunction,
 };
+use crate::stages::{GameDraw, GameFrame, GameStages, NoGame, TranslucentContract};
 use crate::textures::BlockTextures;
 use crate::timing::{GpuPass, GpuTimes, Timer};
 use crate::{Camera, DEPTH_FORMAT, Error, GpuContext, Result, SCENE_FORMAT};
@@ -102,6 +103,11 @@ pub struct FrameStats {
     pub cpu_ms: f64,
     /// What the technique did (its CPU time, sorting, layers, overflow, weight fit).
     pub technique: TechniqueReport,
+    /// The game's translucent objects ordered this frame ([`crate::stages`]; 0 when the
+    /// technique does not sort).
+    pub game_objects_sorted: usize,
+    /// CPU milliseconds ordering them.
+    pub game_sort_ms: f64,
 }
 
 /// GPU memory of the chunks ([`Renderer::chunk_memory`]).
@@ -525,6 +531,27 @@ impl Renderer {
         output: &wgpu::TextureView,
         camera: &Camera,
     ) -> Result<FrameStats> {
+        self.render_with(encoder, output, camera, &mut NoGame)
+    }
+
+    /// What a game's translucent pipelines must match for the technique in force, made
+    /// (with the technique's resources) when first asked for; its `id` changes when a
+    /// technique switch or a setting needs new pipelines ([`crate::stages`]).
+    pub fn translucent_contract(&mut self) -> Result<Arc<TranslucentContract>> {
+        self.oit.contract()
+    }
+
+    /// [`Renderer::render`] with a game's stages: its opaque geometry after the world's,
+    /// its translucent geometry composed by the technique with the chunks, its overlays
+    /// before and after tonemapping (see [`crate::stages`]). A stage the game does not
+    /// declare costs nothing.
+    pub fn render_with(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        output: &wgpu::TextureView,
+        camera: &Camera,
+        game: &mut dyn GameStages,
+    ) -> Result<FrameStats> {
         camera.validate()?;
         self.check_output(output)?;
         let start = Instant::now();
@@ -552,8 +579,46 @@ impl Renderer {
             view_proj,
             translucent: self.culled.translucent_positions(),
         };
-        self.oit.prepare(&mut self.chunks, &view)?;
+        let stages = game.stages();
+        // A sorting technique orders the game's objects with the chunks: farthest first.
+        let sort_start = Instant::now();
+        let sorts = stages.translucent && self.oit.technique().sorts();
+        let (order, distances) = if sorts {
+            let objects = game.translucent_objects();
+            let mut keyed: Vec<(f64, u32)> = objects
+                .iter()
+                .enumerate()
+                .map(|(i, o)| (o.center.distance(camera.eye), i as u32))
+                .collect();
+            keyed.sort_by(|a, b| b.0.total_cmp(&a.0));
+            keyed.into_iter().map(|(d, i)| (i, d)).unzip()
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        let game_sort_ms = sort_start.elapsed().as_secs_f64() * 1e3;
+        let objects = if sorts {
+            order.len()
+        } else {
+            game.translucent_objects().len()
+        };
+        self.oit
+            .prepare(&mut self.chunks, &view, stages.translucent)?;
         self.write_frame_uniforms(camera, view_proj, medium.map(|(b, _)| b));
+        let (eye_int, eye_frac) = camera.eye_split();
+        let game_frame = GameFrame {
+            camera,
+            view_proj,
+            eye_int,
+            eye_frac,
+            size: (w, h),
+            opaque_samples: if self.config.msaa { MSAA_SAMPLES } else { 1 },
+            output_format: self.config.output_format,
+            order: sorts.then_some(order.as_slice()),
+        };
+        if stages != crate::stages::Stages::default() {
+            game.prepare(&self.ctx, &game_frame);
+        }
+        let game = &*game;
 
         let builder = &mut self.builder;
         builder.clear();
@@ -572,7 +637,8 @@ impl Renderer {
 
         let timer = self.timer.as_ref();
         let t = &self.targets;
-        self.draw_opaque(encoder, &draws, opaque, cutout, timer);
+        let game_opaque = stages.opaque.then_some((game, &game_frame));
+        self.draw_opaque(encoder, &draws, opaque, cutout, game_opaque, timer);
         if medium.is_some() {
             let scene = &t.boundary_scene_group;
             self.medium.boundary_pass(
@@ -585,6 +651,36 @@ impl Renderer {
                 timer,
             );
         }
+        // Sorted techniques draw the game's objects between chunks, by the distances of
+        // each chunk's translucent box: nearest point, centre, farthest point.
+        let chunk_distances: Vec<[f64; 3]> = if sorts {
+            self.culled
+                .translucent_positions()
+                .iter()
+                .map(|&p| {
+                    let Some((lo, hi)) = self.chunks.get(p).and_then(|c| c.translucent_bounds())
+                    else {
+                        return [0.0; 3];
+                    };
+                    let (lo, hi) = (glam::DVec3::from(lo), glam::DVec3::from(hi));
+                    let eye = camera.eye;
+                    let near = eye.clamp(lo, hi).distance(eye);
+                    let mid = ((lo + hi) * 0.5).distance(eye);
+                    let far = (eye - lo).abs().max((eye - hi).abs()).length();
+                    [near, mid, far]
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let game_draw = stages.translucent.then(|| GameDraw {
+            stages: game,
+            frame: &game_frame,
+            objects,
+            distances: &distances,
+            frame_buffer: &self.scene.frame_buffer,
+            boundary: &t.boundary.view,
+        });
         self.oit.render(
             encoder,
             &TranslucentFrame {
@@ -595,6 +691,8 @@ impl Renderer {
                 chunks: translucent,
                 timer,
                 two_sided: medium.is_some(),
+                game: game_draw.as_ref(),
+                chunk_distances: &chunk_distances,
             },
         )?;
         if let Some((_, look)) = &medium {
@@ -606,13 +704,26 @@ impl Renderer {
                 .write_buffer(&self.medium.fog_params, 0, bytemuck::bytes_of(&params));
             self.medium.fog_pass(encoder, &t.color, &t.fog_group, timer);
         }
+        if stages.hdr_overlay {
+            let colors = [gpu::load(&t.color.view)];
+            Pass::new("game_hdr_overlay", GpuPass::Game, &colors)
+                .depth(Depth::ReadOnly(&t.depth.view))
+                .record(encoder, timer, |pass| game.hdr_overlay(pass, &game_frame));
+        }
         self.tonemap(encoder, output, timer);
+        if stages.overlay {
+            let colors = [gpu::load(output)];
+            Pass::new("game_overlay", GpuPass::Game, &colors)
+                .record(encoder, timer, |pass| game.overlay(pass, &game_frame));
+        }
         let stats = FrameStats {
             meshes_drawn: lists.each_ref().map(DrawList::meshes),
             translucent_quads: translucent.quads() as usize,
             draw_calls: lists.iter().map(|l| l.calls(self.config.draw)).sum(),
             cpu_ms: 0.0,
             technique: TechniqueReport::default(),
+            game_objects_sorted: order.len(),
+            game_sort_ms,
         };
         if let Some(t) = &mut self.timer {
             t.resolve(encoder);
@@ -722,14 +833,15 @@ impl Renderer {
             .write_buffer(&self.scene.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
     }
 
-    /// The opaque pass, then the cutout pass; with MSAA the colour resolves at the end of
-    /// the last one and the depth in a pass of its own.
+    /// The opaque pass, the cutout pass, then the game's opaque stage; with MSAA the
+    /// colour resolves at the end of the last one and the depth in a pass of its own.
     fn draw_opaque(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         draws: &FrameDraws<'_>,
         opaque: &DrawList,
         cutout: &DrawList,
+        game: Option<(&dyn GameStages, &GameFrame<'_>)>,
         timer: Option<&Timer>,
     ) {
         let t = &self.targets;
@@ -739,16 +851,19 @@ impl Renderer {
             Some((c, d)) => (&c.view, &d.view, Some(&t.color.view)),
             None => (&t.color.view, &t.depth.view, None),
         };
-        let passes = [
-            (GpuPass::Opaque, &self.opaque, opaque),
-            (GpuPass::Cutout, &self.cutout, cutout),
+        // The passes that run, in order: the opaque pass always (it clears), the others
+        // when they have something to draw. The last one resolves MSAA colour.
+        let runs = [
+            (GpuPass::Opaque, true),
+            (GpuPass::Cutout, !cutout.is_empty()),
+            (GpuPass::Game, game.is_some()),
         ];
-        for (kind, pipeline, list) in passes {
-            let first = kind == GpuPass::Opaque;
-            if !first && list.is_empty() {
+        let last = runs.iter().rposition(|r| r.1).unwrap_or(0);
+        for (i, &(kind, run)) in runs.iter().enumerate() {
+            if !run {
                 continue;
             }
-            let last = !first || cutout.is_empty();
+            let first = i == 0;
             let colors = [gpu::attachment(
                 color,
                 if first {
@@ -756,7 +871,7 @@ impl Renderer {
                 } else {
                     wgpu::LoadOp::Load
                 },
-                if last { resolve } else { None },
+                if i == last { resolve } else { None },
             )];
             // Reverse-Z: clear to 0, the far plane.
             let depth = if first {
@@ -764,12 +879,25 @@ impl Renderer {
             } else {
                 Depth::Load(depth)
             };
-            Pass::new(kind.name(), kind, &colors)
+            let label = if kind == GpuPass::Game {
+                "game_opaque"
+            } else {
+                kind.name()
+            };
+            Pass::new(label, kind, &colors)
                 .depth(depth)
-                .record(encoder, timer, |pass| {
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, &t.scene_group, &[]);
-                    draws.draw(list, pass);
+                .record(encoder, timer, |pass| match (kind, game) {
+                    (GpuPass::Game, Some((game, frame))) => game.opaque(pass, frame),
+                    _ => {
+                        let (pipeline, list) = if first {
+                            (&self.opaque, opaque)
+                        } else {
+                            (&self.cutout, cutout)
+                        };
+                        pass.set_pipeline(pipeline);
+                        pass.set_bind_group(0, &t.scene_group, &[]);
+                        draws.draw(list, pass);
+                    }
                 });
         }
         if let Some(group) = &t.depth_resolve_group {
@@ -987,5 +1115,17 @@ impl SceneTargets {
             tonemap_group,
             depth_resolve_group,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// A game moves the renderer to a render thread or keeps it in an ECS resource: it must
+    /// be `Send` (this fails to compile otherwise).
+    #[test]
+    fn renderer_is_send() {
+        fn send<T: Send>() {}
+        send::<super::Renderer>();
+        send::<crate::ChunkStreamer>();
     }
 }

@@ -19,6 +19,8 @@ pub enum GpuPass {
     Opaque,
     /// The cutout (alpha-tested) pass.
     Cutout,
+    /// A game's own passes: its opaque geometry and its overlays (the `stages` module).
+    Game,
     /// The technique's passes over the translucent meshes.
     Translucent,
     /// The technique's composite(s) into the scene colour.
@@ -31,9 +33,10 @@ pub enum GpuPass {
 
 impl GpuPass {
     /// Every pass kind, in frame order.
-    pub const ALL: [GpuPass; 6] = [
+    pub const ALL: [GpuPass; 7] = [
         GpuPass::Opaque,
         GpuPass::Cutout,
+        GpuPass::Game,
         GpuPass::Translucent,
         GpuPass::Composite,
         GpuPass::Medium,
@@ -45,6 +48,7 @@ impl GpuPass {
         match self {
             GpuPass::Opaque => "opaque",
             GpuPass::Cutout => "cutout",
+            GpuPass::Game => "game",
             GpuPass::Translucent => "translucent",
             GpuPass::Composite => "composite",
             GpuPass::Medium => "medium",

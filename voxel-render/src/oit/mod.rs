@@ -26,6 +26,7 @@ use crate::bindings::SharedLayouts;
 use crate::chunks::{ChunkStore, DrawList, FrameDraws};
 use crate::context::Capabilities;
 use crate::gpu::Target;
+use crate::stages::{GameDraw, TranslucentContract, TranslucentVariant};
 use crate::timing::Timer;
 use crate::{Camera, Error, GpuContext, Result};
 
@@ -72,6 +73,12 @@ macro_rules! techniques {
             /// Whether the technique draws the translucent meshes at all.
             pub fn draws(self) -> bool {
                 match self { $( Technique::$variant => <$kind as TechniqueKind>::DRAWS, )* }
+            }
+
+            /// Whether the technique draws translucent things back to front (so that a
+            /// game's objects are ordered with the chunks, [`crate::stages::TranslucentObject`]).
+            pub fn sorts(self) -> bool {
+                match self { $( Technique::$variant => <$kind as TechniqueKind>::SORTS, )* }
             }
 
             /// What replaces the technique on an adapter that cannot run it.
@@ -141,6 +148,9 @@ pub trait TechniqueKind: TranslucentTechnique + Sized + 'static {
 
     /// Whether it draws translucent meshes at all (`false`: no resource, no pass).
     const DRAWS: bool = true;
+
+    /// Whether it draws back to front (a game's objects are then ordered with the chunks).
+    const SORTS: bool = false;
 
     /// Whether `technique` (one this type draws) computes the exact blend.
     fn is_exact(_technique: Technique) -> bool {
@@ -261,6 +271,12 @@ pub struct TranslucentFrame<'a> {
     /// The eye is inside a translucent volume: draw both sides of translucent faces
     /// (the `two_sided` variant of each [`crate::gpu::SidedPipeline`]).
     pub two_sided: bool,
+    /// The game's translucent geometry, drawn in every pass of the technique.
+    pub game: Option<&'a GameDraw<'a>>,
+    /// Sorted techniques with a game: for each visible translucent chunk, in draw order
+    /// (farthest first), the distances from the eye of its translucent box's nearest
+    /// point, centre and farthest point.
+    pub chunk_distances: &'a [[f64; 3]],
 }
 
 impl TranslucentFrame<'_> {
@@ -274,7 +290,7 @@ impl TranslucentFrame<'_> {
 
 /// One transparency technique: its pipelines, targets and caches, created when it becomes
 /// active and dropped when another one does.
-pub trait TranslucentTechnique: fmt::Debug {
+pub trait TranslucentTechnique: fmt::Debug + Send {
     /// Rebuilds size-dependent targets; called only when the size really changed.
     fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<()>;
 
@@ -300,6 +316,9 @@ pub trait TranslucentTechnique: fmt::Debug {
 
     /// Called after the frame's commands were submitted (to start reading results back).
     fn after_submit(&mut self) {}
+
+    /// The passes a game's translucent pipelines must match (see [`crate::stages`]).
+    fn variants(&self) -> Vec<TranslucentVariant>;
 
     /// Technique-specific facts about the last frame.
     fn report(&self) -> TechniqueReport {
@@ -327,6 +346,10 @@ pub struct OitManager {
     /// Created on the first frame that has translucent meshes in view, with its key.
     active: Option<(Key, Box<dyn TranslucentTechnique>)>,
     prepare_ms: f64,
+    /// The game's contract for the active technique, made when first asked for.
+    contract: Option<Arc<TranslucentContract>>,
+    /// Contracts made so far (the next one's id).
+    contracts: u64,
 }
 
 impl OitManager {
@@ -340,6 +363,8 @@ impl OitManager {
             config,
             active: None,
             prepare_ms: 0.0,
+            contract: None,
+            contracts: 0,
         };
         m.config.technique = m.supported(m.config.technique);
         Ok(m)
@@ -390,7 +415,33 @@ impl OitManager {
         if self.active.as_ref().is_some_and(|(k, _)| *k != key) {
             self.active = None;
         }
+        if self.active.is_none() {
+            self.contract = None;
+        }
         Ok(())
+    }
+
+    /// What a game's translucent pipelines must match for the technique in force (creating
+    /// its resources if needed: a game builds its pipelines before the frame that needs
+    /// them). Its `id` changes when a switch (or a setting the technique's pipelines depend
+    /// on) needs new pipelines.
+    pub fn contract(&mut self) -> Result<Arc<TranslucentContract>> {
+        if let Some(c) = &self.contract {
+            return Ok(c.clone());
+        }
+        let technique = self.config.technique;
+        let variants = match self.active(true)? {
+            Some(t) => t.variants(),
+            None => Vec::new(),
+        };
+        self.contracts += 1;
+        let c = Arc::new(TranslucentContract {
+            id: self.contracts,
+            technique: technique.name(),
+            variants,
+        });
+        self.contract = Some(c.clone());
+        Ok(c)
     }
 
     /// Technique-specific facts about the last frame.
@@ -450,11 +501,17 @@ impl OitManager {
     }
 
     /// The technique's CPU work for the frame (see [`TranslucentTechnique::prepare`]). With
-    /// no visible translucent mesh nothing happens and no resource is created.
-    pub fn prepare(&mut self, chunks: &mut ChunkStore, view: &FrameView<'_>) -> Result<()> {
+    /// no visible translucent mesh and no game geometry nothing happens and no resource is
+    /// created.
+    pub fn prepare(
+        &mut self,
+        chunks: &mut ChunkStore,
+        view: &FrameView<'_>,
+        game: bool,
+    ) -> Result<()> {
         let start = std::time::Instant::now();
         let (ctx, config) = (self.setup.ctx.clone(), self.config.clone());
-        if let Some(t) = self.active(!view.translucent.is_empty())? {
+        if let Some(t) = self.active(!view.translucent.is_empty() || game)? {
             t.prepare(&ctx, &config, chunks, view)?;
         }
         self.prepare_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -469,7 +526,7 @@ impl OitManager {
         frame: &TranslucentFrame<'_>,
     ) -> Result<()> {
         let ctx = self.setup.ctx.clone();
-        match self.active(!frame.chunks.is_empty())? {
+        match self.active(!frame.chunks.is_empty() || frame.game.is_some())? {
             Some(t) => t.render(&ctx, encoder, frame),
             None => Ok(()),
         }

@@ -35,4 +35,9 @@ impl TranslucentTechnique for OpaqueOnly {
     ) -> Result<()> {
         Ok(())
     }
+
+    /// No pass: a game's translucent geometry is not drawn either.
+    fn variants(&self) -> Vec<crate::stages::TranslucentVariant> {
+        Vec::new()
+    }
 }

@@ -5,21 +5,8 @@
 // dissolve of chunks fading in, and which translucent fragments count when the eye is
 // inside a translucent volume (`medium.rs`).
 
-struct Frame {
-    view_proj: mat4x4<f32>,
-    eye_int: vec3<i32>,
-    near: f32,
-    eye_frac: vec3<f32>,
-    far: f32,
-    sun_dir: vec3<f32>,
-    ambient: f32,
-    sky: vec3<f32>,
-    viewport: vec2<f32>,
-    // Block id of the translucent type the eye is inside, or NO_MEDIUM.
-    medium: u32,
-    // Ambient-occlusion strength, 0 (off) to 1.
-    ao_strength: f32,
-};
+// Frame (the per-frame uniforms) comes from frame.wgsl, before this file.
+
 
 // NO_MEDIUM (no medium) and FLAG_INTERFACE (quad flag, word 1 bit 16: a translucent face
 // toward another translucent type) come from `bindings.rs`.

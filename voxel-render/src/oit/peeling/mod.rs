@@ -30,6 +30,7 @@ use crate::oit::{
     TranslucentTechnique,
 };
 use crate::readback::QueryReadback;
+use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{DEPTH_FORMAT, Error, GpuContext, Result, SCENE_FORMAT};
 
@@ -102,6 +103,14 @@ impl PeelMode {
     }
 }
 
+/// The two depth limits of a peel pass: the group the chunk pipelines bind, and the views
+/// (a game's group holds them too).
+#[derive(Debug)]
+struct Limits {
+    group: wgpu::BindGroup,
+    views: [wgpu::TextureView; 2],
+}
+
 #[derive(Debug)]
 struct Targets {
     front: [Target; 2],
@@ -110,19 +119,25 @@ struct Targets {
     back_layer: Target,
     front_acc: Target,
     /// Limits for the front peel of an iteration writing slot `i`: (front[1-i], back[1-i]).
-    front_limits: [wgpu::BindGroup; 2],
+    front_limits: [Limits; 2],
     /// Limits for the back peel writing slot `i`: (front[i], back[1-i]).
-    back_limits: [wgpu::BindGroup; 2],
+    back_limits: [Limits; 2],
     /// Converge mode: (front[1-i], back[1]) with back[1] the opaque depth.
-    converge_limits: [wgpu::BindGroup; 2],
+    converge_limits: [Limits; 2],
     front_layer_group: wgpu::BindGroup,
     back_layer_group: wgpu::BindGroup,
     front_acc_group: wgpu::BindGroup,
 }
 
+/// The group-2 entries of the peel pipelines: the front and back limits.
+fn limit_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
+    [0, 1].map(|i| gpu::texture_entry(i, wgpu::TextureSampleType::Depth))
+}
+
 /// Depth peeling resources.
 #[derive(Debug)]
 pub struct Peeling {
+    device: wgpu::Device,
     mode: PeelMode,
     peel_front: SidedPipeline,
     peel_back: SidedPipeline,
@@ -131,6 +146,7 @@ pub struct Peeling {
     front_composite: wgpu::RenderPipeline,
     limits_layout: wgpu::BindGroupLayout,
     layer_layout: wgpu::BindGroupLayout,
+    game_layout: wgpu::BindGroupLayout,
     targets: Targets,
     /// Samples each front peel wrote (occlusion queries).
     counts: QueryReadback,
@@ -171,12 +187,7 @@ impl TechniqueKind for Peeling {
     fn create(setup: &Setup, technique: Technique, config: &OitConfig) -> Result<Self> {
         let mode = Self::key(technique, config, &setup.ctx.caps);
         let device = &setup.ctx.device;
-        let limits_layout = gpu::textures_layout(
-            device,
-            "peel_limits_layout",
-            wgpu::TextureSampleType::Depth,
-            2,
-        );
+        let limits_layout = gpu::layout(device, "peel_limits_layout", &limit_entries());
         let layer_layout = gpu::textures_layout(
             device,
             "peel_layer_layout",
@@ -186,7 +197,11 @@ impl TechniqueKind for Peeling {
         let module = gpu::shader(
             device,
             "peel",
-            &[&crate::bindings::common_wgsl(), include_str!("peel.wgsl")],
+            &[
+                &crate::bindings::common_wgsl(),
+                include_str!("limits.wgsl"),
+                include_str!("peel.wgsl"),
+            ],
         );
         let groups = setup.layouts.with(&[&limits_layout]);
         let peel = |label, depth| {
@@ -216,6 +231,7 @@ impl TechniqueKind for Peeling {
         let targets = Self::targets(device, &limits_layout, &layer_layout, setup.size);
         let max_iterations = mode.max_iterations();
         Ok(Self {
+            device: device.clone(),
             mode,
             peel_front: peel("peel_front", DepthMode::Write),
             peel_back: peel("peel_back", DepthMode::WriteFarthest),
@@ -226,6 +242,7 @@ impl TechniqueKind for Peeling {
                 "fs_front",
                 wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
             ),
+            game_layout: game_layout(device, "peel_game", &limit_entries()),
             limits_layout,
             layer_layout,
             targets,
@@ -259,8 +276,9 @@ impl Peeling {
         };
         let front = [depth("peel_front_depth_0"), depth("peel_front_depth_1")];
         let back = [depth("peel_back_depth_0"), depth("peel_back_depth_1")];
-        let limits = |label, a: &Target, b: &Target| {
-            gpu::texture_group(d, label, limits_layout, &[&a.view, &b.view])
+        let limits = |label, a: &Target, b: &Target| Limits {
+            group: gpu::texture_group(d, label, limits_layout, &[&a.view, &b.view]),
+            views: [a.view.clone(), b.view.clone()],
         };
         let front_limits = [
             limits("peel_front_limits_0", &front[1], &back[1]),
@@ -301,9 +319,19 @@ impl Peeling {
         frame: &TranslucentFrame<'_>,
         back: bool,
         depth: Depth<'_>,
-        limits: &wgpu::BindGroup,
+        limits: &Limits,
         query: Option<u32>,
     ) {
+        let game = frame.game.map(|g| {
+            let own = limits
+                .views
+                .each_ref()
+                .map(wgpu::BindingResource::TextureView);
+            (
+                g,
+                game_group(&self.device, "peel_game", &self.game_layout, g, &own),
+            )
+        });
         let (label, pipeline, layer) = if back {
             ("peel_back", &self.peel_back, &self.targets.back_layer)
         } else {
@@ -316,11 +344,14 @@ impl Peeling {
         };
         pass.record(encoder, frame.timer, |pass| {
             pass.set_pipeline(pipeline.get(frame.two_sided));
-            pass.set_bind_group(2, limits, &[]);
+            pass.set_bind_group(2, &limits.group, &[]);
             if let Some(i) = query {
                 pass.begin_occlusion_query(i);
             }
             frame.draw_chunks(pass);
+            if let Some((g, group)) = &game {
+                g.draw_all(pass, usize::from(back), group);
+            }
             if query.is_some() {
                 pass.end_occlusion_query();
             }
@@ -368,7 +399,7 @@ impl Peeling {
         encoder: &mut wgpu::CommandEncoder,
         frame: &TranslucentFrame<'_>,
         i: u32,
-        limits: &wgpu::BindGroup,
+        limits: &Limits,
     ) {
         let t = &self.targets;
         let cur = (i % 2) as usize;
@@ -524,6 +555,26 @@ impl TranslucentTechnique for Peeling {
 
     fn after_submit(&mut self) {
         self.counts.map();
+    }
+
+    fn variants(&self) -> Vec<TranslucentVariant> {
+        let output = "struct OitOutput {\n    @location(0) color: vec4<f32>,\n};\n\n\
+            // The fragment is a layer candidate strictly between the limits, or dropped.\n\
+            fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
+            if !peel_candidate(position) || color.a <= 0.0 {\n        discard;\n    }\n    \
+            return OitOutput(color);\n}\n";
+        let variant = |name, depth| TranslucentVariant {
+            name,
+            wgsl: game_prelude(include_str!("limits.wgsl"), output),
+            targets: vec![gpu::scene_target(None)],
+            depth_stencil: gpu::depth_state(depth),
+            layout: self.game_layout.clone(),
+        };
+        let front = variant("peel_front", DepthMode::Write);
+        match self.mode {
+            PeelMode::Dual { .. } => vec![front, variant("peel_back", DepthMode::WriteFarthest)],
+            PeelMode::Converge => vec![front],
+        }
     }
 
     fn report(&self) -> TechniqueReport {

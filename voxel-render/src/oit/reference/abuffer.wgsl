@@ -8,15 +8,13 @@
 @group(2) @binding(3) var<uniform> params: Params;
 @group(2) @binding(4) var opaque_depth: texture_depth_2d;
 
-@fragment
-fn fs_abuffer(in: VsOut, @builtin(front_facing) front: bool) {
-    // Derivatives first, while every invocation of the quad still runs.
-    let slope = vec2<f32>(dpdx(in.clip.z), dpdy(in.clip.z));
-    let c = translucent_color(in, front);
-    let p = vec2<u32>(in.clip.xy);
+// Appends a fragment of colour `c` at `position` (its depth's screen-space `slope`) to its
+// pixel's list, if it lies in front of the opaque surface and counts.
+fn abuffer_append(position: vec4<f32>, slope: vec2<f32>, c: vec4<f32>) {
+    let p = vec2<u32>(position.xy);
     // The depth test, in the shader: a fragment with storage writes may run them before a
     // late depth test would have dropped it. The scissor keeps fragments in the tile.
-    if in.clip.z <= textureLoad(opaque_depth, vec2<i32>(p), 0) || c.a <= 0.0 {
+    if position.z <= textureLoad(opaque_depth, vec2<i32>(p), 0) || c.a <= 0.0 {
         return;
     }
     let index = atomicAdd(&counters.nodes, 1u);
@@ -24,7 +22,7 @@ fn fs_abuffer(in: VsOut, @builtin(front_facing) front: bool) {
         return;
     }
     nodes[index].color = vec2<u32>(pack2x16float(c.rg), pack2x16float(c.ba));
-    nodes[index].depth = in.clip.z;
+    nodes[index].depth = position.z;
     nodes[index].slope = slope;
     nodes[index].next = atomicExchange(&heads[head_index(p)], index + 1u);
 }

@@ -30,6 +30,7 @@ use crate::oit::{
     OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
 };
+use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{Error, GpuContext, Result, readback};
 
@@ -118,8 +119,37 @@ pub fn build_wgsl() -> String {
         &crate::bindings::common_wgsl(),
         &types_wgsl(),
         include_str!("abuffer.wgsl"),
+        include_str!("build.wgsl"),
     ]
     .concat()
+}
+
+/// The group-2 entries of the build pass: heads, nodes, counters, the tile's parameters
+/// (dynamic offset) and the opaque depth.
+fn build_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
+    use wgpu::BufferBindingType as B;
+    use wgpu::ShaderStages as S;
+    let storage = |i| gpu::buffer_entry(i, S::FRAGMENT, B::Storage { read_only: false });
+    [
+        storage(0),
+        storage(1),
+        storage(2),
+        params_entry(),
+        gpu::texture_entry(4, wgpu::TextureSampleType::Depth),
+    ]
+}
+
+fn params_entry() -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding: 3,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: true,
+            min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+        },
+        count: None,
+    }
 }
 
 /// The resolve pass's shader (after `fullscreen.wgsl`).
@@ -130,6 +160,7 @@ pub fn resolve_wgsl() -> String {
 #[derive(Debug)]
 struct Buffers {
     heads: wgpu::Buffer,
+    nodes: wgpu::Buffer,
     capacity: u32,
     build_group: wgpu::BindGroup,
     resolve_group: wgpu::BindGroup,
@@ -142,6 +173,7 @@ pub struct Reference {
     resolve: wgpu::RenderPipeline,
     build_layout: wgpu::BindGroupLayout,
     resolve_layout: wgpu::BindGroupLayout,
+    game_layout: wgpu::BindGroupLayout,
     counters: wgpu::Buffer,
     counters_readback: wgpu::Buffer,
     /// One [`Params`] per tile, at a stride the uniform offset alignment allows.
@@ -172,27 +204,7 @@ impl TechniqueKind for Reference {
         use wgpu::BufferBindingType as B;
         use wgpu::ShaderStages as S;
         let storage = |i, read_only| gpu::buffer_entry(i, S::FRAGMENT, B::Storage { read_only });
-        let params_entry = wgpu::BindGroupLayoutEntry {
-            binding: 3,
-            visibility: S::FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: B::Uniform,
-                has_dynamic_offset: true,
-                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
-            },
-            count: None,
-        };
-        let build_layout = gpu::layout(
-            device,
-            "abuffer_build_layout",
-            &[
-                storage(0, false),
-                storage(1, false),
-                storage(2, false),
-                params_entry,
-                gpu::texture_entry(4, wgpu::TextureSampleType::Depth),
-            ],
-        );
+        let build_layout = gpu::layout(device, "abuffer_build_layout", &build_entries());
         let resolve_layout = gpu::layout(
             device,
             "abuffer_resolve_layout",
@@ -200,7 +212,7 @@ impl TechniqueKind for Reference {
                 storage(0, true),
                 storage(1, true),
                 storage(2, false),
-                params_entry,
+                params_entry(),
             ],
         );
         let module = gpu::shader(device, "abuffer_build", &[&build_wgsl()]);
@@ -253,6 +265,7 @@ impl TechniqueKind for Reference {
             resolve,
             build_layout,
             resolve_layout,
+            game_layout: game_layout(device, "abuffer_game", &build_entries()),
             counters,
             counters_readback,
             params,
@@ -337,6 +350,7 @@ impl Reference {
             gpu::bind_group(device, "abuffer_resolve", &self.resolve_layout, &common);
         self.buffers = Some(Buffers {
             heads,
+            nodes,
             capacity,
             build_group,
             resolve_group,
@@ -351,6 +365,23 @@ impl Reference {
         frame: &TranslucentFrame<'_>,
     ) -> u32 {
         let Some(b) = &self.buffers else { return 0 };
+        let game = frame.game.map(|g| {
+            let own = [
+                b.heads.as_entire_binding(),
+                b.nodes.as_entire_binding(),
+                self.counters.as_entire_binding(),
+                wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &self.params,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+                }),
+                wgpu::BindingResource::TextureView(&frame.depth.view),
+            ];
+            (
+                g,
+                game_group(&ctx.device, "abuffer_game", &self.game_layout, g, &own),
+            )
+        });
         let (width, height) = self.size;
         let (tw, th) = self.tile_size(self.tiles);
         let mut k = 0u32;
@@ -382,6 +413,9 @@ impl Reference {
                     pass.set_pipeline(self.build.get(frame.two_sided));
                     pass.set_bind_group(2, &b.build_group, &dynamic);
                     frame.draw_chunks(pass);
+                    if let Some((g, group)) = &game {
+                        g.draw_offsets(pass, 0, group, &dynamic, 0..g.objects);
+                    }
                 });
                 let colors = [gpu::load(&frame.target.view)];
                 Pass::new("abuffer_resolve", GpuPass::Composite, &colors).record(
@@ -433,6 +467,26 @@ impl Reference {
 }
 
 impl TranslucentTechnique for Reference {
+    fn variants(&self) -> Vec<TranslucentVariant> {
+        let own = types_wgsl() + include_str!("abuffer.wgsl");
+        vec![TranslucentVariant {
+            name: "abuffer_build",
+            wgsl: game_prelude(
+                &own,
+                "// The pass has no colour target: the output goes nowhere.\n\
+                 struct OitOutput {\n    @location(0) unused: vec4<f32>,\n};\n\n\
+                 // Appends the fragment to its pixel's list. Call it in uniform control\n\
+                 // flow (it takes the depth's derivatives).\n\
+                 fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
+                 abuffer_append(position, vec2<f32>(dpdx(position.z), dpdy(position.z)), color);\n    \
+                 return OitOutput(vec4<f32>(0.0));\n}\n",
+            ),
+            targets: Vec::new(),
+            depth_stencil: gpu::depth_state(DepthMode::ReadOnly),
+            layout: self.game_layout.clone(),
+        }]
+    }
+
     fn resize(&mut self, _ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
         self.size = (width, height);
         self.buffers = None;

@@ -12,6 +12,15 @@
 //! (its region key changes), so a still camera sorts nothing. The order is exact on every
 //! pixel except where quads form a cycle (no order exists; counted in [`SortReport`], those
 //! quads drawn farthest centre first).
+//!
+//! A game's translucent objects come farthest first by the distance of their centres and
+//! are drawn between the chunks: before a chunk, every object whose centre lies farther
+//! from the eye than the box of the chunk's translucent quads, or inside that box's range
+//! of distances and farther than its centre. So an object behind a glass pane or below a
+//! water surface is drawn before them, one in front after them. It is not exact where an
+//! object reaches in depth into a chunk's layers (a cube crossing a water surface: its
+//! part below the surface is drawn over it), where two objects overlap in depth (their
+//! centres decide), or for the faces within one object (the game's order).
 
 use std::time::Instant;
 
@@ -26,6 +35,7 @@ use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
 };
+use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{GpuContext, Result};
 
@@ -60,6 +70,8 @@ struct ChunkOrder {
 #[derive(Debug)]
 pub struct Sorted {
     pipeline: SidedPipeline,
+    /// The group games bind (frame and boundary only: the pass has no group of its own).
+    game_layout: wgpu::BindGroupLayout,
     sort_quads: bool,
     orders: PosMap<ChunkPos, ChunkOrder>,
     scratch: Vec<PackedQuad>,
@@ -68,6 +80,8 @@ pub struct Sorted {
 
 impl TechniqueKind for Sorted {
     type Key = ();
+
+    const SORTS: bool = true;
 
     fn key(_: Technique, _: &OitConfig, _: &Capabilities) {}
 
@@ -90,6 +104,7 @@ impl TechniqueKind for Sorted {
         .build_sided(device);
         Ok(Self {
             pipeline,
+            game_layout: game_layout(device, "sorted_game", &[]),
             sort_quads: technique == Technique::SortedQuads,
             orders: PosMap::default(),
             scratch: Vec::new(),
@@ -188,18 +203,65 @@ impl TranslucentTechnique for Sorted {
 
     fn render(
         &mut self,
-        _: &GpuContext,
+        ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         frame: &TranslucentFrame<'_>,
     ) -> Result<()> {
         let colors = [gpu::load(&frame.target.view)];
+        let pipeline = self.pipeline.get(frame.two_sided);
+        let group = frame
+            .game
+            .map(|g| game_group(&ctx.device, "sorted_game", &self.game_layout, g, &[]));
         Pass::new("sorted", GpuPass::Translucent, &colors)
             .depth(Depth::ReadOnly(&frame.depth.view))
             .record(encoder, frame.timer, |pass| {
-                pass.set_pipeline(self.pipeline.get(frame.two_sided));
-                frame.draw_chunks(pass);
+                pass.set_pipeline(pipeline);
+                let (Some(game), Some(group)) = (frame.game, &group) else {
+                    frame.draw_chunks(pass);
+                    return;
+                };
+                // Objects farther than a chunk's centre before the chunk.
+                pass.set_bind_group(0, frame.scene, &[]);
+                let mut next = 0;
+                for (i, &[near, mid, far]) in frame.chunk_distances.iter().enumerate() {
+                    let first = next;
+                    while next < game.objects
+                        && game.distances.get(next).is_some_and(|&o| {
+                            // Behind the chunk's translucent box, or inside it and behind
+                            // its centre.
+                            o > far || (o >= near && o > mid)
+                        })
+                    {
+                        next += 1;
+                    }
+                    if next > first {
+                        game.draw(pass, 0, group, first..next);
+                        pass.set_pipeline(pipeline);
+                        pass.set_bind_group(0, frame.scene, &[]);
+                    }
+                    frame.draws.draw_range(frame.chunks, i..i + 1, pass);
+                }
+                if next < game.objects {
+                    game.draw(pass, 0, group, next..game.objects);
+                }
             });
         Ok(())
+    }
+
+    fn variants(&self) -> Vec<TranslucentVariant> {
+        vec![TranslucentVariant {
+            name: "sorted",
+            wgsl: game_prelude(
+                "",
+                "struct OitOutput {\n    @location(0) color: vec4<f32>,\n};\n\n\
+                 // Blended SrcAlpha, OneMinusSrcAlpha over what is behind.\n\
+                 fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
+                 return OitOutput(color);\n}\n",
+            ),
+            targets: vec![gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
+            depth_stencil: gpu::depth_state(DepthMode::ReadOnly),
+            layout: self.game_layout.clone(),
+        }]
     }
 
     fn report(&self) -> TechniqueReport {

@@ -35,3 +35,13 @@ fn unpack_shading_state(packed: u32) -> ShadingParams {
 fn screen_door(alpha: f32, pattern: u32, frag_xy: vec2<f32>) -> bool {
     return alpha <= bayer_threshold(pattern, frag_xy);
 }
+
+// A fragment of colour `c` at `position`: kept opaque, or discarded. The alpha is the
+// fragment's times the uniform alpha of the shading state.
+fn stipple(position: vec4<f32>, c: vec4<f32>) -> vec4<f32> {
+    let s = unpack_shading_state(params.shading_state);
+    if screen_door(c.a * s.uniform_alpha, s.dither_pattern, position.xy) {
+        discard;
+    }
+    return vec4<f32>(c.rgb, 1.0);
+}

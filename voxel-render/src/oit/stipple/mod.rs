@@ -19,6 +19,7 @@ use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, Pass, SidedPipeline, Wgs
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TranslucentFrame, TranslucentTechnique,
 };
+use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{Error, GpuContext, Result};
 
@@ -74,17 +75,36 @@ pub struct StippleParams {
 
 /// The stipple shader: the Bayer offsets from Rust, the shared code, the screen door.
 pub fn stipple_wgsl() -> String {
-    let offsets = BayerSize::ALL.map(|b| bayer::bayer_offset(b) as u32);
-    let consts = WgslConsts::default()
-        .u32_array("BAYER_OFFSETS", &offsets)
-        .finish();
     [
-        consts.as_str(),
+        bayer_consts().as_str(),
         &crate::bindings::common_wgsl(),
         include_str!("dither.wgsl"),
         include_str!("stipple.wgsl"),
     ]
     .concat()
+}
+
+fn bayer_consts() -> String {
+    let offsets = BayerSize::ALL.map(|b| bayer::bayer_offset(b) as u32);
+    WgslConsts::default()
+        .u32_array("BAYER_OFFSETS", &offsets)
+        .finish()
+}
+
+/// The group-2 entries of the stipple pipeline: the shading state and the Bayer tables.
+fn group_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
+    [
+        gpu::buffer_entry(
+            0,
+            wgpu::ShaderStages::FRAGMENT,
+            wgpu::BufferBindingType::Uniform,
+        ),
+        gpu::buffer_entry(
+            1,
+            wgpu::ShaderStages::FRAGMENT,
+            wgpu::BufferBindingType::Storage { read_only: true },
+        ),
+    ]
 }
 
 /// The stipple pipeline and its uniform.
@@ -93,7 +113,9 @@ pub struct Stipple {
     pipeline: SidedPipeline,
     depth_write: bool,
     params: wgpu::Buffer,
+    levels: wgpu::Buffer,
     group: wgpu::BindGroup,
+    game_layout: wgpu::BindGroupLayout,
 }
 
 impl TechniqueKind for Stipple {
@@ -106,22 +128,7 @@ impl TechniqueKind for Stipple {
 
     fn create(setup: &Setup, _: Technique, config: &OitConfig) -> Result<Self> {
         let device = &setup.ctx.device;
-        let layout = gpu::layout(
-            device,
-            "stipple_layout",
-            &[
-                gpu::buffer_entry(
-                    0,
-                    wgpu::ShaderStages::FRAGMENT,
-                    wgpu::BufferBindingType::Uniform,
-                ),
-                gpu::buffer_entry(
-                    1,
-                    wgpu::ShaderStages::FRAGMENT,
-                    wgpu::BufferBindingType::Storage { read_only: true },
-                ),
-            ],
-        );
+        let layout = gpu::layout(device, "stipple_layout", &group_entries());
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("stipple_params"),
             contents: bytemuck::bytes_of(&StippleParams::default()),
@@ -158,7 +165,9 @@ impl TechniqueKind for Stipple {
             pipeline,
             depth_write,
             params,
+            levels,
             group,
+            game_layout: game_layout(device, "stipple_game", &group_entries()),
         })
     }
 }
@@ -185,7 +194,7 @@ impl TranslucentTechnique for Stipple {
 
     fn render(
         &mut self,
-        _: &GpuContext,
+        ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         frame: &TranslucentFrame<'_>,
     ) -> Result<()> {
@@ -194,6 +203,16 @@ impl TranslucentTechnique for Stipple {
         } else {
             Depth::ReadOnly(&frame.depth.view)
         };
+        let game = frame.game.map(|g| {
+            let own = [
+                self.params.as_entire_binding(),
+                self.levels.as_entire_binding(),
+            ];
+            (
+                g,
+                game_group(&ctx.device, "stipple_game", &self.game_layout, g, &own),
+            )
+        });
         let colors = [gpu::load(&frame.target.view)];
         Pass::new("stipple", GpuPass::Translucent, &colors)
             .depth(depth)
@@ -201,8 +220,32 @@ impl TranslucentTechnique for Stipple {
                 pass.set_pipeline(self.pipeline.get(frame.two_sided));
                 pass.set_bind_group(2, &self.group, &[]);
                 frame.draw_chunks(pass);
+                if let Some((g, group)) = &game {
+                    g.draw_all(pass, 0, group);
+                }
             });
         Ok(())
+    }
+
+    fn variants(&self) -> Vec<TranslucentVariant> {
+        let own = bayer_consts() + include_str!("dither.wgsl");
+        vec![TranslucentVariant {
+            name: "stipple",
+            wgsl: game_prelude(
+                &own,
+                "struct OitOutput {\n    @location(0) color: vec4<f32>,\n};\n\n\
+                 // Kept opaque through the screen door, or discarded.\n\
+                 fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
+                 return OitOutput(stipple(position, color));\n}\n",
+            ),
+            targets: vec![gpu::scene_target(None)],
+            depth_stencil: gpu::depth_state(if self.depth_write {
+                DepthMode::Write
+            } else {
+                DepthMode::ReadOnly
+            }),
+            layout: self.game_layout.clone(),
+        }]
     }
 }
 

@@ -102,35 +102,10 @@ fn optical_depth_at(pixel: vec2<f32>, d: f32) -> f32 {
     return min(mix(top, bottom, s.y), MAX_FITTED_DEPTH);
 }
 
-fn accumulation(in: VsOut, front: bool) -> vec4<f32> {
-    let c = translucent_color(in, front);
-    let w = weight(in.clip.xy, in.clip.z, standard_depth(in.clip.z), in.view_depth, c.a)
+// The weighted, premultiplied contribution of colour `c` (straight, alpha its opacity) at
+// `position` (a fragment's) and `view_depth`: what the accumulation target sums.
+fn wboit_accumulation(position: vec4<f32>, view_depth: f32, c: vec4<f32>) -> vec4<f32> {
+    let w = weight(position.xy, position.z, standard_depth(position.z), view_depth, c.a)
         * params.accum_scale;
     return vec4<f32>(c.rgb * c.a, c.a) * w;
-}
-
-struct WboitOut {
-    @location(0) accumulation: vec4<f32>,
-    @location(1) revealage: vec4<f32>,
-};
-
-// Single pass, two targets (needs independent blend).
-@fragment
-fn fs_accumulate_mrt(in: VsOut, @builtin(front_facing) front: bool) -> WboitOut {
-    var out: WboitOut;
-    out.accumulation = accumulation(in, front);
-    // α in every channel: the revealage blend multiplies by one minus the source colour.
-    out.revealage = vec4<f32>(translucent_color(in, front).a);
-    return out;
-}
-
-// Two passes (seed 002): accumulation first, revealage second.
-@fragment
-fn fs_accumulate(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    return accumulation(in, front);
-}
-
-@fragment
-fn fs_revealage(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    return vec4<f32>(translucent_color(in, front).a);
 }

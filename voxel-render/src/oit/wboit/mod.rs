@@ -41,6 +41,7 @@ use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
 };
+use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{GpuContext, Result};
 
@@ -132,20 +133,56 @@ pub fn accum_scale(caps: &Capabilities, settings: &WboitSettings) -> f32 {
     }
 }
 
-/// The accumulation shader: constants from Rust, the shared code, the weights.
+/// The accumulation shader: constants from Rust, the shared code, the weights, the chunk
+/// entries.
 pub fn accumulate_wgsl() -> String {
-    let consts = WeightFunction::wgsl_ids()
+    [
+        weight_consts().as_str(),
+        &crate::bindings::common_wgsl(),
+        include_str!("accumulate.wgsl"),
+        include_str!("chunks.wgsl"),
+    ]
+    .concat()
+}
+
+fn weight_consts() -> String {
+    WeightFunction::wgsl_ids()
         .u32("TILES", TILES as u32)
         .u32("PROFILE_LEN", PROFILE_LEN as u32)
         .u32("TABLE_VEC4S", TABLE_VEC4S as u32)
         .f32("MAX_FITTED_DEPTH", MAX_FITTED_DEPTH)
-        .finish();
-    [
-        consts.as_str(),
-        &crate::bindings::common_wgsl(),
-        include_str!("accumulate.wgsl"),
-    ]
-    .concat()
+        .finish()
+}
+
+/// The group-2 entries of the accumulation pipelines: the uniform.
+fn params_entries() -> [wgpu::BindGroupLayoutEntry; 1] {
+    [gpu::buffer_entry(
+        0,
+        wgpu::ShaderStages::FRAGMENT,
+        wgpu::BufferBindingType::Uniform,
+    )]
+}
+
+/// A game's output for a pass writing the accumulation, the revealage or both.
+fn game_output(accumulation: bool, revealage: bool) -> String {
+    let mut fields = String::new();
+    let mut body = String::new();
+    let mut location = 0;
+    if accumulation {
+        fields += &format!("    @location({location}) accumulation: vec4<f32>,\n");
+        body += "    out.accumulation = wboit_accumulation(position, oit_view_depth(position), color);\n";
+        location += 1;
+    }
+    if revealage {
+        fields += &format!("    @location({location}) revealage: vec4<f32>,\n");
+        body += "    out.revealage = vec4<f32>(color.a);\n";
+    }
+    format!(
+        "struct OitOutput {{\n{fields}}};\n\n\
+         // Weighted sums: accumulation += (C·α, α)·w, revealage *= 1 − α.\n\
+         fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {{\n    \
+         var out: OitOutput;\n{body}    return out;\n}}\n"
+    )
 }
 
 const ADDITIVE: wgpu::BlendState = wgpu::BlendState {
@@ -208,6 +245,9 @@ pub struct Wboit {
     targets: Targets,
     params: wgpu::Buffer,
     params_group: wgpu::BindGroup,
+    game_layout: wgpu::BindGroupLayout,
+    /// The accumulation and revealage target states (for games' pipelines).
+    target_states: [Option<wgpu::ColorTargetState>; 2],
     block_opacity: std::sync::Arc<[f32]>,
     /// Per chunk: the generation summed up and its layers.
     layers: PosMap<ChunkPos, (u64, MeshLayers)>,
@@ -233,15 +273,7 @@ impl TechniqueKind for Wboit {
         if accum_format != wgpu::TextureFormat::Rgba16Float {
             log::warn!("WBOIT accumulates in RGBA8: RGBA16F blending unavailable or disabled");
         }
-        let params_layout = gpu::layout(
-            device,
-            "wboit_params_layout",
-            &[gpu::buffer_entry(
-                0,
-                wgpu::ShaderStages::FRAGMENT,
-                wgpu::BufferBindingType::Uniform,
-            )],
-        );
+        let params_layout = gpu::layout(device, "wboit_params_layout", &params_entries());
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("wboit_params"),
             contents: bytemuck::bytes_of(&WboitParams::zeroed()),
@@ -278,14 +310,22 @@ impl TechniqueKind for Wboit {
         };
         let accumulate = if technique == Technique::WboitTwoPass {
             Accumulate::TwoPass {
-                accumulate: chunk("wboit_accumulate", "fs_accumulate", &[accum_target]),
-                revealage: chunk("wboit_revealage", "fs_revealage", &[reveal_target]),
+                accumulate: chunk(
+                    "wboit_accumulate",
+                    "fs_accumulate",
+                    std::slice::from_ref(&accum_target),
+                ),
+                revealage: chunk(
+                    "wboit_revealage",
+                    "fs_revealage",
+                    std::slice::from_ref(&reveal_target),
+                ),
             }
         } else {
             Accumulate::Mrt(chunk(
                 "wboit_accumulate_mrt",
                 "fs_accumulate_mrt",
-                &[accum_target, reveal_target],
+                &[accum_target.clone(), reveal_target.clone()],
             ))
         };
         let float = wgpu::TextureSampleType::Float { filterable: false };
@@ -309,6 +349,8 @@ impl TechniqueKind for Wboit {
             targets,
             params,
             params_group,
+            game_layout: game_layout(device, "wboit_game", &params_entries()),
+            target_states: [accum_target, reveal_target],
             block_opacity: setup.block_opacity.clone(),
             layers: PosMap::default(),
             report: None,
@@ -425,17 +467,28 @@ impl TranslucentTechnique for Wboit {
 
     fn render(
         &mut self,
-        _ctx: &GpuContext,
+        ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         frame: &TranslucentFrame<'_>,
     ) -> Result<()> {
         let t = &self.targets;
         let (accum, reveal) = (&t.accumulation.view, &t.revealage.view);
         let depth = Depth::ReadOnly(&frame.depth.view);
-        let draw = |pass: &mut wgpu::RenderPass<'_>, pipeline: &SidedPipeline| {
+        let game = frame.game.map(|g| {
+            let own = [self.params.as_entire_binding()];
+            (
+                g,
+                game_group(&ctx.device, "wboit_game", &self.game_layout, g, &own),
+            )
+        });
+        // Chunks, then the game's geometry in its pipeline for this pass.
+        let draw = |pass: &mut wgpu::RenderPass<'_>, pipeline: &SidedPipeline, variant: usize| {
             pass.set_pipeline(pipeline.get(frame.two_sided));
             pass.set_bind_group(2, &self.params_group, &[]);
             frame.draw_chunks(pass);
+            if let Some((g, group)) = &game {
+                g.draw_all(pass, variant, group);
+            }
         };
         match &self.accumulate {
             Accumulate::Mrt(pipeline) => {
@@ -445,13 +498,13 @@ impl TranslucentTechnique for Wboit {
                 ];
                 Pass::new("wboit_accumulate_mrt", GpuPass::Translucent, &colors)
                     .depth(depth)
-                    .record(encoder, frame.timer, |pass| draw(pass, pipeline));
+                    .record(encoder, frame.timer, |pass| draw(pass, pipeline, 0));
             }
             Accumulate::TwoPass {
                 accumulate,
                 revealage,
             } => {
-                for (label, pipeline, view, clear) in [
+                for (variant, (label, pipeline, view, clear)) in [
                     (
                         "wboit_accumulate",
                         accumulate,
@@ -459,11 +512,14 @@ impl TranslucentTechnique for Wboit {
                         wgpu::Color::TRANSPARENT,
                     ),
                     ("wboit_revealage", revealage, reveal, REVEAL_CLEAR),
-                ] {
+                ]
+                .into_iter()
+                .enumerate()
+                {
                     let colors = [gpu::clear(view, clear)];
                     Pass::new(label, GpuPass::Translucent, &colors)
                         .depth(depth)
-                        .record(encoder, frame.timer, |pass| draw(pass, pipeline));
+                        .record(encoder, frame.timer, |pass| draw(pass, pipeline, variant));
                 }
             }
         }
@@ -489,6 +545,30 @@ impl TranslucentTechnique for Wboit {
 
     fn accumulation(&self) -> Option<&wgpu::Texture> {
         Some(&self.targets.accumulation.texture)
+    }
+
+    fn variants(&self) -> Vec<TranslucentVariant> {
+        let own = weight_consts() + include_str!("accumulate.wgsl");
+        let [accum, reveal] = self.target_states.clone();
+        let variant = |name, accumulation, revealage, targets| TranslucentVariant {
+            name,
+            wgsl: game_prelude(&own, &game_output(accumulation, revealage)),
+            targets,
+            depth_stencil: gpu::depth_state(gpu::DepthMode::ReadOnly),
+            layout: self.game_layout.clone(),
+        };
+        match self.accumulate {
+            Accumulate::Mrt(_) => vec![variant(
+                "wboit_accumulate_mrt",
+                true,
+                true,
+                vec![accum, reveal],
+            )],
+            Accumulate::TwoPass { .. } => vec![
+                variant("wboit_accumulate", true, false, vec![accum]),
+                variant("wboit_revealage", false, true, vec![reveal]),
+            ],
+        }
     }
 
     fn revealage(&self) -> Option<&wgpu::Texture> {

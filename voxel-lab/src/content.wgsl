@@ -1,0 +1,80 @@
+// A game's content drawn through the renderer's stages (content.rs): boxes turned any way
+// and camera-facing particles, pulled from a storage buffer, 36 vertices each (a particle
+// uses the first 6). Lit like the world's faces: Lambert with the sun plus ambient, a
+// particle as a face turned to the sky.
+
+struct View {
+    view_proj: mat4x4<f32>,
+    right: vec4<f32>,
+    up: vec4<f32>,
+    sun: vec3<f32>,
+    ambient: f32,
+};
+
+struct Prim {
+    // Camera-relative centre.
+    center: vec3<f32>,
+    // 0: box, 1: particle.
+    kind: u32,
+    // Box axes scaled by the half extents; a particle's half size in axis_x.x.
+    axis_x: vec4<f32>,
+    axis_y: vec4<f32>,
+    axis_z: vec4<f32>,
+    // Linear colour and opacity.
+    color: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(1) @binding(0) var<storage, read> prims: array<Prim>;
+
+struct ContentOut {
+    // Invariant, as depth peeling needs of every translucent surface.
+    @builtin(position) @invariant position: vec4<f32>,
+    @location(0) color: vec4<f32>,
+};
+
+// The two triangles of a square, counter-clockwise in its (u, v).
+const SQUARE = array<vec2<f32>, 6>(
+    vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(1.0, 1.0),
+    vec2(-1.0, -1.0), vec2(1.0, 1.0), vec2(-1.0, 1.0),
+);
+
+@vertex
+fn vs_content(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> ContentOut {
+    let p = prims[ii];
+    var out: ContentOut;
+    let c = SQUARE[vi % 6u];
+    if p.kind == 1u {
+        if vi >= 6u {
+            // Collapsed: no area, nothing drawn.
+            out.position = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+            out.color = vec4<f32>(0.0);
+            return out;
+        }
+        let world = p.center + (view.right.xyz * c.x + view.up.xyz * c.y) * p.axis_x.x;
+        out.position = view.view_proj * vec4<f32>(world, 1.0);
+        let light = view.ambient + (1.0 - view.ambient) * max(view.sun.y, 0.0);
+        out.color = vec4<f32>(p.color.rgb * light, p.color.a);
+        return out;
+    }
+    // Face f of a box: axis f / 2, on its + side for even f.
+    let face = vi / 6u;
+    let axis = face / 2u;
+    let sign = select(-1.0, 1.0, (face & 1u) == 0u);
+    var axes = array<vec3<f32>, 3>(p.axis_x.xyz, p.axis_y.xyz, p.axis_z.xyz);
+    let n = axes[axis] * sign;
+    let u = axes[(axis + 1u) % 3u];
+    let v = axes[(axis + 2u) % 3u];
+    // u × v points along +axis: a − face takes its corners mirrored, to face outward too.
+    let k = select(vec2<f32>(c.y, c.x), c, sign > 0.0);
+    let world = p.center + n + u * k.x + v * k.y;
+    out.position = view.view_proj * vec4<f32>(world, 1.0);
+    let light = view.ambient + (1.0 - view.ambient) * max(dot(normalize(n), view.sun), 0.0);
+    out.color = vec4<f32>(p.color.rgb * light, p.color.a);
+    return out;
+}
+
+@fragment
+fn fs_opaque(in: ContentOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(in.color.rgb, 1.0);
+}

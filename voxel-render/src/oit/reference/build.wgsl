@@ -1,0 +1,9 @@
+// Exact reference, pass 1 for chunks (appended to common.wgsl, types.wgsl and
+// abuffer.wgsl).
+
+@fragment
+fn fs_abuffer(in: VsOut, @builtin(front_facing) front: bool) {
+    // Derivatives first, while every invocation of the quad still runs.
+    let slope = vec2<f32>(dpdx(in.clip.z), dpdy(in.clip.z));
+    abuffer_append(in.clip, slope, translucent_color(in, front));
+}

@@ -1,0 +1,19 @@
+// The per-frame uniforms every pass reads (`FrameUniforms` in bindings.rs, checked equal by
+// a test), shared by the chunk pipelines (group 0) and games' translucent pipelines
+// (the renderer's group there).
+
+struct Frame {
+    view_proj: mat4x4<f32>,
+    eye_int: vec3<i32>,
+    near: f32,
+    eye_frac: vec3<f32>,
+    far: f32,
+    sun_dir: vec3<f32>,
+    ambient: f32,
+    sky: vec3<f32>,
+    viewport: vec2<f32>,
+    // Block id of the translucent type the eye is inside, or NO_MEDIUM.
+    medium: u32,
+    // Ambient-occlusion strength, 0 (off) to 1.
+    ao_strength: f32,
+};

@@ -1,0 +1,328 @@
+//! The frame's stages a game joins, in the shape of egui-wgpu's paint callbacks and glyphon's
+//! "render into the caller's pass": the game's own opaque geometry after the world's opaque
+//! passes, its translucent geometry composed by the active transparency technique together
+//! with the chunks, an HDR overlay before tonemapping and an overlay after it.
+//!
+//! A game implements [`GameStages`] and calls `Renderer::render_with`. The renderer
+//! calls [`GameStages::prepare`] once the frame's camera is known (write uniforms there),
+//! then records each stage the game declared ([`GameStages::stages`]) into a pass it opens.
+//!
+//! **Translucent geometry, the same for every technique.** The game's fragment shader ends
+//! with `return oit_output(in.position, color);` after a prelude the renderer gives
+//! ([`TranslucentVariant::wgsl`], like Bevy's `oit_draw`): it turns a colour and opacity into
+//! whatever the technique's pass writes (weighted sums, a stipple test, a peel layer, an
+//! A-buffer node, a blended colour). A technique draws in several passes, each a
+//! [`TranslucentVariant`] with its own prelude, colour targets, depth state and bind group
+//! layout at [`OIT_GROUP`]; the game builds one pipeline per variant of the
+//! [`TranslucentContract`] in force and rebuilds them when its `id` changes (a technique
+//! switch, or settings its pipelines depend on). The renderer binds its group at
+//! [`OIT_GROUP`] before calling [`GameStages::translucent`]; the game sets its pipeline and
+//! its own groups (0 to `OIT_GROUP - 1`).
+
+use std::ops::Range;
+
+use glam::{DVec3, Mat4, Vec3};
+
+use crate::{Camera, GpuContext};
+
+/// The bind group index the renderer reserves in a game's translucent pipelines (the last
+/// of the four every adapter offers): the game's own groups are 0, 1 and 2.
+pub const OIT_GROUP: u32 = 3;
+
+/// Which stages a game draws in this frame; a stage it leaves out costs nothing (no pass).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stages {
+    /// Opaque geometry into the scene colour and depth, after the world's opaque and
+    /// cutout passes (before translucency, so water and glass are seen over it).
+    pub opaque: bool,
+    /// Translucent geometry, composed with the chunks by the active technique.
+    pub translucent: bool,
+    /// An overlay into the HDR scene colour with the scene depth (read-only) after
+    /// translucency and fog, before tonemapping: a selection box.
+    pub hdr_overlay: bool,
+    /// An overlay into the output after tonemapping: a HUD.
+    pub overlay: bool,
+}
+
+/// A translucent thing a game draws, as the sorted techniques order it: back to front by
+/// the distance of its centre from the eye, interleaved with the chunks. Order-independent
+/// techniques ignore it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TranslucentObject {
+    /// Centre, in world blocks.
+    pub center: DVec3,
+}
+
+/// What a game needs to draw in a stage.
+#[derive(Debug)]
+pub struct GameFrame<'a> {
+    /// The camera the frame is drawn with (`Renderer::drawn_camera`: an eye on a
+    /// translucent face moved off it, the near plane shrunk in front of one).
+    pub camera: &'a Camera,
+    /// Camera-relative view × reverse-Z projection: a world point `p` goes to clip space
+    /// as `view_proj * vec4((p_int - eye_int) + (p_frac - eye_frac), 1)`, integer parts
+    /// first so that precision does not depend on where the camera is.
+    pub view_proj: Mat4,
+    /// Integer part of the eye (`floor`).
+    pub eye_int: [i64; 3],
+    /// Fractional part of the eye, in [0, 1).
+    pub eye_frac: Vec3,
+    /// Render size in pixels.
+    pub size: (u32, u32),
+    /// Samples of the opaque stage's targets (4 with MSAA, else 1); every other stage
+    /// draws single-sampled.
+    pub opaque_samples: u32,
+    /// Format of the output (the overlay stage's target).
+    pub output_format: wgpu::TextureFormat,
+    /// Sorted techniques: the game's translucent objects back to front (indices into
+    /// [`GameStages::translucent_objects`]); `None` when the technique does not sort. A
+    /// game drawing instances uploads them in this order in `prepare`.
+    pub order: Option<&'a [u32]>,
+}
+
+impl GameFrame<'_> {
+    /// The camera-relative position of a world point (what `view_proj` takes).
+    pub fn relative(&self, p: DVec3) -> Vec3 {
+        let i = self.eye_int.map(|v| v as f64);
+        Vec3::new(
+            (p.x - i[0]) as f32,
+            (p.y - i[1]) as f32,
+            (p.z - i[2]) as f32,
+        ) - self.eye_frac
+    }
+}
+
+/// Depth convention of every stage: 32-bit float, reverse-Z (1 at the near plane, 0 far),
+/// nearer passes with `Greater`.
+pub const DEPTH_COMPARE: wgpu::CompareFunction = wgpu::CompareFunction::Greater;
+
+/// One pass of the active technique as a game's translucent pipeline must match it.
+#[derive(Clone, Debug)]
+pub struct TranslucentVariant {
+    /// Which pass (for labels and logs): `"wboit_accumulate_mrt"`, `"peel_front"`, …
+    pub name: &'static str,
+    /// WGSL to put before the game's fragment shader: declares `OitOutput` and
+    /// `fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput` (position the
+    /// fragment's `@builtin(position)`, colour linear and straight, alpha its opacity), and
+    /// the bindings of group [`OIT_GROUP`]. The names it declares besides those two start
+    /// with `oit_` or belong to the technique (`params`, `frame`, `heads`, …): keep the
+    /// game's own names apart.
+    pub wgsl: String,
+    /// The pass's colour targets, blend states included.
+    pub targets: Vec<Option<wgpu::ColorTargetState>>,
+    /// The pass's depth state (format [`crate::DEPTH_FORMAT`]).
+    pub depth_stencil: wgpu::DepthStencilState,
+    /// The layout of the group the renderer binds at [`OIT_GROUP`].
+    pub layout: wgpu::BindGroupLayout,
+}
+
+/// Every pass of the active technique a game's translucent geometry is drawn in.
+#[derive(Clone, Debug)]
+pub struct TranslucentContract {
+    /// Changes whenever the variants do: a game rebuilds its pipelines then.
+    pub id: u64,
+    /// The name of the technique in force (`Technique::name`).
+    pub technique: &'static str,
+    /// One per pass kind; [`GameStages::translucent`] gets the index of the one in use.
+    pub variants: Vec<TranslucentVariant>,
+}
+
+/// A game's part of a frame. Every method has an empty default; [`GameStages::stages`]
+/// says which are used.
+pub trait GameStages {
+    /// Which stages the game draws this frame.
+    fn stages(&self) -> Stages;
+
+    /// The translucent things it draws, for the sorted techniques' order (default: none,
+    /// drawn after the chunks, in one call).
+    fn translucent_objects(&self) -> &[TranslucentObject] {
+        &[]
+    }
+
+    /// Before any pass is recorded: write uniforms and instance buffers (`frame.order`
+    /// gives the sorted order when the technique sorts).
+    fn prepare(&mut self, _ctx: &GpuContext, _frame: &GameFrame<'_>) {}
+
+    /// Opaque geometry, into the scene colour ([`crate::SCENE_FORMAT`]) and depth
+    /// ([`crate::DEPTH_FORMAT`], reverse-Z, test `Greater` and write) with
+    /// `frame.opaque_samples` samples.
+    fn opaque(&self, _pass: &mut wgpu::RenderPass<'_>, _frame: &GameFrame<'_>) {}
+
+    /// Translucent geometry in one pass of the technique: set the pipeline built for
+    /// `contract.variants[variant]` (group [`OIT_GROUP`] is bound) and draw the objects of
+    /// `objects` — positions in `frame.order` for a sorted technique, else indices into
+    /// [`GameStages::translucent_objects`] — or everything when there are none.
+    fn translucent(
+        &self,
+        _pass: &mut wgpu::RenderPass<'_>,
+        _frame: &GameFrame<'_>,
+        _variant: usize,
+        _objects: Range<usize>,
+    ) {
+    }
+
+    /// An overlay into the HDR scene colour with the scene depth, read-only.
+    fn hdr_overlay(&self, _pass: &mut wgpu::RenderPass<'_>, _frame: &GameFrame<'_>) {}
+
+    /// An overlay into the output (format `frame.output_format`), no depth.
+    fn overlay(&self, _pass: &mut wgpu::RenderPass<'_>, _frame: &GameFrame<'_>) {}
+}
+
+/// No game stage: what `Renderer::render` draws with.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoGame;
+
+impl GameStages for NoGame {
+    fn stages(&self) -> Stages {
+        Stages::default()
+    }
+}
+
+/// The game's translucent part of a frame as the techniques see it.
+pub struct GameDraw<'a> {
+    /// The game.
+    pub stages: &'a dyn GameStages,
+    /// The frame it draws in.
+    pub frame: &'a GameFrame<'a>,
+    /// How many objects (positions in the order, or indices).
+    pub objects: usize,
+    /// Sorted techniques: each object's distance from the eye, in the order drawn.
+    pub distances: &'a [f64],
+    /// The resources a technique binds into its group for the game (group 0's frame
+    /// uniforms and medium boundary, besides its own).
+    pub frame_buffer: &'a wgpu::Buffer,
+    /// The medium boundary depth (see `medium.rs`).
+    pub boundary: &'a wgpu::TextureView,
+}
+
+impl std::fmt::Debug for GameDraw<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GameDraw")
+            .field("objects", &self.objects)
+            .finish_non_exhaustive()
+    }
+}
+
+impl GameDraw<'_> {
+    /// Draws the objects `range` in pass `variant`, with `group` bound at [`OIT_GROUP`].
+    pub fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        variant: usize,
+        group: &wgpu::BindGroup,
+        range: Range<usize>,
+    ) {
+        pass.set_bind_group(OIT_GROUP, group, &[]);
+        self.stages.translucent(pass, self.frame, variant, range);
+    }
+
+    /// Like [`GameDraw::draw`], with dynamic `offsets` for the group.
+    pub fn draw_offsets(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        variant: usize,
+        group: &wgpu::BindGroup,
+        offsets: &[u32],
+        range: Range<usize>,
+    ) {
+        pass.set_bind_group(OIT_GROUP, group, offsets);
+        self.stages.translucent(pass, self.frame, variant, range);
+    }
+
+    /// Draws every object in pass `variant`.
+    pub fn draw_all(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        variant: usize,
+        group: &wgpu::BindGroup,
+    ) {
+        self.draw(pass, variant, group, 0..self.objects);
+    }
+}
+
+/// The group a technique binds for games at [`OIT_GROUP`]: binding 0 the frame uniforms,
+/// 1 the medium boundary (what the techniques' WGSL reads of group 0), then the technique's
+/// own entries (its chunk pipelines' group 2) moved up by two.
+pub(crate) fn game_layout(
+    device: &wgpu::Device,
+    label: &str,
+    own: &[wgpu::BindGroupLayoutEntry],
+) -> wgpu::BindGroupLayout {
+    use wgpu::ShaderStages as S;
+    let mut entries = vec![
+        crate::gpu::buffer_entry(0, S::VERTEX_FRAGMENT, wgpu::BufferBindingType::Uniform),
+        crate::gpu::texture_entry(1, wgpu::TextureSampleType::Depth),
+    ];
+    entries.extend(own.iter().map(|e| wgpu::BindGroupLayoutEntry {
+        binding: e.binding + 2,
+        visibility: S::FRAGMENT,
+        ..*e
+    }));
+    crate::gpu::layout(device, label, &entries)
+}
+
+/// The game group of [`game_layout`] for one pass: `own` are the resources of the
+/// technique's group 2, in binding order.
+pub(crate) fn game_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    draw: &GameDraw<'_>,
+    own: &[wgpu::BindingResource<'_>],
+) -> wgpu::BindGroup {
+    let mut resources = vec![
+        draw.frame_buffer.as_entire_binding(),
+        wgpu::BindingResource::TextureView(draw.boundary),
+    ];
+    resources.extend(own.iter().cloned());
+    crate::gpu::bind_group(device, label, layout, &resources)
+}
+
+/// A game's prelude: the frame uniforms and the medium boundary at [`OIT_GROUP`], the
+/// technique's WGSL `own` (its group-2 bindings moved to [`OIT_GROUP`], two up), and
+/// `output` (which declares `OitOutput` and `oit_output`).
+pub(crate) fn game_prelude(own: &str, output: &str) -> String {
+    let header = crate::gpu::WgslConsts::default()
+        .u32("NO_MEDIUM", crate::bindings::NO_MEDIUM)
+        .finish()
+        + crate::bindings::FRAME_WGSL
+        + &format!(
+            "@group({OIT_GROUP}) @binding(0) var<uniform> frame: Frame;\n\
+             @group({OIT_GROUP}) @binding(1) var medium_boundary: texture_depth_2d;\n\n\
+             // View depth of a fragment from its reverse-Z depth.\n\
+             fn oit_view_depth(position: vec4<f32>) -> f32 {{\n    \
+             return frame.near * frame.far / (position.z * (frame.far - frame.near) + frame.near);\n}}\n\n"
+        );
+    header + &regroup(own, 2, OIT_GROUP, 2) + "\n" + output
+}
+
+/// `src` with every `@group(from) @binding(k)` made `@group(to) @binding(k + shift)`.
+fn regroup(src: &str, from: u32, to: u32, shift: u32) -> String {
+    let pattern = format!("@group({from}) @binding(");
+    let mut out = String::with_capacity(src.len());
+    let mut rest = src;
+    while let Some(i) = rest.find(&pattern) {
+        out.push_str(&rest[..i]);
+        rest = &rest[i + pattern.len()..];
+        let end = rest.find(')').unwrap_or(rest.len());
+        let k: u32 = rest[..end].trim().parse().unwrap_or(0);
+        out.push_str(&format!("@group({to}) @binding({})", k + shift));
+        rest = rest.get(end + 1..).unwrap_or("");
+    }
+    out.push_str(rest);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn regroup_moves_group_and_bindings() {
+        let src = "@group(2) @binding(0) var<uniform> a: A;\n@group(0) @binding(1) var b: B;\n@group(2) @binding(3) var c: C;";
+        assert_eq!(
+            regroup(src, 2, 3, 2),
+            "@group(3) @binding(2) var<uniform> a: A;\n@group(0) @binding(1) var b: B;\n@group(3) @binding(5) var c: C;"
+        );
+    }
+}
