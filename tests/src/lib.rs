@@ -102,7 +102,8 @@ pub fn read_hdr(ctx: &GpuContext, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
 pub fn frame(ctx: &GpuContext, renderer: &mut Renderer, camera: &Camera) -> Image {
     let (w, h) = renderer.size();
     let target = Offscreen::new(ctx, w, h);
-    voxel_lab::headless::render_image(ctx, renderer, &target, camera).unwrap()
+    renderer.render_and_submit(&target.view, camera).unwrap();
+    target.read(ctx).unwrap()
 }
 
 /// Per-channel comparison of two images of the same size.

@@ -136,7 +136,7 @@ fn overflow_renderer(ctx: &voxel_render::GpuContext, scene: &Scene, headroom: bo
     };
     config.oit.wboit.weight = WeightFunction::Flat;
     config.oit.wboit.headroom = headroom;
-    renderer_for(ctx, scene, config).unwrap()
+    renderer_for(ctx, scene, config).unwrap().renderer
 }
 
 #[test]

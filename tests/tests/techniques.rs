@@ -252,7 +252,7 @@ fn new_chunks_fade_in_through_the_stipple_pattern() {
     let nothing = tests::scene("empty", box_world(&[]), [0.5, 0.5, 10.0], [0.5, 0.5, 0.0]);
     let empty = render_with(&ctx, &nothing, config(Technique::WboitMrt));
 
-    let mut r: Renderer = renderer_for(&ctx, &scene, c).unwrap();
+    let mut r: Renderer = renderer_for(&ctx, &scene, c).unwrap().renderer;
     let cam = scene.cameras[0];
     let f0 = frame(&ctx, &mut r, &cam);
     assert_eq!(f0, empty, "a chunk that just appeared is fully faded out");

@@ -4,12 +4,11 @@
 use std::path::Path;
 
 use voxel_render::{
-    Camera, FrameStats, GpuContext, Image, OitConfig, Renderer, RendererConfig, Technique,
-    WeightFunction,
+    Camera, FrameStats, GpuContext, Image, OitConfig, RendererConfig, Technique, WeightFunction,
 };
 
 use crate::edges::{self, Edges};
-use crate::headless::{Offscreen, renderer_for};
+use crate::headless::{Offscreen, SceneRenderer, renderer_for};
 use crate::metrics::{self, Metrics, thumbnail};
 use crate::progress::Progress;
 use crate::raymarch;
@@ -23,7 +22,7 @@ pub fn make_renderer(
     ctx: &GpuContext,
     scene: &Scene,
     size: (u32, u32),
-) -> Result<Renderer, String> {
+) -> Result<SceneRenderer, String> {
     let config = RendererConfig {
         width: size.0,
         height: size.1,
@@ -59,7 +58,7 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 /// with the median timings.
 pub fn measure(
     ctx: &GpuContext,
-    renderer: &mut Renderer,
+    renderer: &mut SceneRenderer,
     target: &Offscreen,
     camera: &Camera,
     config: &OitConfig,
@@ -134,7 +133,7 @@ pub struct Reference {
 /// each other and against the CPU ray march of `world`.
 pub fn reference(
     ctx: &GpuContext,
-    renderer: &mut Renderer,
+    renderer: &mut SceneRenderer,
     target: &Offscreen,
     camera: &Camera,
     scene: &Scene,
@@ -246,7 +245,7 @@ pub fn raymarch_check(
         .collect();
     let drawn = renderer.drawn_camera(camera);
     let start = std::time::Instant::now();
-    let marcher = raymarch::RayMarcher::new(&scene.world);
+    let marcher = raymarch::RayMarcher::with_content(&scene.world, &scene.content);
     let ray = marcher.render(&drawn, size.0, size.1, &shading);
     let seconds = start.elapsed().as_secs_f64();
     let comparison = marcher.compare(&ray, &drawn, &shading, &gpu, Some(&depth));

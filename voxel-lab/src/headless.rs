@@ -1,7 +1,9 @@
 //! Rendering without a window: a headless GPU, an offscreen target, PNG output.
 
 use voxel_mesh::mesh_chunks;
-use voxel_render::{Camera, GpuContext, Image, Renderer, RendererConfig, readback};
+use voxel_render::{Camera, FrameStats, GpuContext, Image, Renderer, RendererConfig, readback};
+
+use crate::content::ContentStages;
 
 use crate::scene::Scene;
 
@@ -49,12 +51,54 @@ impl Offscreen {
     }
 }
 
-/// A renderer with every chunk of `scene` meshed and uploaded.
+/// A renderer with a scene's chunks uploaded, and the scene's game content (particles,
+/// entities: [`crate::content`]) drawn through its stages in every frame. Derefs to the
+/// [`Renderer`].
+#[derive(Debug)]
+pub struct SceneRenderer {
+    /// The renderer.
+    pub renderer: Renderer,
+    /// The scene's content, when it has any.
+    pub content: Option<ContentStages>,
+}
+
+impl std::ops::Deref for SceneRenderer {
+    type Target = Renderer;
+    fn deref(&self) -> &Renderer {
+        &self.renderer
+    }
+}
+
+impl std::ops::DerefMut for SceneRenderer {
+    fn deref_mut(&mut self) -> &mut Renderer {
+        &mut self.renderer
+    }
+}
+
+impl SceneRenderer {
+    /// Renders one frame of `camera` into `output`, the content included, and submits it.
+    pub fn render_and_submit(
+        &mut self,
+        output: &wgpu::TextureView,
+        camera: &Camera,
+    ) -> voxel_render::Result<FrameStats> {
+        match &mut self.content {
+            None => self.renderer.render_and_submit(output, camera),
+            Some(content) => {
+                content.update_pipelines(&mut self.renderer)?;
+                self.renderer
+                    .render_and_submit_with(output, camera, content)
+            }
+        }
+    }
+}
+
+/// A renderer with every chunk of `scene` meshed and uploaded, and its content ready.
 pub fn renderer_for(
     ctx: &GpuContext,
     scene: &Scene,
     config: RendererConfig,
-) -> Result<Renderer, String> {
+) -> Result<SceneRenderer, String> {
     let mut renderer =
         Renderer::new(ctx, scene.world.registry(), config).map_err(|e| crate::chain(&e))?;
     let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
@@ -63,13 +107,15 @@ pub fn renderer_for(
             .upload_chunk(pos, &meshes)
             .map_err(|e| crate::chain(&e))?;
     }
-    Ok(renderer)
+    let content =
+        (!scene.content.is_empty()).then(|| ContentStages::new(&renderer, scene.content.clone()));
+    Ok(SceneRenderer { renderer, content })
 }
 
 /// Renders `camera` into `target` and reads the picture back.
 pub fn render_image(
     ctx: &GpuContext,
-    renderer: &mut Renderer,
+    renderer: &mut SceneRenderer,
     target: &Offscreen,
     camera: &Camera,
 ) -> Result<Image, String> {

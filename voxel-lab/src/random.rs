@@ -13,6 +13,10 @@
 //!
 //! # What a scene holds
 //!
+//! The particles and entities (a game's content, drawn through the renderer's stages) come
+//! from a second stream of the same seed and index, drawn after the camera: the blocks and
+//! the camera of a scene are what they were before the generator had content.
+//!
 //! Everything lies in a local box of about 48³ blocks (a stack may run up to 192 blocks
 //! along its axis), moved by a random offset of −48 to 16 blocks per axis so that negative
 //! coordinates and chunk borders occur. Each part is drawn independently, with the
@@ -27,6 +31,8 @@
 //! | a large surface with small objects | 0.3 | a 24–48 wide slab, translucent (70 %) or opaque, 3–12 small objects on it, sunk into it or under it |
 //! | a glass floor and/or ceiling | 0.3 | a translucent sheet 20–48 wide below and/or above the eye, with objects beyond it |
 //! | leaves | 0.15 more | a leaf box if none was drawn above (72 % of scenes end up with cutout blocks) |
+//! | a game's particles | 0.35 | 100–1000 (60 %) or 1000–5000 camera-facing squares, 0.04–0.4 blocks across, opacity 0.1–0.9, one random colour, in a box around the target up to 0.3 of its distance (at most 12 blocks) across |
+//! | a game's entities | 0.3 | 1–3 boxes 0.5–4 blocks on a side, turned any way, near the target: opaque (30 %) or translucent (opacity 0.1–0.95); none around the eye |
 //!
 //! The camera (an aimed eye is never inside an opaque or cutout block, and sees its target
 //! without an opaque block between them whenever one of 40 tries finds such a place):
@@ -66,6 +72,9 @@
 //! | opaque blocks | 86.9 % |
 //! | thin translucent sheets | 87.0 % |
 //! | solid translucent volumes | 70.0 % |
+//! | a game's particles | 35.4 % |
+//! | a game's translucent entity | 24.3 % |
+//! | a game's opaque entity | 13.8 % |
 //!
 //! `demo eval --random` reports the same shares for the scenes it drew, and the share of
 //! scenes where the reference equals `opaque-only` (nothing translucent in view: the aim
@@ -235,6 +244,12 @@ pub struct Features {
     pub fov: f64,
     /// Distance from the eye to the point it looks at.
     pub distance: f64,
+    /// A game's particles around the target (0: none).
+    pub particles: u32,
+    /// A game's translucent box entities, turned any way.
+    pub translucent_entities: u32,
+    /// A game's opaque box entities.
+    pub opaque_entities: u32,
 }
 
 impl Features {
@@ -284,6 +299,9 @@ impl Features {
             ("opaque blocks", self.opaque),
             ("thin translucent sheets", self.thin_sheets),
             ("solid translucent volumes", self.solid_volumes),
+            ("a game's particles", self.particles > 0),
+            ("a game's translucent entity", self.translucent_entities > 0),
+            ("a game's opaque entity", self.opaque_entities > 0),
         ]
     }
 }
@@ -1081,6 +1099,85 @@ impl Gen {
     }
 }
 
+/// A game's particles and entities around the target, from their own stream (so the
+/// blocks and the camera of a scene do not depend on them): `[[particles]]` and
+/// `[[entities]]` text in local coordinates moved by `off`, and the counts in `f`.
+fn content(
+    seed: u64,
+    index: usize,
+    eye: [f64; 3],
+    target: [f64; 3],
+    near: f64,
+    off: [f64; 3],
+    f: &mut Features,
+) -> String {
+    let mut rng = SplitMix64::new(
+        seed ^ (index as u64).wrapping_mul(0x94D0_49BB_1331_11EB) ^ 0x5EED_C0DE_0000_0001,
+    );
+    rng.next_u64();
+    let mut t = String::new();
+    let distance = length(sub(target, eye));
+    let color = |rng: &mut SplitMix64| {
+        let c = [0; 3].map(|_| rng.int(0, 255));
+        format!("[{}, {}, {}]", c[0], c[1], c[2])
+    };
+    if rng.chance(0.35) {
+        // A cloud around the target, never reaching the eye.
+        let r = (distance * 0.3).clamp(0.5, 12.0);
+        let half = [0; 3].map(|_| off_grid(rng.range(0.4, 1.0) * r));
+        let count = if rng.chance(0.6) {
+            rng.int(100, 1000)
+        } else {
+            rng.int(1000, 5000)
+        };
+        t += &format!(
+            "\n[[particles]]\nmin = {}\nmax = {}\ncount = {count}\nseed = {}\nsize = {}\ncolor = {}\nopacity = {}\n",
+            vec3(add(sub(target, half), off)),
+            vec3(add(add(target, half), off)),
+            rng.int(1, 1_000_000),
+            num(f64::from(rng.int(4, 40)) / 100.0),
+            color(&mut rng),
+            num(f64::from(rng.int(10, 90)) / 100.0),
+        );
+        f.particles = count as u32;
+    }
+    if rng.chance(0.3) {
+        let spread = (distance * 0.3).clamp(0.5, 6.0);
+        for _ in 0..rng.int(1, 3) {
+            let size = [0; 3].map(|_| f64::from(rng.int(5, 40)) / 10.0);
+            let center = [0, 1, 2].map(|k| off_grid(target[k] + rng.range(-spread, spread)));
+            let rotation = [rng.int(0, 359), rng.int(-89, 89), rng.int(-89, 89)];
+            let opaque = rng.chance(0.3);
+            let opacity = if opaque {
+                1.0
+            } else {
+                f64::from(rng.int(10, 95)) / 100.0
+            };
+            let c = color(&mut rng);
+            // Not around the eye: its back faces are culled, so it would vanish.
+            let reach = length(size) / 2.0;
+            if length(sub(center, eye)) < reach + near + 0.1 {
+                continue;
+            }
+            t += &format!(
+                "\n[[entities]]\ncenter = {}\nsize = {}\nrotation = [{}.0, {}.0, {}.0]\ncolor = {c}\nopacity = {}\n",
+                vec3(add(center, off)),
+                vec3(size),
+                rotation[0],
+                rotation[1],
+                rotation[2],
+                num(opacity),
+            );
+            if opaque {
+                f.opaque_entities += 1;
+            } else {
+                f.translucent_entities += 1;
+            }
+        }
+    }
+    t
+}
+
 /// Formats an f64 so that TOML reads back the same number (always with a `.` or an
 /// exponent, so it stays a float).
 fn num(v: f64) -> String {
@@ -1132,6 +1229,7 @@ pub fn generate(seed: u64, index: usize, size: (u32, u32)) -> RandomScene {
     g.finish_features(eye);
     let offset = [0; 3].map(|_| g.rng.int(-48, 16));
     let off_f = offset.map(f64::from);
+    let content_text = content(seed, index, eye, target, near, off_f, &mut g.features);
 
     let name = scene_name(seed, index);
     let f = &g.features;
@@ -1173,6 +1271,7 @@ pub fn generate(seed: u64, index: usize, size: (u32, u32)) -> RandomScene {
             b.block, min[0], min[1], min[2], max[0], max[1], max[2]
         );
     }
+    t += &content_text;
     t += &format!(
         "\n[[cameras]]\neye = {}\ntarget = {}\nfov = {}\nnear = {}\nfar = {}\n",
         vec3(add(eye, off_f)),
@@ -1244,7 +1343,7 @@ mod tests {
         assert_eq!(h, GOLDEN_HASH, "generator output changed: {h:#x}");
     }
 
-    const GOLDEN_HASH: u64 = 0x8d9b_6749_d09b_fa37;
+    const GOLDEN_HASH: u64 = 0x395d_289c_ee05_6c31;
 
     #[test]
     fn every_scene_parses_with_the_features_it_claims() {
@@ -1297,6 +1396,7 @@ mod tests {
         near("a stack of 2–8 layers", 0.35 * 0.5);
         near("a stack of 25–64 layers", 0.35 * 0.2);
         near("a grazing view along a surface", 0.15);
+        near("a game's particles", 0.35);
         for name in [
             "the eye inside a translucent volume",
             "the eye exactly on a face plane",

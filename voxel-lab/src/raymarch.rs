@@ -27,6 +27,8 @@ use rayon::prelude::*;
 use voxel_core::{BlockId, CHUNK_SIZE, Chunk, ChunkPos, Face, RenderClass, World};
 use voxel_render::{Camera, Image, RendererConfig};
 
+use crate::content::{Content, box_normal, face_light, particle_light};
+
 /// How the ray march colours a block face.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Texturing {
@@ -112,6 +114,8 @@ pub struct RayResult {
     pub signature: u64,
     /// Hash of the blended layers' unit faces (which block's face each is).
     pub layer_faces: u64,
+    /// The ray ended on an opaque entity of the game's content.
+    pub content_end: bool,
 }
 
 /// A ray-marched picture.
@@ -125,6 +129,8 @@ pub struct RayMarched {
     pub signature: Vec<u64>,
     /// Per pixel: the centre ray's blended unit faces.
     pub layer_faces: Vec<u64>,
+    /// Per pixel: the centre ray ended on an opaque entity.
+    pub content_end: Vec<bool>,
 }
 
 /// The world as the ray march reads it: dense chunks, classes, colours, textures.
@@ -140,6 +146,8 @@ pub struct RayMarcher {
     flat: Vec<[f64; 4]>,
     /// Per translucent block: linear colour and opacity (the medium's fog).
     looks: Vec<Option<voxel_render::medium::MediumLook>>,
+    /// A game's particles and entities ([`crate::content`]).
+    content: Content,
 }
 
 fn srgb_to_linear(c: u8) -> f64 {
@@ -219,7 +227,116 @@ impl RayMarcher {
                 })
                 .collect(),
             looks: voxel_render::medium::looks(registry),
+            content: Content::default(),
         }
+    }
+
+    /// Reads `world`'s chunks and draws `content` (a game's particles and entities) too.
+    pub fn with_content(world: &World, content: &Content) -> Self {
+        Self {
+            content: content.clone(),
+            ..Self::new(world)
+        }
+    }
+
+    /// The game surfaces the ray from `eye` along `dir` meets between `near` and `far`, by
+    /// distance: the particles `particles` (indices) and every entity.
+    fn content_hits(
+        &self,
+        eye: DVec3,
+        dir: DVec3,
+        near: f64,
+        far: f64,
+        particles: &[u32],
+        light: &Light,
+    ) -> Vec<ContentHit> {
+        let mut hits = Vec::new();
+        let [forward, right, up] = light.basis;
+        for &i in particles {
+            let Some(p) = self.content.particles.get(i as usize) else {
+                continue;
+            };
+            // The square lies in the plane through its centre facing the camera.
+            let t = (p.center - eye).dot(forward) / dir.dot(forward);
+            if !(t >= near && t <= far) {
+                continue;
+            }
+            let q = eye + dir * t - p.center;
+            let s = f64::from(p.half_size);
+            if q.dot(right).abs() > s || q.dot(up).abs() > s {
+                continue;
+            }
+            let l = particle_light(light.sun, light.ambient);
+            hits.push(ContentHit {
+                t,
+                color: p.color.map(|c| f64::from(srgb_to_linear(c)) * l),
+                alpha: f64::from(p.opacity.clamp(0.0, 1.0)),
+                opaque: false,
+                id: (1, i, 0),
+            });
+        }
+        for (i, e) in self.content.entities.iter().enumerate() {
+            // In the box's frame, scaled to the unit cube: the slab test.
+            let axes = e.axes();
+            let o = eye - e.center;
+            let (mut t_in, mut t_out, mut face) = (f64::NEG_INFINITY, f64::INFINITY, (0, 0.0));
+            for (a, axis) in axes.iter().enumerate() {
+                let len2 = axis.length_squared();
+                let (oa, da) = (o.dot(*axis) / len2, dir.dot(*axis) / len2);
+                if da == 0.0 {
+                    if oa.abs() > 1.0 {
+                        t_in = f64::INFINITY;
+                    }
+                    continue;
+                }
+                let (t0, t1) = ((-1.0 - oa) / da, (1.0 - oa) / da);
+                let (lo, hi, sign) = if t0 < t1 {
+                    (t0, t1, -1.0)
+                } else {
+                    (t1, t0, 1.0)
+                };
+                if lo > t_in {
+                    t_in = lo;
+                    face = (a, sign);
+                }
+                t_out = t_out.min(hi);
+            }
+            // The face the ray enters through (back faces are culled), in view.
+            if t_in > t_out || !(t_in >= near && t_in <= far) {
+                continue;
+            }
+            let normal = box_normal(e.rotation, face.0, face.1);
+            let l = face_light(normal, light.sun, light.ambient);
+            hits.push(ContentHit {
+                t: t_in,
+                color: e.color.map(|c| f64::from(srgb_to_linear(c)) * l),
+                alpha: f64::from(e.opacity.clamp(0.0, 1.0)),
+                opaque: e.is_opaque(),
+                id: (2, i as u32, face.0 as u8 * 2 + u8::from(face.1 > 0.0)),
+            });
+        }
+        hits.sort_by(|a, b| a.t.total_cmp(&b.t));
+        hits
+    }
+
+    /// Adds the content hits before `t` (from `next` on) to the walk: translucent ones as
+    /// layers; an opaque one ends the ray (returns true).
+    fn content_until(hits: &[ContentHit], next: &mut usize, t: f64, w: &mut Walker<'_>) -> bool {
+        while let Some(h) = hits.get(*next) {
+            if h.t >= t {
+                break;
+            }
+            *next += 1;
+            h.id.hash(w.hasher);
+            if h.opaque {
+                return true;
+            }
+            h.id.hash(w.faces);
+            if w.want_color && h.alpha > 0.0 {
+                w.layers.push([h.color[0], h.color[1], h.color[2], h.alpha]);
+            }
+        }
+        false
     }
 
     /// The blocks of the chunk at chunk coordinates `c`, if it holds any.
@@ -338,7 +455,15 @@ impl RayMarcher {
         shading: &Shading,
         light: &Light,
         want_color: bool,
+        particles: &[u32],
     ) -> RayResult {
+        let hits = if self.content.is_empty() {
+            Vec::new()
+        } else {
+            self.content_hits(eye, dir, near, far, particles, light)
+        };
+        let mut next_hit = 0;
+        let mut content_end = false;
         let mut hasher = std::collections::hash_map::DefaultHasher::new();
         let mut faces = std::collections::hash_map::DefaultHasher::new();
         let mut layers: Vec<[f64; 4]> = Vec::new();
@@ -411,7 +536,10 @@ impl RayMarcher {
                 }
             }
             let mut prev = self.get(cell);
-            if let Some(axis) = entry_axis {
+            if Self::content_until(&hits, &mut next_hit, t0, &mut walker) {
+                content_end = true;
+                end_t = hits[next_hit - 1].t;
+            } else if let Some(axis) = entry_axis {
                 // The ray enters the box from air through a face along `axis`.
                 let ended = self.crossing(
                     &CrossingCtx {
@@ -432,7 +560,7 @@ impl RayMarcher {
             let chunk_of = |cell: &[i64; 3]| cell.map(|v| v.div_euclid(s));
             let mut here = chunk_of(&cell);
             let mut blocks = self.chunk_blocks(here);
-            while walker.end.is_none() {
+            while walker.end.is_none() && !content_end {
                 if blocks.is_none() && prev == BlockId::AIR {
                     // An absent chunk is air: jump to the last cell before it is left.
                     let origin = here.map(|c| c * s);
@@ -476,6 +604,11 @@ impl RayMarcher {
                     2
                 };
                 let t = t_max[axis];
+                if Self::content_until(&hits, &mut next_hit, t.min(t1), &mut walker) {
+                    content_end = true;
+                    end_t = hits[next_hit - 1].t;
+                    break;
+                }
                 if t > t1 {
                     break;
                 }
@@ -504,19 +637,28 @@ impl RayMarcher {
                 prev = b;
             }
         }
+        if !content_end
+            && walker.end.is_none()
+            && Self::content_until(&hits, &mut next_hit, far, &mut walker)
+        {
+            content_end = true;
+            end_t = hits[next_hit - 1].t;
+        }
         let end_surface = end.map(|(s, _)| s);
         end_surface.map(|s| s.plane()).hash(&mut hasher);
+        let content_color = content_end.then(|| hits[next_hit - 1].color);
         let mut result = RayResult {
             color: [0.0; 3],
             end: end_surface,
             signature: hasher.finish(),
             layer_faces: faces.finish(),
+            content_end,
         };
         if !want_color {
             return result;
         }
         // Front to back over the background (the opaque colour, or the sky).
-        let background = end.map_or(light.sky, |(_, c)| c);
+        let background = content_color.unwrap_or_else(|| end.map_or(light.sky, |(_, c)| c));
         let mut acc = [0.0f64; 4];
         for l in &layers {
             let k = 1.0 - acc[3];
@@ -648,16 +790,18 @@ impl RayMarcher {
         want_color: bool,
     ) -> RayResult {
         let light = Light::new(self, camera, shading);
-        let dir = Projection::new(camera, width, height).dir(x, y);
+        let projection = Projection::new(camera, width, height);
+        let bins = Bins::new(&self.content, camera, &projection, &light);
         self.march(
             camera.eye,
-            dir,
+            projection.dir(x, y),
             camera.near,
             camera.far,
             camera.medium,
             shading,
             &light,
             want_color,
+            bins.at(x, y),
         )
     }
 
@@ -673,6 +817,7 @@ impl RayMarcher {
         let (w, h) = (width as usize, height as usize);
         let projection = Projection::new(camera, width, height);
         let light = Light::new(self, camera, shading);
+        let bins = Bins::new(&self.content, camera, &projection, &light);
         let march = |x: f64, y: f64, color: bool| {
             self.march(
                 camera.eye,
@@ -683,6 +828,7 @@ impl RayMarcher {
                 shading,
                 &light,
                 color,
+                bins.at(x, y),
             )
         };
         let centres: Vec<RayResult> = (0..w * h)
@@ -703,6 +849,7 @@ impl RayMarcher {
             end: centres.iter().map(|c| c.end).collect(),
             signature: centres.iter().map(|c| c.signature).collect(),
             layer_faces: centres.iter().map(|c| c.layer_faces).collect(),
+            content_end: centres.iter().map(|c| c.content_end).collect(),
         }
     }
 }
@@ -741,6 +888,80 @@ impl Projection {
         let ndc_x = x / self.size.0 * 2.0 - 1.0;
         let ndc_y = 1.0 - y / self.size.1 * 2.0;
         self.forward + self.right * ndc_x + self.up * ndc_y
+    }
+
+    /// The pixel coordinates of the point `v` (relative to the eye), if in front of it.
+    fn pixel(&self, v: DVec3) -> Option<(f64, f64)> {
+        let z = v.dot(self.forward);
+        if z <= 1e-9 {
+            return None;
+        }
+        let ndc_x = v.dot(self.right) / self.right.length_squared() / z;
+        let ndc_y = v.dot(self.up) / self.up.length_squared() / z;
+        Some((
+            (ndc_x + 1.0) / 2.0 * self.size.0,
+            (1.0 - ndc_y) / 2.0 * self.size.1,
+        ))
+    }
+}
+
+/// The particles whose squares may cover each 16 × 16 pixel tile of a picture, so that a
+/// ray tests a few of them, not thousands.
+struct Bins {
+    cols: usize,
+    cells: Vec<Vec<u32>>,
+}
+
+const BIN_PX: f64 = 16.0;
+
+impl Bins {
+    fn new(content: &Content, camera: &Camera, projection: &Projection, light: &Light) -> Self {
+        let (w, h) = projection.size;
+        let cols = (w / BIN_PX).ceil().max(1.0) as usize;
+        let rows = (h / BIN_PX).ceil().max(1.0) as usize;
+        let mut cells = vec![Vec::new(); cols * rows];
+        let [_, right, up] = light.basis;
+        for (i, p) in content.particles.iter().enumerate() {
+            let s = f64::from(p.half_size);
+            let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(a, b)| {
+                projection.pixel(p.center + right * (a * s) + up * (b * s) - camera.eye)
+            });
+            // A square reaching behind the eye: every tile (rare).
+            let (x0, y0, x1, y1) = if corners.iter().all(Option::is_some) {
+                let c = corners.map(|c| c.unwrap_or_default());
+                let xs = c.map(|c| c.0);
+                let ys = c.map(|c| c.1);
+                let min = |v: [f64; 4]| v.iter().copied().fold(f64::INFINITY, f64::min);
+                let max = |v: [f64; 4]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                (min(xs) - 1.0, min(ys) - 1.0, max(xs) + 1.0, max(ys) + 1.0)
+            } else if corners.iter().any(Option::is_some) {
+                (0.0, 0.0, w, h)
+            } else {
+                continue;
+            };
+            if x1 < 0.0 || y1 < 0.0 || x0 > w || y0 > h {
+                continue;
+            }
+            let tile = |v: f64, n: usize| ((v.max(0.0) / BIN_PX) as usize).min(n - 1);
+            for ty in tile(y0, rows)..=tile(y1, rows) {
+                for tx in tile(x0, cols)..=tile(x1, cols) {
+                    cells[ty * cols + tx].push(i as u32);
+                }
+            }
+        }
+        Self { cols, cells }
+    }
+
+    /// The particles that may cover pixel point `(x, y)`.
+    fn at(&self, x: f64, y: f64) -> &[u32] {
+        let (tx, ty) = (
+            (x.max(0.0) / BIN_PX) as usize,
+            (y.max(0.0) / BIN_PX) as usize,
+        );
+        let rows = self.cells.len() / self.cols;
+        self.cells
+            .get(ty.min(rows - 1) * self.cols + tx.min(self.cols - 1))
+            .map_or(&[], Vec::as_slice)
     }
 }
 
@@ -809,8 +1030,11 @@ impl Walker<'_> {
 /// Per-picture lighting: the sun, the sky, the medium's fog.
 struct Light {
     sun: DVec3,
+    ambient: f64,
     sky: [f64; 3],
     fog: Option<Fog>,
+    /// The camera's forward, right and up (unit): particles face the camera.
+    basis: [DVec3; 3],
 }
 
 struct Fog {
@@ -834,12 +1058,33 @@ impl Light {
                     density: -transmit.ln() / voxel_render::medium::FOG_BLOCKS,
                 }
             });
+        let f = camera.forward.normalize();
+        let up = if f.y.abs() > 0.999 {
+            DVec3::Z
+        } else {
+            DVec3::Y
+        };
+        let right = f.cross(up).normalize();
         Self {
             sun,
+            ambient,
             sky: shading.sky.map(f64::from),
             fog,
+            basis: [f, right, right.cross(f)],
         }
     }
+}
+
+/// A game surface on a ray.
+#[derive(Clone, Copy, Debug)]
+struct ContentHit {
+    t: f64,
+    /// Lit colour, linear.
+    color: [f64; 3],
+    alpha: f64,
+    opaque: bool,
+    /// (1 particle / 2 entity, index, face): the signature's identity of the surface.
+    id: (u8, u32, u8),
 }
 
 /// Where a ray march and a GPU picture differ.
@@ -917,6 +1162,7 @@ impl RayMarcher {
         let w = width as usize;
         let projection = &Projection::new(camera, width, height);
         let light = &Light::new(self, camera, shading);
+        let bins = &Bins::new(&self.content, camera, projection, light);
         // Rays around a pixel's centre within the edge radius: 32 angles on circles of a
         // quarter, half and the whole radius, dense enough to meet the thin sliver of a
         // face seen at a grazing angle.
@@ -935,18 +1181,20 @@ impl RayMarcher {
                     shading,
                     light,
                     false,
+                    bins.at(x + dx, y + dy),
                 )
             })
         };
         let opaque_end =
             |r: Option<Surface>| r.is_some_and(|s| self.class(s.id) == RenderClass::Opaque);
+        let closed = |r: &RayResult| r.content_end || opaque_end(r.end);
         for i in 0..ray.end.len() {
             // A crack: the GPU drew no opaque surface where opaque geometry closes all
             // around the centre.
             if let Some(depth) = gpu_depth
                 && depth.get(i).is_some_and(|&d| d <= 0.0)
-                && opaque_end(ray.end[i])
-                && ring(i).all(|r| opaque_end(r.end))
+                && (ray.content_end[i] || opaque_end(ray.end[i]))
+                && ring(i).all(|r| closed(&r))
             {
                 c.cracks += 1;
             }
@@ -984,7 +1232,11 @@ impl RayMarcher {
                     diff,
                     ray: [a[0], a[1], a[2]],
                     gpu: [b[0], b[1], b[2]],
-                    surface: describe(ray.end[i]),
+                    surface: if ray.content_end[i] {
+                        "an entity of the game's content".into()
+                    } else {
+                        describe(ray.end[i])
+                    },
                 });
             }
         }

@@ -24,6 +24,22 @@
 //! min = [0, 0, 0]
 //! max = [3, 5, 0]
 //!
+//! [[particles]]                    # a game's particles: camera-facing translucent squares
+//! min = [-6.0, -7.0, -8.0]          # scattered uniformly in this box (world units)
+//! max = [6.0, 2.5, 2.0]
+//! count = 2000                      # at most 1 000 000 in a scene
+//! seed = 7                          # where they fall (default 1)
+//! size = 0.12                       # half side, blocks (default 0.25)
+//! color = [225, 240, 255]           # sRGB
+//! opacity = 0.45                    # in (0, 1)
+//!
+//! [[entities]]                      # a game's entities: boxes at any angle
+//! center = [3.5, 0.2, -3.0]
+//! size = [2.5, 2.5, 2.5]            # full extents, blocks
+//! rotation = [35.0, 25.0, 10.0]     # yaw, pitch, roll in degrees (default none)
+//! color = [150, 220, 235]
+//! opacity = 0.45                    # 1 (default): opaque, else translucent
+//!
 //! [[cameras]]
 //! eye = [0.5, 3.5, 12.0]
 //! target = [0.5, 3.5, 0.0]
@@ -39,6 +55,11 @@
 //! [`voxel_core::vox`] for the mapping of MagicaVoxel's materials). Without `[[cameras]]`,
 //! a scene with models gets [`framing_camera`]'s view of them.
 //!
+//! Particles and entities are not blocks: the renderer draws them through its frame stages
+//! (voxel_render::stages) with the game's own shaders, so every technique composes them
+//! with the world, and the ray march intersects them exactly (squares facing the camera
+//! and boxes, lit as the content's shader lights them).
+//!
 //! A bare `.vox` file is a scene too ([`Scene::load`]): its model with the lowest corner at
 //! the origin, seen by [`framing_camera`].
 
@@ -52,7 +73,9 @@ use voxel_core::{
     BlockDef, BlockRegistry, ChunkPos, PaletteOverride, RenderClass, SiteKind, TerrainConfig,
     TerrainGenerator, VoxFile, VoxPlacement, World, WorldPos,
 };
-use voxel_render::Camera;
+use voxel_render::{Camera, WORLD_EXTENT};
+
+use crate::content::{Content, Entity, rotation};
 
 /// A world with cameras.
 #[derive(Debug, Clone)]
@@ -69,6 +92,9 @@ pub struct Scene {
     pub paths: Vec<Option<DVec3>>,
     /// Output size the scene asks for.
     pub size: Option<(u32, u32)>,
+    /// A game's particles and entities ([`crate::content`]), drawn through the renderer's
+    /// stages.
+    pub content: Content,
 }
 
 impl Scene {
@@ -83,6 +109,7 @@ impl Scene {
             cameras: vec![camera],
             paths: vec![None],
             size: None,
+            content: Content::default(),
         }
     }
 
@@ -242,6 +269,7 @@ pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene, String
         cameras: vec![camera],
         paths: vec![Some(eye + side * 6.0)],
         size: None,
+        content: Content::default(),
     })
 }
 
@@ -260,7 +288,49 @@ struct SceneFile {
     #[serde(default)]
     models: Vec<Spanned<ModelDef>>,
     #[serde(default)]
+    particles: Vec<Spanned<ParticlesDef>>,
+    #[serde(default)]
+    entities: Vec<Spanned<EntityDef>>,
+    #[serde(default)]
     cameras: Vec<Spanned<CameraDef>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ParticlesDef {
+    min: [f64; 3],
+    max: [f64; 3],
+    count: usize,
+    #[serde(default = "default_particle_seed")]
+    seed: u64,
+    #[serde(default = "default_particle_size")]
+    size: f32,
+    color: [u8; 3],
+    opacity: f32,
+}
+
+fn default_particle_seed() -> u64 {
+    1
+}
+
+fn default_particle_size() -> f32 {
+    0.25
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EntityDef {
+    center: [f64; 3],
+    size: [f32; 3],
+    #[serde(default)]
+    rotation: [f64; 3],
+    color: [u8; 3],
+    #[serde(default = "default_entity_opacity")]
+    opacity: f32,
+}
+
+fn default_entity_opacity() -> f32 {
+    1.0
 }
 
 #[derive(Deserialize)]
@@ -619,6 +689,7 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
         }
         s => s.as_ref().map(|s| (s.get_ref()[0], s.get_ref()[1])),
     };
+    let content = content_of(text, &file)?;
     Ok(Scene {
         name: file.name,
         description: file.description,
@@ -626,7 +697,68 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
         cameras,
         paths,
         size,
+        content,
     })
+}
+
+/// Most particles a scene file may ask for, in all: a frame draws each one (36 vertices),
+/// and the ray march bins them per picture.
+pub const MAX_PARTICLES: usize = 1_000_000;
+
+/// The particles and entities of a scene file, checked.
+fn content_of(text: &str, file: &SceneFile) -> Result<Content, String> {
+    let mut content = Content::default();
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite() && x.abs() < WORLD_EXTENT);
+    for p in &file.particles {
+        let (span, d) = (p.span(), p.get_ref());
+        let bad = |why: &str| Err(at_line(text, span.start, format!("particles: {why}")));
+        if !finite(&d.min) || !finite(&d.max) || (0..3).any(|i| d.min[i] > d.max[i]) {
+            return bad("min and max must be finite, inside the world, min not above max");
+        }
+        if content.particles.len() + d.count > MAX_PARTICLES {
+            return bad(&format!("more than {MAX_PARTICLES} particles in all"));
+        }
+        if !(d.size.is_finite() && d.size > 0.0 && d.size <= 64.0) {
+            return bad("size (half a side, blocks) must be above 0 and at most 64");
+        }
+        if !(d.opacity.is_finite() && d.opacity > 0.0 && d.opacity <= 1.0) {
+            return bad("opacity must be above 0 and at most 1");
+        }
+        content.particles.extend(Content::scatter(
+            DVec3::from(d.min),
+            DVec3::from(d.max),
+            d.count,
+            d.seed,
+            d.size,
+            d.color,
+            d.opacity,
+        ));
+    }
+    for e in &file.entities {
+        let (span, d) = (e.span(), e.get_ref());
+        let bad = |why: &str| Err(at_line(text, span.start, format!("entities: {why}")));
+        if !finite(&d.center) || !d.rotation.iter().all(|r| r.is_finite()) {
+            return bad("center and rotation must be finite, the centre inside the world");
+        }
+        if !d
+            .size
+            .iter()
+            .all(|s| s.is_finite() && *s > 0.0 && *s <= 256.0)
+        {
+            return bad("size must be above 0 and at most 256 blocks on each axis");
+        }
+        if !(d.opacity.is_finite() && d.opacity > 0.0 && d.opacity <= 1.0) {
+            return bad("opacity must be above 0 and at most 1 (1: opaque)");
+        }
+        content.entities.push(Entity {
+            center: DVec3::from(d.center),
+            half_extents: d.size.map(|s| s / 2.0),
+            rotation: rotation(d.rotation),
+            color: d.color,
+            opacity: d.opacity,
+        });
+    }
+    Ok(content)
 }
 
 /// Fills a box of blocks (corners inclusive).

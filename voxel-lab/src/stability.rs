@@ -305,7 +305,7 @@ fn flicker_path(
     let mut renderer = make_renderer(ctx, scene, size)?;
     let target = Offscreen::new(ctx, size.0, size.1);
     let weight = default_weight();
-    let path = |renderer: &mut voxel_render::Renderer,
+    let path = |renderer: &mut crate::headless::SceneRenderer,
                 t: Technique|
      -> Result<Vec<voxel_render::Image>, String> {
         // Settle at the start (pipelines, adaptive peeling), then walk the path.

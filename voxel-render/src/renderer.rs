@@ -751,13 +751,23 @@ impl Renderer {
         output: &wgpu::TextureView,
         camera: &Camera,
     ) -> Result<FrameStats> {
+        self.render_and_submit_with(output, camera, &mut NoGame)
+    }
+
+    /// [`Renderer::render_and_submit`] with a game's stages ([`Renderer::render_with`]).
+    pub fn render_and_submit_with(
+        &mut self,
+        output: &wgpu::TextureView,
+        camera: &Camera,
+        game: &mut dyn GameStages,
+    ) -> Result<FrameStats> {
         let mut encoder = self
             .ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("frame"),
             });
-        let stats = self.render(&mut encoder, output, camera)?;
+        let stats = self.render_with(&mut encoder, output, camera, game)?;
         self.ctx.queue.submit([encoder.finish()]);
         self.after_submit();
         Ok(stats)

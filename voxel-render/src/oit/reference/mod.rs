@@ -18,7 +18,9 @@
 //! - **Depth complexity**: a pixel with more than [`MAX_LAYERS`] fragments blends its
 //!   nearest [`MAX_LAYERS`]; it is counted as *capped*, and as *capped visibly* when more
 //!   than half a level (1/510) of light came through the kept layers (then the dropped
-//!   ones could change its 8-bit colour: the picture is not exact there).
+//!   ones could change its 8-bit colour: the picture is not exact there). A list longer
+//!   than [`MAX_WALK`] fragments is walked for its latest [`MAX_WALK`] only, and counts
+//!   as capped visibly.
 
 use wgpu::util::DeviceExt;
 
@@ -42,6 +44,11 @@ pub const INITIAL_NODES_PER_PIXEL: u64 = 4;
 pub const MAX_TILES: u32 = 16;
 /// Fragments a pixel blends at most (its nearest ones).
 pub const MAX_LAYERS: u32 = 128;
+/// Fragments of a pixel's list the resolve walks at most (the latest appended). Lavapipe
+/// (llvmpipe) stops a shader loop silently after about 4 000 iterations, which left pixels
+/// of a dense particle cloud empty; on any GPU an unbounded walk is a stall waiting to
+/// happen. A longer list counts as capped visibly: its picture is not exact.
+pub const MAX_WALK: u32 = 2048;
 
 /// What the A-buffer did in the last frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -109,7 +116,10 @@ const COUNTERS_BYTES: u64 = std::mem::size_of::<Counters>() as u64;
 
 /// WGSL of the constants and types both passes share.
 fn types_wgsl() -> String {
-    let consts = WgslConsts::default().u32("MAX_LAYERS", MAX_LAYERS).finish();
+    let consts = WgslConsts::default()
+        .u32("MAX_LAYERS", MAX_LAYERS)
+        .u32("MAX_WALK", MAX_WALK)
+        .finish();
     consts + include_str!("types.wgsl")
 }
 
