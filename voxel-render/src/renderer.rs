@@ -326,7 +326,7 @@ impl Renderer {
             )));
         }
         let new = self.chunks.get(pos).is_none();
-        self.chunks.upload(&self.ctx, pos, meshes);
+        self.chunks.upload(&self.ctx, pos, meshes)?;
         if new && self.config.fade_in_frames > 0 && self.chunks.get(pos).is_some() {
             self.fading.insert(pos, self.frame_index);
             self.chunks.set_alpha(&self.ctx, pos, 0.0);
@@ -336,13 +336,13 @@ impl Renderer {
 
     /// Removes a chunk from the GPU.
     pub fn remove_chunk(&mut self, pos: ChunkPos) {
-        self.chunks.remove(pos);
+        self.chunks.remove(&self.ctx, pos);
         self.fading.remove(&pos);
     }
 
     /// Removes every chunk.
     pub fn clear_chunks(&mut self) {
-        self.chunks.clear();
+        self.chunks.clear(&self.ctx);
         self.fading.clear();
     }
 
@@ -468,8 +468,10 @@ impl Renderer {
     }
 
     /// Call after submitting a frame's encoder: starts reading its GPU timings (and the
-    /// technique's own counters) back.
+    /// technique's own counters) back, and frees for reuse the arena places the frame
+    /// drew that were freed meanwhile (without this call, the next `render` frees them).
     pub fn after_submit(&mut self) {
+        self.chunks.frame_submitted(&self.ctx);
         if let Some(t) = &mut self.timer {
             t.after_submit();
         }
@@ -498,6 +500,11 @@ impl Renderer {
     /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
     /// encoder that replaces it (the order of commands is kept). Real-time techniques never
     /// submit.
+    ///
+    /// Submit each frame before recording the next: what changes between `render` and
+    /// the submit (chunks uploaded or removed) never changes what this frame draws, and
+    /// the arena places it draws are reused only after [`Renderer::after_submit`] or the
+    /// next `render`.
     pub fn render(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -509,8 +516,10 @@ impl Renderer {
         let start = Instant::now();
         self.post.make_tonemap(&self.ctx, self.config.output_format);
         self.update_fades();
+        // The previous frame is submitted (the contract above): what it drew may be reused.
+        self.chunks.frame_submitted(&self.ctx);
         // Before any list of this frame takes the meshes' places.
-        self.chunks.compact(&self.ctx, encoder);
+        self.chunks.compact(&self.ctx);
         let (w, h) = self.size();
         let aspect = f64::from(w) / f64::from(h);
         let camera = &self.drawn_camera(camera);
@@ -525,6 +534,7 @@ impl Renderer {
         // equal cubes (`voxel_mesh::order`); opaque and cutout meshes grouped by page, front
         // to back (early depth rejection).
         self.chunks.cull(&frustum, &mut self.culled);
+        self.chunks.lists_built();
         // The technique's CPU work (it may reorder quads within their places).
         let view = FrameView {
             camera,
