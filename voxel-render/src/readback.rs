@@ -97,6 +97,7 @@ pub fn read_texture(
     texture: &wgpu::Texture,
     bytes_per_texel: u32,
 ) -> Result<Vec<u8>> {
+    ctx.check_device()?;
     let (w, h) = (texture.width(), texture.height());
     let row = w * bytes_per_texel;
     let padded =
@@ -136,6 +137,7 @@ pub fn read_texture(
 
 /// Maps a `MAP_READ` buffer, waits, and copies its contents out.
 pub fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+    ctx.check_device()?;
     let (tx, rx) = std::sync::mpsc::channel();
     buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);

@@ -182,6 +182,7 @@ impl Renderer {
     /// adapter lacks something: MSAA off without 4× support, a technique it cannot run.
     /// A size beyond the adapter's limits or an invalid setting is an error.
     pub fn new(ctx: &GpuContext, registry: &BlockRegistry, config: RendererConfig) -> Result<Self> {
+        ctx.check_device()?;
         let mut config = config;
         config.width = config.width.max(1);
         config.height = config.height.max(1);
@@ -318,6 +319,7 @@ impl Renderer {
     /// on the GPU fades in when [`RendererConfig::fade_in_frames`] is set. A position
     /// outside the `i32` world ([`ChunkPos::is_valid`]) is an error.
     pub fn upload_chunk(&mut self, pos: ChunkPos, meshes: &ChunkMeshes) -> Result<()> {
+        self.ctx.check_device()?;
         if !pos.is_valid() {
             return Err(Error::InvalidSetting(format!(
                 "chunk position {pos:?} lies outside the i32 world (coordinates {} to {})",
@@ -350,6 +352,7 @@ impl Renderer {
     /// technique's pipelines depend on what changed. An invalid setting is an error and
     /// changes nothing.
     pub fn set_oit_config(&mut self, config: OitConfig) -> Result<()> {
+        self.ctx.check_device()?;
         self.oit.set_config(config)?;
         config_with(&mut self.config.oit, self.oit.config());
         Ok(())
@@ -416,6 +419,7 @@ impl Renderer {
     /// Turns 4× MSAA on or off (rebuilds the opaque pipelines and targets). Without 4×
     /// support it stays off (logged at creation).
     pub fn set_msaa(&mut self, msaa: bool) -> Result<()> {
+        self.ctx.check_device()?;
         let msaa = msaa && self.ctx.caps.msaa4;
         if msaa == self.config.msaa {
             return Ok(());
@@ -437,6 +441,7 @@ impl Renderer {
     /// minimised window) does nothing either and keeps the old targets until a real size
     /// comes. A size beyond the adapter's limit is an error and changes nothing.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        self.ctx.check_device()?;
         if width == 0 || height == 0 || (width, height) == self.size() {
             return Ok(());
         }
@@ -452,14 +457,21 @@ impl Renderer {
         scoped(&self.ctx.device, "resizing", || oit.resize(width, height))?
     }
 
-    /// GPU milliseconds per pass of the latest timed frame (empty without timestamps).
-    /// Needs `device.poll` now and then.
+    /// GPU milliseconds per pass of the latest timed frame (empty without timestamps, and
+    /// once the device is lost). Needs `device.poll` now and then.
     pub fn gpu_times(&mut self) -> GpuTimes {
+        if self.ctx.check_device().is_err() {
+            return GpuTimes::default();
+        }
         self.timer.as_mut().map(Timer::poll).unwrap_or_default()
     }
 
-    /// Like [`Renderer::gpu_times`], but waits for the last submitted frame's results.
+    /// Like [`Renderer::gpu_times`], but waits for the last submitted frame's results
+    /// (empty once the device is lost: nothing will come).
     pub fn gpu_times_blocking(&mut self) -> GpuTimes {
+        if self.ctx.check_device().is_err() {
+            return GpuTimes::default();
+        }
         let ctx = self.ctx.clone();
         self.timer
             .as_mut()
@@ -470,8 +482,12 @@ impl Renderer {
     /// Call after submitting a frame's encoder: starts reading its GPU timings (and the
     /// technique's own counters) back, and frees for reuse the arena places the frame
     /// drew that were freed meanwhile (without this call, the next `render` frees them).
+    /// Does nothing once the device is lost.
     pub fn after_submit(&mut self) {
         self.chunks.frame_submitted(&self.ctx);
+        if self.ctx.check_device().is_err() {
+            return;
+        }
         if let Some(t) = &mut self.timer {
             t.after_submit();
         }
@@ -494,7 +510,7 @@ impl Renderer {
     /// with `RENDER_ATTACHMENT` usage.
     ///
     /// Fails without recording anything on an invalid camera (NaN, zero direction, bad
-    /// planes) or a mismatched output.
+    /// planes), a mismatched output or a lost device ([`Error::DeviceLost`]).
     ///
     /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
     /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
@@ -511,6 +527,7 @@ impl Renderer {
         output: &wgpu::TextureView,
         camera: &Camera,
     ) -> Result<FrameStats> {
+        self.ctx.check_device()?;
         camera.validate()?;
         self.check_output(output)?;
         let start = Instant::now();
