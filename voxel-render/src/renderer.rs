@@ -36,19 +36,25 @@ pub struct RendererConfig {
     /// Output height in pixels, like `width`.
     pub height: u32,
     /// Format of the textures `render` draws into. Default `Rgba8UnormSrgb`, what
-    /// offscreen readback and PNG files want; a window passes its surface format.
+    /// offscreen readback and PNG files want; a window passes its surface format. It
+    /// must be a colour format the tonemap can write: float-sampled (not an integer or
+    /// depth format) and renderable on every adapter; another is an error at
+    /// [`Renderer::new`].
     pub output_format: wgpu::TextureFormat,
     /// 4× MSAA for the opaque and cutout passes. Default off: the translucent pass is
     /// single-sampled anyway (seed 000) and lavapipe pays 4× for it.
     pub msaa: bool,
     /// Transparency settings (technique and each technique's own settings).
     pub oit: OitConfig,
-    /// Direction towards the sun (normalised on use). Default: high in the south-east, so
-    /// that every face direction gets a different brightness.
+    /// Direction towards the sun (normalised on use; a zero vector means straight up).
+    /// Default: high in the south-east, so that every face direction gets a different
+    /// brightness. NaN or infinite components are an error at [`Renderer::new`].
     pub sun_dir: [f32; 3],
-    /// Ambient share of the lighting. Default 0.45: faces away from the sun stay readable.
+    /// Ambient share of the lighting, 0 to 1 (outside, NaN or infinite: an error at
+    /// [`Renderer::new`]). Default 0.45: faces away from the sun stay readable.
     pub ambient: f32,
-    /// Sky colour (linear). Default a light blue.
+    /// Sky colour (linear), each channel finite and at least 0 (else an error at
+    /// [`Renderer::new`]). Default a light blue.
     pub sky: [f32; 3],
     /// How chunk meshes are drawn. Default: indirect (`multi_draw_indirect` per page and
     /// pass), which costs the CPU next to nothing per chunk; adapters without indirect
@@ -144,7 +150,9 @@ struct SceneTargets {
 #[derive(Debug)]
 struct Post {
     tonemap_layout: wgpu::BindGroupLayout,
-    tonemap: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+    /// Per output format: the tonemap, and the same with a depth target, which
+    /// [`Renderer::check_output`] sets in a pass beside the scene depth.
+    tonemap: HashMap<wgpu::TextureFormat, (wgpu::RenderPipeline, wgpu::RenderPipeline)>,
     depth_resolve_layout: wgpu::BindGroupLayout,
     depth_resolve: wgpu::RenderPipeline,
 }
@@ -175,6 +183,10 @@ pub struct Renderer {
     culled: Culled,
     /// The last frame's draw commands (likewise).
     builder: DrawBuilder,
+    /// The last output view that passed [`Renderer::check_output`]'s recorded check, so
+    /// that drawing into the same view again skips it (a window's views are new each
+    /// frame and pay it: about 0.08 ms on this project's 2-core machine).
+    checked_view: Option<wgpu::TextureView>,
 }
 
 impl Renderer {
@@ -187,6 +199,8 @@ impl Renderer {
         config.width = config.width.max(1);
         config.height = config.height.max(1);
         check_size(ctx, config.width, config.height)?;
+        check_output_format(ctx, config.output_format)?;
+        check_lighting(&config)?;
         config.oit.validate()?;
         if config.msaa && !ctx.caps.msaa4 {
             log::warn!("4x MSAA is not supported for the scene formats: rendering without MSAA");
@@ -226,7 +240,8 @@ impl Renderer {
             ),
         };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
-        let post = Post::new(device);
+        let mut post = Post::new(device);
+        post.make_tonemap(ctx, config.output_format);
         let medium = MediumPass::new(device, &layouts);
         let size = (config.width, config.height);
         let targets = SceneTargets::new(ctx, &post, &layouts, &scene, &medium, size, config.msaa);
@@ -258,6 +273,7 @@ impl Renderer {
             fading: PosMap::default(),
             culled: Culled::default(),
             builder: DrawBuilder::default(),
+            checked_view: None,
             config,
         })
     }
@@ -451,6 +467,7 @@ impl Renderer {
             self.targets_for((width, height), self.config.msaa)
         })?;
         self.targets = targets;
+        self.checked_view = None;
         self.config.width = width;
         self.config.height = height;
         let oit = &mut self.oit;
@@ -504,23 +521,26 @@ impl Renderer {
         &self.targets.depth.texture
     }
 
-    /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of a
-    /// whole 2D texture of the renderer's size whose format is
-    /// [`RendererConfig::output_format`] (or its sRGB / linear twin, viewed as that format),
-    /// with `RENDER_ATTACHMENT` usage.
+    /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of
+    /// mip level 0 of a single-layer, single-sample 2D texture of the renderer's size
+    /// with `RENDER_ATTACHMENT` usage, whose format is [`RendererConfig::output_format`]
+    /// (or its sRGB / linear twin, viewed as that format): a 2D view of the whole
+    /// texture (a 2D-array view of its one layer draws the same). Anything else is an
+    /// [`Error::Output`] before anything is recorded.
     ///
     /// Fails without recording anything on an invalid camera (NaN, zero direction, bad
-    /// planes), a mismatched output or a lost device ([`Error::DeviceLost`]).
-    ///
-    /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
-    /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
-    /// encoder that replaces it (the order of commands is kept). Real-time techniques never
-    /// submit.
+    /// planes), a mismatched output ([`Error::Output`]) or a lost device
+    /// ([`Error::DeviceLost`]).
     ///
     /// Submit each frame before recording the next: what changes between `render` and
     /// the submit (chunks uploaded or removed) never changes what this frame draws, and
     /// the arena places it draws are reused only after [`Renderer::after_submit`] or the
     /// next `render`.
+    ///
+    /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
+    /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
+    /// encoder that replaces it (the order of commands is kept). Real-time techniques never
+    /// submit.
     pub fn render(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -531,7 +551,6 @@ impl Renderer {
         camera.validate()?;
         self.check_output(output)?;
         let start = Instant::now();
-        self.post.make_tonemap(&self.ctx, self.config.output_format);
         self.update_fades();
         // The previous frame is submitted (the contract above): what it drew may be reused.
         self.chunks.frame_submitted(&self.ctx);
@@ -658,8 +677,12 @@ impl Renderer {
         Ok(stats)
     }
 
-    /// The output must match what the tonemap pipeline and the targets are made for.
-    fn check_output(&self, output: &wgpu::TextureView) -> Result<()> {
+    /// The output must match what the tonemap pipeline and the targets are made for: the
+    /// texture's size, format, usage, samples, dimension and layers here; what only the
+    /// view knows (its mip level, dimension and format; wgpu does not expose them) by
+    /// recording the tonemap's pass into a throwaway encoder inside an error scope, beside
+    /// the scene depth (the renderer's size, so that a view of another level fails).
+    fn check_output(&mut self, output: &wgpu::TextureView) -> Result<()> {
         let t = output.texture();
         let want = self.config.output_format;
         let (w, h) = self.size();
@@ -679,12 +702,54 @@ impl Renderer {
         if !t.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
             || t.sample_count() != 1
             || t.dimension() != wgpu::TextureDimension::D2
+            || t.depth_or_array_layers() != 1
         {
-            return Err(Error::Output(
-                "must be a single-sample 2D texture with RENDER_ATTACHMENT usage".into(),
-            ));
+            return Err(Error::Output(format!(
+                "must be a single-sample, single-layer 2D texture with RENDER_ATTACHMENT usage \
+                 (this one: {:?}, {} samples, {} layers, {:?})",
+                t.dimension(),
+                t.sample_count(),
+                t.depth_or_array_layers(),
+                t.usage()
+            )));
         }
-        Ok(())
+        if self.checked_view.as_ref() == Some(output) {
+            return Ok(());
+        }
+        let Some((_, check)) = self.post.tonemap.get(&want) else {
+            return Err(Error::Output(format!("no tonemap pipeline for {want:?}")));
+        };
+        let device = &self.ctx.device;
+        let checked = scoped(device, "checking the output view", || {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("output_view_check"),
+            });
+            let color = [gpu::load(output)];
+            // One pass (about 10 µs on lavapipe): the scene depth beside the output fails
+            // on another size, the pipeline on another view format.
+            Pass::new("output_view_check", GpuPass::Tonemap, &color)
+                .depth(Depth::Load(&self.targets.depth.view))
+                .record(&mut encoder, None, |pass| pass.set_pipeline(check));
+            // Never submitted: recording and finishing are what validate.
+            drop(encoder.finish());
+        });
+        if checked.is_ok() {
+            self.checked_view = Some(output.clone());
+        }
+        checked.map_err(|e| {
+            let why = match &e {
+                Error::Gpu { source, .. } => source.to_string(),
+                other => other.to_string(),
+            };
+            Error::Output(format!(
+                "the view must be a 2D view of mip level 0 ({w}x{h}) viewed as {want:?}: {}",
+                why.lines()
+                    .map(str::trim)
+                    .filter(|l| !l.is_empty())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            ))
+        })
     }
 
     /// Advances chunk fade-ins by one frame.
@@ -794,7 +859,7 @@ impl Renderer {
         output: &wgpu::TextureView,
         timer: Option<&Timer>,
     ) {
-        let Some(pipeline) = self.post.tonemap.get(&self.config.output_format) else {
+        let Some((pipeline, _)) = self.post.tonemap.get(&self.config.output_format) else {
             return;
         };
         let colors = [gpu::load(output)];
@@ -809,6 +874,51 @@ impl Renderer {
 /// Copies what the manager holds (technique after fallback) into a renderer's config.
 fn config_with(mine: &mut OitConfig, manager: &OitConfig) {
     mine.clone_from(manager);
+}
+
+/// The output format must be one the tonemap writes: a colour format sampled as float
+/// (the shader writes `vec4<f32>`) that every adapter can render to.
+fn check_output_format(ctx: &GpuContext, format: wgpu::TextureFormat) -> Result<()> {
+    let float = matches!(
+        format.sample_type(None, Some(ctx.caps.features)),
+        Some(wgpu::TextureSampleType::Float { .. })
+    );
+    let renderable = format
+        .guaranteed_format_features(ctx.caps.features)
+        .allowed_usages
+        .contains(wgpu::TextureUsages::RENDER_ATTACHMENT);
+    if !format.has_color_aspect() || format.has_depth_aspect() || !float || !renderable {
+        return Err(Error::InvalidSetting(format!(
+            "output_format {format:?}: the tonemap writes float colour, so it must be a \
+             renderable float colour format (e.g. Rgba8UnormSrgb, Bgra8UnormSrgb, Rgba16Float)"
+        )));
+    }
+    Ok(())
+}
+
+/// Lighting values must be numbers the shaders can use: NaN or infinity would reach
+/// every pixel.
+fn check_lighting(config: &RendererConfig) -> Result<()> {
+    let bad = |m: String| Err(Error::InvalidSetting(m));
+    if !config.sun_dir.iter().all(|v| v.is_finite()) {
+        return bad(format!(
+            "sun_dir {:?}: every component must be finite",
+            config.sun_dir
+        ));
+    }
+    if !(0.0..=1.0).contains(&config.ambient) {
+        return bad(format!(
+            "ambient {}: it must be a share from 0 to 1",
+            config.ambient
+        ));
+    }
+    if !config.sky.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        return bad(format!(
+            "sky {:?}: every channel must be finite and at least 0",
+            config.sky
+        ));
+    }
+    Ok(())
 }
 
 /// A render size must fit the adapter's 2D textures.
@@ -867,20 +977,23 @@ impl Post {
     fn make_tonemap(&mut self, ctx: &GpuContext, format: wgpu::TextureFormat) {
         let layout = &self.tonemap_layout;
         self.tonemap.entry(format).or_insert_with(|| {
-            FullscreenPipeline {
-                label: "tonemap",
-                source: include_str!("shaders/tonemap.wgsl"),
-                fragment_entry: "fs_tonemap",
-                groups: &[Some(layout)],
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-                writes_depth: false,
-                constants: &[("SRGB_ENCODE", if format.is_srgb() { 0.0 } else { 1.0 })],
-            }
-            .build(&ctx.device)
+            let make = |label, writes_depth| {
+                FullscreenPipeline {
+                    label,
+                    source: include_str!("shaders/tonemap.wgsl"),
+                    fragment_entry: "fs_tonemap",
+                    groups: &[Some(layout)],
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                    writes_depth,
+                    constants: &[("SRGB_ENCODE", if format.is_srgb() { 0.0 } else { 1.0 })],
+                }
+                .build(&ctx.device)
+            };
+            (make("tonemap", false), make("tonemap_output_check", true))
         });
     }
 }
