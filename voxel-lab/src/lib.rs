@@ -3,8 +3,9 @@
 //! It has no window: the demo's window and the integration tests both build on it.
 //!
 //! Modules depend on each other one way:
-//! - the model: [`progress`], [`random`] (random scenes as scene-file text), [`edges`]
-//!   (which pixels lie on quad edges), [`summary`], [`metrics`], [`scene`], [`headless`];
+//! - the model: [`limits`] (the documented caps on a run), [`progress`], [`random`]
+//!   (random scenes as scene-file text), [`edges`] (which pixels lie on quad edges),
+//!   [`summary`], [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the
 //!   reference), [`stability`] (sweeps and flicker);
 //! - the report, which reads what the runs produced: [`distribution`] (errors over random
@@ -17,6 +18,7 @@ pub mod distribution;
 pub mod edges;
 pub mod eval;
 pub mod headless;
+pub mod limits;
 pub mod metrics;
 pub mod progress;
 pub mod random;
@@ -44,7 +46,11 @@ pub fn chain(e: &dyn std::error::Error) -> String {
 /// the stability sweeps (when asked) and `report.md`. On random scenes
 /// ([`EvalOptions::random`]) no heat maps, but `distribution.json`, `scenes.json`,
 /// `worst/` and the distribution charts.
+///
+/// Fails before rendering anything when `opts` asks for more than [`limits`] allows, a
+/// scene file is broken or asks for a size past the caps ([`EvalOptions::validate`]).
 pub fn evaluate(ctx: &voxel_render::GpuContext, opts: &EvalOptions) -> Result<Summary, String> {
+    opts.validate()?;
     let out = &opts.out;
     let summary = eval::run_suite(ctx, opts)?;
     summary::write_json(&out.join("summary.json"), &summary.records)?;

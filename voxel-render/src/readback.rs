@@ -102,12 +102,26 @@ pub fn read_texture(
     let row = w * bytes_per_texel;
     let padded =
         row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: u64::from(padded) * u64::from(h),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let size = u64::from(padded) * u64::from(h);
+    // One buffer holds the whole texture: past the adapter's largest buffer (an RGBA16F
+    // 16384² picture is 2 GiB) it is an error, not wgpu's validation panic.
+    let limit = ctx.caps.limits.max_buffer_size;
+    if size > limit {
+        return Err(Error::TooLarge {
+            what: format!("a readback of {w}x{h} pixels of {bytes_per_texel} bytes, in bytes,"),
+            value: size,
+            limit_name: "max_buffer_size",
+            limit,
+        });
+    }
+    let buffer = crate::error::scoped(&ctx.device, "making a readback buffer", || {
+        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    })?;
     let mut encoder = ctx
         .device
         .create_command_encoder(&wgpu::CommandEncoderDescriptor {
