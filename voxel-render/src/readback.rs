@@ -36,17 +36,22 @@ impl Image {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(io)?;
         }
-        let file = std::fs::File::create(path).map_err(io)?;
         let png = |source| Error::PngEncode {
             path: path.to_owned(),
             source,
         };
-        let mut enc = png::Encoder::new(std::io::BufWriter::new(file), self.width, self.height);
+        // Encoded in memory and written in one call whose result is checked: a buffered
+        // file writer dropped at the end would lose the error of its last flush (a full
+        // disk, `/dev/full`).
+        let mut bytes = Vec::new();
+        let mut enc = png::Encoder::new(&mut bytes, self.width, self.height);
         enc.set_color(png::ColorType::Rgba);
         enc.set_depth(png::BitDepth::Eight);
         enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         let mut w = enc.write_header().map_err(png)?;
-        w.write_image_data(&self.rgba).map_err(png)
+        w.write_image_data(&self.rgba).map_err(png)?;
+        w.finish().map_err(png)?;
+        std::fs::write(path, &bytes).map_err(io)
     }
 
     /// Reads an 8-bit PNG (grey, RGB or RGBA; palettes expanded).
@@ -203,6 +208,28 @@ mod tests {
         img.save_png(&path).unwrap();
         assert_eq!(Image::load_png(&path).unwrap(), img);
         let _ = std::fs::remove_file(path);
+    }
+
+    /// Issue 26: a full disk is an error naming the file, not a silent success.
+    #[test]
+    fn a_failed_png_write_is_an_error_naming_the_file() {
+        let img = Image {
+            width: 64,
+            height: 64,
+            rgba: vec![7; 64 * 64 * 4],
+        };
+        let full = Path::new("/dev/full");
+        if full.exists() {
+            let e = img.save_png(full).unwrap_err();
+            assert!(matches!(e, Error::Io { .. }), "{e:?}");
+            assert!(e.to_string().contains("/dev/full"), "{e}");
+        }
+        // A folder where the file should be.
+        let dir = std::env::temp_dir().join(format!("voxel_render_png_dir_{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("x.png")).unwrap();
+        let e = img.save_png(&dir.join("x.png")).unwrap_err();
+        assert!(e.to_string().contains("x.png"), "{e}");
+        let _ = std::fs::remove_dir_all(dir);
     }
 }
 
