@@ -40,6 +40,25 @@ enum Command {
     /// Flies over generated terrain with chunk streaming; writes stream.json (CPU and GPU
     /// time per frame, uploads, memory), frames.json and a chart of CPU ms per frame.
     Stream(StreamArgs),
+    /// One scene (a scene file or a .vox model) under every technique: each picture, its
+    /// FLIP error map against the reference, and gallery.png with all of them.
+    Gallery(GalleryArgs),
+}
+
+#[derive(Args, Debug)]
+struct GalleryArgs {
+    /// Scene file or MagicaVoxel .vox model.
+    #[arg(long)]
+    scene: PathBuf,
+    /// Picture size of each technique.
+    #[arg(long, value_parser = size, default_value = "480x270")]
+    size: (u32, u32),
+    /// Tiles per row of gallery.png.
+    #[arg(long, default_value_t = 3)]
+    columns: usize,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 /// How chunk meshes are drawn: `indirect` or `per-chunk`.
@@ -182,6 +201,9 @@ struct WindowArgs {
     /// Scripted: halve the window, get a zero size, restore it (frames 1 to 3).
     #[arg(long, requires = "frames")]
     resize: bool,
+    /// A scene file or a MagicaVoxel .vox model to show instead of generated terrain.
+    #[arg(long)]
+    scene: Option<PathBuf>,
 }
 
 #[derive(Args, Debug)]
@@ -218,7 +240,7 @@ struct RenderArgs {
     /// Layers of dual depth peeling (even, 2 to 512).
     #[arg(long)]
     layers: Option<u32>,
-    /// Scene file (default: the generated default scene).
+    /// Scene file or MagicaVoxel .vox model (default: the generated default scene).
     #[arg(long)]
     scene: Option<PathBuf>,
     /// Picture size.
@@ -230,6 +252,12 @@ struct RenderArgs {
     /// 4x MSAA for the opaque and cutout passes.
     #[arg(long)]
     msaa: bool,
+    /// Ambient-occlusion strength, 0 (off) to 1.
+    #[arg(long, default_value_t = 1.0)]
+    ao_strength: f32,
+    /// Every block one flat colour (what the lab compares with its CPU ray march).
+    #[arg(long)]
+    flat_textures: bool,
     /// Timed frames (after one untimed), 1 to 1000; the medians are printed.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(voxel_lab::limits::MAX_FRAMES)), default_value_t = 1)]
     frames: u32,
@@ -240,7 +268,8 @@ struct RenderArgs {
 
 #[derive(Args, Debug)]
 struct EvalArgs {
-    /// Scene files or folders (default: the suite in scenes/).
+    /// Scene files (.toml), MagicaVoxel models (.vox) or folders of them (default: the
+    /// suite in scenes/).
     #[arg(long, num_args = 1..)]
     scenes: Vec<PathBuf>,
     /// Random scenes instead of scene files: N scenes (1 to 100000) drawn from --seed;
@@ -304,6 +333,7 @@ fn main() {
         Some(Command::Render(a)) => render(a),
         Some(Command::Eval(a)) => eval(a),
         Some(Command::Stream(a)) => stream(a),
+        Some(Command::Gallery(a)) => gallery(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e}");
@@ -410,6 +440,8 @@ fn render(a: RenderArgs) -> Result<(), String> {
         width,
         height,
         msaa: a.msaa,
+        ao_strength: a.ao_strength,
+        flat_textures: a.flat_textures,
         ..RendererConfig::default()
     };
     config.oit.technique = a.technique;
@@ -677,6 +709,26 @@ fn stream(a: StreamArgs) -> Result<(), String> {
     Ok(())
 }
 
+/// Renders one scene with every technique and writes the pictures, error maps and sheet.
+fn gallery(a: GalleryArgs) -> Result<(), String> {
+    writable_dir(&a.out)?;
+    let scene = scene::Scene::load(&a.scene)?;
+    let ctx = headless::context()?;
+    println!("adapter: {}; scene: {}", ctx.caps.adapter_name, scene.name);
+    let entries = voxel_lab::gallery::render(&ctx, &scene, a.size)?;
+    voxel_lab::gallery::write(&a.out, &entries, a.columns)?;
+    for e in &entries {
+        println!(
+            "{:<16} FLIP {:.4}  max error {}/255",
+            e.technique.name(),
+            e.metrics.flip_mean,
+            e.metrics.max_abs_err
+        );
+    }
+    println!("wrote {}", a.out.join("gallery.png").display());
+    Ok(())
+}
+
 /// Opens the interactive demo.
 fn window(a: WindowArgs) -> Result<(), String> {
     demo::app::run(demo::app::DemoOptions {
@@ -690,6 +742,8 @@ fn window(a: WindowArgs) -> Result<(), String> {
         heatmap: a.heatmap,
         edit: a.edit,
         resize: a.resize,
+        // Read before the window opens: a broken file is an error, not an empty window.
+        scene: a.scene.as_deref().map(scene::Scene::load).transpose()?,
     })
 }
 

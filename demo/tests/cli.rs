@@ -355,3 +355,75 @@ fn bad_scene_files_are_refused_before_rendering() {
     );
     let _ = std::fs::remove_dir_all(out);
 }
+
+#[test]
+fn a_broken_vox_model_is_named_before_rendering() {
+    let dir = std::env::temp_dir().join(format!("demo-cli-vox-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("broken.vox");
+    // "VOX ", version 200, then a MAIN chunk declaring more children than the file holds.
+    let mut bytes = b"VOX \xc8\0\0\0MAIN".to_vec();
+    bytes.extend([0, 0, 0, 0, 0, 0, 1, 0]);
+    std::fs::write(&bad, &bytes).unwrap();
+    let out = dir.join("x.png");
+    let (bad_s, out_s) = (bad.to_str().unwrap(), out.to_str().unwrap());
+    fails_saying(
+        &["render", "--scene", bad_s, "--out", out_s],
+        &["broken.vox", "chunk MAIN", "past the end"],
+    );
+    fails_saying(
+        &["window", "--scene", bad_s, "--frames", "1"],
+        &["broken.vox", "past the end"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `demo render --scene X.vox` draws a bare MagicaVoxel model from its default camera (on
+/// lavapipe; skipped loudly without an adapter unless `CI` is set).
+#[test]
+fn a_bare_vox_model_renders_from_its_default_camera() {
+    if voxel_render::GpuContext::headless(wgpu::Backends::VULKAN).is_err() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI is set but no Vulkan adapter"
+        );
+        eprintln!("\n!!!! SKIPPING: no Vulkan adapter !!!!\n");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("demo-cli-vox-ok-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("chapel.png");
+    let model = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/vox/chapel.vox");
+    let out = demo(&[
+        "render",
+        "--scene",
+        model,
+        "--technique",
+        "sorted-quads",
+        "--size",
+        "160x90",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("scene: chapel"), "{stdout}");
+    let img = voxel_render::Image::load_png(&png).unwrap();
+    // The model is in the frame: pixels far from the sky's colour (11 % when this test was
+    // written: the camera frames the bounding box, whose garden corner is mostly empty).
+    let sky = img.pixel(0, 0);
+    let model_px = (0..img.height)
+        .flat_map(|y| (0..img.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let p = img.pixel(x, y);
+            (0..3).any(|c| p[c].abs_diff(sky[c]) > 40)
+        })
+        .count();
+    let share = model_px as f64 / f64::from(img.width * img.height);
+    assert!(share > 0.08, "the model covers {share:.2} of the picture");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -3,6 +3,8 @@
 
 #![allow(clippy::unwrap_used, clippy::missing_panics_doc)] // test support: panics are failures
 
+pub mod vox_models;
+
 use std::path::PathBuf;
 use std::sync::Arc;
 

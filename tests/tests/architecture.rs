@@ -19,6 +19,7 @@ const LAB: &[&str] = &[
     "progress",
     "random",
     "edges",
+    "raymarch",
     "summary",
     "metrics",
     "scene",
@@ -29,6 +30,7 @@ const LAB: &[&str] = &[
     "charts",
     "report",
     "stream",
+    "gallery",
 ];
 
 /// The module each item re-exported by lib.rs (`pub use module::{A, B};`) comes from.

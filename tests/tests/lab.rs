@@ -45,6 +45,17 @@ fn small_eval_of_the_suite() {
             c.max_abs_err
         );
         assert_eq!(c.lost_fragments, 0, "{}: A-buffer lost fragments", c.scene);
+        // The CPU ray march (no mesh, no rasteriser) agrees with the A-buffer to 1/255 on
+        // every pixel off geometric edges, and no background shows through closed geometry.
+        let r = &c.raymarch;
+        assert_eq!(
+            (r.differing, r.cracks),
+            (0, 0),
+            "{}: the ray march differs from the A-buffer off edges (max {}/255): {:?}",
+            c.scene,
+            r.max_abs_err_off_edges,
+            r.worst
+        );
         assert!(c.exact, "{}: the reference is not exact", c.scene);
     }
     assert!(

@@ -47,7 +47,7 @@ fn same_quads(a: &ChunkMeshes, b: &ChunkMeshes) -> bool {
 
 fn serial_mesh(world: &World, p: ChunkPos) -> ChunkMeshes {
     let mut m = Mesher::new(world.registry());
-    m.mesh(world.chunk(p).expect("loaded"), world.neighbours(p))
+    m.mesh(world.chunk(p).expect("loaded"), world.neighbourhood(p))
         .expect("known")
 }
 
@@ -86,7 +86,7 @@ fn border_edit_remeshes_both_chunks_and_matches_a_fresh_mesh() {
     for (pos, m) in &meshes {
         // The edited chunks mesh exactly like chunks rebuilt from scratch.
         let fresh = rebuilt(world.chunk(*pos).expect("loaded"));
-        let nb = world.neighbours(*pos);
+        let nb = world.neighbourhood(*pos);
         let expect = Mesher::new(world.registry())
             .mesh(&fresh, nb)
             .expect("known");

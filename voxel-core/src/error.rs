@@ -44,6 +44,14 @@ pub enum Error {
     /// More blocks than a 16-bit id can name.
     #[error("the registry is full (65536 blocks)")]
     TooManyBlocks,
+    /// A MagicaVoxel file that cannot be imported: which file, and what is wrong with it.
+    #[error("{file}: {error}")]
+    Vox {
+        /// The file (or model) name.
+        file: String,
+        /// What is wrong.
+        error: crate::vox::VoxError,
+    },
 }
 
 /// `Result` with this crate's [`Error`] as the default error.

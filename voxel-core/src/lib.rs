@@ -1,5 +1,7 @@
 //! Blocks, chunks and worlds of the voxel OIT renderer, and a deterministic noise terrain.
 //!
+//! [`vox`] imports MagicaVoxel models into a [`World`].
+//!
 //! Nothing here knows about the GPU: `voxel-mesh` and `voxel-render` build on these types.
 //! Coordinates: `y` is up; a chunk is [`CHUNK_SIZE`]³ blocks; world block coordinates are `i32`.
 
@@ -7,6 +9,7 @@ mod block;
 mod chunk;
 mod error;
 mod terrain;
+pub mod vox;
 mod world;
 
 pub use block::{BlockDef, BlockId, BlockRegistry, RenderClass, blocks};
@@ -16,4 +19,5 @@ pub use chunk::{
 };
 pub use error::{Error, Result};
 pub use terrain::{Site, SiteKind, TerrainConfig, TerrainGenerator};
-pub use world::{ChunkPos, Face, World, WorldPos};
+pub use vox::{PaletteOverride, VoxError, VoxFile, VoxPlacement};
+pub use world::{ChunkPos, Face, Neighbourhood, World, WorldPos, touched_neighbours};

@@ -132,14 +132,121 @@ impl ChunkPos {
 
     /// The adjacent chunk across `face`, or `None` past the edge of the `i32` world.
     pub fn neighbour(self, face: Face) -> Option<ChunkPos> {
-        let n = face.normal();
+        self.offset(face.normal())
+    }
+
+    /// The chunk `d` chunks away, or `None` past the edge of the `i32` world.
+    pub fn offset(self, d: [i32; 3]) -> Option<ChunkPos> {
         let p = ChunkPos::new(
-            self.x.checked_add(n[0])?,
-            self.y.checked_add(n[1])?,
-            self.z.checked_add(n[2])?,
+            self.x.checked_add(d[0])?,
+            self.y.checked_add(d[1])?,
+            self.z.checked_add(d[2])?,
         );
         p.is_valid().then_some(p)
     }
+}
+
+/// The 26 chunks around a chunk, by offset (each component -1, 0 or 1, not all 0): its 6
+/// face, 12 edge and 8 corner neighbours. `None` counts as air. Face neighbours decide which
+/// faces a chunk shows; ambient occlusion at a chunk's edges and corners also reads the
+/// blocks of the edge and corner neighbours that touch it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Neighbourhood<'a> {
+    /// By `(dx + 1) * 9 + (dy + 1) * 3 + (dz + 1)`; the centre (13) stays `None`.
+    chunks: [Option<&'a Chunk>; 27],
+}
+
+impl<'a> Neighbourhood<'a> {
+    /// The 26 offsets, faces first (in [`Face`] order), then edges, then corners.
+    pub const OFFSETS: [[i32; 3]; 26] = {
+        let mut out = [[0; 3]; 26];
+        let faces = [
+            [1, 0, 0],
+            [-1, 0, 0],
+            [0, 1, 0],
+            [0, -1, 0],
+            [0, 0, 1],
+            [0, 0, -1],
+        ];
+        let mut n = 0;
+        while n < 6 {
+            out[n] = faces[n];
+            n += 1;
+        }
+        // Then the offsets with two non-zero components (edges), then three (corners).
+        let mut nonzero = 2;
+        while nonzero <= 3 {
+            let mut i = 0;
+            while i < 27 {
+                let d = [i / 9 - 1, i / 3 % 3 - 1, i % 3 - 1];
+                if (d[0] != 0) as i32 + (d[1] != 0) as i32 + (d[2] != 0) as i32 == nonzero {
+                    out[n] = d;
+                    n += 1;
+                }
+                i += 1;
+            }
+            nonzero += 1;
+        }
+        out
+    };
+
+    fn index(d: [i32; 3]) -> Option<usize> {
+        let ok = d.iter().all(|v| (-1..=1).contains(v)) && d != [0; 3];
+        ok.then(|| ((d[0] + 1) * 9 + (d[1] + 1) * 3 + (d[2] + 1)) as usize)
+    }
+
+    /// Each neighbour from `get(offset)`.
+    pub fn from_fn(mut get: impl FnMut([i32; 3]) -> Option<&'a Chunk>) -> Self {
+        let mut n = Self::default();
+        for d in Self::OFFSETS {
+            if let Some(i) = Self::index(d) {
+                n.chunks[i] = get(d);
+            }
+        }
+        n
+    }
+
+    /// Only the six face neighbours (in [`Face`] order); edges and corners count as air.
+    pub fn faces(faces: [Option<&'a Chunk>; 6]) -> Self {
+        Self::from_fn(|d| {
+            Face::ALL
+                .iter()
+                .position(|f| f.normal() == d)
+                .and_then(|i| faces[i])
+        })
+    }
+
+    /// The neighbour at offset `d`; `None` for air, the centre, or an offset beyond one
+    /// chunk.
+    pub fn get(&self, d: [i32; 3]) -> Option<&'a Chunk> {
+        Self::index(d).and_then(|i| self.chunks[i])
+    }
+
+    /// The face neighbour across `face`.
+    pub fn face(&self, face: Face) -> Option<&'a Chunk> {
+        self.get(face.normal())
+    }
+}
+
+impl<'a> From<[Option<&'a Chunk>; 6]> for Neighbourhood<'a> {
+    fn from(faces: [Option<&'a Chunk>; 6]) -> Self {
+        Self::faces(faces)
+    }
+}
+
+/// The neighbours (offsets of [`Neighbourhood::OFFSETS`]) whose meshes depend on the block
+/// at local `local` of a chunk: a block on a chunk's face touches that face neighbour, on
+/// an edge also the edge neighbour, on a corner also the corner neighbours (ambient
+/// occlusion reads diagonal blocks).
+pub fn touched_neighbours(local: [usize; 3]) -> impl Iterator<Item = [i32; 3]> {
+    let last = CHUNK_SIZE - 1;
+    Neighbourhood::OFFSETS.into_iter().filter(move |d| {
+        (0..3).all(|a| match d[a] {
+            1 => local[a] == last,
+            -1 => local[a] == 0,
+            _ => true,
+        })
+    })
 }
 
 /// A sparse world of chunks over one block registry. Chunks are shared (`Arc`): cloning a
@@ -203,19 +310,8 @@ impl World {
         let old = Arc::make_mut(self.chunks.entry(c).or_default()).set(x, y, z, id)?;
         if old != id {
             self.dirty.insert(c);
-            let last = CHUNK_SIZE - 1;
-            for (face, on_border) in [
-                (Face::PosX, x == last),
-                (Face::NegX, x == 0),
-                (Face::PosY, y == last),
-                (Face::NegY, y == 0),
-                (Face::PosZ, z == last),
-                (Face::NegZ, z == 0),
-            ] {
-                if let Some(n) = c
-                    .neighbour(face)
-                    .filter(|n| on_border && self.chunks.contains_key(n))
-                {
+            for d in touched_neighbours([x, y, z]) {
+                if let Some(n) = c.offset(d).filter(|n| self.chunks.contains_key(n)) {
                     self.dirty.insert(n);
                 }
             }
@@ -293,10 +389,12 @@ impl World {
         old
     }
 
+    /// Marks `pos` and its loaded neighbours (all 26: ambient occlusion reads diagonal
+    /// blocks) dirty.
     fn mark_with_neighbours(&mut self, pos: ChunkPos) {
         self.dirty.insert(pos);
-        for face in Face::ALL {
-            if let Some(n) = pos.neighbour(face).filter(|n| self.chunks.contains_key(n)) {
+        for d in Neighbourhood::OFFSETS {
+            if let Some(n) = pos.offset(d).filter(|n| self.chunks.contains_key(n)) {
                 self.dirty.insert(n);
             }
         }
@@ -363,9 +461,9 @@ impl World {
         self.chunks.values().map(|c| c.packed_index_bytes()).sum()
     }
 
-    /// The six neighbours of `pos` in [`Face`] order; `None` where not loaded.
-    pub fn neighbours(&self, pos: ChunkPos) -> [Option<&Chunk>; 6] {
-        Face::ALL.map(|f| pos.neighbour(f).and_then(|n| self.chunk(n)))
+    /// The 26 chunks around `pos` (what the mesher needs); `None` where not loaded.
+    pub fn neighbourhood(&self, pos: ChunkPos) -> Neighbourhood<'_> {
+        Neighbourhood::from_fn(|d| pos.offset(d).and_then(|n| self.chunk(n)))
     }
 
     /// All loaded chunks, in no particular order.
@@ -495,6 +593,50 @@ mod tests {
     }
 
     #[test]
+    fn edge_and_corner_edits_dirty_the_diagonal_neighbours() {
+        let mut w = world();
+        for d in Neighbourhood::OFFSETS.into_iter().chain([[0; 3]]) {
+            w.insert_chunk(ChunkPos::new(d[0], d[1], d[2]), Chunk::default())
+                .unwrap();
+        }
+        w.take_dirty();
+        // On the +x face only: the chunk and its +x neighbour.
+        w.set_block(WorldPos::new(31, 5, 5), STONE).unwrap();
+        assert_eq!(w.take_dirty().len(), 2);
+        // On the +x/-z edge: + the -z and the (+x, -z) edge neighbour.
+        w.set_block(WorldPos::new(31, 5, 0), STONE).unwrap();
+        let dirty = w.take_dirty();
+        assert_eq!(dirty.len(), 4, "{dirty:?}");
+        assert!(dirty.contains(&ChunkPos::new(1, 0, -1)));
+        // On the (-x, +y, +z) corner: all 7 chunks that touch it, and the chunk.
+        w.set_block(WorldPos::new(0, 31, 31), STONE).unwrap();
+        let dirty = w.take_dirty();
+        assert_eq!(dirty.len(), 8, "{dirty:?}");
+        assert!(dirty.contains(&ChunkPos::new(-1, 1, 1)));
+        assert_eq!(touched_neighbours([0, 31, 31]).count(), 7);
+        assert_eq!(touched_neighbours([4, 31, 31]).count(), 3);
+        assert_eq!(touched_neighbours([4, 4, 4]).count(), 0);
+    }
+
+    #[test]
+    fn neighbourhood_offsets_are_the_26_around_a_chunk() {
+        let set: HashSet<[i32; 3]> = Neighbourhood::OFFSETS.into_iter().collect();
+        assert_eq!(set.len(), 26);
+        assert!(!set.contains(&[0, 0, 0]));
+        for (i, f) in Face::ALL.iter().enumerate() {
+            assert_eq!(Neighbourhood::OFFSETS[i], f.normal());
+        }
+        let stone = Chunk::uniform(STONE);
+        let n = Neighbourhood::faces([Some(&stone), None, None, None, None, None]);
+        assert!(n.face(Face::PosX).is_some());
+        assert!(n.get([1, 1, 0]).is_none());
+        assert!(n.get([0, 0, 0]).is_none());
+        assert!(n.get([2, 0, 0]).is_none());
+        let all = Neighbourhood::from_fn(|_| Some(&stone));
+        assert!(Neighbourhood::OFFSETS.iter().all(|&d| all.get(d).is_some()));
+    }
+
+    #[test]
     fn insert_and_remove_dirty_neighbours() {
         let mut w = world();
         w.insert_chunk(ChunkPos::new(0, 0, 0), Chunk::default())
@@ -511,10 +653,11 @@ mod tests {
             w.take_dirty(),
             vec![ChunkPos::new(0, 0, 0), ChunkPos::new(0, 1, 0)]
         );
+        let around = w.neighbourhood(ChunkPos::new(0, 0, 0));
         assert!(
-            w.neighbours(ChunkPos::new(0, 0, 0))
+            Neighbourhood::OFFSETS
                 .iter()
-                .all(Option::is_none)
+                .all(|&d| around.get(d).is_none())
         );
     }
 

@@ -42,7 +42,7 @@ impl Edges {
         let mut mesher = Mesher::new(world.registry());
         let mut segments = Vec::new();
         for (pos, chunk) in world.iter() {
-            let Ok(meshes) = mesher.mesh(chunk, world.neighbours(pos)) else {
+            let Ok(meshes) = mesher.mesh(chunk, world.neighbourhood(pos)) else {
                 continue;
             };
             let o = DVec3::from(pos.origin().map(|v| v as f64));

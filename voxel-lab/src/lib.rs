@@ -5,23 +5,27 @@
 //! Modules depend on each other one way:
 //! - the model: [`limits`] (the documented caps on a run), [`progress`], [`random`]
 //!   (random scenes as scene-file text), [`edges`] (which pixels lie on quad edges),
+//!   [`raymarch`] (the CPU ray-march reference),
 //!   [`summary`], [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the
 //!   reference), [`stability`] (sweeps and flicker);
 //! - the report, which reads what the runs produced: [`distribution`] (errors over random
 //!   scenes, where each technique fails), [`charts`], [`report`];
 //! - [`evaluate`] here, which runs everything and writes every file;
-//! - [`stream`]: the streaming flight (`demo stream`), which draws its own chart.
+//! - [`stream`]: the streaming flight (`demo stream`), which draws its own chart;
+//! - [`gallery`]: one scene under every technique with its error maps (`demo gallery`).
 
 pub mod charts;
 pub mod distribution;
 pub mod edges;
 pub mod eval;
+pub mod gallery;
 pub mod headless;
 pub mod limits;
 pub mod metrics;
 pub mod progress;
 pub mod random;
+pub mod raymarch;
 pub mod report;
 pub mod scene;
 pub mod stability;

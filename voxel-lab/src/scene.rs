@@ -1,7 +1,8 @@
 //! Scenes: a world and the cameras to look at it with, from generated terrain, from a
-//! hand-written TOML file, or built in code.
+//! hand-written TOML file, from a MagicaVoxel `.vox` file, or built in code.
 //!
-//! The file format (every key but `name` and one camera is optional):
+//! The file format (every key but `name` and one camera is optional; the camera too when
+//! the scene has models):
 //!
 //! ```toml
 //! name = "Stained-glass corridor"
@@ -31,6 +32,15 @@
 //! far = 1000.0
 //! path_to = [6.5, 3.5, 12.0]        # the flicker test moves the eye here in 60 frames
 //! ```
+//!
+//! Boxes and models are applied in the order the file lists them (terrain first); a
+//! model's voxels set blocks, its empty cells leave what was there. Each palette entry a
+//! model uses becomes a block type named after the file (`harbour#165`; see
+//! [`voxel_core::vox`] for the mapping of MagicaVoxel's materials). Without `[[cameras]]`,
+//! a scene with models gets [`framing_camera`]'s view of them.
+//!
+//! A bare `.vox` file is a scene too ([`Scene::load`]): its model with the lowest corner at
+//! the origin, seen by [`framing_camera`].
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -39,7 +49,8 @@ use glam::DVec3;
 use serde::Deserialize;
 use toml::Spanned;
 use voxel_core::{
-    BlockDef, BlockRegistry, ChunkPos, SiteKind, TerrainConfig, TerrainGenerator, World, WorldPos,
+    BlockDef, BlockRegistry, ChunkPos, PaletteOverride, RenderClass, SiteKind, TerrainConfig,
+    TerrainGenerator, VoxFile, VoxPlacement, World, WorldPos,
 };
 use voxel_render::Camera;
 
@@ -76,12 +87,98 @@ impl Scene {
     }
 
     /// Reads a scene file (at most [`crate::limits::MAX_SCENE_FILE_BYTES`]: a longer
-    /// file, or an endless one like `/dev/zero`, is an error after that many bytes).
-    /// Errors name the file, the line and the field.
+    /// file, or an endless one like `/dev/zero`, is an error after that many bytes), or a
+    /// bare `.vox` model ([`Scene::from_vox`]). Errors name the file, the line and the
+    /// field.
     pub fn load(path: &Path) -> Result<Self, String> {
+        if is_vox(path) {
+            return Self::from_vox(path);
+        }
         let text = read_limited(path, crate::limits::MAX_SCENE_FILE_BYTES)?;
-        parse(&text).map_err(|e| format!("{}:{}", path.display(), e))
+        let dir = path.parent().unwrap_or(Path::new(""));
+        parse_in(&text, dir).map_err(|e| format!("{}:{}", path.display(), e))
     }
+
+    /// A MagicaVoxel model as a scene: its blocks with the lowest corner at the origin
+    /// (palette entries as its materials say), seen by [`framing_camera`]. Named after the
+    /// file. Errors name the file and what is wrong with it.
+    pub fn from_vox(path: &Path) -> Result<Self, String> {
+        let file = VoxFile::load(path).map_err(|e| e.to_string())?;
+        let name = model_name(path);
+        let mut registry = BlockRegistry::default();
+        let blocks = file
+            .register_blocks(&name, &[], &mut registry)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut world = World::new(Arc::new(registry));
+        let placed = file
+            .place(&name, &blocks, VoxPlacement::default(), &mut world)
+            .map_err(|e| format!("{}: {e}", path.display()))?
+            .ok_or_else(|| format!("{}: the file places no voxels", path.display()))?;
+        let (camera, path_to) = framing_camera(placed.0, placed.1)?;
+        let mut scene = Scene::new(&name, world, camera);
+        scene.description = format!(
+            "MagicaVoxel model {}",
+            path.file_name()
+                .map_or(name.clone(), |f| f.to_string_lossy().into_owned())
+        );
+        scene.paths = vec![Some(path_to)];
+        Ok(scene)
+    }
+}
+
+/// Whether `path` names a MagicaVoxel file (by its extension).
+pub fn is_vox(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|x| x.eq_ignore_ascii_case("vox"))
+}
+
+/// The name a model's blocks and scene take: the file's stem.
+fn model_name(path: &Path) -> String {
+    path.file_stem()
+        .map_or_else(|| "model".to_owned(), |s| s.to_string_lossy().into_owned())
+}
+
+/// The default view of the blocks `min..=max` (inclusive): a three-quarter view from above,
+/// as MagicaVoxel opens a model: from the front right (MagicaVoxel's front, its −y, is our
+/// +z), 35° above the horizon, looking at the box's centre from just far enough that the
+/// whole box lies within 92 % of a 60° field of view both ways (so any picture at least as
+/// wide as high shows all of it). Also returns where the flicker test moves the eye: 10°
+/// further round the box.
+pub fn framing_camera(min: WorldPos, max: WorldPos) -> Result<(Camera, DVec3), String> {
+    let lo = DVec3::new(f64::from(min.x), f64::from(min.y), f64::from(min.z));
+    let hi = DVec3::new(f64::from(max.x), f64::from(max.y), f64::from(max.z)) + DVec3::ONE;
+    let centre = (lo + hi) * 0.5;
+    let (fov, elevation) = (60.0f64, 35.0f64.to_radians());
+    let direction = |azimuth: f64| {
+        DVec3::new(
+            azimuth.sin() * elevation.cos(),
+            elevation.sin(),
+            azimuth.cos() * elevation.cos(),
+        )
+    };
+    let d = direction(45.0f64.to_radians());
+    let right = DVec3::Y.cross(d).normalize();
+    let up = d.cross(right);
+    // A corner c (from the centre) is in view when |c·up| and |c·right| stay within
+    // tan(fov/2) times its depth, distance − c·d.
+    let tan = (fov * 0.5).to_radians().tan() * 0.92;
+    let mut distance: f64 = 1.0;
+    for k in 0..8 {
+        let pick = |bit: i32, a: f64, b: f64| if k & bit == 0 { a } else { b };
+        let c = DVec3::new(
+            pick(1, lo.x, hi.x),
+            pick(2, lo.y, hi.y),
+            pick(4, lo.z, hi.z),
+        ) - centre;
+        let spread = c.dot(up).abs().max(c.dot(right).abs());
+        distance = distance.max(c.dot(d) + spread / tan);
+    }
+    let radius = (hi - lo).length() * 0.5;
+    let eye = centre + d * distance;
+    let camera = Camera::look_at(eye, centre, fov, 0.1, distance + 2.0 * radius + 16.0)
+        .map_err(|e| e.to_string())?;
+    let path_to = centre + direction(55.0f64.to_radians()) * distance;
+    Ok((camera, path_to))
 }
 
 /// The text of `path`, reading at most `limit` bytes: more is an error naming the file
@@ -180,7 +277,29 @@ struct SceneFile {
     blocks: Vec<Spanned<BlockDefFile>>,
     #[serde(default)]
     boxes: Vec<Spanned<BoxDef>>,
+    #[serde(default)]
+    models: Vec<Spanned<ModelDef>>,
+    #[serde(default)]
     cameras: Vec<Spanned<CameraDef>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ModelDef {
+    file: Spanned<String>,
+    #[serde(default)]
+    at: [i32; 3],
+    rotate: Option<Spanned<i64>>,
+    #[serde(default)]
+    palette: Vec<Spanned<PaletteDef>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PaletteDef {
+    index: Spanned<i64>,
+    class: Spanned<String>,
+    opacity: Option<f32>,
 }
 
 #[derive(Deserialize)]
@@ -273,8 +392,70 @@ fn field_at(text: &str, at: usize) -> String {
     }
 }
 
-/// Parses the text of a scene file; errors read `LINE: field: message`.
+/// Parses the text of a scene file; errors read `LINE: field: message`. Model files are
+/// found relative to the working folder; [`parse_in`] names another.
 pub fn parse(text: &str) -> Result<Scene, String> {
+    parse_in(text, Path::new(""))
+}
+
+/// What a `[[models.palette]]` entry asks for, checked.
+fn palette_override(text: &str, p: &Spanned<PaletteDef>) -> Result<PaletteOverride, String> {
+    let d = p.get_ref();
+    let index = u8::try_from(*d.index.get_ref())
+        .ok()
+        .filter(|i| *i >= 1)
+        .ok_or_else(|| {
+            at_line(
+                text,
+                d.index.span().start,
+                format!(
+                    "models.palette.index: {} is not a colour index (1 to 255)",
+                    d.index.get_ref()
+                ),
+            )
+        })?;
+    let class = match d.class.get_ref().as_str() {
+        "opaque" => RenderClass::Opaque,
+        "cutout" => RenderClass::Cutout,
+        "translucent" => RenderClass::Translucent,
+        other => {
+            return Err(at_line(
+                text,
+                d.class.span().start,
+                format!(
+                    "models.palette.class: {other:?} is not a class: opaque, cutout or translucent"
+                ),
+            ));
+        }
+    };
+    let opacity = match (class, d.opacity) {
+        (RenderClass::Translucent, Some(a)) if a.is_finite() && a > 0.0 && a < 1.0 => a,
+        (RenderClass::Translucent, _) => {
+            return Err(at_line(
+                text,
+                p.span().start,
+                "models.palette.opacity: a translucent entry needs an opacity above 0 and below 1",
+            ));
+        }
+        (_, None) => 1.0,
+        (_, Some(1.0)) => 1.0,
+        (_, Some(_)) => {
+            return Err(at_line(
+                text,
+                p.span().start,
+                "models.palette.opacity: only a translucent entry has an opacity below 1",
+            ));
+        }
+    };
+    Ok(PaletteOverride {
+        index,
+        class,
+        opacity,
+    })
+}
+
+/// [`parse`], with model files found relative to `dir` (the scene file's folder).
+pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
     let file: SceneFile = toml::from_str(text).map_err(|e| match e.span() {
         Some(s) => {
             let field = field_at(text, s.start);
@@ -294,6 +475,53 @@ pub fn parse(text: &str) -> Result<Scene, String> {
         registry
             .register(BlockDef::new(def.name.clone(), def.color, def.opacity))
             .map_err(|e| at_line(text, span.start, format!("blocks: {e}")))?;
+    }
+    // Models are read (and their block types registered) before the world exists: the
+    // world's registry is fixed once it is made.
+    let mut models = Vec::new();
+    let mut voxels: i128 = 0;
+    for m in &file.models {
+        let (span, def) = (m.span(), m.get_ref());
+        let path = dir.join(def.file.get_ref());
+        let line = def.file.span().start;
+        let vox =
+            VoxFile::load(&path).map_err(|e| at_line(text, line, format!("models.file: {e}")))?;
+        voxels += i128::from(vox.voxel_count());
+        if voxels > MAX_BOX_BLOCKS {
+            return Err(at_line(
+                text,
+                span.start,
+                format!("models: more than {MAX_BOX_BLOCKS} voxels in all"),
+            ));
+        }
+        let turns = match &def.rotate {
+            None => 0,
+            Some(r) if r.get_ref().rem_euclid(90) == 0 => (r.get_ref().rem_euclid(360) / 90) as u8,
+            Some(r) => {
+                return Err(at_line(
+                    text,
+                    r.span().start,
+                    format!(
+                        "models.rotate: {} is not a multiple of 90 degrees",
+                        r.get_ref()
+                    ),
+                ));
+            }
+        };
+        let overrides = def
+            .palette
+            .iter()
+            .map(|p| palette_override(text, p))
+            .collect::<Result<Vec<_>, _>>()?;
+        let name = model_name(&path);
+        let blocks = vox
+            .register_blocks(&name, &overrides, &mut registry)
+            .map_err(|e| at_line(text, span.start, format!("models: {}: {e}", path.display())))?;
+        let placement = VoxPlacement {
+            at: def.at,
+            quarter_turns: turns,
+        };
+        models.push((span.start, path, vox, blocks, placement));
     }
     let registry = Arc::new(registry);
     let mut world = match &file.terrain {
@@ -325,8 +553,59 @@ pub fn parse(text: &str) -> Result<Scene, String> {
         None => World::new(registry.clone()),
     };
     let mut filled: i128 = 0;
+    // Boxes and models in the order the file lists them.
+    enum Item<'a> {
+        Box(&'a Spanned<BoxDef>),
+        Model(usize),
+    }
+    let mut items: Vec<(usize, Item<'_>)> = file
+        .boxes
+        .iter()
+        .map(|b| (b.span().start, Item::Box(b)))
+        .chain(
+            models
+                .iter()
+                .enumerate()
+                .map(|(i, m)| (m.0, Item::Model(i))),
+        )
+        .collect();
+    items.sort_by_key(|(at, _)| *at);
+    let mut model_bounds: Option<(WorldPos, WorldPos)> = None;
+    // Chunks the boxes and models touch, bounded like the blocks they fill.
     let mut touched: i128 = 0;
-    for b in &file.boxes {
+    let chunks_between = |lo: [i32; 3], hi: [i32; 3]| {
+        let chunk = |v: i32| i128::from(v.div_euclid(voxel_core::CHUNK_SIZE as i32));
+        (0..3)
+            .map(|i| chunk(hi[i]) - chunk(lo[i]) + 1)
+            .product::<i128>()
+    };
+    for (_, item) in items {
+        let b = match item {
+            Item::Box(b) => b,
+            Item::Model(i) => {
+                let (at, path, vox, blocks, placement) = &models[i];
+                let placed = vox
+                    .place(&path.display().to_string(), blocks, *placement, &mut world)
+                    .map_err(|e| at_line(text, *at, format!("models: {e}")))?;
+                if let Some((lo, hi)) = placed {
+                    touched += chunks_between([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]);
+                    if touched > MAX_BOX_CHUNKS {
+                        return Err(at_line(
+                            text,
+                            *at,
+                            format!(
+                                "models: boxes and models touch more than {MAX_BOX_CHUNKS} chunks in all"
+                            ),
+                        ));
+                    }
+                    let (mut a, mut b) = model_bounds.unwrap_or((lo, hi));
+                    (a.x, a.y, a.z) = (a.x.min(lo.x), a.y.min(lo.y), a.z.min(lo.z));
+                    (b.x, b.y, b.z) = (b.x.max(hi.x), b.y.max(hi.y), b.z.max(hi.z));
+                    model_bounds = Some((a, b));
+                }
+                continue;
+            }
+        };
         let (span, def) = (b.span(), b.get_ref());
         let id = registry
             .id(def.block.get_ref())
@@ -348,10 +627,7 @@ pub fn parse(text: &str) -> Result<Scene, String> {
                 format!("boxes: more than {MAX_BOX_BLOCKS} blocks in all"),
             ));
         }
-        let chunk = |v: i32| i128::from(v.div_euclid(voxel_core::CHUNK_SIZE as i32));
-        touched += (0..3)
-            .map(|i| chunk(def.max[i]) - chunk(def.min[i]) + 1)
-            .product::<i128>();
+        touched += chunks_between(def.min, def.max);
         if touched > MAX_BOX_CHUNKS {
             return Err(at_line(
                 text,
@@ -362,11 +638,15 @@ pub fn parse(text: &str) -> Result<Scene, String> {
         fill_box(&mut world, def.min, def.max, id)
             .map_err(|e| at_line(text, span.start, format!("boxes: {e}")))?;
     }
-    if file.cameras.is_empty() {
-        return Err("1: cameras: a scene needs at least one [[cameras]] entry".into());
-    }
     let mut cameras = Vec::new();
     let mut paths = Vec::new();
+    if file.cameras.is_empty() {
+        let (lo, hi) = model_bounds
+            .ok_or("1: cameras: a scene needs at least one [[cameras]] entry (or a model)")?;
+        let (camera, path_to) = framing_camera(lo, hi)?;
+        cameras.push(camera.in_medium(world.medium_at(camera.eye.to_array())));
+        paths.push(Some(path_to));
+    }
     for c in &file.cameras {
         let (span, d) = (c.span(), c.get_ref());
         let camera = Camera::look_at(
@@ -421,16 +701,16 @@ pub fn fill_box(
         .map_err(|e| e.to_string())
 }
 
-/// The scene files of a folder, sorted.
+/// The scene files of a folder (`.toml` scenes and bare `.vox` models), sorted.
 pub fn scene_files(dir: &Path) -> Result<Vec<PathBuf>, String> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| format!("{}: {e}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml") || is_vox(p))
         .collect();
     v.sort();
     if v.is_empty() {
-        return Err(format!("{}: no .toml scene files", dir.display()));
+        return Err(format!("{}: no .toml or .vox scene files", dir.display()));
     }
     Ok(v)
 }
@@ -472,6 +752,49 @@ path_to = [3.0, 1.0, 10.0]
             s.world.get_block(WorldPos::new(4, 2, 0)),
             voxel_core::BlockId::AIR
         );
+    }
+
+    #[test]
+    fn the_framing_camera_shows_the_whole_box_tightly() {
+        for (min, max) in [
+            ([0, 0, 0], [0, 0, 0]),
+            ([0, 0, 0], [63, 23, 55]),
+            ([-40, 5, 7], [300, 9, 12]),
+            ([0, 0, 0], [3, 200, 3]),
+        ] {
+            let (lo, hi) = (
+                WorldPos::new(min[0], min[1], min[2]),
+                WorldPos::new(max[0], max[1], max[2]),
+            );
+            let (cam, path_to) = framing_camera(lo, hi).unwrap();
+            // The renderer's own projection, square: every corner inside, one near an edge.
+            let vp = cam.view_proj(1.0);
+            let mut widest = 0.0f32;
+            for k in 0..8 {
+                let pick =
+                    |bit: i32, a: i32, b: i32| f64::from(if k & bit == 0 { a } else { b + 1 });
+                let c = DVec3::new(
+                    pick(1, min[0], max[0]),
+                    pick(2, min[1], max[1]),
+                    pick(4, min[2], max[2]),
+                ) - cam.eye;
+                let p = vp * c.as_vec3().extend(1.0);
+                let ndc = p.truncate() / p.w;
+                assert!(p.w > 0.0 && ndc.z > 0.0 && ndc.z < 1.0, "{min:?}: {ndc}");
+                assert!(ndc.x.abs() <= 0.93 && ndc.y.abs() <= 0.93, "{min:?}: {ndc}");
+                widest = widest.max(ndc.x.abs()).max(ndc.y.abs());
+            }
+            assert!(widest > 0.85, "{min:?}..{max:?}: framed loosely ({widest})");
+            // From above, and the flicker path stays as far from the box.
+            assert!(cam.forward.y < -0.5);
+            let centre = DVec3::new(
+                f64::from(min[0] + max[0] + 1),
+                f64::from(min[1] + max[1] + 1),
+                f64::from(min[2] + max[2] + 1),
+            ) * 0.5;
+            let (a, b) = ((cam.eye - centre).length(), (path_to - centre).length());
+            assert!((a - b).abs() < 1e-6 * a);
+        }
     }
 
     #[test]

@@ -6,8 +6,10 @@
 //!
 //! Fairness: binary-greedy-meshing gets its input ready-made (the padded 34³ array and the
 //! opaque/transparent column masks its `fast_mesh` expects a chunk to maintain), outside the
-//! timed region. Ours is timed from our chunk storage and the six neighbour chunks, with all
-//! neighbour lookups inside the timed region, and it produces three meshes instead of one.
+//! timed region. Ours is timed from our chunk storage and the 26 neighbour chunks, with all
+//! neighbour lookups inside the timed region, and it produces three meshes instead of one,
+//! with per-vertex ambient occlusion (which binary-greedy-meshing does not compute); ours
+//! without ambient occlusion is timed in the same rounds.
 //!
 //! Ours is timed twice in the same rounds: from the mask form (the mesher's input, as
 //! stored), and from the packed form (the compact resident form: the mesher builds the
@@ -25,12 +27,24 @@ use block_mesh::ndshape::{ConstShape, ConstShape3u32};
 use block_mesh::{
     GreedyQuadsBuffer, MergeVoxel, RIGHT_HANDED_Y_UP_CONFIG, Voxel, VoxelVisibility, greedy_quads,
 };
+use voxel_core::Neighbourhood;
 use voxel_core::blocks::{GLASS, LEAVES, WATER};
 use voxel_core::{
     BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Face, MaskBuffer, RenderClass,
     TerrainConfig, TerrainGenerator, World, blocks,
 };
-use voxel_mesh::{ChunkMeshes, Mesher, mesh_chunks};
+use voxel_mesh::{ChunkMeshes, MeshOptions, Mesher, mesh_chunks};
+
+/// The mesher without ambient occlusion (the peer of "ours" with it).
+fn without_ao(reg: &BlockRegistry) -> Mesher {
+    Mesher::with_options(
+        reg,
+        MeshOptions {
+            ambient_occlusion: false,
+            ..MeshOptions::default()
+        },
+    )
+}
 
 const CS: usize = 32;
 type Bgm = bgm::Mesher<CS>;
@@ -91,7 +105,10 @@ fn padded_block(c: &Chunk, nb: &[Option<Chunk>], p: [i32; 3]) -> BlockId {
 
 fn prepare(reg: &BlockRegistry, world: &World, pos: ChunkPos) -> Case {
     let chunk = world.chunk(pos).expect("generated").clone();
-    let neighbours: Vec<Option<Chunk>> = world.neighbours(pos).iter().map(|c| c.cloned()).collect();
+    let neighbours: Vec<Option<Chunk>> = Face::ALL
+        .iter()
+        .map(|f| world.neighbourhood(pos).face(*f).cloned())
+        .collect();
     let _ = &chunk;
     let transparents: BTreeSet<u16> = reg
         .iter()
@@ -149,7 +166,11 @@ fn pick_cases(reg: &BlockRegistry, generator: &TerrainGenerator) -> (World, Vec<
     let registry = Arc::new(reg.clone());
     let mut world = World::new(registry);
     for p in &positions {
-        for q in Face::ALL.iter().filter_map(|f| p.neighbour(*f)).chain([*p]) {
+        for q in Neighbourhood::OFFSETS
+            .iter()
+            .filter_map(|d| p.offset(*d))
+            .chain([*p])
+        {
             if world.chunk(q).is_none() {
                 world
                     .insert_chunk(q, generator.generate_chunk(q))
@@ -196,22 +217,27 @@ fn main() {
 
 fn mesher_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[Case]) {
     let mut ours = Mesher::new(reg);
+    let mut plain = without_ao(reg);
     let mut out = ChunkMeshes::default();
     let mut theirs = Bgm::new();
     let mut bm_buf = GreedyQuadsBuffer::new(Padded::SIZE as usize);
     let n = cases.len() as f64;
 
     // Output sizes, once.
-    let (mut q_ours, mut q_split, mut q_bgm, mut q_bm) = (0, [0; 3], 0, 0);
+    let (mut q_ours, mut q_split, mut q_bgm, mut q_bm, mut q_plain) = (0, [0; 3], 0, 0, 0);
     for c in cases {
         let chunk = world.chunk(c.pos).expect("generated");
-        ours.mesh_into(chunk, world.neighbours(c.pos), &mut out)
+        plain
+            .mesh_into(chunk, world.neighbourhood(c.pos), &mut out)
+            .expect("known blocks");
+        q_plain += out.len();
+        ours.mesh_into(chunk, world.neighbourhood(c.pos), &mut out)
             .expect("known blocks");
         q_ours += out.len();
         let from_masks = out.clone();
         ours.mesh_into(
             packed.chunk(c.pos).expect("generated"),
-            packed.neighbours(c.pos),
+            packed.neighbourhood(c.pos),
             &mut out,
         )
         .expect("known blocks");
@@ -234,11 +260,12 @@ fn mesher_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[C
         q_bm += bm_buf.quads.num_quads();
     }
     println!(
-        "quads per chunk: ours {:.0} (opaque {:.0} / cutout {:.0} / translucent {:.0}), binary-greedy-meshing {:.0}, block-mesh {:.0}",
+        "quads per chunk: ours {:.0} (opaque {:.0} / cutout {:.0} / translucent {:.0}; without AO {:.0}), binary-greedy-meshing {:.0}, block-mesh {:.0}",
         q_ours as f64 / n,
         q_split[0] as f64 / n,
         q_split[1] as f64 / n,
         q_split[2] as f64 / n,
+        q_plain as f64 / n,
         q_bgm as f64 / n,
         q_bm as f64 / n
     );
@@ -249,12 +276,13 @@ fn mesher_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[C
         .filter(|(_, d)| matches!(d.class, RenderClass::Cutout | RenderClass::Translucent))
         .map(|(id, _)| id.0)
         .collect();
-    let mut times: [Vec<f64>; 5] = Default::default();
+    const METHODS: usize = 6;
+    let mut times: [Vec<f64>; METHODS] = Default::default();
     for round in 0..ROUNDS {
         // The order rotates every round, so that no mesher always runs cold right after
         // another one's sweep through memory.
-        for k in 0..5 {
-            let method = (round + k) % 5;
+        for k in 0..METHODS {
+            let method = (round + k) % METHODS;
             // block-mesh is ~20× slower: a third of the rounds is plenty.
             if method == 3 && round % 3 != 0 {
                 continue;
@@ -264,13 +292,20 @@ fn mesher_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[C
                 match method {
                     0 => {
                         let chunk = world.chunk(c.pos).expect("generated");
-                        ours.mesh_into(black_box(chunk), world.neighbours(c.pos), &mut out)
+                        ours.mesh_into(black_box(chunk), world.neighbourhood(c.pos), &mut out)
                             .expect("known blocks");
                         black_box(&out);
                     }
                     4 => {
                         let chunk = packed.chunk(c.pos).expect("generated");
-                        ours.mesh_into(black_box(chunk), packed.neighbours(c.pos), &mut out)
+                        ours.mesh_into(black_box(chunk), packed.neighbourhood(c.pos), &mut out)
+                            .expect("known blocks");
+                        black_box(&out);
+                    }
+                    5 => {
+                        let chunk = world.chunk(c.pos).expect("generated");
+                        plain
+                            .mesh_into(black_box(chunk), world.neighbourhood(c.pos), &mut out)
                             .expect("known blocks");
                         black_box(&out);
                     }
@@ -305,19 +340,24 @@ fn mesher_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[C
             times[method].push(secs(t.elapsed()) / n);
         }
     }
-    let [t_ours, t_bgm_fast, t_bgm_mesh, t_bm, t_packed] = times;
+    let [t_ours, t_bgm_fast, t_bgm_mesh, t_bm, t_packed, t_plain] = times;
     let us = |v: Vec<f64>| median(v) * 1e6;
     let (ours_us, fast_us, mesh_us, bm_us) = (us(t_ours), us(t_bgm_fast), us(t_bgm_mesh), us(t_bm));
-    let packed_us = us(t_packed);
+    let (packed_us, plain_us) = (us(t_packed), us(t_plain));
     println!("\n## mesher (µs per 32^3 chunk, median of {ROUNDS} interleaved rounds)");
-    println!("ours (three meshes, from chunk storage + 6 neighbours) {ours_us:9.1}");
+    println!("ours with AO (three meshes, chunk storage + 26 neighbours) {ours_us:5.1}");
+    println!("ours without AO                                       {plain_us:9.1}");
     println!("binary-greedy-meshing 0.5 fast_mesh (input prepared)  {fast_us:9.1}");
     println!("binary-greedy-meshing 0.5 mesh (BTreeSet transparents) {mesh_us:8.1}");
     println!("block-mesh 0.2 greedy_quads                           {bm_us:9.1}");
-    println!("ours, packed chunk + 6 packed neighbours (masks built) {packed_us:9.1}");
+    println!("ours with AO, packed chunk + packed neighbours (masks built) {packed_us:3.1}");
     println!(
-        "ratio ours / binary-greedy-meshing fast_mesh = {:.3} (target <= 0.8)",
+        "ratio ours with AO / binary-greedy-meshing fast_mesh = {:.3} (target <= 1.0)",
         ours_us / fast_us
+    );
+    println!(
+        "ratio ours without AO / binary-greedy-meshing fast_mesh = {:.3}",
+        plain_us / fast_us
     );
     println!(
         "ratio ours packed / binary-greedy-meshing fast_mesh = {:.3}",
@@ -362,7 +402,7 @@ fn packed_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[C
                     }
                     4 => {
                         chunk.unpack();
-                        ours.mesh_into(black_box(&*chunk), packed.neighbours(c.pos), &mut out)
+                        ours.mesh_into(black_box(&*chunk), packed.neighbourhood(c.pos), &mut out)
                             .expect("known blocks");
                         chunk.pack();
                         black_box(&out);
@@ -373,7 +413,7 @@ fn packed_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[C
                     _ => (world, world),
                 };
                 let chunk = centre.chunk(c.pos).expect("generated");
-                ours.mesh_into(black_box(chunk), nb.neighbours(c.pos), &mut out)
+                ours.mesh_into(black_box(chunk), nb.neighbourhood(c.pos), &mut out)
                     .expect("known blocks");
                 black_box(&out);
             }
@@ -497,6 +537,20 @@ fn storage_and_terrain_section(reg: &BlockRegistry, generator: &TerrainGenerator
         median(t_total),
         quads,
         translucent
+    );
+    // The same world meshed without ambient occlusion: what AO costs in quads (faces merge
+    // only with faces of equal corner values).
+    let mut plain = without_ao(reg);
+    let mut plain_quads = 0;
+    for (p, chunk) in world.iter() {
+        plain_quads += plain
+            .mesh(chunk, world.neighbourhood(p))
+            .expect("known blocks")
+            .len();
+    }
+    println!(
+        "quads with AO / without on the 2048-chunk world: {quads} / {plain_quads} = {:.3} (target <= 1.5)",
+        quads as f64 / plain_quads as f64
     );
 
     storage_section(&world);

@@ -4,16 +4,30 @@
 /// lowest row first, as wide as the run, then as tall as the rows below repeat it.
 /// Calls `emit(row, rows, bit, bits)` per rectangle and leaves `rows` all zero.
 #[inline]
-pub fn greedy_rects(rows: &mut [u32; 32], mut emit: impl FnMut(usize, usize, usize, usize)) {
+pub fn greedy_rects(rows: &mut [u32; 32], emit: impl FnMut(usize, usize, usize, usize)) {
     // Most planes are empty: a vectorised OR finds out before any per-row work.
     if rows.iter().fold(0, |acc, &r| acc | r) == 0 {
         return;
     }
-    // Rows still holding bits, one bit each, so that empty rows cost nothing below.
-    let mut live = rows
-        .iter()
+    greedy_rects_live(rows, live_rows(rows), emit);
+}
+
+/// One bit per row of `rows` that holds any bit.
+#[inline]
+pub(crate) fn live_rows(rows: &[u32; 32]) -> u32 {
+    rows.iter()
         .enumerate()
-        .fold(0u32, |acc, (r, &bits)| acc | u32::from(bits != 0) << r);
+        .fold(0u32, |acc, (r, &bits)| acc | u32::from(bits != 0) << r)
+}
+
+/// [`greedy_rects`] when the caller knows which rows hold bits (`live`, one bit per row):
+/// empty rows cost nothing.
+#[inline]
+pub(crate) fn greedy_rects_live(
+    rows: &mut [u32; 32],
+    mut live: u32,
+    mut emit: impl FnMut(usize, usize, usize, usize),
+) {
     while live != 0 {
         let r = live.trailing_zeros() as usize;
         live &= live - 1;
@@ -39,6 +53,28 @@ pub fn greedy_rects(rows: &mut [u32; 32], mut emit: impl FnMut(usize, usize, usi
             emit(r, h, b0 as usize, w as usize);
         }
     }
+}
+
+/// Transposes a 32×32 bit matrix: bit `c` of row `r` becomes bit `r` of row `c`.
+pub fn transpose32(rows: &[u32; 32]) -> [u32; 32] {
+    let mut a = *rows;
+    // Swap ever smaller blocks across the diagonal (Hacker's Delight 7-3, with bit 0 as the
+    // first column): the upper-right block of each 2j × 2j square with the lower-left one.
+    let mut j = 16;
+    let mut m: u32 = 0x0000_ffff;
+    while j != 0 {
+        let mut k = 0;
+        while k < 32 {
+            // Row k's high j bits of each 2j group against row k + j's low j bits.
+            let t = ((a[k] >> j) ^ a[k + j]) & m;
+            a[k] ^= t << j;
+            a[k + j] ^= t;
+            k = (k + j + 1) & !j;
+        }
+        j >>= 1;
+        m ^= m << j;
+    }
+    a
 }
 
 #[cfg(test)]
@@ -77,6 +113,22 @@ mod tests {
                 assert_eq!(cover, a);
                 assert_eq!(rows, [0; 32]);
             }
+        }
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)] // (row, bit) indices read as the matrix they are
+    fn transpose_moves_every_bit_across_the_diagonal() {
+        let mut s = 5;
+        for _ in 0..20 {
+            let a: [u32; 32] = std::array::from_fn(|_| lcg(&mut s));
+            let t = transpose32(&a);
+            for r in 0..32 {
+                for c in 0..32 {
+                    assert_eq!(a[r] >> c & 1, t[c] >> r & 1, "({r}, {c})");
+                }
+            }
+            assert_eq!(transpose32(&t), a);
         }
     }
 

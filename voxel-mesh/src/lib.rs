@@ -1,13 +1,15 @@
 //! Chunk mesher of the voxel OIT renderer: splits every chunk's visible faces into opaque,
 //! cutout and translucent meshes of 8-byte packed quads, culling against neighbour chunks.
 //!
-//! - [`Mesher`]: one chunk with its neighbours → [`ChunkMeshes`] (binary greedy meshing).
+//! - [`Mesher`]: one chunk with its neighbours → [`ChunkMeshes`] (binary greedy meshing),
+//!   with per-vertex ambient occlusion ([`ao`]).
 //! - [`PackedQuad`]: the 8-byte quad format the renderer expands in its vertex shader.
 //! - [`mesh_dirty`]: remesh a world's dirty chunks in parallel with rayon.
 //! - [`order`]: exact back-to-front order of a chunk's translucent quads, re-sorted only
 //!   when the eye crosses a trigger plane; exact chunk order.
 //! - [`sort`]: back-to-front ordering of translucent quads and chunks for a camera.
 
+pub mod ao;
 mod bits;
 mod mesher;
 pub mod order;
@@ -15,9 +17,11 @@ mod quad;
 pub mod sort;
 mod world;
 
+pub use ao::AO_NONE;
 pub use bits::greedy_rects;
-pub use mesher::{ChunkMeshes, Mesher, Neighbours};
+pub use mesher::{ChunkMeshes, MeshOptions, Mesher, Neighbours};
 pub use quad::{FLAG_INTERFACE, PackedQuad, Quad, UV_AXES};
+pub use voxel_core::Neighbourhood;
 pub use world::{mesh_chunks, mesh_dirty};
 
 use voxel_core::BlockId;

@@ -34,6 +34,12 @@
 //! direction are full (one 32×32 quad each), and its border layers are meshed against the
 //! neighbours like any other.
 //!
+//! Ambient occlusion ([`crate::ao`]): every opaque and cutout face gets per-vertex
+//! occlusion from the opaque blocks around its corners, across chunk borders too (the
+//! edge and corner neighbours of a [`Neighbourhood`] included), and merges only with faces
+//! of the same four corner values. Translucent faces take none (see
+//! [`MeshOptions::translucent_occlusion`]).
+//!
 //! Greedy merging is applied to all three meshes. For cutout and translucent blocks it is
 //! as correct as for opaque ones: texture coordinates come from world position, so a merged
 //! quad shows the same texels as the unit faces it replaces, and coverage is identical. It
@@ -41,11 +47,12 @@
 //! depth peeling are per pixel and do not care.
 
 use voxel_core::{
-    BlockId, BlockRegistry, CHUNK_AREA, CHUNK_SIZE, Chunk, ColumnMask, Face, MaskBuffer, Occupancy,
-    RenderClass, row_index,
+    BlockId, BlockRegistry, CHUNK_AREA, CHUNK_SIZE, Chunk, ColumnMask, Face, LayerMask, MaskBuffer,
+    Neighbourhood, Occupancy, RenderClass, row_index,
 };
 
-use crate::bits::greedy_rects;
+use crate::ao::{AO_NONE, Buckets, Pad, split_by_ao};
+use crate::bits::{greedy_rects_live, live_rows};
 use crate::{Error, PackedQuad, Result};
 
 /// The quads of one chunk, split by the pass that draws them.
@@ -86,8 +93,31 @@ impl ChunkMeshes {
     }
 }
 
-/// The neighbours of a chunk in [`Face`] order (`[+x, -x, +y, -y, +z, -z]`); `None` is air.
+/// The face neighbours of a chunk in [`Face`] order (`[+x, -x, +y, -y, +z, -z]`); `None`
+/// is air. Converts into a [`Neighbourhood`] whose edge and corner neighbours are air.
 pub type Neighbours<'a> = [Option<&'a Chunk>; 6];
+
+/// What the mesher computes besides the faces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MeshOptions {
+    /// Per-vertex ambient occlusion of opaque and cutout faces. Default on: without it one-block
+    /// steps of terrain cannot be seen (a top face is lit like the one below it). Off, quads
+    /// merge as they did before (no occlusion bits), for comparisons.
+    pub ambient_occlusion: bool,
+    /// Ambient occlusion of translucent faces too. Default off: measured on the benchmark's
+    /// terrain it adds translucent quads (which `sorted-quads` sorts every time the eye
+    /// crosses a plane) for a shading no one reads through water or glass; see the README.
+    pub translucent_occlusion: bool,
+}
+
+impl Default for MeshOptions {
+    fn default() -> Self {
+        Self {
+            ambient_occlusion: true,
+            translucent_occlusion: false,
+        }
+    }
+}
 
 type Plane = [u32; CHUNK_SIZE];
 
@@ -120,9 +150,23 @@ struct Split<'a> {
 #[derive(Clone)]
 pub struct Mesher {
     classes: Vec<RenderClass>,
+    options: MeshOptions,
     s: Box<Scratch>,
     /// A packed centre's masks.
     built: MaskBuffer,
+    /// Opaque blocks of the chunk and the shell around it, for ambient occlusion.
+    pad: Box<Pad>,
+    /// Faces of one plane grouped by their occlusion.
+    buckets: Buckets,
+    /// An edge neighbour's touching layer, per type.
+    edge_layers: Vec<(BlockId, LayerMask)>,
+}
+
+/// Where a plane's faces go: the mesh, and (with ambient occlusion) the occluders of the
+/// chunk with the scratch to group faces by them.
+struct Sink<'a> {
+    out: &'a mut Vec<PackedQuad>,
+    ao: Option<(&'a Pad, &'a mut Buckets)>,
 }
 
 impl std::fmt::Debug for Mesher {
@@ -145,7 +189,8 @@ fn or_into(dst: &mut [u32], src: &[u32]) {
 }
 
 /// Emits the rectangles covering the faces in `rows` (layer `layer` of `face`) as quads
-/// with `flags`.
+/// with `flags`; with ambient occlusion, faces an occluder touches are grouped by their
+/// corner values first and each group covered on its own.
 #[inline]
 fn emit_plane(
     rows: &mut Plane,
@@ -153,15 +198,45 @@ fn emit_plane(
     layer: usize,
     block: BlockId,
     flags: u32,
+    sink: &mut Sink<'_>,
+) {
+    let occluders = sink
+        .ao
+        .as_ref()
+        .and_then(|(pad, _)| pad.occluders(face, layer));
+    if let (Some(occ), Some((_, buckets))) = (occluders, sink.ao.as_mut()) {
+        let out = &mut *sink.out;
+        split_by_ao(rows, occ, face.axis(), buckets, |ao, live, plane| {
+            cover(plane, live, face, layer, block, flags, ao, out);
+        });
+    }
+    if rows.iter().fold(0, |acc, &r| acc | r) != 0 {
+        let live = live_rows(rows);
+        cover(rows, live, face, layer, block, flags, AO_NONE, sink.out);
+    }
+}
+
+/// Covers the faces in `rows` (whose rows holding any are `live`) with rectangles, emitted
+/// as quads.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn cover(
+    rows: &mut Plane,
+    live: u32,
+    face: Face,
+    layer: usize,
+    block: BlockId,
+    flags: u32,
+    ao: u8,
     out: &mut Vec<PackedQuad>,
 ) {
-    greedy_rects(rows, |r, h, b, w| {
+    greedy_rects_live(rows, live, |r, h, b, w| {
         let q = match face.axis() {
             0 => PackedQuad::new([layer, b, r], w, h, face, block),
             1 => PackedQuad::new([b, layer, r], h, w, face, block),
             _ => PackedQuad::new([b, r, layer], w, h, face, block),
         };
-        out.push(q.with_flags(flags));
+        out.push(q.with_flags(flags).with_ao(ao));
     });
 }
 
@@ -174,7 +249,7 @@ fn emit_split(
     face: Face,
     layer: usize,
     block: BlockId,
-    out: &mut Vec<PackedQuad>,
+    sink: &mut Sink<'_>,
 ) {
     if rows.iter().all(|&r| r == 0) {
         return;
@@ -184,10 +259,17 @@ fn emit_split(
         let mut flagged: Plane = std::array::from_fn(|r| rows[r] & next[r]);
         if flagged.iter().any(|&r| r != 0) {
             rows.iter_mut().zip(&flagged).for_each(|(r, f)| *r &= !f);
-            emit_plane(&mut flagged, face, layer, block, crate::FLAG_INTERFACE, out);
+            emit_plane(
+                &mut flagged,
+                face,
+                layer,
+                block,
+                crate::FLAG_INTERFACE,
+                sink,
+            );
         }
     }
-    emit_plane(rows, face, layer, block, 0, out);
+    emit_plane(rows, face, layer, block, 0, sink);
 }
 
 const EMPTY_OCCUPANCY: Occupancy = Occupancy {
@@ -196,10 +278,20 @@ const EMPTY_OCCUPANCY: Occupancy = Occupancy {
 };
 
 impl Mesher {
-    /// A mesher for chunks whose ids come from `registry`.
+    /// A mesher for chunks whose ids come from `registry`, with the default
+    /// [`MeshOptions`] (ambient occlusion on).
     pub fn new(registry: &BlockRegistry) -> Self {
+        Self::with_options(registry, MeshOptions::default())
+    }
+
+    /// A mesher with `options`.
+    pub fn with_options(registry: &BlockRegistry, options: MeshOptions) -> Self {
         Self {
             classes: registry.iter().map(|(_, d)| d.class).collect(),
+            options,
+            pad: Pad::new(),
+            buckets: Buckets::new(),
+            edge_layers: Vec::new(),
             s: Box::new(Scratch {
                 opaque: EMPTY_OCCUPANCY,
                 hide: EMPTY_OCCUPANCY,
@@ -219,8 +311,19 @@ impl Mesher {
             .ok_or(Error::UnknownBlock(id))
     }
 
-    /// Meshes `chunk` against its `neighbours`.
-    pub fn mesh(&mut self, chunk: &Chunk, neighbours: Neighbours<'_>) -> Result<ChunkMeshes> {
+    /// The options this mesher was made with.
+    pub fn options(&self) -> MeshOptions {
+        self.options
+    }
+
+    /// Meshes `chunk` against its `neighbours`: a [`Neighbourhood`] (what
+    /// [`voxel_core::World::neighbourhood`] gives), or the six face neighbours alone
+    /// ([`Neighbours`]; edges and corners then count as air for ambient occlusion).
+    pub fn mesh<'n>(
+        &mut self,
+        chunk: &Chunk,
+        neighbours: impl Into<Neighbourhood<'n>>,
+    ) -> Result<ChunkMeshes> {
         let mut out = ChunkMeshes::default();
         self.mesh_into(chunk, neighbours, &mut out)?;
         Ok(out)
@@ -231,14 +334,18 @@ impl Mesher {
     /// may each be in any storage form (uniform, masks or packed): a packed centre has the
     /// masks of its non-air types built into this mesher's scratch memory, a packed
     /// neighbour gives only its touching layer.
-    pub fn mesh_into(
+    pub fn mesh_into<'n>(
         &mut self,
         chunk: &Chunk,
-        neighbours: Neighbours<'_>,
+        neighbours: impl Into<Neighbourhood<'n>>,
         out: &mut ChunkMeshes,
     ) -> Result<()> {
+        let neighbourhood: Neighbourhood<'n> = neighbours.into();
         out.clear();
-        for c in neighbours.iter().flatten().chain([&chunk]) {
+        let around = Neighbourhood::OFFSETS
+            .iter()
+            .filter_map(|&d| neighbourhood.get(d));
+        for c in around.chain([chunk]) {
             for (id, _) in c.palette() {
                 self.class(id)?;
             }
@@ -246,7 +353,16 @@ impl Mesher {
         if chunk.as_uniform() == Some(BlockId::AIR) {
             return Ok(());
         }
-        let Self { classes, s, built } = self;
+        let neighbours: Neighbours<'n> = Face::ALL.map(|f| neighbourhood.face(f));
+        let Self {
+            classes,
+            options,
+            s,
+            built,
+            pad,
+            buckets,
+            edge_layers,
+        } = self;
         let classes = &*classes;
         let s = &mut **s;
         let class = |id: BlockId| classes[id.index()];
@@ -328,6 +444,15 @@ impl Mesher {
             // any cutout or translucent block (uniform leaves included) is meshed below.
             return Ok(());
         }
+        if options.ambient_occlusion {
+            pad.fill(
+                &s.opaque,
+                &s.nb_opaque,
+                &neighbourhood,
+                &is_opaque,
+                edge_layers,
+            );
+        }
 
         for (id, bits) in entries() {
             let class = class(id);
@@ -359,7 +484,12 @@ impl Mesher {
                 inside: &s.translucent,
                 neighbours: &s.nb_translucent,
             });
-            let out = out.for_class(class);
+            let occludes = options.ambient_occlusion
+                && (class != RenderClass::Translucent || options.translucent_occlusion);
+            let mut sink = Sink {
+                out: out.for_class(class),
+                ao: occludes.then_some((&**pad, &mut *buckets)),
+            };
             if chunk.as_uniform().is_some() {
                 // One block type everywhere. An opaque or translucent type hides itself, so
                 // only the border layers can show. A cutout type hides nothing: every inner
@@ -373,17 +503,15 @@ impl Mesher {
                     };
                     if class == RenderClass::Cutout {
                         for l in (0..CHUNK_SIZE).filter(|&l| l != border) {
-                            let mut pos = [0; 3];
-                            pos[face.axis()] = l;
-                            out.push(PackedQuad::new(pos, CHUNK_SIZE, CHUNK_SIZE, face, id));
+                            emit_plane(&mut [u32::MAX; CHUNK_SIZE], face, l, id, 0, &mut sink);
                         }
                     }
                     let mut rows = nb_hide[face as usize].map(|h| !h);
                     let interface = split.map(|sp| || sp.neighbours[face as usize]);
-                    emit_split(&mut rows, interface, face, border, id, out);
+                    emit_split(&mut rows, interface, face, border, id, &mut sink);
                 }
             } else {
-                mesh_type(bits, hide, &nb_hide, split, id, out);
+                mesh_type(bits, hide, &nb_hide, split, id, &mut sink);
             }
         }
         Ok(())
@@ -401,7 +529,7 @@ fn mesh_type(
     nb_hide: &[Plane; 6],
     split: Option<Split<'_>>,
     id: BlockId,
-    out: &mut Vec<PackedQuad>,
+    sink: &mut Sink<'_>,
 ) {
     let empty = |rows: &Plane| rows.iter().all(|&r| r == 0);
     for (mine, theirs, inter, faces) in [
@@ -440,7 +568,7 @@ fn mesh_type(
                         }
                     }
                 });
-                emit_split(&mut faces, interface, face, i, id, out);
+                emit_split(&mut faces, interface, face, i, id, sink);
             }
         }
     }
@@ -471,7 +599,7 @@ fn mesh_type(
                     })
                 }
             });
-            emit_split(&mut faces, interface, face, z, id, out);
+            emit_split(&mut faces, interface, face, z, id, sink);
         }
     }
 }
@@ -555,11 +683,12 @@ mod tests {
 
     /// Every unit face of one chunk as a dense table: for each mesh (opaque, cutout,
     /// translucent), face direction and block position, the block id plus one (0: no face),
-    /// with [`INTERFACE_BIT`] set on a face flagged as an interface.
+    /// with [`INTERFACE_BIT`] set on a face flagged as an interface, and the face's AO byte
+    /// in bits 16..24.
     /// Much faster to fill and compare than a set, so that the property test can afford
     /// hundreds of chunks.
     #[derive(PartialEq, Eq)]
-    struct FaceMap(Vec<u16>);
+    struct FaceMap(Vec<u32>);
 
     impl FaceMap {
         fn new() -> Self {
@@ -575,10 +704,12 @@ mod tests {
             p: [usize; 3],
             block: BlockId,
             interface: bool,
+            ao: u8,
         ) -> bool {
             let slot = &mut self.0[(mesh * 6 + face) * VOLUME + (p[0] * 32 + p[1]) * 32 + p[2]];
             let was = *slot;
-            *slot = (block.0 + 1) | if interface { INTERFACE_BIT } else { 0 };
+            *slot = u32::from((block.0 + 1) | if interface { INTERFACE_BIT } else { 0 })
+                | u32::from(ao) << 16;
             was == 0
         }
 
@@ -594,14 +725,16 @@ mod tests {
             let (mesh, face, p) = (i / (6 * VOLUME), i / VOLUME % 6, i % VOLUME);
             Some(format!(
                 "{} unit faces differ; first: mesh {mesh} (0 opaque, 1 cutout, 2 translucent), \
-                 {:?} of block ({}, {}, {}): mesher has id+1 = {}, the rules {}",
+                 {:?} of block ({}, {}, {}): mesher has id+1 = {} AO {:08b}, the rules {} AO {:08b}",
                 bad.count() + 1,
                 Face::ALL[face],
                 p / 1024,
                 p / 32 % 32,
                 p % 32,
-                self.0[i],
-                want.0[i]
+                self.0[i] & 0xffff,
+                self.0[i] >> 16,
+                want.0[i] & 0xffff,
+                want.0[i] >> 16,
             ))
         }
     }
@@ -619,7 +752,7 @@ mod tests {
                 let interface = q.flags() & crate::FLAG_INTERFACE != 0;
                 for p in covered_blocks(u) {
                     assert!(
-                        map.insert(k, u.face as usize, p, u.block, interface),
+                        map.insert(k, u.face as usize, p, u.block, interface, q.ao()),
                         "face twice: {p:?} {u:?}"
                     );
                 }
@@ -628,26 +761,50 @@ mod tests {
         map
     }
 
-    /// The face rules written the slow, obvious way, one block at a time.
-    fn naive(reg: &BlockRegistry, chunk: &Chunk, nb: Neighbours<'_>) -> FaceMap {
+    /// The face rules and the ambient occlusion rule (with the default options) written
+    /// the slow, obvious way, one block at a time, from the whole 3×3×3 neighbourhood.
+    fn naive<'n>(reg: &BlockRegistry, chunk: &Chunk, nb: impl Into<Neighbourhood<'n>>) -> FaceMap {
+        let nb: Neighbourhood<'n> = nb.into();
         let class = |id: BlockId| reg.class(id).expect("known");
         let dense = chunk.to_dense();
-        let nb_dense = nb.map(|c| c.map(Chunk::to_dense));
+        let nb_dense: Vec<([i32; 3], Vec<BlockId>)> = Neighbourhood::OFFSETS
+            .iter()
+            .filter_map(|&d| Some((d, nb.get(d)?.to_dense())))
+            .collect();
         let get = |p: [i64; 3]| -> BlockId {
-            let inside = |v: i64| (0..32).contains(&v);
             let wrap = p.map(|v| v.rem_euclid(32) as usize);
             let at = |d: &[BlockId]| d[Chunk::dense_index(wrap[0], wrap[1], wrap[2])];
-            if p.iter().all(|&v| inside(v)) {
+            let d = p.map(|v| (v.div_euclid(32)) as i32);
+            if d == [0; 3] {
                 return at(&dense);
             }
-            let face = Face::ALL
-                .into_iter()
-                .find(|f| {
-                    let v = p[f.axis()];
-                    if f.is_positive() { v == 32 } else { v == -1 }
-                })
-                .expect("one step outside");
-            nb_dense[face as usize].as_deref().map_or(AIR, at)
+            nb_dense
+                .iter()
+                .find(|(o, _)| *o == d)
+                .map_or(AIR, |(_, blocks)| at(blocks))
+        };
+        let opaque_at = |p: [i64; 3]| class(get(p)) == RenderClass::Opaque;
+        // The AO byte of a face of block `b` in direction `face`: per corner (u, v) of the
+        // face's (U, V) axes, the sides and the corner in the layer in front.
+        let ao_of = |b: [i64; 3], face: Face| -> u8 {
+            let [ua, va] = crate::UV_AXES[face.axis()];
+            let n = face.normal();
+            let front = [0, 1, 2].map(|a| b[a] + i64::from(n[a]));
+            let mut ao = 0;
+            for v in 0..2 {
+                for u in 0..2 {
+                    let (du, dv) = (2 * u as i64 - 1, 2 * v as i64 - 1);
+                    let mut s1 = front;
+                    s1[ua] += du;
+                    let mut s2 = front;
+                    s2[va] += dv;
+                    let mut c = s1;
+                    c[va] += dv;
+                    let value = crate::ao::vertex_ao(opaque_at(s1), opaque_at(s2), opaque_at(c));
+                    ao |= value << (2 * (u + 2 * v));
+                }
+            }
+            ao
         };
         let mut out = FaceMap::new();
         for x in 0..32 {
@@ -676,7 +833,12 @@ mod tests {
                             // A translucent face toward another translucent type.
                             let interface = ca == RenderClass::Translucent
                                 && class(b) == RenderClass::Translucent;
-                            out.insert(k, face as usize, [x, y, z], a, interface);
+                            let ao = if ca == RenderClass::Translucent {
+                                AO_NONE
+                            } else {
+                                ao_of([x, y, z].map(|v| v as i64), face)
+                            };
+                            out.insert(k, face as usize, [x, y, z], a, interface, ao);
                         }
                     }
                 }
@@ -686,11 +848,11 @@ mod tests {
     }
 
     /// Panics, saying `what` and where, unless `m` holds exactly the faces of the rules.
-    fn assert_rules(
+    fn assert_rules<'n>(
         m: &ChunkMeshes,
         reg: &BlockRegistry,
         chunk: &Chunk,
-        nb: Neighbours<'_>,
+        nb: impl Into<Neighbourhood<'n>>,
         what: &str,
     ) {
         if let Some(d) = face_map(m).diff(&naive(reg, chunk, nb)) {
@@ -925,16 +1087,94 @@ mod tests {
         assert_eq!(face_map(&m).count(), 6 * 32 * 32 * 32);
         assert_eq!((m.cutout.len(), m.len()), (6 * 32, 6 * 32));
         assert_rules(&m, &reg, &leaves, NONE, "leaves alone");
-        // Between stone only the faces against the stone go.
+        // Between stone only the faces against the stone go. The stone around each inner
+        // layer's rim darkens its edge rows (4 edges and 4 corners of different occlusion
+        // beside the open middle: 9 quads a layer).
         let stone = Chunk::uniform(STONE);
         let m = mesh(&leaves, [Some(&stone); 6]);
         assert_eq!(face_map(&m).count(), 6 * 31 * 32 * 32);
-        assert_eq!((m.cutout.len(), m.len()), (6 * 31, 6 * 31));
+        assert_eq!((m.cutout.len(), m.len()), (6 * 31 * 9, 6 * 31 * 9));
         assert_rules(&m, &reg, &leaves, [Some(&stone); 6], "leaves in stone");
         // Leaves beside leaves, water and air: every face.
         let water = Chunk::uniform(WATER);
         let nb = [Some(&leaves), Some(&water), None, Some(&leaves), None, None];
         assert_eq!(face_map(&mesh(&leaves, nb)).count(), 6 * 32 * 32 * 32);
+    }
+
+    /// The AO byte of the unit face of `pos` facing `face` (panics if there is none).
+    fn ao_at(quads: &[PackedQuad], pos: [usize; 3], face: Face) -> u8 {
+        quads
+            .iter()
+            .find(|q| {
+                let u = q.unpack().expect("valid quad");
+                u.face == face && covered_blocks(u).any(|p| p == pos)
+            })
+            .map(|q| q.ao())
+            .unwrap_or_else(|| panic!("no {face:?} face at {pos:?}"))
+    }
+
+    #[test]
+    fn occlusion_reads_edge_and_corner_neighbours() {
+        // A stone floor at the top of the chunk; its top faces look into the +y neighbour.
+        let mut floor = Chunk::default();
+        floor.fill_box([0, 31, 0], [31, 31, 31], STONE).unwrap();
+        let top = [31, 31, 31];
+        // One stone block in the corner chunk (+1, +1, +1), touching only the vertex
+        // (32, 32, 32): corner (u1, v1) of the +y face of block (31, 31, 31) drops to 2.
+        let mut corner = Chunk::default();
+        corner.set(0, 0, 0, STONE).unwrap();
+        let nb = Neighbourhood::from_fn(|d| (d == [1, 1, 1]).then_some(&corner));
+        let m = Mesher::new(&registry()).mesh(&floor, nb).unwrap();
+        assert_eq!(ao_at(&m.opaque, top, Face::PosY), 0b10_11_11_11);
+        assert_rules(&m, &registry(), &floor, nb, "corner neighbour");
+        // A stone block in the edge chunk (+1, +1, 0) at z = 31 is a side of the +y face
+        // of block (31, 31, 31) along +x, its V axis: both (u, v1) corners drop to 2.
+        let mut edge = Chunk::default();
+        edge.set(0, 0, 31, STONE).unwrap();
+        let nb = Neighbourhood::from_fn(|d| (d == [1, 1, 0]).then_some(&edge));
+        let m = Mesher::new(&registry()).mesh(&floor, nb).unwrap();
+        assert_eq!(ao_at(&m.opaque, top, Face::PosY), 0b10_10_11_11);
+        assert_rules(&m, &registry(), &floor, nb, "edge neighbour");
+        // Without the edge and corner neighbours (six faces only) nothing occludes.
+        let m = Mesher::new(&registry()).mesh(&floor, NONE).unwrap();
+        assert_eq!(ao_at(&m.opaque, top, Face::PosY), AO_NONE);
+        assert_eq!(m.opaque.iter().filter(|q| q.face_index() == 2).count(), 1);
+    }
+
+    #[test]
+    fn faces_merge_only_with_equal_occlusion() {
+        // A 32×32 stone floor with one block on it: the floor's top faces around the block
+        // are darkened, each of the 8 around it with its own corners; the rest merges.
+        let mut c = Chunk::default();
+        c.fill_box([0, 0, 0], [31, 0, 31], STONE).unwrap();
+        c.set(10, 1, 10, STONE).unwrap();
+        let m = Mesher::new(&registry()).mesh(&c, NONE).unwrap();
+        assert_rules(&m, &registry(), &c, NONE, "block on a floor");
+        let tops: Vec<_> = m
+            .opaque
+            .iter()
+            .filter(|q| q.face_index() == Face::PosY as usize && q.unpack().unwrap().pos[1] == 0)
+            .collect();
+        let shaded: Vec<_> = tops.iter().filter(|q| q.ao() != AO_NONE).collect();
+        assert_eq!(shaded.len(), 8, "one quad per darkened face: {shaded:?}");
+        assert!(shaded.iter().all(|q| q.area() == 1));
+        // Beside the block (a side occluder): the two corners toward it are 2, the others 3.
+        let beside = ao_at(&m.opaque, [11, 0, 10], Face::PosY);
+        let values: Vec<u8> = (0..4).map(|i| beside >> (2 * i) & 3).collect();
+        assert_eq!(values.iter().filter(|&&v| v == 2).count(), 2, "{values:?}");
+        assert_eq!(values.iter().filter(|&&v| v == 3).count(), 2, "{values:?}");
+        // Options off: no occlusion, and the floor's open faces merge as before.
+        let plain = Mesher::with_options(
+            &registry(),
+            MeshOptions {
+                ambient_occlusion: false,
+                ..MeshOptions::default()
+            },
+        )
+        .mesh(&c, NONE)
+        .unwrap();
+        assert!(plain.opaque.iter().all(|q| q.ao() == AO_NONE));
+        assert!(plain.opaque.len() < m.opaque.len());
     }
 
     /// Deterministic xorshift64 for the property test.
@@ -1011,10 +1251,12 @@ mod tests {
     /// opaque, every cutout, every translucent type) and then mixed (random boxes and
     /// single blocks, from nearly uniform to noise); each centre meets eight neighbour
     /// patterns: all missing, all uniform of random blocks, all uniform of the centre's
-    /// block, all uniform opaque (enclosed), all mixed, and three where each of the six
+    /// block, all uniform opaque (enclosed), all mixed, and three where each of the 26
     /// neighbours is independently missing, uniform of a random block or mixed. The test
     /// checks that every centre class (air, opaque, cutout, translucent, mixed) met every
-    /// neighbour kind (missing, uniform air, opaque, cutout or translucent, mixed).
+    /// neighbour kind (missing, uniform air, opaque, cutout or translucent, mixed). The
+    /// neighbours are all 26 around the centre (the edge and corner ones matter to ambient
+    /// occlusion), and the rules' oracle checks every face's corner occlusion too.
     ///
     /// Storage forms: each mixed chunk (centre or neighbour) is packed or left in mask form
     /// at random, and every case is meshed again with each mixed chunk in the other form,
@@ -1061,7 +1303,8 @@ mod tests {
                         Kind::Uniform(id) => id,
                         _ => rng.pick(&ids),
                     };
-                    let nb_kinds: [Kind; 6] = std::array::from_fn(|_| match pattern {
+                    // Face neighbours first, then edges and corners (`Neighbourhood::OFFSETS`).
+                    let nb_kinds: [Kind; 26] = std::array::from_fn(|_| match pattern {
                         0 => Kind::Missing,
                         1 => Kind::Uniform(rng.pick(&ids)),
                         2 => Kind::Uniform(same),
@@ -1088,7 +1331,13 @@ mod tests {
                     };
                     let centre = make(centre_kind).expect("a centre");
                     let nbs = nb_kinds.map(&mut make);
-                    let nb: Neighbours<'_> = std::array::from_fn(|i| nbs[i].as_ref());
+                    fn around(nbs: &[Option<Chunk>; 26]) -> Neighbourhood<'_> {
+                        Neighbourhood::from_fn(|d| {
+                            let i = Neighbourhood::OFFSETS.iter().position(|&o| o == d)?;
+                            nbs[i].as_ref()
+                        })
+                    }
+                    let nb = around(&nbs);
                     let m = mesher.mesh(&centre, nb).unwrap();
                     let what = format!(
                         "case {cases}: {} blocks, centre {centre_kind:?} {}, neighbours {nb_kinds:?} {:?}",
@@ -1109,8 +1358,7 @@ mod tests {
                     };
                     let centre2 = flip(&centre);
                     let nbs2 = nbs.each_ref().map(|c| c.as_ref().map(flip));
-                    let nb2: Neighbours<'_> = std::array::from_fn(|i| nbs2[i].as_ref());
-                    let m2 = mesher.mesh(&centre2, nb2).unwrap();
+                    let m2 = mesher.mesh(&centre2, around(&nbs2)).unwrap();
                     assert!(
                         same_quads(&m, &m2),
                         "{what}: the other forms mesh differently"

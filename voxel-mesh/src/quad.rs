@@ -9,10 +9,13 @@
 //!         bits 15..20  w - 1    extent along the face's U axis, 1..32
 //!         bits 20..25  h - 1    extent along the face's V axis, 1..32
 //!         bits 25..28  face     0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z (voxel_core::Face)
-//!         bits 28..32  0        reserved (ambient occlusion)
+//!         bits 28..32  0        reserved
 //! word 1: bits  0..16  block    BlockId
-//!         bit  16      interface: a translucent face toward another translucent type
-//!         bits 17..32  0        reserved (light)
+//!         bits 16..24  flags    bit 16: interface, a translucent face toward another
+//!                               translucent type; bits 17..24 reserved (0)
+//!         bits 24..32  occlusion  ambient occlusion of the corners (u0,v0), (u1,v0),
+//!                               (u0,v1), (u1,v1), 2 bits each: 3 − the corner's AO value
+//!                               (see `ao`), so that 0 is an unoccluded corner
 //! ```
 //!
 //! The face's (U, V) axes are cyclic after the normal axis: +-x → (y, z), +-y → (z, x),
@@ -45,6 +48,9 @@ pub struct Quad {
     /// The block the face belongs to.
     pub block: BlockId,
 }
+
+/// Mask of the flag bits in word 1 (after shifting down by 16).
+const FLAG_MASK: u32 = 0xff;
 
 impl Quad {
     /// The face's rectangle in block coordinates of its chunk: lowest and highest corner
@@ -91,19 +97,35 @@ impl PackedQuad {
         }
     }
 
-    /// The same quad with `flags` (16 bits) in word 1's bits 16..32.
+    /// The same quad with `flags` (8 bits: [`FLAG_INTERFACE`]) in word 1's bits 16..24.
     #[inline]
     pub fn with_flags(self, flags: u32) -> Self {
         Self {
-            block: (self.block & 0xffff) | flags << 16,
+            block: (self.block & !(FLAG_MASK << 16)) | (flags & FLAG_MASK) << 16,
             ..self
         }
     }
 
-    /// The flags in word 1's bits 16..32 ([`FLAG_INTERFACE`]).
+    /// The flags in word 1's bits 16..24 ([`FLAG_INTERFACE`]).
     #[inline]
     pub fn flags(self) -> u32 {
-        self.block >> 16
+        self.block >> 16 & FLAG_MASK
+    }
+
+    /// The same quad with corner AO values `ao` (2 bits per corner, 3 = unoccluded, in the
+    /// order of [`crate::ao`]: [`crate::AO_NONE`] is no occlusion).
+    #[inline]
+    pub fn with_ao(self, ao: u8) -> Self {
+        Self {
+            block: (self.block & 0x00ff_ffff) | u32::from(!ao) << 24,
+            ..self
+        }
+    }
+
+    /// The corner AO values (see [`PackedQuad::with_ao`]).
+    #[inline]
+    pub fn ao(self) -> u8 {
+        !((self.block >> 24) as u8)
     }
 
     /// Packs an unpacked quad.
@@ -188,6 +210,12 @@ mod tests {
                 let f = p.with_flags(FLAG_INTERFACE);
                 assert_eq!(f.flags(), FLAG_INTERFACE);
                 assert_eq!(f.unpack(), Some(q), "flags leave the fields alone");
+                assert_eq!(p.ao(), crate::AO_NONE, "no occlusion unless set");
+                let a = f.with_ao(0b11_10_01_00);
+                assert_eq!((a.ao(), a.flags()), (0b11_10_01_00, FLAG_INTERFACE));
+                assert_eq!(a.with_flags(0).ao(), 0b11_10_01_00, "flags keep the AO");
+                assert_eq!(a.unpack(), Some(q), "AO leaves the fields alone");
+                assert_eq!(a.block >> 24, 0b00_01_10_11, "stored as occlusion");
                 assert_eq!(p.face_index(), face as usize);
                 assert_eq!(p.area(), u32::from(size[0]) * u32::from(size[1]));
             }

@@ -16,7 +16,7 @@ pub fn mesh_chunks(world: &World, positions: &[ChunkPos]) -> Result<Vec<(ChunkPo
             || proto.clone(),
             |mesher, &p| {
                 let meshes = match world.chunk(p) {
-                    Some(c) => mesher.mesh(c, world.neighbours(p))?,
+                    Some(c) => mesher.mesh(c, world.neighbourhood(p))?,
                     None => ChunkMeshes::default(),
                 };
                 Ok((p, meshes))

@@ -13,9 +13,31 @@ pub fn common_wgsl() -> String {
     gpu::WgslConsts::default()
         .u32("NO_MEDIUM", NO_MEDIUM)
         .u32("FLAG_INTERFACE", FLAG_INTERFACE)
+        .f32("AO_DEPTH", AO_DEPTH)
+        .f32("OPAQUE_EXPANSION_PX", OPAQUE_EXPANSION_PX)
         .finish()
         + include_str!("shaders/common.wgsl")
 }
+
+/// How much ambient occlusion darkens at full strength: a vertex of AO value `v` (0 to 3,
+/// `voxel_mesh::ao`) gets brightness `1 − strength · AO_DEPTH · (3 − v) / 3`, so an inner
+/// corner (value 0) keeps 45 % of its light, about Minecraft's smooth lighting.
+pub const AO_DEPTH: f32 = 0.55;
+
+/// Opaque quads grow by this many pixels at each vertex (along the quad's own
+/// plane, scaled with the vertex's distance), so that the T-junctions of greedy-merged
+/// quads leave no crack: the rasteriser snaps the vertex in the middle of another quad's
+/// edge to its sub-pixel grid independently of that edge, which can leave a sliver no
+/// quad covers. An eighth of a pixel is several times the snapping error (1/256 px with 8
+/// sub-pixel bits) and changes only pixels on an edge: an opaque block hides its neighbours'
+/// faces, so what pokes out of a convex edge is a sliver beyond the silhouette and what
+/// pokes into a concave one is hidden. Translucent quads do not grow (an overlap would blend
+/// twice), nor cutout ones (leaves keep their inner faces, which would poke out along the
+/// seams of the faces in front).
+pub const OPAQUE_EXPANSION_PX: f32 = 1.0 / 64.0;
+
+/// The tonemap's shoulder (`shaders/tonemap.wgsl`): values up to it pass unchanged.
+pub const TONEMAP_SHOULDER: f32 = 0.8;
 
 /// Per-frame uniforms every pass uses (`Frame` in WGSL).
 #[repr(C)]
@@ -43,8 +65,12 @@ pub struct FrameUniforms {
     pub viewport: [f32; 2],
     /// Block id of the translucent type the eye is inside, or [`NO_MEDIUM`].
     pub medium: u32,
+    /// Ambient-occlusion strength, 0 (off) to 1.
+    pub ao_strength: f32,
+    /// World size of one pixel at unit view depth: `2 tan(fov_y / 2) / height`.
+    pub pixel_size: f32,
     /// Padding to the struct's 16-byte alignment.
-    pub _pad2: u32,
+    pub _pad2: [f32; 3],
 }
 
 /// [`FrameUniforms::medium`] when the eye is in no translucent volume.
@@ -149,7 +175,14 @@ mod tests {
                 field!(FrameUniforms, sky),
                 field!(FrameUniforms, viewport),
                 field!(FrameUniforms, medium),
+                field!(FrameUniforms, ao_strength),
+                field!(FrameUniforms, pixel_size),
             ],
+        );
+        let tonemap = include_str!("shaders/tonemap.wgsl");
+        assert!(
+            tonemap.contains(&format!("const SHOULDER: f32 = {TONEMAP_SHOULDER:?};")),
+            "TONEMAP_SHOULDER is the shader's"
         );
         assert_layout::<ChunkUniforms>(
             &module,

@@ -62,12 +62,13 @@ pub enum DepthMode {
     WriteFarthest,
 }
 
-/// A pipeline that draws chunk quads with `common.wgsl`'s `vs_main` (vertex pulling).
+/// A pipeline that draws chunk quads with `common.wgsl`'s vertex pulling (`vs_main`, or
+/// `vs_solid` for opaque quads).
 #[derive(Debug)]
 pub struct ChunkPipeline<'a> {
     /// Debug label.
     pub label: &'a str,
-    /// The module holding `vs_main` and the fragment entry.
+    /// The module holding `common.wgsl`'s vertex entries and the fragment entry.
     pub module: &'a wgpu::ShaderModule,
     /// The fragment entry point.
     pub fragment_entry: &'a str,
@@ -104,25 +105,32 @@ impl SidedPipeline {
 impl ChunkPipeline<'_> {
     /// Creates the pipeline (back faces culled).
     pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        self.build_with(device, Some(wgpu::Face::Back))
+        self.build_with(device, "vs_main", Some(wgpu::Face::Back))
+    }
+
+    /// Creates an opaque pipeline: back faces culled, quads grown against T-junction
+    /// cracks (`vs_solid`; see `OPAQUE_EXPANSION_PX` in `bindings.rs`).
+    pub fn build_solid(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        self.build_with(device, "vs_solid", Some(wgpu::Face::Back))
     }
 
     /// Creates the pipeline drawing both sides of every face.
     pub fn build_two_sided(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        self.build_with(device, None)
+        self.build_with(device, "vs_main", None)
     }
 
     /// Creates both variants of a translucent pipeline (see [`SidedPipeline`]).
     pub fn build_sided(&self, device: &wgpu::Device) -> SidedPipeline {
         SidedPipeline {
-            culled: self.build_with(device, Some(wgpu::Face::Back)),
-            two_sided: self.build_with(device, None),
+            culled: self.build_with(device, "vs_main", Some(wgpu::Face::Back)),
+            two_sided: self.build_with(device, "vs_main", None),
         }
     }
 
     fn build_with(
         &self,
         device: &wgpu::Device,
+        vertex_entry: &str,
         cull_mode: Option<wgpu::Face>,
     ) -> wgpu::RenderPipeline {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -140,7 +148,7 @@ impl ChunkPipeline<'_> {
             layout: Some(&layout),
             vertex: wgpu::VertexState {
                 module: self.module,
-                entry_point: Some("vs_main"),
+                entry_point: Some(vertex_entry),
                 compilation_options: Default::default(),
                 buffers: &[],
             },

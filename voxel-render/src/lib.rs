@@ -54,3 +54,4 @@ pub use timing::{GpuPass, GpuTimes, Timer};
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The HDR scene colour format (seed 003): opaque image, composites, before tonemapping.
 pub const SCENE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub use bindings::{AO_DEPTH, OPAQUE_EXPANSION_PX, TONEMAP_SHOULDER};

@@ -64,6 +64,14 @@ pub struct RendererConfig {
     /// opaque and cutout faces, alpha ramp of its translucent ones). Default 0: off, so
     /// that a picture depends only on the scene; the interactive demo turns it on.
     pub fade_in_frames: u32,
+    /// How strongly the mesher's per-vertex ambient occlusion darkens, 0 to 1. Default 1:
+    /// one-block steps of terrain read as steps. 0 draws every face with its Lambert light
+    /// alone (the pictures before ambient occlusion).
+    pub ao_strength: f32,
+    /// Every block drawn in one flat colour (its base colour and opacity; cutout blocks
+    /// solid), no texture pattern. Default off. For comparisons with references that
+    /// cannot filter textures as a GPU does (the lab's CPU ray march).
+    pub flat_textures: bool,
 }
 
 impl Default for RendererConfig {
@@ -79,6 +87,8 @@ impl Default for RendererConfig {
             sky: [0.45, 0.65, 0.9],
             draw: DrawMode::Indirect,
             fade_in_frames: 0,
+            ao_strength: 1.0,
+            flat_textures: false,
         }
     }
 }
@@ -202,6 +212,7 @@ impl Renderer {
         check_output_format(ctx, config.output_format)?;
         check_lighting(&config)?;
         config.oit.validate()?;
+        check_ao_strength(config.ao_strength)?;
         if config.msaa && !ctx.caps.msaa4 {
             log::warn!("4x MSAA is not supported for the scene formats: rendering without MSAA");
             config.msaa = false;
@@ -230,7 +241,7 @@ impl Renderer {
                 contents: bytemuck::bytes_of(&FrameUniforms::default()),
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             }),
-            textures: BlockTextures::new(ctx, registry)?,
+            textures: BlockTextures::new(ctx, registry, config.flat_textures)?,
             no_boundary: gpu::target(
                 device,
                 "no_medium_boundary",
@@ -289,8 +300,11 @@ impl Renderer {
             &[&common_wgsl(), include_str!("shaders/opaque.wgsl")],
         );
         let groups = layouts.with(&[]);
-        let make = |label, fragment_entry| {
-            ChunkPipeline {
+        // Opaque quads grow against T-junction cracks; cutout quads do not: leaves keep
+        // their faces toward other leaves, and a grown inner face would poke out along the
+        // seams of the faces in front of it.
+        let make = |label, fragment_entry, grow: bool| {
+            let pipeline = ChunkPipeline {
                 label,
                 module: &module,
                 fragment_entry,
@@ -298,10 +312,17 @@ impl Renderer {
                 targets: &[gpu::scene_target(None)],
                 depth: DepthMode::Write,
                 samples: if msaa { MSAA_SAMPLES } else { 1 },
+            };
+            if grow {
+                pipeline.build_solid(&ctx.device)
+            } else {
+                pipeline.build(&ctx.device)
             }
-            .build(&ctx.device)
         };
-        (make("opaque", "fs_opaque"), make("cutout", "fs_cutout"))
+        (
+            make("opaque", "fs_opaque", true),
+            make("cutout", "fs_cutout", false),
+        )
     }
 
     fn targets_for(&self, size: (u32, u32), msaa: bool) -> SceneTargets {
@@ -410,6 +431,15 @@ impl Renderer {
             pages: arena.pages,
             free_ranges: arena.fragments,
         }
+    }
+
+    /// Changes the ambient-occlusion strength (0 to 1; see
+    /// [`RendererConfig::ao_strength`]) from the next frame on: a uniform, nothing is
+    /// rebuilt or uploaded again. A value outside 0..=1 or not finite is an error.
+    pub fn set_ao_strength(&mut self, strength: f32) -> Result<()> {
+        check_ao_strength(strength)?;
+        self.config.ao_strength = strength;
+        Ok(())
     }
 
     /// Changes how many frames new chunks take to fade in (0: no fade).
@@ -785,6 +815,8 @@ impl Renderer {
             sky: self.config.sky,
             viewport: [w as f32, h as f32],
             medium: medium.map_or(NO_MEDIUM, |b| u32::from(b.0)),
+            ao_strength: self.config.ao_strength,
+            pixel_size: (2.0 * (camera.fov_y_deg.to_radians() / 2.0).tan() / f64::from(h)) as f32,
             ..FrameUniforms::default()
         };
         self.ctx
@@ -919,6 +951,17 @@ fn check_lighting(config: &RendererConfig) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// An ambient-occlusion strength must be a number from 0 to 1.
+fn check_ao_strength(strength: f32) -> Result<()> {
+    if (0.0..=1.0).contains(&strength) {
+        Ok(())
+    } else {
+        Err(Error::InvalidSetting(format!(
+            "ambient-occlusion strength {strength}: it must be from 0 to 1"
+        )))
+    }
 }
 
 /// A render size must fit the adapter's 2D textures.

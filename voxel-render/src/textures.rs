@@ -23,6 +23,9 @@ pub enum Pattern {
     Leaves,
     /// Glass: a one-texel opaque frame (darker) around a centre of the block's opacity.
     Framed,
+    /// One flat colour, alpha the block's opacity for translucent blocks and 1 for others
+    /// (cutout blocks solid): `RendererConfig::flat_textures`.
+    Flat,
 }
 
 impl Pattern {
@@ -57,7 +60,8 @@ fn srgb_to_linear(c: u8) -> f32 {
     }
 }
 
-fn linear_to_srgb(c: f32) -> u8 {
+/// A linear colour channel as 8-bit sRGB (how the texture stores it).
+pub fn linear_to_srgb(c: f32) -> u8 {
     let c = c.clamp(0.0, 1.0);
     let s = if c <= 0.003_130_8 {
         c * 12.92
@@ -69,7 +73,11 @@ fn linear_to_srgb(c: f32) -> u8 {
 
 /// Level 0 of a block's texture: 16×16 texels, RGBA, linear colour.
 pub fn texels(def: &BlockDef, id: u32) -> Vec<[f32; 4]> {
-    let pattern = Pattern::for_block(def);
+    pattern_texels(def, id, Pattern::for_block(def))
+}
+
+/// Level 0 of a block's texture drawn with `pattern`.
+pub fn pattern_texels(def: &BlockDef, id: u32, pattern: Pattern) -> Vec<[f32; 4]> {
     let base = def.color.map(srgb_to_linear);
     let n = TEXTURE_SIZE;
     let mut out = Vec::with_capacity((n * n) as usize);
@@ -91,6 +99,14 @@ pub fn texels(def: &BlockDef, id: u32) -> Vec<[f32; 4]> {
                 }
                 Pattern::Framed if edge => [base[0] * 0.45, base[1] * 0.45, base[2] * 0.45, 1.0],
                 Pattern::Framed => [base[0], base[1], base[2], def.opacity],
+                Pattern::Flat => {
+                    let a = if def.class == RenderClass::Translucent {
+                        def.opacity
+                    } else {
+                        1.0
+                    };
+                    [base[0], base[1], base[2], a]
+                }
             };
             out.push(texel);
         }
@@ -148,8 +164,9 @@ pub struct BlockTextures {
 }
 
 impl BlockTextures {
-    /// Builds and uploads one layer per registered block.
-    pub fn new(ctx: &GpuContext, registry: &BlockRegistry) -> Result<Self> {
+    /// Builds and uploads one layer per registered block; `flat`: every block one colour
+    /// ([`Pattern::Flat`]).
+    pub fn new(ctx: &GpuContext, registry: &BlockRegistry, flat: bool) -> Result<Self> {
         let layers = registry.len() as u32;
         if layers > ctx.caps.limits.max_texture_array_layers {
             return Err(Error::Unsupported(format!(
@@ -172,7 +189,12 @@ impl BlockTextures {
             view_formats: &[],
         });
         for (id, def) in registry.iter() {
-            for (mip, level) in mip_chain(texels(def, u32::from(id.0))).iter().enumerate() {
+            let level0 = if flat && def.class != RenderClass::Air {
+                pattern_texels(def, u32::from(id.0), Pattern::Flat)
+            } else {
+                texels(def, u32::from(id.0))
+            };
+            for (mip, level) in mip_chain(level0).iter().enumerate() {
                 let side = TEXTURE_SIZE >> mip;
                 ctx.queue.write_texture(
                     wgpu::TexelCopyTextureInfo {

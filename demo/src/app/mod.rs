@@ -1,5 +1,5 @@
-//! The interactive demo: a winit window with a wgpu surface, generated terrain streamed
-//! around the eye (a [`ChunkStreamer`]: chunks generated, meshed and uploaded in the
+//! The interactive demo: a winit window with a wgpu surface, generated terrain (or a scene
+//! file or MagicaVoxel model, `--scene`) streamed around the eye (a [`ChunkStreamer`]: chunks generated, meshed and uploaded in the
 //! background, up to 32 chunks of view distance) and drawn by the voxel renderer, an egui
 //! side panel to switch techniques and settings, a fly camera, block edits remeshed in the
 //! background, live GPU timings and a live error map against the exact reference.
@@ -59,6 +59,9 @@ pub struct DemoOptions {
     /// Scripted: on frames 1 to 3, halve the window, get a zero size (what a minimised
     /// window reports), then restore the size (resize test).
     pub resize: bool,
+    /// A scene to show instead of generated terrain (a scene file or a `.vox` model, read
+    /// with [`scene::Scene::load`] before the window opens), from its first camera.
+    pub scene: Option<scene::Scene>,
 }
 
 impl Default for DemoOptions {
@@ -74,6 +77,7 @@ impl Default for DemoOptions {
             heatmap: false,
             edit: false,
             resize: false,
+            scene: None,
         }
     }
 }
@@ -279,18 +283,37 @@ impl ChunkSink for Sinks<'_> {
     }
 }
 
-/// A streamer of `seed`'s terrain with `view_distance` chunks each way (4 up and down).
-fn streamer(seed: u32, view_distance: u32) -> Result<ChunkStreamer, String> {
-    let generator = TerrainGenerator::new(TerrainConfig {
-        seed,
-        ..TerrainConfig::default()
-    });
+/// A streamer of `seed`'s terrain (or of the opened scene's world) with `view_distance`
+/// chunks each way (4 up and down).
+fn streamer(
+    seed: u32,
+    view_distance: u32,
+    scene: Option<&OpenScene>,
+) -> Result<ChunkStreamer, String> {
     let config = StreamConfig {
         view_distance,
         vertical_distance: 4,
         ..StreamConfig::default()
     };
-    ChunkStreamer::new(Arc::new(BlockRegistry::default()), generator, config).map_err(|e| chain(&e))
+    match scene {
+        Some(s) => ChunkStreamer::new(s.world.registry().clone(), s.world.clone(), config),
+        None => {
+            let generator = TerrainGenerator::new(TerrainConfig {
+                seed,
+                ..TerrainConfig::default()
+            });
+            ChunkStreamer::new(Arc::new(BlockRegistry::default()), generator, config)
+        }
+    }
+    .map_err(|e| chain(&e))
+}
+
+/// A scene opened with `--scene`: its name and world (streamed like terrain).
+struct OpenScene {
+    name: String,
+    world: voxel_core::World,
+    /// The far plane of its camera: the window's never comes nearer.
+    far: f64,
 }
 
 /// The far plane for a view distance: its chunks and a little more.
@@ -332,13 +355,29 @@ struct Gfx {
     status: Status,
     last: Instant,
     script: Script,
+    /// The scene shown instead of terrain, if any.
+    scene: Option<OpenScene>,
 }
 
 impl Gfx {
     fn new(window: Arc<Window>, opts: DemoOptions) -> Result<Self, String> {
         let (display, ctx) = Display::new(window)?;
-        // The default view of the seed (its world is only the few chunks around it).
-        let cam = scene::default_scene_with_radius(opts.seed, 1)?.cameras[0];
+        // The scene's first camera, or the default view of the seed (its world is only the
+        // few chunks around it).
+        let (cam, open) = match &opts.scene {
+            Some(s) => {
+                let open = OpenScene {
+                    name: s.name.clone(),
+                    world: s.world.clone(),
+                    far: s.cameras[0].far,
+                };
+                (s.cameras[0], Some(open))
+            }
+            None => (
+                scene::default_scene_with_radius(opts.seed, 1)?.cameras[0],
+                None,
+            ),
+        };
         let view_distance = opts.view_distance.clamp(1, MAX_VIEW_DISTANCE);
         let (yaw, pitch) = cam.yaw_pitch();
         let settings = Settings {
@@ -361,8 +400,10 @@ impl Gfx {
             fade_in_frames: settings.fade_in_frames,
             ..RendererConfig::default()
         };
-        let renderer =
-            Renderer::new(&ctx, &BlockRegistry::default(), config).map_err(|e| chain(&e))?;
+        let registry = open
+            .as_ref()
+            .map_or_else(BlockRegistry::default, |s| (**s.world.registry()).clone());
+        let renderer = Renderer::new(&ctx, &registry, config).map_err(|e| chain(&e))?;
         let post = Post::new(&ctx.device, display.config.format);
         let frames = Frames::new(&ctx.device, &post, w, h, 0);
         let ui = Ui::new(&display.window, &ctx);
@@ -380,7 +421,7 @@ impl Gfx {
             frames,
             ui,
             streaming: Streaming {
-                streamer: streamer(opts.seed, view_distance)?,
+                streamer: streamer(opts.seed, view_distance, open.as_ref())?,
                 last: StreamFrame::default(),
             },
             input: Input {
@@ -395,7 +436,7 @@ impl Gfx {
                 dragged: 0.0,
                 ctrl: false,
             },
-            far: far_plane(view_distance),
+            far: far_plane(view_distance).max(open.as_ref().map_or(0.0, |s| s.far)),
             applied: settings.clone(),
             settings,
             status: Status::default(),
@@ -405,6 +446,7 @@ impl Gfx {
                 cycle,
                 screenshot_request: None,
             },
+            scene: open,
         };
         if let Some(t) = g.script.cycle.first() {
             g.settings.oit.technique = *t;
@@ -616,14 +658,14 @@ impl Gfx {
     fn apply_settings(&mut self) -> Result<(), String> {
         let s = self.settings.clone();
         let a = self.applied.clone();
-        if s.seed != a.seed {
+        if s.seed != a.seed && self.scene.is_none() {
             // Another world: start it over at its default view.
             let cam = scene::default_scene_with_radius(s.seed, 1)?.cameras[0];
             let (yaw, pitch) = cam.yaw_pitch();
             self.input.fly.eye = cam.eye;
             self.input.fly.yaw = yaw;
             self.input.fly.pitch = pitch;
-            self.streaming.streamer = streamer(s.seed, s.view_distance)?;
+            self.streaming.streamer = streamer(s.seed, s.view_distance, None)?;
             self.renderer.clear_chunks();
             if let Some(r) = &mut self.reference {
                 r.clear_chunks();
@@ -634,7 +676,7 @@ impl Gfx {
                 .set_view_distance(s.view_distance)
                 .map_err(|e| chain(&e))?;
         }
-        self.far = far_plane(s.view_distance);
+        self.far = far_plane(s.view_distance).max(self.scene.as_ref().map_or(0.0, |s| s.far));
         if s.oit != a.oit {
             self.renderer
                 .set_oit_config(s.oit.clone())

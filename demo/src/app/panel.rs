@@ -182,10 +182,17 @@ impl Gfx {
 
     fn world_settings(&mut self, ui: &mut egui::Ui) {
         let s = &mut self.settings;
-        ui.horizontal(|ui| {
-            ui.label("Seed");
-            ui.add(egui::DragValue::new(&mut s.seed));
-        });
+        match &self.scene {
+            Some(scene) => {
+                ui.label(format!("Scene: {}", scene.name));
+            }
+            None => {
+                ui.horizontal(|ui| {
+                    ui.label("Seed");
+                    ui.add(egui::DragValue::new(&mut s.seed));
+                });
+            }
+        }
         ui.add(
             egui::Slider::new(&mut s.view_distance, 1..=super::MAX_VIEW_DISTANCE)
                 .text("view distance (chunks)"),

@@ -1,8 +1,9 @@
 // Shared by every chunk pipeline: frame and chunk uniforms (`bindings.rs`, checked equal
 // by a test), vertex pulling of the 8-byte packed quads (voxel-mesh's layout), the shading
-// all passes use (seed 000: Lambert with a sun direction plus ambient, the same for opaque
-// and translucent surfaces), the dissolve of chunks fading in, and which translucent
-// fragments count when the eye is inside a translucent volume (`medium.rs`).
+// all passes use (Lambert with a sun direction plus ambient, the same for opaque and
+// translucent surfaces, times the per-vertex ambient occlusion the mesher stored), the
+// dissolve of chunks fading in, and which translucent fragments count when the eye is
+// inside a translucent volume (`medium.rs`).
 
 struct Frame {
     view_proj: mat4x4<f32>,
@@ -16,6 +17,10 @@ struct Frame {
     viewport: vec2<f32>,
     // Block id of the translucent type the eye is inside, or NO_MEDIUM.
     medium: u32,
+    // Ambient-occlusion strength, 0 (off) to 1.
+    ao_strength: f32,
+    // World size of one pixel at unit view depth.
+    pixel_size: f32,
 };
 
 // NO_MEDIUM (no medium) and FLAG_INTERFACE (quad flag, word 1 bit 16: a translucent face
@@ -52,10 +57,13 @@ struct VsOut {
     @location(4) @interpolate(flat) flags: u32,
     // The chunk's opacity (fade-in), 1 when settled.
     @location(5) @interpolate(flat) alpha: f32,
+    // Ambient-occlusion brightness, interpolated from the quad's corners.
+    @location(6) shade: f32,
 };
 
 // Corners of the two triangles of a quad, counter-clockwise seen from the side the normal
-// points to (positive faces); negative faces take them in the other order.
+// points to (positive faces); negative faces take them in the other order. The triangles
+// share the diagonal (0,0)-(1,1), or (1,0)-(0,1) in the FLIP variants.
 const CORNERS_POS = array<vec2<f32>, 6>(
     vec2(0.0, 0.0), vec2(1.0, 0.0), vec2(1.0, 1.0),
     vec2(0.0, 0.0), vec2(1.0, 1.0), vec2(0.0, 1.0),
@@ -64,6 +72,34 @@ const CORNERS_NEG = array<vec2<f32>, 6>(
     vec2(0.0, 0.0), vec2(1.0, 1.0), vec2(1.0, 0.0),
     vec2(0.0, 0.0), vec2(0.0, 1.0), vec2(1.0, 1.0),
 );
+const CORNERS_POS_FLIP = array<vec2<f32>, 6>(
+    vec2(0.0, 0.0), vec2(1.0, 0.0), vec2(0.0, 1.0),
+    vec2(1.0, 0.0), vec2(1.0, 1.0), vec2(0.0, 1.0),
+);
+const CORNERS_NEG_FLIP = array<vec2<f32>, 6>(
+    vec2(0.0, 0.0), vec2(0.0, 1.0), vec2(1.0, 0.0),
+    vec2(1.0, 0.0), vec2(0.0, 1.0), vec2(1.0, 1.0),
+);
+
+// AO value (3 open .. 0 darkest) of the quad's corner `slot` = u + 2v: word 1 bits 24..32
+// hold 3 − value, two bits per corner (voxel-mesh's `ao`).
+fn corner_ao(q: vec2<u32>, slot: u32) -> u32 {
+    return 3u - ((q.y >> (24u + 2u * slot)) & 3u);
+}
+
+// Brightness of corner `c` (each coordinate 0 or 1) of quad `q`.
+fn corner_shade(q: vec2<u32>, c: vec2<f32>) -> f32 {
+    let ao = corner_ao(q, u32(c.x) + 2u * u32(c.y));
+    return 1.0 - frame.ao_strength * AO_DEPTH * f32(3u - ao) / 3.0;
+}
+
+// Vertex k (0..6) of a quad: which corner, for the face's side and the diagonal.
+fn quad_corner(positive: bool, flip: bool, k: u32) -> vec2<f32> {
+    if positive {
+        return select(CORNERS_POS[k], CORNERS_POS_FLIP[k], flip);
+    }
+    return select(CORNERS_NEG[k], CORNERS_NEG_FLIP[k], flip);
+}
 const NORMALS = array<vec3<f32>, 6>(
     vec3(1.0, 0.0, 0.0), vec3(-1.0, 0.0, 0.0),
     vec3(0.0, 1.0, 0.0), vec3(0.0, -1.0, 0.0),
@@ -71,20 +107,20 @@ const NORMALS = array<vec3<f32>, 6>(
 );
 
 // Expands vertex `vi` of the page's quads (a draw starts at its mesh's first quad times
-// 6): quad vi / 6, corner vi % 6, of the chunk in slot `slot`.
-@vertex
-fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -> VsOut {
+// 6): quad vi / 6, corner vi % 6, of the chunk in slot `slot`. The quad is split along the
+// diagonal whose corners are brighter in sum (Sodium's rule), so that interpolated
+// occlusion is symmetric; with `grow` it grows by OPAQUE_EXPANSION_PX pixels along its
+// plane (opaque quads: no crack at T-junctions, `bindings.rs`).
+fn quad_vertex(vi: u32, slot: u32, grow: bool) -> VsOut {
     let q = quads[vi / 6u];
     let chunk = chunks[slot];
     let g = q.x;
     let face = min((g >> 25u) & 7u, 5u);
     let size = vec2<f32>(f32(((g >> 15u) & 31u) + 1u), f32(((g >> 20u) & 31u) + 1u));
-    var corner: vec2<f32>;
-    if (face & 1u) == 0u {
-        corner = CORNERS_POS[vi % 6u];
-    } else {
-        corner = CORNERS_NEG[vi % 6u];
-    }
+    let flip = corner_ao(q, 1u) + corner_ao(q, 2u) > corner_ao(q, 0u) + corner_ao(q, 3u);
+    let k = vi % 6u;
+    let positive = (face & 1u) == 0u;
+    let corner = quad_corner(positive, flip, k);
     let axis = face / 2u;
     let u_axis = (axis + 1u) % 3u;
     let v_axis = (axis + 2u) % 3u;
@@ -92,13 +128,37 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -
     if (face & 1u) == 0u {
         p[axis] += 1.0;
     }
-    let uv = corner * size;
+    var uv = corner * size;
     p[u_axis] += uv.x;
     p[v_axis] += uv.y;
     // Camera-relative position: integer parts cancel exactly before any float rounding.
     let rel = vec3<f32>(chunk.origin - frame.eye_int) + p - frame.eye_frac;
     var out: VsOut;
     out.clip = frame.view_proj * vec4<f32>(rel, 1.0);
+    out.shade = corner_shade(q, corner);
+    if grow {
+        let grown = (corner * 2.0 - 1.0)
+            * (OPAQUE_EXPANSION_PX * frame.pixel_size * max(out.clip.w, 0.0));
+        var offset = vec3<f32>(0.0);
+        offset[u_axis] = grown.x;
+        offset[v_axis] = grown.y;
+        out.clip += frame.view_proj * vec4<f32>(offset, 0.0);
+        uv += grown;
+        // The shade the vertex's triangle extends to the grown corner, so that every
+        // point of the quad keeps the shade it had.
+        let first = k / 3u * 3u;
+        let a = quad_corner(positive, flip, first);
+        let b = quad_corner(positive, flip, first + 1u);
+        let c = quad_corner(positive, flip, first + 2u);
+        let e0 = b - a;
+        let e1 = c - a;
+        let d = corner + grown / size - a;
+        let det = e0.x * e1.y - e1.x * e0.y;
+        let beta = (d.x * e1.y - e1.x * d.y) / det;
+        let gamma = (e0.x * d.y - d.x * e0.y) / det;
+        let sa = corner_shade(q, a);
+        out.shade = sa + beta * (corner_shade(q, b) - sa) + gamma * (corner_shade(q, c) - sa);
+    }
     out.uv = uv;
     out.block = q.y & 0xffffu;
     out.flags = q.y >> 16u;
@@ -109,15 +169,27 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -
     return out;
 }
 
+// Translucent quads (every technique, the medium boundary): exactly as meshed.
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -> VsOut {
+    return quad_vertex(vi, slot, false);
+}
+
+// Opaque quads, grown against T-junction cracks.
+@vertex
+fn vs_solid(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -> VsOut {
+    return quad_vertex(vi, slot, true);
+}
+
 // Texture colour (linear) and alpha of a fragment.
 fn albedo(in: VsOut) -> vec4<f32> {
     return textureSample(block_textures, block_sampler, in.uv, in.block);
 }
 
-// Lambert with the sun plus ambient.
-fn light(rgb: vec3<f32>, face: u32) -> vec3<f32> {
-    let n_dot_l = max(dot(NORMALS[face], frame.sun_dir), 0.0);
-    return rgb * (frame.ambient + (1.0 - frame.ambient) * n_dot_l);
+// Lambert with the sun plus ambient, times the ambient occlusion.
+fn light(rgb: vec3<f32>, in: VsOut) -> vec3<f32> {
+    let n_dot_l = max(dot(NORMALS[in.face], frame.sun_dir), 0.0);
+    return rgb * (frame.ambient + (1.0 - frame.ambient) * n_dot_l) * in.shade;
 }
 
 // Whether a translucent fragment counts (the model in `medium.rs`): every front face
@@ -139,7 +211,7 @@ fn counts(in: VsOut, front: bool) -> bool {
 fn translucent_color(in: VsOut, front: bool) -> vec4<f32> {
     let a = albedo(in);
     let alpha = select(0.0, clamp(a.a * in.alpha, 0.0, 1.0), counts(in, front));
-    return vec4<f32>(light(a.rgb, in.face), alpha);
+    return vec4<f32>(light(a.rgb, in), alpha);
 }
 
 // Level of the n×n Bayer matrix (n a power of two) at a pixel, over n²: the matrix

@@ -7,7 +7,7 @@ fn fs_opaque(in: VsOut) -> @location(0) vec4<f32> {
     if faded_out(in) {
         discard;
     }
-    return vec4<f32>(light(a.rgb, in.face), 1.0);
+    return vec4<f32>(light(a.rgb, in), 1.0);
 }
 
 // Alpha test on texture alpha (leaves): seed 001's alpha-test threshold.
@@ -19,5 +19,5 @@ fn fs_cutout(in: VsOut) -> @location(0) vec4<f32> {
     if a.a < ALPHA_TEST || faded_out(in) {
         discard;
     }
-    return vec4<f32>(light(a.rgb, in.face), 1.0);
+    return vec4<f32>(light(a.rgb, in), 1.0);
 }
