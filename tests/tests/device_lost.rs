@@ -46,6 +46,7 @@ fn a_lost_device_gives_errors_and_a_new_device_works() {
     lost(r.upload_chunk(pos, &meshes).unwrap_err(), "upload_chunk");
     lost(r.resize(128, 64).unwrap_err(), "resize");
     lost(r.set_msaa(true).unwrap_err(), "set_msaa");
+    lost(r.set_ao_strength(0.5).unwrap_err(), "set_ao_strength");
     lost(
         r.set_oit_config(r.config().oit.clone()).unwrap_err(),
         "set_oit_config",

@@ -437,6 +437,7 @@ impl Renderer {
     /// [`RendererConfig::ao_strength`]) from the next frame on: a uniform, nothing is
     /// rebuilt or uploaded again. A value outside 0..=1 or not finite is an error.
     pub fn set_ao_strength(&mut self, strength: f32) -> Result<()> {
+        self.ctx.check_device()?;
         check_ao_strength(strength)?;
         self.config.ao_strength = strength;
         Ok(())
