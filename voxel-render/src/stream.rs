@@ -23,7 +23,9 @@
 //! - **Unload**: a chunk farther than the view distance plus
 //!   [`StreamConfig::hysteresis`] leaves the world and the sink, at most
 //!   [`StreamConfig::max_unloads`] per update (a teleport spreads its unloads over frames).
-//!   Its jobs still in flight come back to nothing (each position has a version).
+//!   Its jobs still in flight come back to nothing (each position has a version). The
+//!   unload queue holds each chunk at most once, so a teleport costs no more than loading
+//!   the new place and unloading the old at the budget.
 //! - **Edits**: [`ChunkStreamer::set_block`] changes the world; the chunks it touched are
 //!   meshed again before anything new. An edited chunk is kept when it unloads and comes
 //!   back as edited. An edit of a chunk that is not loaded generates it on the spot and
@@ -200,9 +202,20 @@ struct Slot {
     version: u32,
     /// Whether the sink holds meshes of it.
     uploaded: bool,
+    /// Whether it is in the unload queue.
+    unload_queued: bool,
 }
 
 impl Slot {
+    fn new(state: State, version: u32) -> Self {
+        Self {
+            state,
+            version,
+            uploaded: false,
+            unload_queued: false,
+        }
+    }
+
     /// Whether the job of `version` that leaves the slot in `state` is still the one it
     /// waits for (a stale job counts for nothing).
     fn awaits(&self, version: u32, state: State) -> bool {
@@ -273,6 +286,7 @@ pub struct ChunkStreamer {
     centre: Option<ChunkPos>,
     /// Offsets before it are meshed or on their way.
     cursor: usize,
+    /// Chunks to unload, each once ([`Slot::unload_queued`]).
     unload: VecDeque<ChunkPos>,
     remesh: VecDeque<ChunkPos>,
     ready: BinaryHeap<Ready>,
@@ -293,6 +307,7 @@ impl std::fmt::Debug for ChunkStreamer {
             .field("positions", &self.slots.len())
             .field("resident", &self.world.len())
             .field("jobs", &self.jobs)
+            .field("unload", &self.unload.len())
             .finish_non_exhaustive()
     }
 }
@@ -502,15 +517,33 @@ impl ChunkStreamer {
         )
     }
 
+    /// Queues every position past the margin not queued yet (each at most once: a
+    /// teleport followed by moves used to queue every far chunk again on every move).
     fn queue_unloads(&mut self) {
         let Some(centre) = self.centre else { return };
         let far: Vec<ChunkPos> = self
             .slots
-            .keys()
-            .copied()
-            .filter(|p| !self.keeps(*p, centre))
+            .iter()
+            .filter(|(p, s)| !s.unload_queued && !self.keeps(**p, centre))
+            .map(|(p, _)| *p)
             .collect();
-        self.unload.extend(far);
+        for pos in far {
+            if let Some(slot) = self.slots.get_mut(&pos) {
+                slot.unload_queued = true;
+            }
+            self.unload.push_back(pos);
+        }
+    }
+
+    /// Chunks in the unload queue (each at most once: never more than
+    /// [`ChunkStreamer::positions`]).
+    pub fn queued_unloads(&self) -> usize {
+        self.unload.len()
+    }
+
+    /// Jobs in flight.
+    pub fn jobs(&self) -> usize {
+        self.jobs
     }
 
     /// One frame's streaming for `eye`: takes what the workers finished, unloads, starts
@@ -614,6 +647,9 @@ impl ChunkStreamer {
             let Some(pos) = self.unload.pop_front() else {
                 break;
             };
+            if let Some(slot) = self.slots.get_mut(&pos) {
+                slot.unload_queued = false;
+            }
             if self.keeps(pos, centre) {
                 continue;
             }
@@ -642,26 +678,13 @@ impl ChunkStreamer {
         if let Some(chunk) = self.saved.remove(&pos) {
             // An edited chunk comes back as it was left.
             self.edited.insert(pos);
-            self.slots.insert(
-                pos,
-                Slot {
-                    state: State::Generated,
-                    version,
-                    uploaded: false,
-                },
-            );
+            self.slots.insert(pos, Slot::new(State::Generated, version));
             let _ = self.world.insert_chunk(pos, chunk);
             self.world.take_dirty();
             return;
         }
-        self.slots.insert(
-            pos,
-            Slot {
-                state: State::Generating,
-                version,
-                uploaded: false,
-            },
-        );
+        self.slots
+            .insert(pos, Slot::new(State::Generating, version));
         // A chunk outside the view distance is only a neighbour: packed at once.
         let pack = !self.wanted(pos, centre);
         let source = self.source.clone();
@@ -1231,5 +1254,37 @@ mod tests {
             sink.held.contains_key(&ChunkPos::new(0, 0, 0)),
             "its neighbours still draw"
         );
+    }
+
+    /// Issue 26, row 7: the unload queue holds each chunk once. After a teleport, the eye
+    /// moves to a new chunk every update while unloads trickle (one per update): the queue
+    /// never holds more than the positions known (it used to take every far chunk again
+    /// on every move: 730 MiB and 292 ms updates at view distance 64).
+    #[test]
+    fn the_unload_queue_holds_each_chunk_once() {
+        let config = StreamConfig {
+            view_distance: 6,
+            vertical_distance: 1,
+            max_unloads: 1,
+            threads: 1,
+            ..StreamConfig::default()
+        };
+        let mut s = ChunkStreamer::new(registry(), Pillars, config).unwrap();
+        let mut sink = Recorder::default();
+        settle(&mut s, DVec3::splat(16.0), &mut sink, 20_000);
+        let loaded = s.positions();
+        let mut most = 0;
+        for i in 0..300 {
+            let eye = DVec3::new(16.0 + 32.0 * (5_000.0 + f64::from(i)), 16.0, 16.0);
+            s.update(eye, &mut sink).unwrap();
+            assert!(s.queued_unloads() <= s.positions(), "update {i}: {s:?}");
+            most = most.max(s.queued_unloads());
+        }
+        assert!(most <= loaded + s.positions(), "{most}");
+        // And it all drains: the old place leaves memory, the new one loads.
+        let eye = DVec3::new(16.0 + 32.0 * 5_300.0, 16.0, 16.0);
+        settle(&mut s, eye, &mut sink, 50_000);
+        let centre = ChunkPos::new(5_300, 0, 0);
+        assert!(s.world().iter().all(|(p, _)| (p.x - centre.x).abs() < 20));
     }
 }
