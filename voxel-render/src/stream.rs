@@ -26,6 +26,8 @@
 //!   Its jobs still in flight come back to nothing (each position has a version). The
 //!   unload queue holds each chunk at most once, so a teleport costs no more than loading
 //!   the new place and unloading the old at the budget.
+//! - **Drop**: dropping the streamer stops its jobs: queued ones return at once, without
+//!   calling the source or the mesher.
 //! - **Edits**: [`ChunkStreamer::set_block`] changes the world; the chunks it touched are
 //!   meshed again before anything new. An edited chunk is kept when it unloads and comes
 //!   back as edited. An edit of a chunk that is not loaded generates it on the spot and
@@ -34,6 +36,7 @@
 use std::collections::{BinaryHeap, HashMap, HashSet, VecDeque};
 use std::panic::AssertUnwindSafe;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, Sender, channel};
 
 use glam::DVec3;
@@ -294,6 +297,8 @@ pub struct ChunkStreamer {
     edited: HashSet<ChunkPos>,
     /// Edited chunks that are not loaded (packed).
     saved: HashMap<ChunkPos, Chunk>,
+    /// Set when the streamer is dropped: queued jobs return without working.
+    cancelled: Arc<AtomicBool>,
     tx: Sender<Done>,
     rx: Receiver<Done>,
     jobs: usize,
@@ -309,6 +314,13 @@ impl std::fmt::Debug for ChunkStreamer {
             .field("jobs", &self.jobs)
             .field("unload", &self.unload.len())
             .finish_non_exhaustive()
+    }
+}
+
+impl Drop for ChunkStreamer {
+    fn drop(&mut self) {
+        // The pool finishes what is queued before its threads exit: make that nothing.
+        self.cancelled.store(true, Ordering::Relaxed);
     }
 }
 
@@ -390,6 +402,7 @@ impl ChunkStreamer {
             ready: BinaryHeap::new(),
             edited: HashSet::new(),
             saved: HashMap::new(),
+            cancelled: Arc::new(AtomicBool::new(false)),
             tx,
             rx,
             jobs: 0,
@@ -690,8 +703,12 @@ impl ChunkStreamer {
         let source = self.source.clone();
         let registry = self.registry.clone();
         let tx = self.tx.clone();
+        let cancelled = self.cancelled.clone();
         self.jobs += 1;
         self.pool.spawn(move || {
+            if cancelled.load(Ordering::Relaxed) {
+                return;
+            }
             let generated = std::panic::catch_unwind(AssertUnwindSafe(|| source.generate(pos)));
             let done = match generated {
                 Ok(mut chunk) => {
@@ -763,8 +780,12 @@ impl ChunkStreamer {
             Neighbourhood::OFFSETS.map(|d| pos.offset(d).and_then(|n| self.world.shared(n)));
         let registry = self.registry.clone();
         let tx = self.tx.clone();
+        let cancelled = self.cancelled.clone();
         self.jobs += 1;
         self.pool.spawn(move || {
+            if cancelled.load(Ordering::Relaxed) {
+                return;
+            }
             let done = std::panic::catch_unwind(AssertUnwindSafe(|| {
                 let meshes = mesh_on_worker(&registry, &centre, &neighbours);
                 let packed = (!centre.is_packed()).then(|| {
@@ -1286,5 +1307,41 @@ mod tests {
         settle(&mut s, eye, &mut sink, 50_000);
         let centre = ChunkPos::new(5_300, 0, 0);
         assert!(s.world().iter().all(|(p, _)| (p.x - centre.x).abs() < 20));
+    }
+
+    /// A source that counts its calls and takes 2 ms each.
+    struct Slow(Arc<std::sync::atomic::AtomicUsize>);
+
+    impl ChunkSource for Slow {
+        fn generate(&self, _: ChunkPos) -> Chunk {
+            std::thread::sleep(std::time::Duration::from_millis(2));
+            self.0.fetch_add(1, Ordering::SeqCst);
+            Chunk::uniform(blocks::STONE)
+        }
+    }
+
+    /// Issue 26, row 8: dropping the streamer with 64 jobs queued stops them: at most the
+    /// one running goes on (they all ran, 64 calls, before).
+    #[test]
+    fn dropping_the_streamer_stops_its_jobs() {
+        let calls = Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let config = StreamConfig {
+            view_distance: 8,
+            threads: 1,
+            max_jobs: 64,
+            ..StreamConfig::default()
+        };
+        let mut s = ChunkStreamer::new(registry(), Slow(calls.clone()), config).unwrap();
+        s.update(DVec3::splat(16.0), &mut Recorder::default())
+            .unwrap();
+        assert_eq!(s.jobs(), 64);
+        drop(s);
+        let at_drop = calls.load(Ordering::SeqCst);
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        let after = calls.load(Ordering::SeqCst);
+        assert!(
+            after <= at_drop + 1,
+            "{at_drop} calls at the drop, {after} after"
+        );
     }
 }
