@@ -55,8 +55,9 @@ pub const MAX_VIEW_DISTANCE: u32 = 64;
 /// Where chunks come from. Called on rayon's workers, any number at once.
 pub trait ChunkSource: Send + Sync + 'static {
     /// The blocks of the chunk at `pos` (a valid position). Every id must be in the
-    /// registry the streamer was made with; a chunk with an unknown id is not drawn (the
-    /// update reports it).
+    /// registry the streamer was made with. A chunk whose generation panics or holds an
+    /// unknown id is reported by the update ([`StreamFrame::failed`]) or by
+    /// [`ChunkStreamer::set_block`] ([`Error::ChunkSource`]), and counts as air.
     fn generate(&self, pos: ChunkPos) -> Chunk;
 }
 
@@ -207,6 +208,8 @@ struct Slot {
     uploaded: bool,
     /// Whether it is in the unload queue.
     unload_queued: bool,
+    /// The source failed for it: air stands in (reported when it happened).
+    failed: bool,
 }
 
 impl Slot {
@@ -216,6 +219,7 @@ impl Slot {
             version,
             uploaded: false,
             unload_queued: false,
+            failed: false,
         }
     }
 
@@ -364,6 +368,29 @@ fn mesh_on_worker(
         });
         mesher.mesh(centre, nb).map_err(|e| e.to_string())
     })
+}
+
+/// Calls the source for `pos`, catching a panic, and checks its block ids: the chunk, or
+/// why it failed.
+fn generate_checked(
+    source: &dyn ChunkSource,
+    registry: &BlockRegistry,
+    pos: ChunkPos,
+) -> std::result::Result<Chunk, String> {
+    let chunk = std::panic::catch_unwind(AssertUnwindSafe(|| source.generate(pos)))
+        .map_err(|_| "the chunk source panicked".to_owned())?;
+    if let Some(id) = chunk
+        .palette()
+        .map(|(id, _)| id)
+        .find(|id| !registry.contains(*id))
+    {
+        return Err(format!(
+            "the chunk source made block id {}, unknown to the registry of {} blocks",
+            id.0,
+            registry.len()
+        ));
+    }
+    Ok(chunk)
 }
 
 impl ChunkStreamer {
@@ -638,8 +665,9 @@ impl ChunkStreamer {
                     if let Some(slot) = self.slots.get_mut(&pos)
                         && slot.version == version
                     {
-                        // Not retried: the source failed for this position. Air stands
-                        // in, so that its neighbours still mesh.
+                        // Not retried while loaded: the source failed for this position.
+                        // Air stands in, so that its neighbours still mesh.
+                        slot.failed |= slot.state == State::Generating;
                         slot.state = State::Meshed;
                         frame.failed.push((pos, why));
                     }
@@ -709,38 +737,18 @@ impl ChunkStreamer {
             if cancelled.load(Ordering::Relaxed) {
                 return;
             }
-            let generated = std::panic::catch_unwind(AssertUnwindSafe(|| source.generate(pos)));
-            let done = match generated {
+            let done = match generate_checked(&*source, &registry, pos) {
                 Ok(mut chunk) => {
-                    let unknown = chunk
-                        .palette()
-                        .map(|(id, _)| id)
-                        .find(|id| !registry.contains(*id));
-                    match unknown {
-                        Some(id) => Done::Failed {
-                            pos,
-                            version,
-                            why: format!(
-                                "the source made block id {id:?}, unknown to the registry"
-                            ),
-                        },
-                        None => {
-                            if pack {
-                                chunk.pack();
-                            }
-                            Done::Generated {
-                                pos,
-                                version,
-                                chunk,
-                            }
-                        }
+                    if pack {
+                        chunk.pack();
+                    }
+                    Done::Generated {
+                        pos,
+                        version,
+                        chunk,
                     }
                 }
-                Err(_) => Done::Failed {
-                    pos,
-                    version,
-                    why: "the chunk source panicked".into(),
-                },
+                Err(why) => Done::Failed { pos, version, why },
             };
             let _ = tx.send(done);
         });
@@ -913,27 +921,39 @@ impl ChunkStreamer {
 
     /// Sets the block at `pos` and returns the old one. The chunks it touches are meshed
     /// again before any new chunk. A chunk not loaded is generated here (one chunk's work
-    /// on this thread), edited, and kept until it loads. Fails on a block id the registry
-    /// does not hold.
+    /// on this thread), edited, and kept until it loads. Fails, changing nothing, on a
+    /// block id the registry does not hold, and with [`Error::ChunkSource`] where the
+    /// source fails for the chunk (it panicked or made unknown ids): the panic is caught
+    /// here, never propagated.
     pub fn set_block(&mut self, pos: WorldPos, id: BlockId) -> Result<BlockId> {
         if !self.registry.contains(id) {
             return Err(voxel_core::Error::UnknownBlock(id, self.registry.len()).into());
         }
         let (c, [x, y, z]) = pos.split();
-        match self.slots.get(&c).map(|s| s.state) {
+        let from_source = |s: &Self| {
+            generate_checked(&*s.source, &s.registry, c)
+                .map_err(|why| Error::ChunkSource { pos: c, why })
+        };
+        match self.slots.get(&c).map(|s| (s.state, s.failed)) {
             None => {
                 let mut chunk = match self.saved.remove(&c) {
                     Some(chunk) => chunk,
-                    None => self.source.generate(c),
+                    None => from_source(self)?,
                 };
                 let old = chunk.set(x, y, z, id);
                 chunk.pack();
                 self.saved.insert(c, chunk);
                 return Ok(old?);
             }
-            Some(State::Generating) => {
+            Some((_, true)) => {
+                return Err(Error::ChunkSource {
+                    pos: c,
+                    why: "the chunk source failed for it when it loaded (it stands as air)".into(),
+                });
+            }
+            Some((State::Generating, false)) => {
                 // Its job's result will not count: generate it here.
-                let chunk = self.source.generate(c);
+                let chunk = from_source(self)?;
                 if let Some(slot) = self.slots.get_mut(&c) {
                     slot.version = slot.version.wrapping_add(1);
                     slot.state = State::Generated;
@@ -950,6 +970,7 @@ impl ChunkStreamer {
         for d in self.world.take_dirty() {
             if let Some(slot) = self.slots.get_mut(&d)
                 && matches!(slot.state, State::Meshing | State::Ready | State::Meshed)
+                && !slot.failed
             {
                 slot.version = slot.version.wrapping_add(1);
                 slot.state = State::Generated;
@@ -1275,6 +1296,60 @@ mod tests {
             sink.held.contains_key(&ChunkPos::new(0, 0, 0)),
             "its neighbours still draw"
         );
+    }
+
+    /// Issue 26, rows 5 and 6: an edit of a chunk whose source panics or makes unknown ids
+    /// is an error (the panic never reaches the caller), whether the chunk is not loaded,
+    /// on its way, or loaded (where it stands as air, reported by the update).
+    #[test]
+    fn edits_of_chunks_whose_source_fails_are_errors() {
+        let config = StreamConfig {
+            view_distance: 3,
+            vertical_distance: 1,
+            threads: 1,
+            max_jobs: 1,
+            ..StreamConfig::default()
+        };
+        let mut s = ChunkStreamer::new(registry(), Broken, config).unwrap();
+        let mut sink = Recorder::default();
+        // (1, 0, 0) panics, (-1, 0, 0) makes unknown ids; far copies of them too.
+        for c in [1, -1] {
+            let at = WorldPos::new(c * 32 + 4, 4, 4);
+            let e = s.set_block(at, blocks::GLASS).unwrap_err();
+            assert!(matches!(e, Error::ChunkSource { .. }), "{e:?}");
+            let msg = e.to_string();
+            assert!(msg.contains(&format!("x: {c}")), "{msg}");
+            assert!(
+                msg.contains(if c == 1 { "panicked" } else { "unknown" }),
+                "{msg}"
+            );
+        }
+        // On their way: one job at a time, so both are still generating after an update.
+        s.update(DVec3::splat(16.0), &mut sink).unwrap();
+        for c in [1, -1] {
+            assert!(
+                s.set_block(WorldPos::new(c * 32 + 4, 4, 4), blocks::GLASS)
+                    .is_err()
+            );
+        }
+        let frames = settle(&mut s, DVec3::splat(16.0), &mut sink, 20_000);
+        let failed: HashSet<ChunkPos> = frames
+            .iter()
+            .flat_map(|f| f.failed.iter().map(|x| x.0))
+            .collect();
+        assert!(
+            failed.contains(&ChunkPos::new(1, 0, 0)) && failed.contains(&ChunkPos::new(-1, 0, 0))
+        );
+        for c in [1, -1] {
+            let e = s
+                .set_block(WorldPos::new(c * 32 + 4, 4, 4), blocks::GLASS)
+                .unwrap_err();
+            assert!(e.to_string().contains("stands as air"), "{e}");
+            assert!(!sink.held.contains_key(&ChunkPos::new(c, 0, 0)));
+        }
+        // Their neighbours draw; an edit next to them works.
+        assert!(sink.held.contains_key(&ChunkPos::new(0, 0, 0)));
+        s.set_block(WorldPos::new(31, 5, 5), blocks::STONE).unwrap();
     }
 
     /// Issue 26, row 7: the unload queue holds each chunk once. After a teleport, the eye
