@@ -36,8 +36,11 @@
 //!   one mesh) per update. The unload queue holds each chunk at most once, so a teleport
 //!   costs no more than loading the new place and unloading the old at the budget.
 //!   Resident blocks are those within the view distance plus the hysteresis (at least 2)
-//!   and the ring of neighbours drawn chunks need. An edited chunk that unloads is kept
-//!   (packed) and comes back as edited.
+//!   and the ring of neighbours drawn chunks need. Edits are kept as a sparse list per
+//!   chunk, [`EDIT_BYTES`] per edited block plus [`EDITED_CHUNK_BYTES`] per edited chunk
+//!   ([`ChunkStreamer::memory_bytes`] counts them): an edited chunk that unloads keeps only
+//!   its edits, and comes back as the source's blocks with its edits applied.
+//!   [`ChunkStreamer::edits`] lists them for a game to save.
 //! - **Dropping the streamer stops its jobs**: queued jobs return at once, without
 //!   calling the source or the mesher.
 //!
@@ -45,10 +48,10 @@
 //!
 //! - **Load**: the positions within the view distance (a cylinder: `view_distance`
 //!   chunks across, `vertical_distance` up and down) are walked nearest first; a missing
-//!   position and its missing neighbours are generated on a worker (an edited chunk that
-//!   unloaded comes back from what was kept). A chunk whose 26 neighbours have their
-//!   blocks is meshed on a worker, which also packs it ([`voxel_core::Chunk::pack`], about
-//!   1× a packed-index palette). Uniform air chunks are not stored.
+//!   position and its missing neighbours are generated on a worker (with the chunk's
+//!   edits applied there). A chunk whose 26 neighbours have their blocks is meshed on a
+//!   worker, which also packs it ([`voxel_core::Chunk::pack`], about 1× a packed-index
+//!   palette). Uniform air chunks are not stored.
 //! - **Upload**: finished meshes wait in a queue, nearest first, and go to the
 //!   [`ChunkSink`] (the [`Renderer`]) within the upload budget. Each position has a
 //!   version: a job whose position was edited, unloaded or regenerated since comes back
@@ -59,7 +62,7 @@
 //!   memory (its neighbours past the margin are queued in turn); one still needed is
 //!   dropped from the queue and queued again when its drawn neighbour leaves.
 
-use std::collections::{BinaryHeap, HashMap, HashSet, VecDeque};
+use std::collections::{BTreeMap, BinaryHeap, HashMap, VecDeque};
 use std::panic::AssertUnwindSafe;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -212,6 +215,17 @@ pub struct StreamFrame {
     pub failed: Vec<(ChunkPos, String)>,
 }
 
+/// Bytes counted per edited block ([`ChunkStreamer::memory_bytes`]), an upper bound: a
+/// 4-byte entry (index, block id) in a B-tree leaf of 11 entries that is at least half
+/// full (56 bytes for 5 entries), plus its share of the inner nodes. Measured by a
+/// counting allocator (`tests/tests/stream_memory.rs`): 10.6 bytes per edit when whole
+/// chunks are edited.
+pub const EDIT_BYTES: usize = 20;
+/// Bytes counted per edited chunk, an upper bound: its hash table slot (25 bytes at a load
+/// of 7/16 to 7/8), the shared map (40) and its first leaf (56). Measured: 138 bytes per
+/// chunk with one edit, over 10 000 chunks.
+pub const EDITED_CHUNK_BYTES: usize = 160;
+
 /// How far along a position is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum State {
@@ -270,6 +284,23 @@ impl Slot {
     fn needs_neighbours(&self) -> bool {
         self.uploaded || matches!(self.state, State::Meshing | State::Ready)
     }
+}
+
+/// The edits of one chunk: in-chunk index ([`local_index`]) → block.
+type ChunkEdits = Arc<BTreeMap<u16, BlockId>>;
+
+/// The index of a block within its chunk (x fastest), as the edit lists key it.
+fn local_index([x, y, z]: [usize; 3]) -> u16 {
+    (x + CHUNK_SIZE * (y + CHUNK_SIZE * z)) as u16
+}
+
+fn local_of(index: u16) -> [usize; 3] {
+    let i = usize::from(index);
+    [
+        i % CHUNK_SIZE,
+        (i / CHUNK_SIZE) % CHUNK_SIZE,
+        i / (CHUNK_SIZE * CHUNK_SIZE),
+    ]
 }
 
 enum Done {
@@ -336,10 +367,11 @@ pub struct ChunkStreamer {
     /// Edited chunks to mesh again, each once ([`Slot::remesh_queued`]).
     remesh: VecDeque<ChunkPos>,
     ready: BinaryHeap<Ready>,
-    /// Chunks edited since they were generated: kept when they unload.
-    edited: HashSet<ChunkPos>,
-    /// Edited chunks that are not loaded (packed).
-    saved: HashMap<ChunkPos, Chunk>,
+    /// Every edit made, per chunk: applied when the chunk is generated again.
+    edits: HashMap<ChunkPos, ChunkEdits>,
+    /// The source's blocks of the last chunk not loaded that an edit read (without its
+    /// edits): many edits of one far chunk call the source once.
+    last_source: Option<(ChunkPos, Arc<Chunk>)>,
     /// Set when the streamer is dropped: queued jobs return without working.
     cancelled: Arc<AtomicBool>,
     tx: Sender<Done>,
@@ -416,13 +448,14 @@ fn mesh_on_worker(
 }
 
 /// Calls the source for `pos`, catching a panic, and checks its block ids: the chunk, or
-/// why it failed.
+/// why it failed. Then applies `edits` (ids the registry holds: checked when made).
 fn generate_checked(
     source: &dyn ChunkSource,
     registry: &BlockRegistry,
     pos: ChunkPos,
+    edits: Option<&BTreeMap<u16, BlockId>>,
 ) -> std::result::Result<Chunk, String> {
-    let chunk = std::panic::catch_unwind(AssertUnwindSafe(|| source.generate(pos)))
+    let mut chunk = std::panic::catch_unwind(AssertUnwindSafe(|| source.generate(pos)))
         .map_err(|_| "the chunk source panicked".to_owned())?;
     if let Some(id) = chunk
         .palette()
@@ -434,6 +467,10 @@ fn generate_checked(
             id.0,
             registry.len()
         ));
+    }
+    for (&index, &id) in edits.into_iter().flatten() {
+        let [x, y, z] = local_of(index);
+        chunk.set(x, y, z, id).map_err(|e| e.to_string())?;
     }
     Ok(chunk)
 }
@@ -472,8 +509,8 @@ impl ChunkStreamer {
             unload: VecDeque::new(),
             remesh: VecDeque::new(),
             ready: BinaryHeap::new(),
-            edited: HashSet::new(),
-            saved: HashMap::new(),
+            edits: HashMap::new(),
+            last_source: None,
             cancelled: Arc::new(AtomicBool::new(false)),
             tx,
             rx,
@@ -546,10 +583,33 @@ impl ChunkStreamer {
         self.slots.get(&pos).is_some_and(Slot::has_blocks)
     }
 
-    /// Heap and inline bytes of the chunks held: resident ones and edited ones unloaded.
+    /// Bytes of the chunks held (heap and inline) plus the edits kept
+    /// ([`EDIT_BYTES`] per edited block, [`EDITED_CHUNK_BYTES`] per edited chunk). Besides
+    /// these the streamer keeps the source's blocks of the last chunk not loaded that an
+    /// edit read (one chunk).
     pub fn memory_bytes(&self) -> usize {
-        self.world.chunk_memory_bytes()
-            + self.saved.values().map(Chunk::memory_bytes).sum::<usize>()
+        self.world.chunk_memory_bytes() + self.edit_bytes()
+    }
+
+    /// Bytes counted for the edits kept (see [`ChunkStreamer::memory_bytes`]).
+    pub fn edit_bytes(&self) -> usize {
+        self.edits
+            .values()
+            .map(|e| EDITED_CHUNK_BYTES + EDIT_BYTES * e.len())
+            .sum()
+    }
+
+    /// Every edit kept, per chunk: `(position in the world, block)` for each block set
+    /// through [`ChunkStreamer::set_block`] (the last value set), for a game to save.
+    pub fn edits(&self) -> impl Iterator<Item = (WorldPos, BlockId)> + '_ {
+        self.edits.iter().flat_map(|(pos, e)| {
+            let o = pos.origin();
+            e.iter().map(move |(&i, &id)| {
+                let [x, y, z] = local_of(i);
+                let at = |k: usize, v: usize| (o[k] + v as i64) as i32;
+                (WorldPos::new(at(0, x), at(1, y), at(2, z)), id)
+            })
+        })
     }
 
     /// Positions whose meshes are in the sink.
@@ -805,12 +865,8 @@ impl ChunkStreamer {
             }
             if self.may_leave(pos, centre) {
                 self.slots.remove(&pos);
-                if let Some(mut chunk) = self.world.remove_chunk(pos)
-                    && self.edited.remove(&pos)
-                {
-                    chunk.pack();
-                    self.saved.insert(pos, chunk);
-                }
+                // Its edits stay in `edits`: it comes back as the source plus them.
+                self.world.remove_chunk(pos);
                 worked = true;
             }
             // A chunk still needed stays resident, out of the queue: the neighbour that
@@ -822,20 +878,13 @@ impl ChunkStreamer {
 
     fn generate(&mut self, pos: ChunkPos, centre: ChunkPos) {
         let version = self.next_version();
-        if let Some(chunk) = self.saved.remove(&pos) {
-            // An edited chunk comes back as it was left.
-            self.edited.insert(pos);
-            self.slots.insert(pos, Slot::new(State::Generated, version));
-            let _ = self.world.insert_chunk(pos, chunk);
-            self.world.take_dirty();
-            return;
-        }
         self.slots
             .insert(pos, Slot::new(State::Generating, version));
         // A chunk outside the view distance is only a neighbour: packed at once.
         let pack = !self.wanted(pos, centre);
         let source = self.source.clone();
         let registry = self.registry.clone();
+        let edits = self.edits.get(&pos).cloned();
         let tx = self.tx.clone();
         let cancelled = self.cancelled.clone();
         self.jobs += 1;
@@ -843,7 +892,7 @@ impl ChunkStreamer {
             if cancelled.load(Ordering::Relaxed) {
                 return;
             }
-            let done = match generate_checked(&*source, &registry, pos) {
+            let done = match generate_checked(&*source, &registry, pos, edits.as_deref()) {
                 Ok(mut chunk) => {
                     if pack {
                         chunk.pack();
@@ -1046,10 +1095,38 @@ impl ChunkStreamer {
         }
     }
 
-    /// The source's blocks of the chunk at `pos`, generated here on the calling thread.
+    /// The blocks of the chunk at `pos` generated here, on the calling thread, with its
+    /// edits: for an edit of a chunk whose generation is in flight.
     fn generate_here(&self, pos: ChunkPos) -> Result<Chunk> {
-        generate_checked(&*self.source, &self.registry, pos)
-            .map_err(|why| Error::ChunkSource { pos, why })
+        generate_checked(
+            &*self.source,
+            &self.registry,
+            pos,
+            self.edits.get(&pos).map(|e| &**e),
+        )
+        .map_err(|why| Error::ChunkSource { pos, why })
+    }
+
+    /// The source's block at `local` of the chunk at `pos` (not loaded), its ids checked;
+    /// the chunk is kept for the next edit of the same chunk.
+    fn source_block(&mut self, pos: ChunkPos, [x, y, z]: [usize; 3]) -> Result<BlockId> {
+        let chunk = match &self.last_source {
+            Some((p, c)) if *p == pos => c.clone(),
+            _ => {
+                let c = generate_checked(&*self.source, &self.registry, pos, None)
+                    .map_err(|why| Error::ChunkSource { pos, why })?;
+                let c = Arc::new(c);
+                self.last_source = Some((pos, c.clone()));
+                c
+            }
+        };
+        Ok(chunk.get(x, y, z)?)
+    }
+
+    /// Records an edit in the chunk's edit list.
+    fn record_edit(&mut self, pos: WorldPos, id: BlockId) {
+        let (c, local) = pos.split();
+        Arc::make_mut(self.edits.entry(c).or_default()).insert(local_index(local), id);
     }
 
     /// Sets the block at `pos` and returns the old one. The chunks whose meshes it touches
@@ -1066,14 +1143,16 @@ impl ChunkStreamer {
         match self.slots.get(&c).map(|s| (s.state, s.failed)) {
             None => {
                 // Not loaded: no drawn chunk's mesh depends on it (see `may_leave`).
-                let mut chunk = match self.saved.remove(&c) {
-                    Some(chunk) => chunk,
-                    None => self.generate_here(c)?,
+                let old = match self
+                    .edits
+                    .get(&c)
+                    .and_then(|e| e.get(&local_index([x, y, z])))
+                {
+                    Some(&old) => old,
+                    None => self.source_block(c, [x, y, z])?,
                 };
-                let old = chunk.set(x, y, z, id);
-                chunk.pack();
-                self.saved.insert(c, chunk);
-                return Ok(old?);
+                self.record_edit(pos, id);
+                return Ok(old);
             }
             Some((_, true)) => {
                 return Err(Error::ChunkSource {
@@ -1097,7 +1176,7 @@ impl ChunkStreamer {
         }
         self.world.take_dirty();
         let old = self.world.set_block(pos, id)?;
-        self.edited.insert(c);
+        self.record_edit(pos, id);
         for d in self.world.take_dirty() {
             let version = self.next_version();
             if let Some(slot) = self.slots.get_mut(&d)
@@ -1116,6 +1195,7 @@ impl ChunkStreamer {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::collections::HashSet;
     use voxel_core::blocks;
 
     /// A sink that records what it holds and checks the streamer's calls.
@@ -2180,5 +2260,42 @@ mod tests {
             after <= at_drop + 1,
             "{at_drop} calls at the drop, {after} after"
         );
+    }
+
+    /// Issue 26, row 8: 10 000 edits of chunks far away are kept as edits, within the
+    /// documented bound (they took 135 MB as whole chunks), and each comes back when its
+    /// chunk loads; the edit list reports them for saving.
+    #[test]
+    fn far_edits_are_kept_within_the_bound() {
+        let mut s = ChunkStreamer::new(registry(), Pillars, config(1)).unwrap();
+        let mut sink = Recorder::default();
+        settle(&mut s, DVec3::splat(16.0), &mut sink, 10_000);
+        let before = s.memory_bytes();
+        let at = |i: i32| WorldPos::new(1000 * 32 + (i % 100) * 64 + 3, 7, (i / 100) * 64 + 9);
+        for i in 0..10_000 {
+            assert_eq!(s.set_block(at(i), blocks::GLASS).unwrap(), BlockId::AIR);
+        }
+        let kept = s.memory_bytes() - before;
+        assert_eq!(kept, s.edit_bytes());
+        assert_eq!(kept, 10_000 * (EDIT_BYTES + EDITED_CHUNK_BYTES));
+        assert!(kept < 2 << 20, "{kept} bytes");
+        assert_eq!(s.edits().count(), 10_000);
+        assert!(
+            s.edits()
+                .any(|(p, id)| p == at(4321) && id == blocks::GLASS)
+        );
+        // One of them, loaded: the glass is there, drawn.
+        let (c, [x, y, z]) = at(4321).split();
+        let eye = DVec3::new(
+            f64::from(c.x) * 32.0 + 16.0,
+            16.0,
+            f64::from(c.z) * 32.0 + 16.0,
+        );
+        settle(&mut s, eye, &mut sink, 20_000);
+        assert_eq!(
+            s.world().chunk(c).unwrap().get(x, y, z).unwrap(),
+            blocks::GLASS
+        );
+        assert!(sink.held.contains_key(&c));
     }
 }
