@@ -111,19 +111,23 @@ fn names_help() -> String {
     )
 }
 
-/// `WxH`, both sides 1 to 16384.
+/// `WxH`, each side 1 to [`voxel_lab::limits::MAX_SIDE`], at most
+/// [`voxel_lab::limits::MAX_PIXELS`] in all.
 fn size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("{s:?} is not WxH (e.g. 1280x720)"))?;
+    let max = voxel_lab::limits::MAX_SIDE;
     let side = |v: &str| {
         v.trim()
             .parse::<u32>()
             .ok()
-            .filter(|n| (1..=16384).contains(n))
-            .ok_or_else(|| format!("{v:?} is not a whole number from 1 to 16384"))
+            .filter(|n| (1..=max).contains(n))
+            .ok_or_else(|| format!("{v:?} is not a whole number from 1 to {max}"))
     };
-    Ok((side(w)?, side(h)?))
+    let size = (side(w)?, side(h)?);
+    voxel_lab::limits::check_size("size", size)?;
+    Ok(size)
 }
 
 /// A number of random scenes: 1 to [`voxel_lab::random::MAX_SCENES`].
@@ -254,8 +258,8 @@ struct RenderArgs {
     /// Every block one flat colour (what the lab compares with its CPU ray march).
     #[arg(long)]
     flat_textures: bool,
-    /// Timed frames (after one untimed); the medians are printed.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1)]
+    /// Timed frames (after one untimed), 1 to 1000; the medians are printed.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(voxel_lab::limits::MAX_FRAMES)), default_value_t = 1)]
     frames: u32,
     /// Output PNG.
     #[arg(long)]
@@ -286,20 +290,20 @@ struct EvalArgs {
     /// Picture size (default: each scene's own, else 640x360).
     #[arg(long, value_parser = size)]
     size: Option<(u32, u32)>,
-    /// Timed frames per picture (the median is reported).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 10)]
+    /// Timed frames per picture, 1 to 1000 (the median is reported).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(voxel_lab::limits::MAX_FRAMES)), default_value_t = 10)]
     frames: u32,
-    /// Untimed frames first.
-    #[arg(long, default_value_t = 2)]
+    /// Untimed frames first, 0 to 100.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(voxel_lab::limits::MAX_WARMUP)), default_value_t = 2)]
     warmup: u32,
     /// Skip the stability sweeps and flicker paths.
     #[arg(long)]
     no_stability: bool,
-    /// Frames of the flicker camera path.
-    #[arg(long, default_value_t = 60)]
+    /// Frames of the flicker camera path, 2 to 240.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=i64::from(voxel_lab::limits::MAX_FLICKER_FRAMES)), default_value_t = 60)]
     flicker_frames: u32,
-    /// Points per stability sweep.
-    #[arg(long, default_value_t = 9)]
+    /// Points per stability sweep, 2 to 9.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(i64::from(voxel_lab::limits::MIN_SWEEP_POINTS)..=i64::from(voxel_lab::limits::MAX_SWEEP_POINTS)), default_value_t = 9)]
     sweep_points: u32,
     /// Width of the saved heat maps (downscaled; default full size).
     #[arg(long)]
@@ -620,6 +624,8 @@ fn eval(a: EvalArgs) -> Result<(), String> {
         heatmap_width: a.heatmap_width,
         random,
     };
+    // Before the GPU: a broken scene or an option past its cap is the first thing said.
+    opts.validate()?;
     let ctx = headless::context()?;
     eprintln!(
         "adapter: {}; {} scenes x {} techniques + {} weights",

@@ -237,6 +237,125 @@ fn bad_stream_runs_are_refused_before_rendering() {
     );
 }
 
+/// Writes `text` as `name` in a fresh temporary folder and returns its path.
+fn scene_file(name: &str, text: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("demo-cli-scenes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A one-box scene; `camera_extra` is added to its camera.
+fn small_scene(boxes_max: &str, camera_extra: &str) -> String {
+    format!(
+        "name = \"small\"\n[[boxes]]\nblock = \"red_glass\"\nmin = [0, 0, 0]\nmax = {boxes_max}\n\
+         [[cameras]]\neye = [0.5, 1.0, 10.0]\ntarget = [0.5, 1.0, 0.0]\n{camera_extra}\n"
+    )
+}
+
+/// Issue 26: sizes, frame counts, warm-up frames, flicker frames and sweep points past
+/// their documented caps are errors naming the flag and the cap, before anything runs
+/// (these used to panic, fail to allocate, or run for ever).
+#[test]
+fn counts_and_sizes_past_their_caps_are_refused_before_rendering() {
+    fails_saying(
+        &["eval", "--size", "16384x16384", "--out", "x"],
+        &["--size", "8192"],
+    );
+    fails_saying(
+        &["render", "--size", "8192x8192", "--out", "x.png"],
+        &["--size", "33177600 pixels"],
+    );
+    fails_saying(
+        &["render", "--frames", "4294967295", "--out", "x.png"],
+        &["--frames", "4294967295", "1..=1000"],
+    );
+    fails_saying(
+        &["eval", "--frames", "1001", "--out", "x"],
+        &["--frames", "1..=1000"],
+    );
+    fails_saying(
+        &["eval", "--warmup", "4294967295", "--out", "x"],
+        &["--warmup", "0..=100"],
+    );
+    fails_saying(
+        &["eval", "--flicker-frames", "100000000", "--out", "x"],
+        &["--flicker-frames", "100000000", "2..=240"],
+    );
+    for points in ["1", "10"] {
+        fails_saying(
+            &["eval", "--sweep-points", points, "--out", "x"],
+            &["--sweep-points", "2..=9"],
+        );
+    }
+    fails_saying(
+        &[
+            "stream",
+            "--view-distance",
+            "4",
+            "--frames",
+            "5",
+            "--size",
+            "9000x10",
+            "--out",
+            "x",
+        ],
+        &["--size", "8192"],
+    );
+}
+
+/// Issue 26: scene files are read with a size limit (an endless device is an error after
+/// 1 MiB, naming it), boxes that touch too many chunks are an error (20 M blocks in one
+/// row passed the block count), and a `path_to` no camera can take is refused by
+/// `render` as by `eval`: all before any GPU work.
+#[test]
+fn bad_scene_files_are_refused_before_rendering() {
+    for endless in ["/dev/zero", "/dev/urandom"] {
+        fails_saying(
+            &["render", "--scene", endless, "--out", "x.png"],
+            &[endless, "larger than 1048576 bytes"],
+        );
+    }
+    let row = scene_file("row.toml", &small_scene("[19999999, 0, 0]", ""));
+    fails_saying(
+        &["render", "--scene", row.to_str().unwrap(), "--out", "x.png"],
+        &["row.toml", "boxes", "16384 chunks"],
+    );
+    let big = scene_file(
+        "big.toml",
+        &format!("size = [16384, 16384]\n{}", small_scene("[3, 3, 0]", "")),
+    );
+    // eval makes its output folder first: a temporary one.
+    let out = std::env::temp_dir().join(format!("demo-cli-out-{}", std::process::id()));
+    let out = out.to_str().unwrap();
+    for (args, target) in [
+        (&["render", "--scene"][..], "x.png"),
+        (&["eval", "--techniques", "opaque-only", "--scenes"], out),
+    ] {
+        let mut a = args.to_vec();
+        a.extend([big.to_str().unwrap(), "--out", target]);
+        fails_saying(&a, &["big.toml", "size", "8192"]);
+    }
+    let nan = scene_file(
+        "nan_path.toml",
+        &small_scene("[3, 3, 0]", "path_to = [nan, 1.0, 10.0]"),
+    );
+    for (args, target) in [
+        (&["render", "--scene"][..], "x.png"),
+        (&["eval", "--techniques", "opaque-only", "--scenes"], out),
+    ] {
+        let mut a = args.to_vec();
+        a.extend([nan.to_str().unwrap(), "--out", target]);
+        fails_saying(&a, &["nan_path.toml", "cameras.path_to", "finite"]);
+    }
+    assert!(
+        std::fs::read_dir(out).unwrap().next().is_none(),
+        "nothing written"
+    );
+    let _ = std::fs::remove_dir_all(out);
+}
+
 #[test]
 fn a_broken_vox_model_is_named_before_rendering() {
     let dir = std::env::temp_dir().join(format!("demo-cli-vox-{}", std::process::id()));

@@ -15,6 +15,7 @@ const RENDER: &[&str] = &[
 
 /// voxel-lab, bottom up: the model, then the runs, then the report (its lib.rs docs).
 const LAB: &[&str] = &[
+    "limits",
     "progress",
     "random",
     "edges",

@@ -276,3 +276,191 @@ fn unknown_names_list_the_known_ones() {
     let e = voxel_render::BayerSize::from_side(3).unwrap_err();
     assert!(e.to_string().contains("16"), "{e}");
 }
+
+/// A texture of `size` with `mips` levels and `layers` layers, usable as a render target,
+/// with `view_formats`.
+fn texture(
+    ctx: &voxel_render::GpuContext,
+    size: (u32, u32),
+    mips: u32,
+    layers: u32,
+    format: wgpu::TextureFormat,
+    view_formats: &[wgpu::TextureFormat],
+) -> wgpu::Texture {
+    ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("test_output"),
+        size: wgpu::Extent3d {
+            width: size.0,
+            height: size.1,
+            depth_or_array_layers: layers,
+        },
+        mip_level_count: mips,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats,
+    })
+}
+
+/// Issue 26: the output must be a whole level-0 2D view of the renderer's size, viewed
+/// as a format the tonemap pipeline writes. A view of mip level 1 (the right size for a
+/// level but not the renderer), the sRGB twin viewed as the linear format, a 2D-array
+/// view or a layer of an array texture are errors before anything is recorded (under
+/// the panicking error handler, a validation error let through fails the test); the
+/// allowed twin (a linear texture viewed as the sRGB format asked for) draws the same
+/// picture as the plain target.
+#[test]
+fn output_views_other_than_a_whole_level_0_2d_view_are_errors() {
+    use wgpu::TextureFormat as F;
+    let Some(ctx) = gpu() else { return };
+    let scene = dense_sheets(2, 0.5);
+    let cam = scene.cameras[0];
+    let (w, h) = (160, 90);
+    let mut r = renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, w, h)).unwrap();
+    let plain = frame(&ctx, &mut r, &cam);
+    assert!(distinct_colours(&plain) > 8);
+
+    let expect_output_error =
+        |r: &mut voxel_render::Renderer, view: &wgpu::TextureView, what| match r
+            .render_and_submit(view, &cam)
+        {
+            Err(e @ voxel_render::Error::Output(_)) => e.to_string(),
+            Err(e) => panic!("{what}: {e:?}"),
+            Ok(_) => panic!("{what}: accepted"),
+        };
+    let mipped = texture(&ctx, (w, h), 2, 1, F::Rgba8UnormSrgb, &[]);
+    let level1 = mipped.create_view(&wgpu::TextureViewDescriptor {
+        base_mip_level: 1,
+        mip_level_count: Some(1),
+        ..Default::default()
+    });
+    let msg = expect_output_error(&mut r, &level1, "mip level 1");
+    assert!(
+        msg.contains("mip level 0") && msg.contains("160x90"),
+        "{msg}"
+    );
+    // Level 0 of the same texture is fine.
+    let level0 = mipped.create_view(&wgpu::TextureViewDescriptor {
+        mip_level_count: Some(1),
+        ..Default::default()
+    });
+    r.render_and_submit(&level0, &cam).unwrap();
+
+    let twin = texture(&ctx, (w, h), 1, 1, F::Rgba8UnormSrgb, &[F::Rgba8Unorm]);
+    let linear = twin.create_view(&wgpu::TextureViewDescriptor {
+        format: Some(F::Rgba8Unorm),
+        ..Default::default()
+    });
+    let msg = expect_output_error(&mut r, &linear, "sRGB texture viewed linear");
+    assert!(msg.contains("Rgba8UnormSrgb"), "{msg}");
+
+    let layered = texture(&ctx, (w, h), 1, 2, F::Rgba8UnormSrgb, &[]);
+    let array_view = layered.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    let msg = expect_output_error(&mut r, &array_view, "2D-array view of 2 layers");
+    assert!(msg.contains("2 layers"), "{msg}");
+    let layer = layered.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: 1,
+        array_layer_count: Some(1),
+        ..Default::default()
+    });
+    let msg = expect_output_error(&mut r, &layer, "a layer of an array texture");
+    assert!(msg.contains("2 layers"), "{msg}");
+    // A 2D-array view of a single-layer texture is the whole texture: wgpu draws into it
+    // like a 2D view (the same picture), so it is accepted.
+    let single = texture(&ctx, (w, h), 1, 1, F::Rgba8UnormSrgb, &[]);
+    let single_array = single.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    r.render_and_submit(&single_array, &cam).unwrap();
+    let rgba = voxel_render::readback::read_texture(&ctx, &single, 4).unwrap();
+    let image = voxel_render::Image {
+        width: w,
+        height: h,
+        rgba,
+    };
+    assert_close("output_single_layer_array_view", &image, &plain, 0);
+
+    // The allowed twin: a linear texture viewed as the sRGB format the renderer writes.
+    let unorm = texture(&ctx, (w, h), 1, 1, F::Rgba8Unorm, &[F::Rgba8UnormSrgb]);
+    let srgb = unorm.create_view(&wgpu::TextureViewDescriptor {
+        format: Some(F::Rgba8UnormSrgb),
+        ..Default::default()
+    });
+    r.render_and_submit(&srgb, &cam).unwrap();
+    let bytes = voxel_render::readback::read_texture(&ctx, &unorm, 4).unwrap();
+    let twin_image = voxel_render::Image {
+        width: w,
+        height: h,
+        rgba: bytes,
+    };
+    assert_close("output_twin_view", &twin_image, &plain, 0);
+    // And the plain target still works after every refusal.
+    assert_close(
+        "output_after_refusals",
+        &frame(&ctx, &mut r, &cam),
+        &plain,
+        0,
+    );
+}
+
+/// Issue 26: an `output_format` the tonemap cannot write (integer, depth, not
+/// renderable) is an error at `new`, naming it; NaN, infinite or out-of-range lighting
+/// values are errors at `new`, naming the field.
+#[test]
+fn bad_output_formats_and_lighting_are_errors_at_new() {
+    use wgpu::TextureFormat as F;
+    let Some(ctx) = gpu() else { return };
+    let registry = voxel_core::BlockRegistry::default();
+    let config = technique_config(Technique::WboitMrt, 64, 48);
+    for format in [F::Rgba8Uint, F::Depth32Float, F::R32Sint, F::Rgb9e5Ufloat] {
+        let c = voxel_render::RendererConfig {
+            output_format: format,
+            ..config.clone()
+        };
+        let e = voxel_render::Renderer::new(&ctx, &registry, c).unwrap_err();
+        assert!(matches!(e, voxel_render::Error::InvalidSetting(_)), "{e:?}");
+        assert!(e.to_string().contains(&format!("{format:?}")), "{e}");
+    }
+    for format in [F::Rgba16Float, F::Bgra8UnormSrgb, F::Rgba8Unorm] {
+        let c = voxel_render::RendererConfig {
+            output_format: format,
+            ..config.clone()
+        };
+        voxel_render::Renderer::new(&ctx, &registry, c).unwrap();
+    }
+    const NAN: f32 = f32::NAN;
+    const INF: f32 = f32::INFINITY;
+    type Change = Box<dyn Fn(&mut voxel_render::RendererConfig)>;
+    let cases: [(&str, Change); 7] = [
+        ("ambient", Box::new(|c| c.ambient = NAN)),
+        ("ambient", Box::new(|c| c.ambient = INF)),
+        ("ambient", Box::new(|c| c.ambient = -0.5)),
+        ("sky", Box::new(|c| c.sky = [0.1, NAN, 0.2])),
+        ("sky", Box::new(|c| c.sky = [INF, 0.1, 0.2])),
+        ("sky", Box::new(|c| c.sky = [0.1, -1.0, 0.2])),
+        ("sun_dir", Box::new(|c| c.sun_dir = [0.0, INF, 0.0])),
+    ];
+    for (field, change) in cases {
+        let mut c = config.clone();
+        change(&mut c);
+        let e = voxel_render::Renderer::new(&ctx, &registry, c).unwrap_err();
+        assert!(matches!(e, voxel_render::Error::InvalidSetting(_)), "{e:?}");
+        assert!(e.to_string().contains(field), "{field}: {e}");
+    }
+    // The edges of the ranges are fine: all ambient light, a black sky, a zero sun
+    // direction (straight up).
+    let mut c = config.clone();
+    c.ambient = 1.0;
+    c.sky = [0.0; 3];
+    c.sun_dir = [0.0; 3];
+    let scene = dense_sheets(2, 0.5);
+    let mut r = renderer_for(&ctx, &scene, c).unwrap();
+    let img = frame(&ctx, &mut r, &scene.cameras[0]);
+    assert!(distinct_colours(&img) > 4);
+}

@@ -186,3 +186,112 @@ fn compacting_the_arena_keeps_the_picture() {
     assert!(tests::distinct_colours(&a) > 50, "a real picture");
     tests::assert_close("compacted", &a, &b, 0);
 }
+
+/// Issue 26, the streamer's contract on a real renderer: edits near the eye, on the
+/// outer face of the chunk at the view-distance edge, on the chunk past the margin next to
+/// a drawn one, and far away; the eye flies two chunks away and back (the edge chunk's
+/// outer neighbour passes the margin) and far away and back. Once idle, the streamed
+/// picture equals that of a fresh renderer given fresh meshes of the true world (the
+/// generator's terrain with every edit), and the chunks drawn are exactly those within
+/// the view distance whose true meshes are not empty.
+#[test]
+fn streamed_edits_everywhere_draw_like_the_true_world() {
+    let Some(ctx) = tests::gpu() else { return };
+    let g = generator();
+    let registry = Arc::new(BlockRegistry::default());
+    let config = StreamConfig {
+        view_distance: 3,
+        vertical_distance: 1,
+        hysteresis: 1,
+        ..StreamConfig::default()
+    };
+    let mut s = ChunkStreamer::new(registry.clone(), g.clone(), config).unwrap();
+    let mut streamed = renderer(&ctx, DrawMode::Indirect);
+    let ground = |x: i32, z: i32| g.height_at(i64::from(x), i64::from(z)) as i32;
+    let home = DVec3::new(16.0, f64::from(ground(16, 16)) + 20.0, 16.0);
+    settle(&mut s, home, &mut streamed);
+    let mut edits: Vec<(WorldPos, voxel_core::BlockId)> = Vec::new();
+    let mut edit = |s: &mut ChunkStreamer, at: WorldPos, id| {
+        s.set_block(at, id).unwrap();
+        edits.push((at, id));
+    };
+    // A glass wall across the border of two chunks near the eye.
+    for y in 0..6 {
+        for z in 4..12 {
+            let base = ground(31, z);
+            edit(&mut s, WorldPos::new(31, base + y, z), blocks::GLASS);
+            edit(&mut s, WorldPos::new(32, base + y, z), blocks::RED_GLASS);
+        }
+    }
+    // Two chunks away and back: the outer neighbour of the edge chunk passes the margin.
+    settle(&mut s, home - DVec3::X * 64.0, &mut streamed);
+    settle(&mut s, home, &mut streamed);
+    // The outer face of the chunk at the view-distance edge, and the chunk past it.
+    for z in 0..32 {
+        let at = WorldPos::new(3 * 32 + 31, ground(3 * 32 + 31, z) + 1, z);
+        edit(&mut s, at, blocks::BLUE_GLASS);
+        let beyond = WorldPos::new(4 * 32, ground(4 * 32, z) + 2, z);
+        edit(&mut s, beyond, blocks::STONE);
+    }
+    // Far away, not loaded.
+    edit(
+        &mut s,
+        WorldPos::new(40 * 32 + 5, ground(40 * 32 + 5, 9) + 1, 9),
+        blocks::ICE,
+    );
+    settle(&mut s, home, &mut streamed);
+    settle(&mut s, home + DVec3::X * 32.0 * 40.0, &mut streamed);
+    settle(&mut s, home, &mut streamed);
+
+    // The true world around the eye: the generator's chunks with every edit, in order.
+    let centre = ChunkPos::new(0, (home.y / 32.0).floor() as i32, 0);
+    let mut truth = voxel_core::World::new(registry);
+    for x in -6..=6 {
+        for y in centre.y - 3..=centre.y + 3 {
+            for z in -6..=6 {
+                let p = ChunkPos::new(x, y, z);
+                truth.insert_chunk(p, g.generate_chunk(p)).unwrap();
+            }
+        }
+    }
+    for &(at, id) in &edits {
+        if truth.chunk(at.split().0).is_some() {
+            truth.set_block(at, id).unwrap();
+        }
+    }
+    let wanted: Vec<ChunkPos> = (-3..=3)
+        .flat_map(|x| (-3..=3).map(move |z| (x, z)))
+        .filter(|(x, z)| x * x + z * z <= 9)
+        .flat_map(|(x, z)| (-1..=1).map(move |dy| ChunkPos::new(x, centre.y + dy, z)))
+        .collect();
+    let drawn: std::collections::HashSet<ChunkPos> = s.uploaded().collect();
+    let true_meshes = voxel_mesh::mesh_chunks(&truth, &wanted).unwrap();
+    let should: std::collections::HashSet<ChunkPos> = true_meshes
+        .iter()
+        .filter(|(_, m)| !m.is_empty())
+        .map(|(p, _)| *p)
+        .collect();
+    assert_eq!(
+        drawn
+            .iter()
+            .filter(|p| wanted.contains(p))
+            .copied()
+            .collect::<std::collections::HashSet<_>>(),
+        should
+    );
+    let held: Vec<ChunkPos> = drawn.iter().copied().collect();
+    let mut fresh = renderer(&ctx, DrawMode::Indirect);
+    for (pos, m) in voxel_mesh::mesh_chunks(&truth, &held).unwrap() {
+        fresh.upload_chunk(pos, &m).unwrap();
+    }
+    let edge_eye = DVec3::new(90.0, f64::from(ground(100, 16)) + 25.0, 30.0);
+    let edge = DVec3::new(3.0 * 32.0 + 31.0, f64::from(ground(127, 16)) + 1.0, 16.0);
+    let wall = DVec3::new(32.0, f64::from(ground(32, 8)) + 3.0, 8.0);
+    for (name, eye, target) in [("edge", edge_eye, edge), ("wall", home, wall)] {
+        let look = Camera::look_at(eye, target, 70.0, 0.1, 400.0).unwrap();
+        let a = tests::frame(&ctx, &mut streamed, &look);
+        let b = tests::frame(&ctx, &mut fresh, &look);
+        assert!(tests::distinct_colours(&a) > 50, "a real picture");
+        tests::assert_close(&format!("stream_truth_{name}"), &a, &b, 0);
+    }
+}

@@ -107,21 +107,47 @@ pub fn speed_vs_accuracy(
     means: &[Series],
 ) -> Result<(), String> {
     fonts();
-    let draw = |root: DrawingArea<_, Shift>| -> Result<(), String> {
+    draw_png(&path.with_extension("png"), (1000, 640), |root| {
         scatter(root, title, per_scene, means)
-    };
-    draw(BitMapBackend::new(&path.with_extension("png"), (1000, 640)).into_drawing_area())?;
+    })?;
     draw_svg(&path.with_extension("svg"), (1000, 640), |root| {
         scatter(root, title, per_scene, means)
     })
 }
 
+/// Draws with `f` into a bitmap in memory and writes it to `path` as a PNG, in one
+/// checked write: plotters' own file output drops a buffered writer, losing the error of
+/// its last flush (a full disk).
+fn draw_png(
+    path: &Path,
+    size: (u32, u32),
+    f: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
+) -> Result<(), String> {
+    let (w, h) = size;
+    let mut rgb = vec![255u8; w as usize * h as usize * 3];
+    f(BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area())?;
+    let rgba = rgb
+        .chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect();
+    voxel_render::Image {
+        width: w,
+        height: h,
+        rgba,
+    }
+    .save_png(path)
+    .map_err(|e| crate::chain(&e))
+}
+
+/// Draws with `f` into an SVG text in memory and writes it to `path` in one checked write.
 fn draw_svg(
     path: &Path,
     size: (u32, u32),
     f: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
 ) -> Result<(), String> {
-    f(SVGBackend::new(path, size).into_drawing_area())
+    let mut text = String::new();
+    f(SVGBackend::with_string(&mut text, size).into_drawing_area())?;
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 fn scatter<DB: DrawingBackend>(
@@ -229,13 +255,9 @@ pub fn line_chart(
 ) -> Result<(), String> {
     fonts();
     let axes = (x_desc, y_desc);
-    lines(
-        BitMapBackend::new(&path.with_extension("png"), (900, 560)).into_drawing_area(),
-        title,
-        axes,
-        log_x,
-        series,
-    )?;
+    draw_png(&path.with_extension("png"), (900, 560), |root| {
+        lines(root, title, axes, log_x, series)
+    })?;
     draw_svg(&path.with_extension("svg"), (900, 560), |root| {
         lines(root, title, axes, log_x, series)
     })
@@ -324,12 +346,9 @@ pub fn bars(
     values: &[(String, f64)],
 ) -> Result<(), String> {
     fonts();
-    bar_body(
-        BitMapBackend::new(&path.with_extension("png"), (900, 520)).into_drawing_area(),
-        title,
-        y_desc,
-        values,
-    )?;
+    draw_png(&path.with_extension("png"), (900, 520), |root| {
+        bar_body(root, title, y_desc, values)
+    })?;
     draw_svg(&path.with_extension("svg"), (900, 520), |root| {
         bar_body(root, title, y_desc, values)
     })
@@ -398,11 +417,9 @@ pub fn speed_vs_accuracy_spread(
     spreads: &[Spread],
 ) -> Result<(), String> {
     fonts();
-    spread_body(
-        BitMapBackend::new(&path.with_extension("png"), (1000, 640)).into_drawing_area(),
-        title,
-        spreads,
-    )?;
+    draw_png(&path.with_extension("png"), (1000, 640), |root| {
+        spread_body(root, title, spreads)
+    })?;
     draw_svg(&path.with_extension("svg"), (1000, 640), |root| {
         spread_body(root, title, spreads)
     })
@@ -473,13 +490,9 @@ pub fn histograms(
     let cols = 3usize;
     let rows = series.len().div_ceil(cols).max(1);
     let size = (1100, 60 + 260 * rows as u32);
-    histogram_body(
-        BitMapBackend::new(&path.with_extension("png"), size).into_drawing_area(),
-        title,
-        bins,
-        series,
-        (rows, cols),
-    )?;
+    draw_png(&path.with_extension("png"), size, |root| {
+        histogram_body(root, title, bins, series, (rows, cols))
+    })?;
     draw_svg(&path.with_extension("svg"), size, |root| {
         histogram_body(root, title, bins, series, (rows, cols))
     })
@@ -611,6 +624,24 @@ mod tests {
         ] {
             let len = std::fs::metadata(dir.join(f)).unwrap().len();
             assert!(len > 1000, "{f}: {len} bytes");
+        }
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// Issue 26: a chart that cannot be written (a folder in the way of the PNG, then of
+    /// the SVG) is an error naming the file, not a success.
+    #[test]
+    fn a_failed_chart_write_is_an_error_naming_the_file() {
+        let dir = std::env::temp_dir().join(format!("voxel_charts_fail_{}", std::process::id()));
+        let s = vec![Series {
+            name: "a".into(),
+            points: vec![(0.5, 0.1), (2.0, 0.05)],
+        }];
+        for blocked in ["sva.png", "sva.svg"] {
+            let _ = std::fs::remove_dir_all(&dir);
+            std::fs::create_dir_all(dir.join(blocked)).unwrap();
+            let e = speed_vs_accuracy(&dir.join("sva"), "t", &s, &s).unwrap_err();
+            assert!(e.contains(blocked), "{blocked}: {e}");
         }
         let _ = std::fs::remove_dir_all(dir);
     }

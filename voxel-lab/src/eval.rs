@@ -275,6 +275,46 @@ fn runs(opts: &EvalOptions) -> Vec<(String, OitConfig)> {
     runs
 }
 
+/// Checked here, above [`crate::scene`], since it reads the scene files.
+impl EvalOptions {
+    /// Checks what the run asks for against the documented caps ([`crate::limits`]) and
+    /// reads every scene file (parsing it and checking the size it asks for), so that
+    /// nothing is rendered or written when any of it is wrong. The error names the option
+    /// or the file.
+    pub fn validate(&self) -> Result<(), String> {
+        use crate::limits::{self, check_range};
+        if let Some(size) = self.size {
+            limits::check_size("--size", size)?;
+        }
+        check_range("--frames", self.frames as u64, 1, limits::MAX_FRAMES.into())?;
+        check_range("--warmup", self.warmup as u64, 0, limits::MAX_WARMUP.into())?;
+        if self.stability {
+            check_range(
+                "--flicker-frames",
+                self.flicker_frames as u64,
+                2,
+                limits::MAX_FLICKER_FRAMES.into(),
+            )?;
+            check_range(
+                "--sweep-points",
+                self.sweep_points as u64,
+                limits::MIN_SWEEP_POINTS.into(),
+                limits::MAX_SWEEP_POINTS.into(),
+            )?;
+        }
+        if self.random.is_none() {
+            if self.scenes.is_empty() {
+                return Err("no scene files to evaluate".into());
+            }
+            for path in &self.scenes {
+                // Parsing checks a scene's own size against the same caps.
+                Scene::load(path)?;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Output size when neither the command nor the scene gives one.
 pub const DEFAULT_SIZE: (u32, u32) = (640, 360);
 

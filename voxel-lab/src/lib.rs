@@ -3,8 +3,9 @@
 //! It has no window: the demo's window and the integration tests both build on it.
 //!
 //! Modules depend on each other one way:
-//! - the model: [`progress`], [`random`] (random scenes as scene-file text), [`edges`]
-//!   (which pixels lie on quad edges), [`content`] (a game's particles and entities),
+//! - the model: [`limits`] (the documented caps on a run), [`progress`], [`random`]
+//!   (random scenes as scene-file text), [`edges`] (which pixels lie on quad edges),
+//!   [`content`] (a game's particles and entities),
 //!   [`raymarch`] (the CPU ray-march reference),
 //!   [`summary`], [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the
@@ -22,6 +23,7 @@ pub mod edges;
 pub mod eval;
 pub mod gallery;
 pub mod headless;
+pub mod limits;
 pub mod metrics;
 pub mod progress;
 pub mod random;
@@ -50,7 +52,11 @@ pub fn chain(e: &dyn std::error::Error) -> String {
 /// the stability sweeps (when asked) and `report.md`. On random scenes
 /// ([`EvalOptions::random`]) no heat maps, but `distribution.json`, `scenes.json`,
 /// `worst/` and the distribution charts.
+///
+/// Fails before rendering anything when `opts` asks for more than [`limits`] allows, a
+/// scene file is broken or asks for a size past the caps ([`EvalOptions::validate`]).
 pub fn evaluate(ctx: &voxel_render::GpuContext, opts: &EvalOptions) -> Result<Summary, String> {
+    opts.validate()?;
     let out = &opts.out;
     let summary = eval::run_suite(ctx, opts)?;
     summary::write_json(&out.join("summary.json"), &summary.records)?;

@@ -190,8 +190,7 @@ pub fn write(
         if let Some(st) = stability {
             stability_section(&mut s, st);
         }
-        return std::fs::write(out.join("report.md"), s)
-            .map_err(|e| format!("{}: {e}", out.display()));
+        return write_report(out, s);
     }
     header(&mut s, summary, opts);
     suite_means(&mut s, summary);
@@ -202,7 +201,13 @@ pub fn write(
     if let Some(st) = stability {
         stability_section(&mut s, st);
     }
-    std::fs::write(out.join("report.md"), s).map_err(|e| format!("{}: {e}", out.display()))
+    write_report(out, s)
+}
+
+/// Writes `out/report.md`; an error names that file.
+fn write_report(out: &Path, text: String) -> Result<(), String> {
+    let path = out.join("report.md");
+    std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 fn header(s: &mut String, summary: &Summary, opts: &EvalOptions) {

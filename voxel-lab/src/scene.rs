@@ -113,13 +113,15 @@ impl Scene {
         }
     }
 
-    /// Reads a scene file, or a bare `.vox` model ([`Scene::from_vox`]). Errors name the
-    /// file, the line and the field.
+    /// Reads a scene file (at most [`crate::limits::MAX_SCENE_FILE_BYTES`]: a longer
+    /// file, or an endless one like `/dev/zero`, is an error after that many bytes), or a
+    /// bare `.vox` model ([`Scene::from_vox`]). Errors name the file, the line and the
+    /// field.
     pub fn load(path: &Path) -> Result<Self, String> {
         if is_vox(path) {
             return Self::from_vox(path);
         }
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = read_limited(path, crate::limits::MAX_SCENE_FILE_BYTES)?;
         let dir = path.parent().unwrap_or(Path::new(""));
         parse_in(&text, dir).map_err(|e| format!("{}:{}", path.display(), e))
     }
@@ -204,6 +206,24 @@ pub fn framing_camera(min: WorldPos, max: WorldPos) -> Result<(Camera, DVec3), S
         .map_err(|e| e.to_string())?;
     let path_to = centre + direction(55.0f64.to_radians()) * distance;
     Ok((camera, path_to))
+}
+
+/// The text of `path`, reading at most `limit` bytes: more is an error naming the file
+/// and the limit, as is text that is not UTF-8.
+pub fn read_limited(path: &Path, limit: u64) -> Result<String, String> {
+    use std::io::Read as _;
+    let file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut bytes = Vec::new();
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    if bytes.len() as u64 > limit {
+        return Err(format!(
+            "{}: larger than {limit} bytes, the most a scene file may hold",
+            path.display()
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| format!("{}: not UTF-8 text ({e})", path.display()))
 }
 
 /// Chunks generated around the default scene's structure, in each horizontal direction.
@@ -410,6 +430,11 @@ fn default_far() -> f64 {
 const MAX_TERRAIN_CHUNKS: i128 = 4096;
 /// Most blocks all boxes together may fill.
 const MAX_BOX_BLOCKS: i128 = 20_000_000;
+/// Most chunks all boxes together may touch (a box counts every chunk its corners span):
+/// a thin row of blocks touches a chunk per 32 blocks, and a chunk holding part of a box
+/// costs up to about 40 KiB, so 20 M blocks in a row (625 000 chunks) would take tens of
+/// GiB. 16 384 chunks hold a 4096 × 4096 floor.
+const MAX_BOX_CHUNKS: i128 = 16_384;
 
 /// `line N: message` for the byte offset `at` of `text`.
 fn at_line(text: &str, at: usize, message: impl std::fmt::Display) -> String {
@@ -616,6 +641,14 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
         .collect();
     items.sort_by_key(|(at, _)| *at);
     let mut model_bounds: Option<(WorldPos, WorldPos)> = None;
+    // Chunks the boxes and models touch, bounded like the blocks they fill.
+    let mut touched: i128 = 0;
+    let chunks_between = |lo: [i32; 3], hi: [i32; 3]| {
+        let chunk = |v: i32| i128::from(v.div_euclid(voxel_core::CHUNK_SIZE as i32));
+        (0..3)
+            .map(|i| chunk(hi[i]) - chunk(lo[i]) + 1)
+            .product::<i128>()
+    };
     for (_, item) in items {
         let b = match item {
             Item::Box(b) => b,
@@ -625,6 +658,16 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
                     .place(&path.display().to_string(), blocks, *placement, &mut world)
                     .map_err(|e| at_line(text, *at, format!("models: {e}")))?;
                 if let Some((lo, hi)) = placed {
+                    touched += chunks_between([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]);
+                    if touched > MAX_BOX_CHUNKS {
+                        return Err(at_line(
+                            text,
+                            *at,
+                            format!(
+                                "models: boxes and models touch more than {MAX_BOX_CHUNKS} chunks in all"
+                            ),
+                        ));
+                    }
                     let (mut a, mut b) = model_bounds.unwrap_or((lo, hi));
                     (a.x, a.y, a.z) = (a.x.min(lo.x), a.y.min(lo.y), a.z.min(lo.z));
                     (b.x, b.y, b.z) = (b.x.max(hi.x), b.y.max(hi.y), b.z.max(hi.z));
@@ -654,6 +697,14 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
                 format!("boxes: more than {MAX_BOX_BLOCKS} blocks in all"),
             ));
         }
+        touched += chunks_between(def.min, def.max);
+        if touched > MAX_BOX_CHUNKS {
+            return Err(at_line(
+                text,
+                span.start,
+                format!("boxes: they touch more than {MAX_BOX_CHUNKS} chunks in all"),
+            ));
+        }
         fill_box(&mut world, def.min, def.max, id)
             .map_err(|e| at_line(text, span.start, format!("boxes: {e}")))?;
     }
@@ -676,18 +727,23 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
             d.far,
         )
         .map_err(|e| at_line(text, span.start, format!("cameras: {e}")))?;
+        // The flicker test moves the eye to `path_to`: the camera there must be valid too,
+        // so that every command accepts or refuses the same files.
+        if let Some(to) = d.path_to {
+            Camera::look_at(DVec3::from(to), DVec3::from(d.target), d.fov, d.near, d.far)
+                .map_err(|e| at_line(text, span.start, format!("cameras.path_to: {e}")))?;
+        }
         cameras.push(camera.in_medium(world.medium_at(d.eye)));
         paths.push(d.path_to.map(DVec3::from));
     }
     let size = match &file.size {
-        Some(s) if s.get_ref().iter().any(|v| !(1..=16384).contains(v)) => {
-            return Err(at_line(
-                text,
-                s.span().start,
-                "size: both sides must be in 1..=16384",
-            ));
+        Some(s) => {
+            let size = (s.get_ref()[0], s.get_ref()[1]);
+            crate::limits::check_size("size", size)
+                .map_err(|e| at_line(text, s.span().start, e))?;
+            Some(size)
         }
-        s => s.as_ref().map(|s| (s.get_ref()[0], s.get_ref()[1])),
+        None => None,
     };
     let content = content_of(text, &file)?;
     Ok(Scene {
@@ -941,5 +997,71 @@ path_to = [3.0, 1.0, 10.0]
         ))
         .unwrap_err();
         assert!(e.contains("at most 4096 chunks"), "{e}");
+    }
+
+    /// Issue 26: 20 M blocks in one row pass the block count but touch 625 000 chunks:
+    /// an error before any chunk is made. A 4096 × 4096 floor (16 384 chunks) is fine.
+    #[test]
+    fn the_box_check_bounds_chunks_too() {
+        let row = GOOD.replace("max = [3, 2, 0]", "max = [19999999, 0, 0]");
+        let e = parse(&row).unwrap_err();
+        assert!(e.contains("16384 chunks"), "{e}");
+        let floor = GOOD.replace("max = [3, 2, 0]", "max = [4095, 0, 4095]");
+        let s = parse(&floor).unwrap();
+        assert_eq!(s.world.len(), 16_384);
+        let beyond = GOOD.replace("max = [3, 2, 0]", "max = [4096, 0, 4095]");
+        assert!(parse(&beyond).unwrap_err().contains("chunks"));
+    }
+
+    /// Issue 26: a `path_to` where no camera can be (NaN, infinite, on the target, outside
+    /// the world) is an error at parsing, for every command alike.
+    #[test]
+    fn a_bad_path_to_is_an_error() {
+        for bad in [
+            "[nan, 1.0, 10.0]",
+            "[inf, 1.0, 10.0]",
+            "[0.5, 1.0, 0.0]",
+            "[3e10, 1.0, 0.0]",
+        ] {
+            let e = parse(&GOOD.replace("path_to = [3.0, 1.0, 10.0]", &format!("path_to = {bad}")))
+                .unwrap_err();
+            assert!(e.contains("cameras.path_to"), "{bad}: {e}");
+        }
+    }
+
+    /// Issue 26: sizes past the lab's caps are errors naming the field and the cap.
+    #[test]
+    fn sizes_past_the_caps_are_errors() {
+        for (size, word) in [("[16384, 16384]", "8192"), ("[8192, 8192]", "pixels")] {
+            let e = parse(&GOOD.replace("size = [64, 32]", &format!("size = {size}"))).unwrap_err();
+            assert!(e.starts_with("3: size") && e.contains(word), "{e}");
+        }
+    }
+
+    /// Issue 26: an endless or huge file is read only up to the limit; the error names the
+    /// file and the limit.
+    #[test]
+    fn scene_files_are_read_with_a_size_limit() {
+        let limit = crate::limits::MAX_SCENE_FILE_BYTES;
+        for endless in ["/dev/zero", "/dev/urandom"] {
+            if Path::new(endless).exists() {
+                let e = Scene::load(Path::new(endless)).unwrap_err();
+                assert!(e.contains(endless) && e.contains(&limit.to_string()), "{e}");
+            }
+        }
+        let dir = std::env::temp_dir().join(format!("voxel_scene_limit_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let big = dir.join("big.toml");
+        let mut text = GOOD.to_owned();
+        text.push_str(&"# padding\n".repeat(limit as usize / 10 + 1));
+        std::fs::write(&big, &text).unwrap();
+        assert!(Scene::load(&big).unwrap_err().contains("larger than"));
+        let ok = dir.join("ok.toml");
+        std::fs::write(&ok, GOOD).unwrap();
+        Scene::load(&ok).unwrap();
+        let bad = dir.join("bad.toml");
+        std::fs::write(&bad, [0xffu8, 0xfe, 0x00]).unwrap();
+        assert!(Scene::load(&bad).unwrap_err().contains("UTF-8"));
+        let _ = std::fs::remove_dir_all(dir);
     }
 }

@@ -305,9 +305,13 @@ fn flicker_path(
     let mut renderer = make_renderer(ctx, scene, size)?;
     let target = Offscreen::new(ctx, size.0, size.1);
     let weight = default_weight();
+    // Walks the path with technique `t`, handing `visit` each frame's index and picture:
+    // only the reference's pictures are kept (at most `MAX_FLICKER_FRAMES` of them), a
+    // technique's are compared as they come.
     let path = |renderer: &mut crate::headless::SceneRenderer,
-                t: Technique|
-     -> Result<Vec<voxel_render::Image>, String> {
+                t: Technique,
+                visit: &mut dyn FnMut(usize, voxel_render::Image)|
+     -> Result<(), String> {
         // Settle at the start (pipelines, adaptive peeling), then walk the path.
         measure(
             ctx,
@@ -318,17 +322,18 @@ fn flicker_path(
             opts.warmup,
             0,
         )?;
-        cameras
-            .iter()
-            .map(|c| {
-                renderer
-                    .render_and_submit(&target.view, c)
-                    .map_err(|e| crate::chain(&e))?;
-                target.read(ctx)
-            })
-            .collect()
+        for (i, c) in cameras.iter().enumerate() {
+            renderer
+                .render_and_submit(&target.view, c)
+                .map_err(|e| crate::chain(&e))?;
+            visit(i, target.read(ctx)?);
+        }
+        Ok(())
     };
-    let reference = path(&mut renderer, Technique::Reference)?;
+    let mut reference = Vec::with_capacity(cameras.len());
+    path(&mut renderer, Technique::Reference, &mut |_, img| {
+        reference.push(img);
+    })?;
     let change = |v: &[voxel_render::Image]| -> f64 {
         v.windows(2)
             .map(|w| metrics::mean_abs_diff(&w[0], &w[1]))
@@ -337,13 +342,15 @@ fn flicker_path(
     };
     let mut excess = Vec::new();
     for &t in techniques {
-        let imgs = path(&mut renderer, t)?;
-        let e = (1..imgs.len())
-            .map(|i| {
-                metrics::excess_change(&imgs[i - 1], &imgs[i], &reference[i - 1], &reference[i])
-            })
-            .sum::<f64>()
-            / (imgs.len() - 1) as f64;
+        let mut previous: Option<voxel_render::Image> = None;
+        let mut sum = 0.0;
+        path(&mut renderer, t, &mut |i, img| {
+            if let Some(p) = &previous {
+                sum += metrics::excess_change(p, &img, &reference[i - 1], &reference[i]);
+            }
+            previous = Some(img);
+        })?;
+        let e = sum / (cameras.len() - 1) as f64;
         excess.push((t.name().to_owned(), e));
     }
     Ok(Flicker {

@@ -4,17 +4,26 @@
 //!
 //! Allocation is best fit over free lists kept by address and by length (O(log n));
 //! freeing coalesces with the free neighbours. When no page has room, a new page is added,
-//! twice the size of the last (from [`FIRST_PAGE_QUADS`] up to the adapter's largest
-//! storage binding). Waste is measured, not assumed: [`QuadArena::stats`] reports the
-//! bytes held and the bytes in use. Under streaming churn the live meshes of a page span
-//! at most 1.21× the quads they hold (a unit test's measure). Whole pages stay bounded by
-//! compaction: [`QuadArena::compact`] moves the meshes of the emptiest page into the
-//! others (a GPU copy) and frees it, which the chunk store runs when more than half of the
-//! arena's bytes are free and a page would be freed.
+//! twice the size of the largest (from [`FIRST_PAGE_QUADS`] up to the adapter's largest
+//! storage binding); a mesh larger than that binding is refused ([`QuadArena::alloc`]
+//! returns `None`; the chunk store turns it into an error). Waste is measured, not
+//! assumed: [`QuadArena::stats`] reports the bytes held and the bytes in use. Under
+//! streaming churn the live meshes of a page span at most 1.21× the quads they hold (a
+//! unit test's measure). Whole pages stay bounded two ways: a page whose last mesh is
+//! freed is given back ([`QuadArena::free`] says so, and the chunk store drops it once
+//! no frame in flight draws from it), so an arena holding no chunk holds no page; and
+//! [`QuadArena::compact`] moves the meshes of the emptiest page into the others (a GPU
+//! copy) and frees it, which the chunk store runs when more than half of the arena's
+//! bytes are free and a page would be freed. A page keeps its index for its whole life
+//! (a freed page leaves a hole that the next new page fills), so that a place handed out
+//! never changes meaning.
 
 use std::collections::{BTreeMap, BTreeSet};
 
 use voxel_mesh::PackedQuad;
+
+use crate::Result;
+use crate::error::scoped;
 
 /// Quads in the first page: 4 MiB.
 pub const FIRST_PAGE_QUADS: u32 = 1 << 19;
@@ -156,7 +165,8 @@ pub struct ArenaStats {
 /// The pages and their allocators.
 #[derive(Debug)]
 pub struct QuadArena {
-    pages: Vec<Page>,
+    /// Indexed by page number; `None` where a page was given back.
+    pages: Vec<Option<Page>>,
     /// Largest page, in quads (the adapter's storage binding limit).
     max_page_quads: u32,
 }
@@ -164,70 +174,127 @@ pub struct QuadArena {
 impl QuadArena {
     /// An empty arena whose pages may hold up to `max_binding` bytes.
     pub fn new(max_binding: u64) -> Self {
+        // A draw counts 6 vertices per quad in a `u32` (first vertex and count): a page
+        // holds no more quads than that can address.
+        let addressable = u64::from(u32::MAX / 6);
         Self {
             pages: Vec::new(),
-            max_page_quads: (max_binding / QUAD_BYTES).min(u64::from(u32::MAX)) as u32,
+            max_page_quads: (max_binding / QUAD_BYTES).min(addressable) as u32,
         }
     }
 
-    /// Room for `quads` quads; adds a page when none has room. The page list grew when
-    /// the returned flag is true (bind groups over the pages must be remade).
-    pub fn alloc(&mut self, device: &wgpu::Device, quads: u32) -> Option<(Alloc, bool)> {
+    /// The most quads one mesh may have: a page as large as the adapter's storage binding.
+    pub fn max_mesh_quads(&self) -> u32 {
+        self.max_page_quads
+    }
+
+    fn live(&self) -> impl Iterator<Item = (usize, &Page)> {
+        self.pages
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| Some((i, p.as_ref()?)))
+    }
+
+    /// Room for `quads` quads; adds a page when none has room. The page list changed when
+    /// the returned flag is true (bind groups over the pages must be remade). `Ok(None)`
+    /// for 0 quads or more than [`QuadArena::max_mesh_quads`]; an error (and no new page)
+    /// when the device cannot make the page.
+    pub fn alloc(&mut self, device: &wgpu::Device, quads: u32) -> Result<Option<(Alloc, bool)>> {
         if quads == 0 || quads > self.max_page_quads {
-            return None;
+            return Ok(None);
         }
         for (i, p) in self.pages.iter_mut().enumerate() {
-            if let Some(offset) = p.alloc.alloc(quads) {
-                return Some((
+            if let Some(p) = p
+                && let Some(offset) = p.alloc.alloc(quads)
+            {
+                return Ok(Some((
                     Alloc {
                         page: i as u32,
                         offset,
                         quads,
                     },
                     false,
-                ));
+                )));
             }
         }
-        let last = self
-            .pages
-            .last()
-            .map_or(FIRST_PAGE_QUADS / 2, |p| p.alloc.capacity());
-        let size = last
+        let largest = self
+            .live()
+            .map(|(_, p)| p.alloc.capacity())
+            .max()
+            .unwrap_or(FIRST_PAGE_QUADS / 2);
+        let size = largest
             .saturating_mul(2)
             .max(quads)
             .max(FIRST_PAGE_QUADS)
             .min(self.max_page_quads);
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("quad_arena_page"),
-            size: u64::from(size) * QUAD_BYTES,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
+        // Out of memory comes back as an error, not through the device's panicking handler.
+        let buffer = scoped(device, "adding a quad arena page", || {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("quad_arena_page"),
+                size: u64::from(size) * QUAD_BYTES,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        })?;
         let mut alloc = Allocator::new(size);
-        let offset = alloc.alloc(quads)?;
-        self.pages.push(Page { buffer, alloc });
-        Some((
+        let Some(offset) = alloc.alloc(quads) else {
+            return Ok(None);
+        };
+        let page = Some(Page { buffer, alloc });
+        // The first hole, else a new index.
+        let index = match self.pages.iter().position(Option::is_none) {
+            Some(i) => {
+                self.pages[i] = page;
+                i
+            }
+            None => {
+                self.pages.push(page);
+                self.pages.len() - 1
+            }
+        };
+        Ok(Some((
             Alloc {
-                page: self.pages.len() as u32 - 1,
+                page: index as u32,
                 offset,
                 quads,
             },
             true,
-        ))
+        )))
     }
 
-    /// Gives back a mesh's quads.
-    pub fn free(&mut self, a: Alloc) {
-        if let Some(p) = self.pages.get_mut(a.page as usize) {
-            p.alloc.free(a.offset, a.quads);
+    /// Gives back a mesh's quads; returns whether its page now holds none (see
+    /// [`QuadArena::drop_page`]).
+    pub fn free(&mut self, a: Alloc) -> bool {
+        match self.pages.get_mut(a.page as usize) {
+            Some(Some(p)) => {
+                p.alloc.free(a.offset, a.quads);
+                p.alloc.used() == 0
+            }
+            _ => false,
         }
+    }
+
+    /// Gives back page `page` if it holds no quads; returns whether it did. Its index
+    /// stays free for the next new page.
+    pub fn drop_page(&mut self, page: u32) -> bool {
+        let Some(slot) = self.pages.get_mut(page as usize) else {
+            return false;
+        };
+        if slot.as_ref().is_some_and(|p| p.alloc.used() == 0) {
+            *slot = None;
+            while self.pages.last().is_some_and(Option::is_none) {
+                self.pages.pop();
+            }
+            return true;
+        }
+        false
     }
 
     /// Writes `quads` into `a` (as many as both hold).
     pub fn write(&self, queue: &wgpu::Queue, a: Alloc, quads: &[PackedQuad]) {
-        if let Some(p) = self.pages.get(a.page as usize) {
+        if let Some(Some(p)) = self.pages.get(a.page as usize) {
             let n = quads.len().min(a.quads as usize);
             queue.write_buffer(
                 &p.buffer,
@@ -237,12 +304,12 @@ impl QuadArena {
         }
     }
 
-    /// The buffer of page `i`.
+    /// The buffer of page `i` (`None` for a page given back).
     pub fn page(&self, i: usize) -> Option<&wgpu::Buffer> {
-        self.pages.get(i).map(|p| &p.buffer)
+        self.pages.get(i)?.as_ref().map(|p| &p.buffer)
     }
 
-    /// Number of pages.
+    /// One past the highest page index (pages given back below it leave holes).
     pub fn pages(&self) -> usize {
         self.pages.len()
     }
@@ -250,14 +317,13 @@ impl QuadArena {
     /// Bytes held and used.
     pub fn stats(&self) -> ArenaStats {
         ArenaStats {
-            pages: self.pages.len(),
-            bytes: self.pages.iter().map(|p| p.buffer.size()).sum(),
+            pages: self.live().count(),
+            bytes: self.live().map(|(_, p)| p.buffer.size()).sum(),
             used_bytes: self
-                .pages
-                .iter()
-                .map(|p| u64::from(p.alloc.used()) * QUAD_BYTES)
+                .live()
+                .map(|(_, p)| u64::from(p.alloc.used()) * QUAD_BYTES)
                 .sum(),
-            fragments: self.pages.iter().map(|p| p.alloc.fragments()).sum(),
+            fragments: self.live().map(|(_, p)| p.alloc.fragments()).sum(),
         }
     }
 
@@ -266,18 +332,12 @@ impl QuadArena {
     /// pages have room for them.
     pub fn page_to_compact(&self) -> Option<u32> {
         let s = self.stats();
-        if self.pages.len() < 2 || s.used_bytes * 2 >= s.bytes {
+        if s.pages < 2 || s.used_bytes * 2 >= s.bytes {
             return None;
         }
-        let (i, p) = self
-            .pages
-            .iter()
-            .enumerate()
-            .min_by_key(|(_, p)| p.alloc.used())?;
+        let (i, p) = self.live().min_by_key(|(_, p)| p.alloc.used())?;
         let room: u64 = self
-            .pages
-            .iter()
-            .enumerate()
+            .live()
             .filter(|(j, _)| *j != i)
             .map(|(_, q)| u64::from(q.alloc.capacity() - q.alloc.used()))
             .sum();
@@ -285,8 +345,10 @@ impl QuadArena {
     }
 
     /// Moves the meshes `moving` (all on page `page`) to other pages with GPU copies
-    /// recorded in `encoder`, then drops the page (the last page takes its index). `None`
-    /// (nothing changed) when the other pages lack room.
+    /// recorded in `encoder`, then gives the page back (its index becomes a hole). `None`
+    /// (nothing changed) when the other pages lack room. The copies read the page as the
+    /// queue holds it when `encoder` runs: submit `encoder` before writing to the new
+    /// places, or the copies overwrite what was written.
     pub fn compact(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -300,7 +362,7 @@ impl QuadArena {
                 .iter_mut()
                 .enumerate()
                 .filter(|(j, _)| *j as u32 != page)
-                .find_map(|(j, p)| p.alloc.alloc(a.quads).map(|o| (j, o)));
+                .find_map(|(j, p)| p.as_mut()?.alloc.alloc(a.quads).map(|o| (j, o)));
             let Some((j, offset)) = target else {
                 // Undo what was placed so far.
                 for b in &placed {
@@ -314,26 +376,22 @@ impl QuadArena {
                 quads: a.quads,
             });
         }
-        for (from, to) in moving.iter().zip(&placed) {
-            encoder.copy_buffer_to_buffer(
-                &self.pages[page as usize].buffer,
-                u64::from(from.offset) * QUAD_BYTES,
-                &self.pages[to.page as usize].buffer,
-                u64::from(to.offset) * QUAD_BYTES,
-                u64::from(from.quads) * QUAD_BYTES,
-            );
-        }
-        let last = self.pages.len() as u32 - 1;
-        self.pages.swap_remove(page as usize);
-        let renamed = (last != page).then_some((last, page));
-        if let Some((from, to)) = renamed {
-            for a in &mut placed {
-                if a.page == from {
-                    a.page = to;
-                }
+        let from = self.pages.get_mut(page as usize)?.take()?;
+        for (a, to) in moving.iter().zip(&placed) {
+            if let Some(Some(dst)) = self.pages.get(to.page as usize) {
+                encoder.copy_buffer_to_buffer(
+                    &from.buffer,
+                    u64::from(a.offset) * QUAD_BYTES,
+                    &dst.buffer,
+                    u64::from(to.offset) * QUAD_BYTES,
+                    u64::from(a.quads) * QUAD_BYTES,
+                );
             }
         }
-        Some(Compacted { placed, renamed })
+        while self.pages.last().is_some_and(Option::is_none) {
+            self.pages.pop();
+        }
+        Some(Compacted { placed })
     }
 }
 
@@ -342,8 +400,6 @@ impl QuadArena {
 pub struct Compacted {
     /// The new place of each mesh moved, in the order given.
     pub placed: Vec<Alloc>,
-    /// The page that took the freed page's index: `(old index, new index)`.
-    pub renamed: Option<(u32, u32)>,
 }
 
 #[cfg(test)]

@@ -24,10 +24,10 @@ use glam::{DVec3, Mat4, Vec3, Vec4};
 use voxel_core::{CHUNK_SIZE, ChunkPos};
 use voxel_mesh::{ChunkMeshes, PackedQuad};
 
-use crate::GpuContext;
 use crate::arena::{Alloc, ArenaStats, QuadArena};
 use crate::bindings::ChunkUniforms;
 use crate::gpu;
+use crate::{Error, GpuContext, Result};
 
 /// A fast hasher for small keys of integers (chunk positions): a multiply-rotate per word
 /// and a final mix, instead of SipHash (the store and the techniques look chunks up by
@@ -261,7 +261,7 @@ impl FrameDraws<'_> {
                 first: a as u32,
                 count: (b - a) as u32,
             };
-            let Some(group) = self.store.groups.get(run.page as usize) else {
+            let Some(Some(group)) = self.store.groups.get(run.page as usize) else {
                 continue;
             };
             pass.set_bind_group(1, group, &[]);
@@ -524,8 +524,9 @@ pub struct ChunkStore {
     /// One [`ChunkUniforms`] per slot, and its CPU copy.
     infos: wgpu::Buffer,
     info_data: Vec<ChunkUniforms>,
-    /// Group 1 per page: the page's quads and the chunk records.
-    groups: Vec<wgpu::BindGroup>,
+    /// Group 1 per page index: the page's quads and the chunk records (`None` for a page
+    /// given back).
+    groups: Vec<Option<wgpu::BindGroup>>,
     slots: Vec<Option<GpuChunk>>,
     free_slots: Vec<u32>,
     by_pos: PosMap<ChunkPos, u32>,
@@ -533,6 +534,13 @@ pub struct ChunkStore {
     regions: Regions,
     indirect: wgpu::Buffer,
     next_generation: u64,
+    /// Whether a frame's draw lists hold places that its submit has not yet drawn (from
+    /// [`ChunkStore::lists_built`] to [`ChunkStore::frame_submitted`]).
+    in_flight: bool,
+    /// Places and slots freed while a frame was in flight: reused only once it is
+    /// submitted, so that nothing written before its submit changes what it draws.
+    retired: Vec<Alloc>,
+    retired_slots: Vec<u32>,
 }
 
 const FIRST_SLOTS: usize = 1024;
@@ -556,6 +564,9 @@ impl ChunkStore {
             regions: Regions::default(),
             indirect,
             next_generation: 1,
+            in_flight: false,
+            retired: Vec::new(),
+            retired_slots: Vec::new(),
         }
     }
 
@@ -580,16 +591,49 @@ impl ChunkStore {
     /// Group 1 of every page, remade after the pages or the record buffer changed.
     fn remake_groups(&mut self, device: &wgpu::Device) {
         self.groups = (0..self.arena.pages())
-            .filter_map(|i| self.arena.page(i))
-            .map(|page| {
-                gpu::bind_group(
+            .map(|i| {
+                let page = self.arena.page(i)?;
+                Some(gpu::bind_group(
                     device,
                     "chunk_page",
                     &self.layout,
                     &[page.as_entire_binding(), self.infos.as_entire_binding()],
-                )
+                ))
             })
             .collect();
+    }
+
+    /// Call once a frame's draw lists hold the meshes' places: from now until
+    /// [`ChunkStore::frame_submitted`], freed places and slots are kept from reuse.
+    pub fn lists_built(&mut self) {
+        self.in_flight = true;
+    }
+
+    /// Call once the frame whose lists were built is submitted (or before the next
+    /// frame's lists are built, which implies it): the places and slots freed meanwhile
+    /// become free, and pages left empty are given back.
+    pub fn frame_submitted(&mut self, ctx: &GpuContext) {
+        self.in_flight = false;
+        let mut dropped = false;
+        for a in std::mem::take(&mut self.retired) {
+            if self.arena.free(a) {
+                dropped |= self.arena.drop_page(a.page);
+            }
+        }
+        self.free_slots.append(&mut self.retired_slots);
+        if dropped {
+            self.remake_groups(&ctx.device);
+        }
+    }
+
+    /// Frees a place now, or once the frame in flight is submitted; gives its page back
+    /// when that leaves it empty. Returns whether the pages changed.
+    fn free_place(&mut self, a: Alloc) -> bool {
+        if self.in_flight {
+            self.retired.push(a);
+            return false;
+        }
+        self.arena.free(a) && self.arena.drop_page(a.page)
     }
 
     /// The layout of group 1.
@@ -617,28 +661,84 @@ impl ChunkStore {
         }
     }
 
-    /// Room for `quads` in the arena (a new page, with its bind group, when needed).
-    fn alloc(&mut self, ctx: &GpuContext, quads: &[PackedQuad]) -> Option<Alloc> {
-        let (a, grew) = self.arena.alloc(&ctx.device, quads.len() as u32)?;
+    /// Room for `quads` in the arena (a new page, with its bind group, when needed), with
+    /// the quads written. `Ok(None)` for a mesh the arena refuses (checked before).
+    fn alloc(&mut self, ctx: &GpuContext, quads: &[PackedQuad]) -> Result<Option<Alloc>> {
+        let Ok(n) = u32::try_from(quads.len()) else {
+            return Ok(None);
+        };
+        let Some((a, grew)) = self.arena.alloc(&ctx.device, n)? else {
+            return Ok(None);
+        };
         if grew {
             self.remake_groups(&ctx.device);
         }
         self.arena.write(&ctx.queue, a, quads);
-        Some(a)
+        Ok(Some(a))
     }
 
     /// Uploads (or replaces) a chunk's meshes. A chunk whose meshes are all empty is
-    /// removed: no quad and no draw exists for an empty mesh. A mesh larger than the
-    /// adapter's storage binding (impossible for a 32³ chunk) is dropped with a log line.
-    pub fn upload(&mut self, ctx: &GpuContext, pos: ChunkPos, meshes: &ChunkMeshes) {
-        if meshes.is_empty() {
-            self.remove(pos);
-            return;
+    /// removed: no quad and no draw exists for an empty mesh. A mesh of more quads than
+    /// one page holds ([`crate::arena::QuadArena::max_mesh_quads`]: the adapter's storage
+    /// binding; a 32³ chunk has at most 196 608 quads) is an [`Error::TooLarge`] and
+    /// changes nothing. A new page the device cannot make is an [`Error::Gpu`].
+    ///
+    /// The places a frame in flight draws are never written: a replaced mesh keeps its
+    /// place until that frame is submitted ([`ChunkStore::frame_submitted`]).
+    pub fn upload(&mut self, ctx: &GpuContext, pos: ChunkPos, meshes: &ChunkMeshes) -> Result<()> {
+        let limit = self.arena.max_mesh_quads();
+        for (kind, quads) in [
+            ("opaque", &meshes.opaque),
+            ("cutout", &meshes.cutout),
+            ("translucent", &meshes.translucent),
+        ] {
+            if quads.len() as u64 > u64::from(limit) {
+                return Err(Error::TooLarge {
+                    what: format!("the {kind} mesh of chunk {pos:?}, in quads,"),
+                    value: quads.len() as u64,
+                    limit_name: "max_storage_buffer_binding_size (in 8-byte quads)",
+                    limit: u64::from(limit),
+                });
+            }
         }
-        let slot = match self.by_pos.get(&pos) {
+        if meshes.is_empty() {
+            self.remove(ctx, pos);
+            return Ok(());
+        }
+        // Place the new meshes before freeing the old ones: a failure changes nothing, and
+        // the old places (which a frame in flight may draw) are not reused by the new.
+        let mut allocs = [None; 3];
+        for (k, quads) in [&meshes.opaque, &meshes.cutout, &meshes.translucent]
+            .into_iter()
+            .enumerate()
+        {
+            if quads.is_empty() {
+                continue;
+            }
+            match self.alloc(ctx, quads) {
+                Ok(Some(a)) => allocs[k] = Some(a),
+                failed => {
+                    let mut changed = false;
+                    for a in allocs.into_iter().flatten() {
+                        changed |= self.arena.free(a) && self.arena.drop_page(a.page);
+                    }
+                    if changed {
+                        self.remake_groups(&ctx.device);
+                    }
+                    return Err(failed.err().unwrap_or_else(|| {
+                        Error::Unsupported(format!(
+                            "the quad arena found no room for {} quads",
+                            quads.len()
+                        ))
+                    }));
+                }
+            }
+        }
+        let (slot, alpha) = match self.by_pos.get(&pos) {
             Some(&s) => {
-                self.free_meshes(s);
-                s
+                self.free_meshes(ctx, s);
+                // A chunk fading in goes on fading from where it was.
+                (s, self.info_data.get(s as usize).map_or(1.0, |i| i.alpha))
             }
             None => {
                 let s = self.free_slots.pop().unwrap_or(self.slots.len() as u32);
@@ -646,26 +746,11 @@ impl ChunkStore {
                     self.slots.push(None);
                 }
                 self.by_pos.insert(pos, s);
-                s
+                (s, 1.0)
             }
         };
-        let mut allocs = [None; 3];
-        for (k, quads) in [&meshes.opaque, &meshes.cutout, &meshes.translucent]
-            .into_iter()
-            .enumerate()
-        {
-            if !quads.is_empty() {
-                allocs[k] = self.alloc(ctx, quads);
-                if allocs[k].is_none() {
-                    log::warn!(
-                        "chunk {pos:?}: a mesh of {} quads found no room",
-                        quads.len()
-                    );
-                }
-            }
-        }
         let origin = pos.origin().map(|v| v as i32);
-        self.write_info(ctx, slot, ChunkUniforms { origin, alpha: 1.0 });
+        self.write_info(ctx, slot, ChunkUniforms { origin, alpha });
         self.regions.set(slot, pos, allocs);
         self.slots[slot as usize] = Some(GpuChunk {
             pos,
@@ -675,30 +760,40 @@ impl ChunkStore {
             generation: self.next_generation,
         });
         self.next_generation += 1;
+        Ok(())
     }
 
-    fn free_meshes(&mut self, slot: u32) {
+    fn free_meshes(&mut self, ctx: &GpuContext, slot: u32) {
         if let Some(c) = self.slots.get_mut(slot as usize).and_then(Option::take) {
+            let mut changed = false;
             for a in c.meshes.into_iter().flatten() {
-                self.arena.free(a);
+                changed |= self.free_place(a);
+            }
+            if changed {
+                self.remake_groups(&ctx.device);
             }
         }
     }
 
-    /// Removes a chunk and frees its quads.
-    pub fn remove(&mut self, pos: ChunkPos) {
+    /// Removes a chunk and frees its quads (once the frame in flight is submitted, if
+    /// one is); a page left empty is given back.
+    pub fn remove(&mut self, ctx: &GpuContext, pos: ChunkPos) {
         if let Some(slot) = self.by_pos.remove(&pos) {
-            self.free_meshes(slot);
+            self.free_meshes(ctx, slot);
             self.regions.remove(slot);
-            self.free_slots.push(slot);
+            if self.in_flight {
+                self.retired_slots.push(slot);
+            } else {
+                self.free_slots.push(slot);
+            }
         }
     }
 
     /// Removes every chunk.
-    pub fn clear(&mut self) {
+    pub fn clear(&mut self, ctx: &GpuContext) {
         let all: Vec<ChunkPos> = self.by_pos.keys().copied().collect();
         for pos in all {
-            self.remove(pos);
+            self.remove(ctx, pos);
         }
     }
 
@@ -814,9 +909,16 @@ impl ChunkStore {
     }
 
     /// Moves the meshes off the arena's emptiest page when more than half of the arena is
-    /// free (see [`crate::arena`]); records the copies in `encoder`. Returns whether a page
-    /// was freed.
-    pub fn compact(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) -> bool {
+    /// free (see [`crate::arena`]). Returns whether a page was freed. Runs only between
+    /// frames (no frame in flight: see [`ChunkStore::frame_submitted`]).
+    ///
+    /// The copies are submitted at once, on an encoder of their own: a write to a moved
+    /// mesh's new place made after this (a technique re-sorting its quads this frame, an
+    /// upload before the frame's submit) lands after the copy, never under it.
+    pub fn compact(&mut self, ctx: &GpuContext) -> bool {
+        if self.in_flight {
+            return false;
+        }
         let Some(page) = self.arena.page_to_compact() else {
             return false;
         };
@@ -833,28 +935,21 @@ impl ChunkStore {
             })
             .collect();
         let allocs: Vec<Alloc> = moving.iter().map(|m| m.2).collect();
-        let Some(crate::arena::Compacted { placed, renamed }) =
-            self.arena.compact(encoder, page, &allocs)
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("quad_arena_compaction"),
+            });
+        let Some(crate::arena::Compacted { placed }) =
+            self.arena.compact(&mut encoder, page, &allocs)
         else {
             return false;
         };
+        ctx.queue.submit([encoder.finish()]);
         for ((s, k, _), to) in moving.iter().zip(placed) {
             if let Some(c) = self.slots[*s].as_mut() {
                 c.meshes[*k] = Some(to);
-            }
-        }
-        if let Some((from, to)) = renamed {
-            for c in self.slots.iter_mut().flatten() {
-                for a in c.meshes.iter_mut().flatten() {
-                    if a.page == from {
-                        a.page = to;
-                    }
-                }
-            }
-        }
-        for (s, c) in self.slots.iter().enumerate() {
-            if let Some(c) = c {
-                self.regions.set(s as u32, c.pos, c.meshes);
+                self.regions.set(*s as u32, c.pos, c.meshes);
             }
         }
         self.remake_groups(&ctx.device);

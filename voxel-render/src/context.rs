@@ -1,6 +1,8 @@
 //! The GPU a renderer draws with: the game's own device and queue, or a headless one for
 //! tests and tools, plus the capabilities the renderer adapts to.
 
+use std::sync::{Arc, Mutex, PoisonError};
+
 use crate::{Error, Result};
 
 /// What the adapter can do that changes how we render. Read once from the adapter.
@@ -93,6 +95,8 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     /// What the adapter can do.
     pub caps: Capabilities,
+    /// Set by the device-lost callback: why the device was lost.
+    lost: Arc<Mutex<Option<String>>>,
 }
 
 /// Optional features the renderer uses when the adapter has them.
@@ -102,13 +106,57 @@ pub const WANTED_FEATURES: wgpu::Features =
 impl GpuContext {
     /// Wraps a device the embedding game already owns. `adapter` is the one it came from
     /// (for capability queries); `device.features()` says which optional features we may use.
+    ///
+    /// Installs the device's lost callback (wgpu keeps one per device, so this replaces a
+    /// callback set before): the renderer learns of a loss through it and answers every
+    /// call after it with [`Error::DeviceLost`]. A game that wants to know too asks
+    /// [`GpuContext::check_device`] rather than setting a callback of its own (which would
+    /// replace this one).
     pub fn from_device(adapter: &wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
         let caps = Capabilities::new(adapter, device.features(), device.limits());
+        let lost = Arc::new(Mutex::new(None));
+        let flag = Arc::clone(&lost);
+        device.set_device_lost_callback(move |reason, message| {
+            let why = if message.is_empty() {
+                format!("{reason:?}")
+            } else {
+                format!("{reason:?}: {message}")
+            };
+            *flag.lock().unwrap_or_else(PoisonError::into_inner) = Some(why);
+        });
         Self {
             device,
             queue,
             caps,
+            lost,
         }
+    }
+
+    /// [`Error::DeviceLost`] once the device is lost, else `Ok`. Polls the device first
+    /// (without waiting), because wgpu runs the lost callback only when it maintains the
+    /// device: a device destroyed since the last poll is noticed here.
+    pub fn check_device(&self) -> Result<()> {
+        // A poll error on a lost device says no more than the callback does.
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        match self
+            .lost
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .as_ref()
+        {
+            Some(reason) => Err(Error::DeviceLost {
+                reason: reason.clone(),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// Whether the device is known to be lost (no poll: what the last one found).
+    pub fn is_lost(&self) -> bool {
+        self.lost
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .is_some()
     }
 
     /// A headless context on the first adapter of `backends` (tests use

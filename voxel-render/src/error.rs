@@ -105,6 +105,22 @@ pub enum Error {
     /// A readback finished but its data cannot be what the GPU wrote (wrong length).
     #[error("reading GPU results back: {0}")]
     ReadbackData(String),
+    /// A chunk source failed for a chunk: it panicked, or made block ids the registry does
+    /// not hold (the chunk stands as air).
+    #[error("the chunk source failed for chunk {pos:?}: {why}")]
+    ChunkSource {
+        /// The chunk.
+        pos: voxel_core::ChunkPos,
+        /// What went wrong.
+        why: String,
+    },
+    /// The device is lost (destroyed, reset, driver failure): nothing made on it can be
+    /// used again. Make a new `GpuContext` (a new device) and a new renderer on it.
+    #[error("the GPU device is lost ({reason}); make a new device and renderer")]
+    DeviceLost {
+        /// What wgpu said: the reason and its message.
+        reason: String,
+    },
 }
 
 /// `Result` with this crate's [`Error`] as the default error.

@@ -36,17 +36,22 @@ impl Image {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(io)?;
         }
-        let file = std::fs::File::create(path).map_err(io)?;
         let png = |source| Error::PngEncode {
             path: path.to_owned(),
             source,
         };
-        let mut enc = png::Encoder::new(std::io::BufWriter::new(file), self.width, self.height);
+        // Encoded in memory and written in one call whose result is checked: a buffered
+        // file writer dropped at the end would lose the error of its last flush (a full
+        // disk, `/dev/full`).
+        let mut bytes = Vec::new();
+        let mut enc = png::Encoder::new(&mut bytes, self.width, self.height);
         enc.set_color(png::ColorType::Rgba);
         enc.set_depth(png::BitDepth::Eight);
         enc.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         let mut w = enc.write_header().map_err(png)?;
-        w.write_image_data(&self.rgba).map_err(png)
+        w.write_image_data(&self.rgba).map_err(png)?;
+        w.finish().map_err(png)?;
+        std::fs::write(path, &bytes).map_err(io)
     }
 
     /// Reads an 8-bit PNG (grey, RGB or RGBA; palettes expanded).
@@ -97,16 +102,31 @@ pub fn read_texture(
     texture: &wgpu::Texture,
     bytes_per_texel: u32,
 ) -> Result<Vec<u8>> {
+    ctx.check_device()?;
     let (w, h) = (texture.width(), texture.height());
     let row = w * bytes_per_texel;
     let padded =
         row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: u64::from(padded) * u64::from(h),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let size = u64::from(padded) * u64::from(h);
+    // One buffer holds the whole texture: past the adapter's largest buffer (an RGBA16F
+    // 16384² picture is 2 GiB) it is an error, not wgpu's validation panic.
+    let limit = ctx.caps.limits.max_buffer_size;
+    if size > limit {
+        return Err(Error::TooLarge {
+            what: format!("a readback of {w}x{h} pixels of {bytes_per_texel} bytes, in bytes,"),
+            value: size,
+            limit_name: "max_buffer_size",
+            limit,
+        });
+    }
+    let buffer = crate::error::scoped(&ctx.device, "making a readback buffer", || {
+        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    })?;
     let mut encoder = ctx
         .device
         .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -136,6 +156,7 @@ pub fn read_texture(
 
 /// Maps a `MAP_READ` buffer, waits, and copies its contents out.
 pub fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+    ctx.check_device()?;
     let (tx, rx) = std::sync::mpsc::channel();
     buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
@@ -187,6 +208,28 @@ mod tests {
         img.save_png(&path).unwrap();
         assert_eq!(Image::load_png(&path).unwrap(), img);
         let _ = std::fs::remove_file(path);
+    }
+
+    /// Issue 26: a full disk is an error naming the file, not a silent success.
+    #[test]
+    fn a_failed_png_write_is_an_error_naming_the_file() {
+        let img = Image {
+            width: 64,
+            height: 64,
+            rgba: vec![7; 64 * 64 * 4],
+        };
+        let full = Path::new("/dev/full");
+        if full.exists() {
+            let e = img.save_png(full).unwrap_err();
+            assert!(matches!(e, Error::Io { .. }), "{e:?}");
+            assert!(e.to_string().contains("/dev/full"), "{e}");
+        }
+        // A folder where the file should be.
+        let dir = std::env::temp_dir().join(format!("voxel_render_png_dir_{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("x.png")).unwrap();
+        let e = img.save_png(&dir.join("x.png")).unwrap_err();
+        assert!(e.to_string().contains("x.png"), "{e}");
+        let _ = std::fs::remove_dir_all(dir);
     }
 }
 

@@ -37,19 +37,25 @@ pub struct RendererConfig {
     /// Output height in pixels, like `width`.
     pub height: u32,
     /// Format of the textures `render` draws into. Default `Rgba8UnormSrgb`, what
-    /// offscreen readback and PNG files want; a window passes its surface format.
+    /// offscreen readback and PNG files want; a window passes its surface format. It
+    /// must be a colour format the tonemap can write: float-sampled (not an integer or
+    /// depth format) and renderable on every adapter; another is an error at
+    /// [`Renderer::new`].
     pub output_format: wgpu::TextureFormat,
     /// 4× MSAA for the opaque and cutout passes. Default off: the translucent pass is
     /// single-sampled anyway (seed 000) and lavapipe pays 4× for it.
     pub msaa: bool,
     /// Transparency settings (technique and each technique's own settings).
     pub oit: OitConfig,
-    /// Direction towards the sun (normalised on use). Default: high in the south-east, so
-    /// that every face direction gets a different brightness.
+    /// Direction towards the sun (normalised on use; a zero vector means straight up).
+    /// Default: high in the south-east, so that every face direction gets a different
+    /// brightness. NaN or infinite components are an error at [`Renderer::new`].
     pub sun_dir: [f32; 3],
-    /// Ambient share of the lighting. Default 0.45: faces away from the sun stay readable.
+    /// Ambient share of the lighting, 0 to 1 (outside, NaN or infinite: an error at
+    /// [`Renderer::new`]). Default 0.45: faces away from the sun stay readable.
     pub ambient: f32,
-    /// Sky colour (linear). Default a light blue.
+    /// Sky colour (linear), each channel finite and at least 0 (else an error at
+    /// [`Renderer::new`]). Default a light blue.
     pub sky: [f32; 3],
     /// How chunk meshes are drawn. Default: indirect (`multi_draw_indirect` per page and
     /// pass), which costs the CPU next to nothing per chunk; adapters without indirect
@@ -158,7 +164,9 @@ struct SceneTargets {
 #[derive(Debug)]
 struct Post {
     tonemap_layout: wgpu::BindGroupLayout,
-    tonemap: HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+    /// Per output format: the tonemap, and the same with a depth target, which
+    /// [`Renderer::check_output`] sets in a pass beside the scene depth.
+    tonemap: HashMap<wgpu::TextureFormat, (wgpu::RenderPipeline, wgpu::RenderPipeline)>,
     depth_resolve_layout: wgpu::BindGroupLayout,
     depth_resolve: wgpu::RenderPipeline,
 }
@@ -189,6 +197,10 @@ pub struct Renderer {
     culled: Culled,
     /// The last frame's draw commands (likewise).
     builder: DrawBuilder,
+    /// The last output view that passed [`Renderer::check_output`]'s recorded check, so
+    /// that drawing into the same view again skips it (a window's views are new each
+    /// frame and pay it: about 0.08 ms on this project's 2-core machine).
+    checked_view: Option<wgpu::TextureView>,
 }
 
 impl Renderer {
@@ -196,10 +208,13 @@ impl Renderer {
     /// adapter lacks something: MSAA off without 4× support, a technique it cannot run.
     /// A size beyond the adapter's limits or an invalid setting is an error.
     pub fn new(ctx: &GpuContext, registry: &BlockRegistry, config: RendererConfig) -> Result<Self> {
+        ctx.check_device()?;
         let mut config = config;
         config.width = config.width.max(1);
         config.height = config.height.max(1);
         check_size(ctx, config.width, config.height)?;
+        check_output_format(ctx, config.output_format)?;
+        check_lighting(&config)?;
         config.oit.validate()?;
         check_ao_strength(config.ao_strength)?;
         if config.msaa && !ctx.caps.msaa4 {
@@ -233,7 +248,8 @@ impl Renderer {
             textures: BlockTextures::new(ctx, registry, config.flat_textures)?,
         };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
-        let post = Post::new(device);
+        let mut post = Post::new(device);
+        post.make_tonemap(ctx, config.output_format);
         let medium = MediumPass::new(device, &layouts);
         let size = (config.width, config.height);
         let targets = SceneTargets::new(ctx, &post, &layouts, &scene, &medium, size, config.msaa);
@@ -265,6 +281,7 @@ impl Renderer {
             fading: PosMap::default(),
             culled: Culled::default(),
             builder: DrawBuilder::default(),
+            checked_view: None,
             config,
         })
     }
@@ -336,6 +353,7 @@ impl Renderer {
     /// on the GPU fades in when [`RendererConfig::fade_in_frames`] is set. A position
     /// outside the `i32` world ([`ChunkPos::is_valid`]) is an error.
     pub fn upload_chunk(&mut self, pos: ChunkPos, meshes: &ChunkMeshes) -> Result<()> {
+        self.ctx.check_device()?;
         if !pos.is_valid() {
             return Err(Error::InvalidSetting(format!(
                 "chunk position {pos:?} lies outside the i32 world (coordinates {} to {})",
@@ -344,7 +362,7 @@ impl Renderer {
             )));
         }
         let new = self.chunks.get(pos).is_none();
-        self.chunks.upload(&self.ctx, pos, meshes);
+        self.chunks.upload(&self.ctx, pos, meshes)?;
         if new && self.config.fade_in_frames > 0 && self.chunks.get(pos).is_some() {
             self.fading.insert(pos, self.frame_index);
             self.chunks.set_alpha(&self.ctx, pos, 0.0);
@@ -354,13 +372,13 @@ impl Renderer {
 
     /// Removes a chunk from the GPU.
     pub fn remove_chunk(&mut self, pos: ChunkPos) {
-        self.chunks.remove(pos);
+        self.chunks.remove(&self.ctx, pos);
         self.fading.remove(&pos);
     }
 
     /// Removes every chunk.
     pub fn clear_chunks(&mut self) {
-        self.chunks.clear();
+        self.chunks.clear(&self.ctx);
         self.fading.clear();
     }
 
@@ -368,6 +386,7 @@ impl Renderer {
     /// technique's pipelines depend on what changed. An invalid setting is an error and
     /// changes nothing.
     pub fn set_oit_config(&mut self, config: OitConfig) -> Result<()> {
+        self.ctx.check_device()?;
         self.oit.set_config(config)?;
         config_with(&mut self.config.oit, self.oit.config());
         Ok(())
@@ -415,6 +434,7 @@ impl Renderer {
     /// [`RendererConfig::ao_strength`]) from the next frame on: a uniform, nothing is
     /// rebuilt or uploaded again. A value outside 0..=1 or not finite is an error.
     pub fn set_ao_strength(&mut self, strength: f32) -> Result<()> {
+        self.ctx.check_device()?;
         check_ao_strength(strength)?;
         self.config.ao_strength = strength;
         Ok(())
@@ -443,6 +463,7 @@ impl Renderer {
     /// Turns 4× MSAA on or off (rebuilds the opaque pipelines and targets). Without 4×
     /// support it stays off (logged at creation).
     pub fn set_msaa(&mut self, msaa: bool) -> Result<()> {
+        self.ctx.check_device()?;
         let msaa = msaa && self.ctx.caps.msaa4;
         if msaa == self.config.msaa {
             return Ok(());
@@ -464,6 +485,7 @@ impl Renderer {
     /// minimised window) does nothing either and keeps the old targets until a real size
     /// comes. A size beyond the adapter's limit is an error and changes nothing.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        self.ctx.check_device()?;
         if width == 0 || height == 0 || (width, height) == self.size() {
             return Ok(());
         }
@@ -473,20 +495,28 @@ impl Renderer {
             self.targets_for((width, height), self.config.msaa)
         })?;
         self.targets = targets;
+        self.checked_view = None;
         self.config.width = width;
         self.config.height = height;
         let oit = &mut self.oit;
         scoped(&self.ctx.device, "resizing", || oit.resize(width, height))?
     }
 
-    /// GPU milliseconds per pass of the latest timed frame (empty without timestamps).
-    /// Needs `device.poll` now and then.
+    /// GPU milliseconds per pass of the latest timed frame (empty without timestamps, and
+    /// once the device is lost). Needs `device.poll` now and then.
     pub fn gpu_times(&mut self) -> GpuTimes {
+        if self.ctx.check_device().is_err() {
+            return GpuTimes::default();
+        }
         self.timer.as_mut().map(Timer::poll).unwrap_or_default()
     }
 
-    /// Like [`Renderer::gpu_times`], but waits for the last submitted frame's results.
+    /// Like [`Renderer::gpu_times`], but waits for the last submitted frame's results
+    /// (empty once the device is lost: nothing will come).
     pub fn gpu_times_blocking(&mut self) -> GpuTimes {
+        if self.ctx.check_device().is_err() {
+            return GpuTimes::default();
+        }
         let ctx = self.ctx.clone();
         self.timer
             .as_mut()
@@ -495,8 +525,14 @@ impl Renderer {
     }
 
     /// Call after submitting a frame's encoder: starts reading its GPU timings (and the
-    /// technique's own counters) back.
+    /// technique's own counters) back, and frees for reuse the arena places the frame
+    /// drew that were freed meanwhile (without this call, the next `render` frees them).
+    /// Does nothing once the device is lost.
     pub fn after_submit(&mut self) {
+        self.chunks.frame_submitted(&self.ctx);
+        if self.ctx.check_device().is_err() {
+            return;
+        }
         if let Some(t) = &mut self.timer {
             t.after_submit();
         }
@@ -513,13 +549,21 @@ impl Renderer {
         &self.targets.depth.texture
     }
 
-    /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of a
-    /// whole 2D texture of the renderer's size whose format is
-    /// [`RendererConfig::output_format`] (or its sRGB / linear twin, viewed as that format),
-    /// with `RENDER_ATTACHMENT` usage.
+    /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of
+    /// mip level 0 of a single-layer, single-sample 2D texture of the renderer's size
+    /// with `RENDER_ATTACHMENT` usage, whose format is [`RendererConfig::output_format`]
+    /// (or its sRGB / linear twin, viewed as that format): a 2D view of the whole
+    /// texture (a 2D-array view of its one layer draws the same). Anything else is an
+    /// [`Error::Output`] before anything is recorded.
     ///
     /// Fails without recording anything on an invalid camera (NaN, zero direction, bad
-    /// planes) or a mismatched output.
+    /// planes), a mismatched output ([`Error::Output`]) or a lost device
+    /// ([`Error::DeviceLost`]).
+    ///
+    /// Submit each frame before recording the next: what changes between `render` and
+    /// the submit (chunks uploaded or removed) never changes what this frame draws, and
+    /// the arena places it draws are reused only after [`Renderer::after_submit`] or the
+    /// next `render`.
     ///
     /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
     /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
@@ -538,6 +582,7 @@ impl Renderer {
     /// (with the technique's resources) when first asked for; its `id` changes when a
     /// technique switch or a setting needs new pipelines ([`crate::stages`]).
     pub fn translucent_contract(&mut self) -> Result<Arc<TranslucentContract>> {
+        self.ctx.check_device()?;
         self.oit.contract()
     }
 
@@ -552,13 +597,15 @@ impl Renderer {
         camera: &Camera,
         game: &mut dyn GameStages,
     ) -> Result<FrameStats> {
+        self.ctx.check_device()?;
         camera.validate()?;
         self.check_output(output)?;
         let start = Instant::now();
-        self.post.make_tonemap(&self.ctx, self.config.output_format);
         self.update_fades();
+        // The previous frame is submitted (the contract above): what it drew may be reused.
+        self.chunks.frame_submitted(&self.ctx);
         // Before any list of this frame takes the meshes' places.
-        self.chunks.compact(&self.ctx, encoder);
+        self.chunks.compact(&self.ctx);
         let (w, h) = self.size();
         let aspect = f64::from(w) / f64::from(h);
         let camera = &self.drawn_camera(camera);
@@ -573,6 +620,7 @@ impl Renderer {
         // equal cubes (`voxel_mesh::order`); opaque and cutout meshes grouped by page, front
         // to back (early depth rejection).
         self.chunks.cull(&frustum, &mut self.culled);
+        self.chunks.lists_built();
         // The technique's CPU work (it may reorder quads within their places).
         let view = FrameView {
             camera,
@@ -773,8 +821,12 @@ impl Renderer {
         Ok(stats)
     }
 
-    /// The output must match what the tonemap pipeline and the targets are made for.
-    fn check_output(&self, output: &wgpu::TextureView) -> Result<()> {
+    /// The output must match what the tonemap pipeline and the targets are made for: the
+    /// texture's size, format, usage, samples, dimension and layers here; what only the
+    /// view knows (its mip level, dimension and format; wgpu does not expose them) by
+    /// recording the tonemap's pass into a throwaway encoder inside an error scope, beside
+    /// the scene depth (the renderer's size, so that a view of another level fails).
+    fn check_output(&mut self, output: &wgpu::TextureView) -> Result<()> {
         let t = output.texture();
         let want = self.config.output_format;
         let (w, h) = self.size();
@@ -794,12 +846,54 @@ impl Renderer {
         if !t.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
             || t.sample_count() != 1
             || t.dimension() != wgpu::TextureDimension::D2
+            || t.depth_or_array_layers() != 1
         {
-            return Err(Error::Output(
-                "must be a single-sample 2D texture with RENDER_ATTACHMENT usage".into(),
-            ));
+            return Err(Error::Output(format!(
+                "must be a single-sample, single-layer 2D texture with RENDER_ATTACHMENT usage \
+                 (this one: {:?}, {} samples, {} layers, {:?})",
+                t.dimension(),
+                t.sample_count(),
+                t.depth_or_array_layers(),
+                t.usage()
+            )));
         }
-        Ok(())
+        if self.checked_view.as_ref() == Some(output) {
+            return Ok(());
+        }
+        let Some((_, check)) = self.post.tonemap.get(&want) else {
+            return Err(Error::Output(format!("no tonemap pipeline for {want:?}")));
+        };
+        let device = &self.ctx.device;
+        let checked = scoped(device, "checking the output view", || {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("output_view_check"),
+            });
+            let color = [gpu::load(output)];
+            // One pass (about 10 µs on lavapipe): the scene depth beside the output fails
+            // on another size, the pipeline on another view format.
+            Pass::new("output_view_check", GpuPass::Tonemap, &color)
+                .depth(Depth::Load(&self.targets.depth.view))
+                .record(&mut encoder, None, |pass| pass.set_pipeline(check));
+            // Never submitted: recording and finishing are what validate.
+            drop(encoder.finish());
+        });
+        if checked.is_ok() {
+            self.checked_view = Some(output.clone());
+        }
+        checked.map_err(|e| {
+            let why = match &e {
+                Error::Gpu { source, .. } => source.to_string(),
+                other => other.to_string(),
+            };
+            Error::Output(format!(
+                "the view must be a 2D view of mip level 0 ({w}x{h}) viewed as {want:?}: {}",
+                why.lines()
+                    .map(str::trim)
+                    .filter(|l| !l.is_empty())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            ))
+        })
     }
 
     /// Advances chunk fade-ins by one frame.
@@ -927,7 +1021,7 @@ impl Renderer {
         output: &wgpu::TextureView,
         timer: Option<&Timer>,
     ) {
-        let Some(pipeline) = self.post.tonemap.get(&self.config.output_format) else {
+        let Some((pipeline, _)) = self.post.tonemap.get(&self.config.output_format) else {
             return;
         };
         let colors = [gpu::load(output)];
@@ -942,6 +1036,51 @@ impl Renderer {
 /// Copies what the manager holds (technique after fallback) into a renderer's config.
 fn config_with(mine: &mut OitConfig, manager: &OitConfig) {
     mine.clone_from(manager);
+}
+
+/// The output format must be one the tonemap writes: a colour format sampled as float
+/// (the shader writes `vec4<f32>`) that every adapter can render to.
+fn check_output_format(ctx: &GpuContext, format: wgpu::TextureFormat) -> Result<()> {
+    let float = matches!(
+        format.sample_type(None, Some(ctx.caps.features)),
+        Some(wgpu::TextureSampleType::Float { .. })
+    );
+    let renderable = format
+        .guaranteed_format_features(ctx.caps.features)
+        .allowed_usages
+        .contains(wgpu::TextureUsages::RENDER_ATTACHMENT);
+    if !format.has_color_aspect() || format.has_depth_aspect() || !float || !renderable {
+        return Err(Error::InvalidSetting(format!(
+            "output_format {format:?}: the tonemap writes float colour, so it must be a \
+             renderable float colour format (e.g. Rgba8UnormSrgb, Bgra8UnormSrgb, Rgba16Float)"
+        )));
+    }
+    Ok(())
+}
+
+/// Lighting values must be numbers the shaders can use: NaN or infinity would reach
+/// every pixel.
+fn check_lighting(config: &RendererConfig) -> Result<()> {
+    let bad = |m: String| Err(Error::InvalidSetting(m));
+    if !config.sun_dir.iter().all(|v| v.is_finite()) {
+        return bad(format!(
+            "sun_dir {:?}: every component must be finite",
+            config.sun_dir
+        ));
+    }
+    if !(0.0..=1.0).contains(&config.ambient) {
+        return bad(format!(
+            "ambient {}: it must be a share from 0 to 1",
+            config.ambient
+        ));
+    }
+    if !config.sky.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        return bad(format!(
+            "sky {:?}: every channel must be finite and at least 0",
+            config.sky
+        ));
+    }
+    Ok(())
 }
 
 /// An ambient-occlusion strength must be a number from 0 to 1.
@@ -1011,20 +1150,23 @@ impl Post {
     fn make_tonemap(&mut self, ctx: &GpuContext, format: wgpu::TextureFormat) {
         let layout = &self.tonemap_layout;
         self.tonemap.entry(format).or_insert_with(|| {
-            FullscreenPipeline {
-                label: "tonemap",
-                source: include_str!("shaders/tonemap.wgsl"),
-                fragment_entry: "fs_tonemap",
-                groups: &[Some(layout)],
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-                writes_depth: false,
-                constants: &[("SRGB_ENCODE", if format.is_srgb() { 0.0 } else { 1.0 })],
-            }
-            .build(&ctx.device)
+            let make = |label, writes_depth| {
+                FullscreenPipeline {
+                    label,
+                    source: include_str!("shaders/tonemap.wgsl"),
+                    fragment_entry: "fs_tonemap",
+                    groups: &[Some(layout)],
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                    writes_depth,
+                    constants: &[("SRGB_ENCODE", if format.is_srgb() { 0.0 } else { 1.0 })],
+                }
+                .build(&ctx.device)
+            };
+            (make("tonemap", false), make("tonemap_output_check", true))
         });
     }
 }
