@@ -1,6 +1,7 @@
 //! The lab on random scenes in CI: a small draw (40 scenes at 96×54, one timed frame),
 //! asserting from it that nothing turns NaN, that the two exact methods agree on every
-//! scene, that `sorted-quads` is exact wherever its quad order has no cycle (off the
+//! scene, that `sorted-quads` is exact wherever its quad order has no cycle and no game
+//! content is drawn (off the
 //! pixels on quad edges, where sub-pixel snapping decides: rare), that the
 //! default WBOIT weight has the lowest median FLIP of all weights, and that a worst scene
 //! written to `worst/` replays with the same error.
@@ -180,10 +181,23 @@ fn sorted_quads_is_exact_without_cycles() {
         .filter(|r| r.technique == "sorted-quads")
         .collect();
     assert_eq!(runs.len(), COUNT);
-    let without_cycle: Vec<_> = runs.iter().filter(|r| r.sort_cycles == Some(0)).collect();
+    // A game's particles and entities are ordered by their centres, which is not exact
+    // (`voxel_render::oit::sorted`): only scenes of blocks count here.
+    let blocks_only = |scene: &str| {
+        summary.features.iter().any(|f| {
+            f.scene == scene
+                && f.features.particles == 0
+                && f.features.translucent_entities == 0
+                && f.features.opaque_entities == 0
+        })
+    };
+    let without_cycle: Vec<_> = runs
+        .iter()
+        .filter(|r| r.sort_cycles == Some(0) && blocks_only(&r.scene))
+        .collect();
     assert!(
-        without_cycle.len() >= COUNT / 2,
-        "most scenes have no quad cycle"
+        without_cycle.len() >= COUNT / 3,
+        "most scenes of blocks have no quad cycle"
     );
     // Off quad edges, where the order alone decides the colour (`voxel_lab::edges`).
     let findings: Vec<(String, String)> = without_cycle

@@ -184,7 +184,10 @@ fn compacting_the_arena_keeps_the_picture() {
     a.save_png(&tests::out_dir("stream").join("compacted.png"))
         .unwrap();
     assert!(tests::distinct_colours(&a) > 50, "a real picture");
-    tests::assert_close("compacted", &a, &b, 0);
+    // Opaque quads grow by 1/64 px against cracks (`voxel_render::renderer`), so where two
+    // coplanar quads meet, the one drawn first takes a pixel centre inside the sliver they
+    // share; compaction changes that order. Such pixels differ by at most 1/255 here.
+    tests::assert_close("compacted", &a, &b, 1);
 }
 
 /// Issue 26, the streamer's contract on a real renderer: edits near the eye, on the

@@ -332,13 +332,20 @@ impl ContentStages {
         content
             .particles
             .iter()
-            .map(|p| TranslucentObject { center: p.center })
+            .map(|p| TranslucentObject {
+                center: p.center,
+                // The square's corners.
+                radius: f64::from(p.half_size) * std::f64::consts::SQRT_2,
+            })
             .chain(
                 content
                     .entities
                     .iter()
                     .filter(|e| !e.is_opaque())
-                    .map(|e| TranslucentObject { center: e.center }),
+                    .map(|e| TranslucentObject {
+                        center: e.center,
+                        radius: DVec3::from(e.half_extents.map(f64::from)).length(),
+                    }),
             )
             .collect()
     }

@@ -269,7 +269,7 @@ impl RayMarcher {
             let l = particle_light(light.sun, light.ambient);
             hits.push(ContentHit {
                 t,
-                color: p.color.map(|c| f64::from(srgb_to_linear(c)) * l),
+                color: p.color.map(|c| srgb_to_linear(c) * l),
                 alpha: f64::from(p.opacity.clamp(0.0, 1.0)),
                 opaque: false,
                 id: (1, i, 0),
@@ -309,7 +309,7 @@ impl RayMarcher {
             let l = face_light(normal, light.sun, light.ambient);
             hits.push(ContentHit {
                 t: t_in,
-                color: e.color.map(|c| f64::from(srgb_to_linear(c)) * l),
+                color: e.color.map(|c| srgb_to_linear(c) * l),
                 alpha: f64::from(e.opacity.clamp(0.0, 1.0)),
                 opaque: e.is_opaque(),
                 id: (2, i as u32, face.0 as u8 * 2 + u8::from(face.1 > 0.0)),

@@ -21,7 +21,7 @@ use std::hash::{BuildHasherDefault, Hasher};
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Mat4, Vec3, Vec4};
-use voxel_core::{CHUNK_SIZE, ChunkPos};
+use voxel_core::{CHUNK_SIZE, ChunkPos, Face};
 use voxel_mesh::{ChunkMeshes, PackedQuad};
 
 use crate::arena::{Alloc, ArenaStats, QuadArena};
@@ -119,6 +119,9 @@ pub struct GpuChunk {
     translucent: Vec<PackedQuad>,
     /// The box of the translucent quads, chunk-local blocks (min, max).
     translucent_bounds: Option<([f64; 3], [f64; 3])>,
+    /// The distinct planes of the translucent quads: face and chunk-local coordinate along
+    /// its axis.
+    translucent_planes: Vec<(Face, u8)>,
     /// Changes with every upload of the chunk.
     generation: u64,
 }
@@ -145,11 +148,54 @@ impl GpuChunk {
         })
     }
 
+    /// The translucent quads as the sorted techniques order a game's objects against them
+    /// (`oit::sorted::interleave`): their box and their distinct planes, world blocks.
+    pub fn translucent_surfaces(&self) -> Option<Surfaces<'_>> {
+        let (lo, hi) = self.translucent_bounds()?;
+        Some(Surfaces {
+            lo: DVec3::from(lo),
+            hi: DVec3::from(hi),
+            origin: self.pos.origin().map(|v| v as f64),
+            planes: &self.translucent_planes,
+            quads: &self.translucent,
+        })
+    }
+
     /// A number that changes with every upload (remesh) of this chunk, never repeated by
     /// the store.
     pub fn generation(&self) -> u64 {
         self.generation
     }
+}
+
+/// A chunk's translucent quads seen from afar: their box and their planes.
+#[derive(Clone, Copy, Debug)]
+pub struct Surfaces<'a> {
+    /// The box's lowest corner, world blocks.
+    pub lo: DVec3,
+    /// The box's highest corner, world blocks.
+    pub hi: DVec3,
+    /// The chunk's origin, world blocks.
+    pub origin: [f64; 3],
+    /// The distinct planes: which way the quads face, chunk-local coordinate on the axis.
+    pub planes: &'a [(Face, u8)],
+    /// The quads, in their drawn order.
+    pub quads: &'a [PackedQuad],
+}
+
+/// The distinct planes of a set of quads, sorted.
+fn quad_planes(quads: &[PackedQuad]) -> Vec<(Face, u8)> {
+    let mut planes: Vec<(Face, u8)> = quads
+        .iter()
+        .filter_map(|q| q.unpack())
+        .map(|q| {
+            let (lo, _) = q.bounds();
+            (q.face, lo[q.face.axis()] as u8)
+        })
+        .collect();
+    planes.sort_unstable_by_key(|&(f, c)| (f as u8, c));
+    planes.dedup();
+    planes
 }
 
 /// The box a set of quads spans, chunk-local blocks.
@@ -282,6 +328,47 @@ impl FrameDraws<'_> {
                 }
             }
         }
+    }
+
+    /// Draws quads `quads` (positions in the mesh's drawn order, clamped to it) of mesh
+    /// `index` of `list`: part of a chunk, for objects drawn among its quads.
+    pub fn draw_quads(
+        &self,
+        list: &DrawList,
+        index: usize,
+        quads: std::ops::Range<u32>,
+        pass: &mut wgpu::RenderPass<'_>,
+    ) {
+        let Some(base) = list.runs.first().map(|r| r.first as usize) else {
+            return;
+        };
+        if index >= list.meshes {
+            return;
+        }
+        let at = (base + index) as u32;
+        let Some(run) = list
+            .runs
+            .iter()
+            .find(|r| (r.first..r.first + r.count).contains(&at))
+        else {
+            return;
+        };
+        let (Some(Some(group)), Some(c)) = (
+            self.store.groups.get(run.page as usize),
+            self.commands.get(at as usize),
+        ) else {
+            return;
+        };
+        let n = c.vertex_count / 6;
+        let (a, b) = (quads.start.min(n), quads.end.min(n));
+        if a >= b {
+            return;
+        }
+        pass.set_bind_group(1, group, &[]);
+        pass.draw(
+            c.first_vertex + 6 * a..c.first_vertex + 6 * b,
+            c.first_instance..c.first_instance + 1,
+        );
     }
 }
 
@@ -757,6 +844,7 @@ impl ChunkStore {
             meshes: allocs,
             translucent: meshes.translucent.clone(),
             translucent_bounds: quad_bounds(&meshes.translucent),
+            translucent_planes: quad_planes(&meshes.translucent),
             generation: self.next_generation,
         });
         self.next_generation += 1;

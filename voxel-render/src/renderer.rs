@@ -19,6 +19,7 @@ use crate::chunks::{
 use crate::error::scoped;
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
 use crate::medium::{self, MediumLook, MediumPass};
+use crate::oit::sorted::interleave::{Ball, interleave};
 use crate::oit::{
     FrameView, OitConfig, OitManager, Setup, Technique, TechniqueReport, TranslucentFrame,
     WeightFunction,
@@ -628,18 +629,45 @@ impl Renderer {
             translucent: self.culled.translucent_positions(),
         };
         let stages = game.stages();
-        // A sorting technique orders the game's objects with the chunks: farthest first.
+        self.oit
+            .prepare(&mut self.chunks, &view, stages.translucent)?;
+        // A sorting technique orders the game's objects with the chunks (after `prepare`:
+        // sorted-quads splits a chunk's quads in their new order).
         let sort_start = Instant::now();
         let sorts = stages.translucent && self.oit.technique().sorts();
-        let (order, distances) = if sorts {
-            let objects = game.translucent_objects();
-            let mut keyed: Vec<(f64, u32)> = objects
+        let (order, splits) = if sorts {
+            let balls: Vec<Ball> = game
+                .translucent_objects()
                 .iter()
-                .enumerate()
-                .map(|(i, o)| (o.center.distance(camera.eye), i as u32))
+                .map(|o| Ball {
+                    center: o.center,
+                    radius: if o.radius.is_finite() {
+                        o.radius.max(0.0)
+                    } else {
+                        0.0
+                    },
+                })
                 .collect();
-            keyed.sort_by(|a, b| b.0.total_cmp(&a.0));
-            keyed.into_iter().map(|(d, i)| (i, d)).unzip()
+            // Each visible translucent chunk, in draw order: its surfaces and the
+            // distances of their box (nearest point, centre, farthest point).
+            let eye = camera.eye;
+            let chunks: Vec<_> = self
+                .culled
+                .translucent_positions()
+                .iter()
+                .map(|&p| {
+                    let s = self.chunks.get(p).and_then(|c| c.translucent_surfaces());
+                    let d = s.map_or([0.0; 3], |s| {
+                        let near = eye.clamp(s.lo, s.hi).distance(eye);
+                        let mid = ((s.lo + s.hi) * 0.5).distance(eye);
+                        let far = (eye - s.lo).abs().max((eye - s.hi).abs()).length();
+                        [near, mid, far]
+                    });
+                    (s, d)
+                })
+                .collect();
+            let split_quads = self.oit.technique() == Technique::SortedQuads;
+            interleave(&balls, eye, &chunks, medium.is_some(), split_quads)
         } else {
             (Vec::new(), Vec::new())
         };
@@ -649,8 +677,6 @@ impl Renderer {
         } else {
             game.translucent_objects().len()
         };
-        self.oit
-            .prepare(&mut self.chunks, &view, stages.translucent)?;
         self.write_frame_uniforms(camera, view_proj, medium.map(|(b, _)| b));
         let (eye_int, eye_frac) = camera.eye_split();
         let game_frame = GameFrame {
@@ -699,33 +725,11 @@ impl Renderer {
                 timer,
             );
         }
-        // Sorted techniques draw the game's objects between chunks, by the distances of
-        // each chunk's translucent box: nearest point, centre, farthest point.
-        let chunk_distances: Vec<[f64; 3]> = if sorts {
-            self.culled
-                .translucent_positions()
-                .iter()
-                .map(|&p| {
-                    let Some((lo, hi)) = self.chunks.get(p).and_then(|c| c.translucent_bounds())
-                    else {
-                        return [0.0; 3];
-                    };
-                    let (lo, hi) = (glam::DVec3::from(lo), glam::DVec3::from(hi));
-                    let eye = camera.eye;
-                    let near = eye.clamp(lo, hi).distance(eye);
-                    let mid = ((lo + hi) * 0.5).distance(eye);
-                    let far = (eye - lo).abs().max((eye - hi).abs()).length();
-                    [near, mid, far]
-                })
-                .collect()
-        } else {
-            Vec::new()
-        };
         let game_draw = stages.translucent.then(|| GameDraw {
             stages: game,
             frame: &game_frame,
             objects,
-            distances: &distances,
+            splits: &splits,
             frame_buffer: &self.scene.frame_buffer,
             boundary: &t.boundary.view,
         });
@@ -740,7 +744,6 @@ impl Renderer {
                 timer,
                 two_sided: medium.is_some(),
                 game: game_draw.as_ref(),
-                chunk_distances: &chunk_distances,
             },
         )?;
         if let Some((_, look)) = &medium {

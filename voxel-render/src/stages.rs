@@ -23,6 +23,7 @@ use std::ops::Range;
 
 use glam::{DVec3, Mat4, Vec3};
 
+use crate::oit::sorted::interleave::Split;
 use crate::{Camera, GpuContext};
 
 /// The bind group index the renderer reserves in a game's translucent pipelines (the last
@@ -44,13 +45,16 @@ pub struct Stages {
     pub overlay: bool,
 }
 
-/// A translucent thing a game draws, as the sorted techniques order it: back to front by
-/// the distance of its centre from the eye, interleaved with the chunks. Order-independent
-/// techniques ignore it.
+/// A translucent thing a game draws, as the sorted techniques order it: a ball around it,
+/// placed among the chunks by where it lies against their translucent quads and back to
+/// front by its centre among the other objects (the sorted techniques' module docs say
+/// where that is exact). Order-independent techniques ignore it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TranslucentObject {
     /// Centre, in world blocks.
     pub center: DVec3,
+    /// Radius of a ball holding all of it, blocks (0: order it as a point).
+    pub radius: f64,
 }
 
 /// What a game needs to draw in a stage.
@@ -186,8 +190,10 @@ pub struct GameDraw<'a> {
     pub frame: &'a GameFrame<'a>,
     /// How many objects (positions in the order, or indices).
     pub objects: usize,
-    /// Sorted techniques: each object's distance from the eye, in the order drawn.
-    pub distances: &'a [f64],
+    /// Sorted techniques: where runs of the ordered objects are drawn among the visible
+    /// translucent chunks (in draw order); the objects after the last run come after every
+    /// chunk.
+    pub splits: &'a [Split],
     /// The resources a technique binds into its group for the game (group 0's frame
     /// uniforms and medium boundary, besides its own).
     pub frame_buffer: &'a wgpu::Buffer,

@@ -273,10 +273,6 @@ pub struct TranslucentFrame<'a> {
     pub two_sided: bool,
     /// The game's translucent geometry, drawn in every pass of the technique.
     pub game: Option<&'a GameDraw<'a>>,
-    /// Sorted techniques with a game: for each visible translucent chunk, in draw order
-    /// (farthest first), the distances from the eye of its translucent box's nearest
-    /// point, centre and farthest point.
-    pub chunk_distances: &'a [[f64; 3]],
 }
 
 impl TranslucentFrame<'_> {

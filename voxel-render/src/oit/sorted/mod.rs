@@ -13,14 +13,20 @@
 //! pixel except where quads form a cycle (no order exists; counted in [`SortReport`], those
 //! quads drawn farthest centre first).
 //!
-//! A game's translucent objects come farthest first by the distance of their centres and
-//! are drawn between the chunks: before a chunk, every object whose centre lies farther
-//! from the eye than the box of the chunk's translucent quads, or inside that box's range
-//! of distances and farther than its centre. So an object behind a glass pane or below a
-//! water surface is drawn before them, one in front after them. It is not exact where an
-//! object reaches in depth into a chunk's layers (a cube crossing a water surface: its
-//! part below the surface is drawn over it), where two objects overlap in depth (their
-//! centres decide), or for the faces within one object (the game's order).
+//! A game's translucent objects are drawn among the chunks ([`interleave`]): each before
+//! the first chunk it lies behind, by sound tests of its bounding ball against the box and
+//! the planes of the chunk's translucent quads (distance, the box's faces, the quads'
+//! planes). Where none decides (a bubble between a water surface and a pane of one chunk),
+//! `sorted-quads` draws the object among the chunk's quads, whose order is exact: after
+//! those whose plane has the ball on the eye's side, before those with it beyond (the split
+//! that the fewest planes disagree with); `sorted` lets the box's centre decide. So a
+//! bubble under a water surface is drawn before it, one above after it, one behind a pane
+//! over the water between the two. It is not exact for an object that crosses a layer (a
+//! cube through a water surface: the part on the other side is drawn on the wrong side),
+//! where two objects overlap in depth (their centres decide), or for the faces within one
+//! object (the game's order); `sorted` is not exact where the centre decides either.
+
+pub(crate) mod interleave;
 
 use std::time::Instant;
 
@@ -220,27 +226,39 @@ impl TranslucentTechnique for Sorted {
                     frame.draw_chunks(pass);
                     return;
                 };
-                // Objects farther than a chunk's centre before the chunk.
+                // The objects where `interleave` put them (before a chunk, or among its
+                // quads), then the rest.
                 pass.set_bind_group(0, frame.scene, &[]);
-                let mut next = 0;
-                for (i, &[near, mid, far]) in frame.chunk_distances.iter().enumerate() {
-                    let first = next;
-                    while next < game.objects
-                        && game.distances.get(next).is_some_and(|&o| {
-                            // Behind the chunk's translucent box, or inside it and behind
-                            // its centre.
-                            o > far || (o >= near && o > mid)
-                        })
-                    {
-                        next += 1;
+                let draws = frame.draws;
+                // Chunks before `chunk` are drawn, and quads `..quad` of it.
+                let (mut next, mut chunk, mut quad) = (0, 0usize, 0u32);
+                for split in game.splits {
+                    let c = split.chunk as usize;
+                    if c > chunk {
+                        if quad > 0 {
+                            draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
+                            chunk += 1;
+                        }
+                        draws.draw_range(frame.chunks, chunk..c, pass);
+                        (chunk, quad) = (c, 0);
                     }
-                    if next > first {
-                        game.draw(pass, 0, group, first..next);
+                    if split.quad > quad {
+                        draws.draw_quads(frame.chunks, c, quad..split.quad, pass);
+                        quad = split.quad;
+                    }
+                    let end = split.end as usize;
+                    if end > next {
+                        game.draw(pass, 0, group, next..end);
                         pass.set_pipeline(pipeline);
                         pass.set_bind_group(0, frame.scene, &[]);
+                        next = end;
                     }
-                    frame.draws.draw_range(frame.chunks, i..i + 1, pass);
                 }
+                if quad > 0 {
+                    draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
+                    chunk += 1;
+                }
+                draws.draw_range(frame.chunks, chunk..usize::MAX, pass);
                 if next < game.objects {
                     game.draw(pass, 0, group, next..game.objects);
                 }

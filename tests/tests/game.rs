@@ -1,0 +1,346 @@
+//! A game's own geometry in the world (issue 22): translucent game quads composed by every
+//! technique with water and glass, opaque entities treated like terrain, and game draws
+//! that survive technique switches, resizes and MSAA.
+
+use glam::{DQuat, DVec3};
+use tests::{Scene, box_world, diff, gpu, out_dir, technique_config};
+use voxel_core::blocks::{GLASS, SAND, WATER};
+use voxel_lab::content::{Content, Entity, Particle};
+use voxel_render::{Image, RendererConfig, Technique};
+
+const W: u32 = 160;
+const H: u32 = 90;
+
+/// A pool of water over sand and a glass pane above it, seen from above and in front. The
+/// pane and the objects put near it lie in one chunk (x and z in 0..32), with water under
+/// them: the case where the sorted techniques must place an object between the layers of
+/// one chunk.
+fn pool() -> Scene {
+    let world = box_world(&[
+        ([-12, -8, -12], [12, -8, 12], SAND),
+        ([-12, -7, -12], [12, 0, 12], WATER),
+        ([2, 2, 6], [9, 5, 6], GLASS),
+    ]);
+    tests::scene("pool", world, [5.5, 6.0, 16.0], [5.5, -1.0, -2.0])
+}
+
+/// A translucent square facing the camera: the simplest game quad.
+fn quad(center: [f64; 3]) -> Particle {
+    Particle {
+        center: DVec3::from(center),
+        half_size: 1.5,
+        color: [230, 40, 40],
+        opacity: 0.5,
+    }
+}
+
+/// A translucent plate turned 40° about y and tilted: crosses what it is put through.
+fn plate(center: [f64; 3], opacity: f32) -> Entity {
+    Entity {
+        center: DVec3::from(center),
+        half_extents: [1.8, 1.8, 0.05],
+        rotation: DQuat::from_rotation_y(40f64.to_radians())
+            * DQuat::from_rotation_x(-25f64.to_radians()),
+        color: [40, 60, 230],
+        opacity,
+    }
+}
+
+fn particles(p: Vec<Particle>) -> Content {
+    Content {
+        particles: p,
+        entities: vec![],
+    }
+}
+
+fn entities(e: Vec<Entity>) -> Content {
+    Content {
+        particles: vec![],
+        entities: e,
+    }
+}
+
+/// A case: a name, the content, whether the sorted techniques' order is exact for it
+/// (`sorted`, `sorted-quads`), and whether the object is the nearest translucent layer
+/// wherever it is seen.
+type Case = (&'static str, Content, [bool; 2], bool);
+
+fn cases() -> Vec<Case> {
+    vec![
+        // Under the water surface: a chunk-wide test decides.
+        (
+            "under_water",
+            particles(vec![quad([5.5, -3.5, 3.0])]),
+            [true, true],
+            false,
+        ),
+        // In front of the pane and over the water: every plane says in front.
+        (
+            "before_glass",
+            particles(vec![quad([5.5, 3.5, 10.0])]),
+            [true, true],
+            true,
+        ),
+        // Over the water and behind the pane of the same chunk: no chunk-wide test
+        // decides; sorted-quads draws it between their quads, sorted by the box's centre.
+        (
+            "behind_glass",
+            particles(vec![quad([5.5, 3.5, 3.0])]),
+            [false, true],
+            false,
+        ),
+        // Over the water beside the pane, several at once.
+        (
+            "over_water",
+            particles(vec![quad([14.5, 3.5, 3.0]), quad([20.5, 2.5, 8.0])]),
+            [false, true],
+            true,
+        ),
+        // Crossing a layer: the part on the other side is drawn on the wrong side.
+        (
+            "through_water",
+            entities(vec![plate([5.5, 1.0, 3.0], 0.5)]),
+            [false, false],
+            false,
+        ),
+        (
+            "through_glass",
+            entities(vec![plate([5.5, 3.5, 7.0], 0.5)]),
+            [false, false],
+            false,
+        ),
+    ]
+}
+
+/// `scene` with `content`.
+fn with(scene: &Scene, content: Content) -> Scene {
+    Scene {
+        content,
+        ..scene.clone()
+    }
+}
+
+fn render(scene: &Scene, config: RendererConfig) -> Image {
+    let ctx = gpu().expect("GPU");
+    tests::render_with(&ctx, scene, config)
+}
+
+/// The largest channel difference of each pixel, in 1/255 steps.
+fn pixel_diffs(a: &Image, b: &Image) -> Vec<u8> {
+    a.rgba
+        .chunks_exact(4)
+        .zip(b.rgba.chunks_exact(4))
+        .map(|(p, q)| (0..3).map(|c| p[c].abs_diff(q[c])).max().unwrap_or(0))
+        .collect()
+}
+
+/// Mean of `pixel_diffs` over the pixels where `mask` holds.
+fn mean_where(d: &[u8], mask: &[bool]) -> f64 {
+    let (sum, n) = d
+        .iter()
+        .zip(mask)
+        .filter(|(_, m)| **m)
+        .fold((0u64, 0u64), |(s, n), (d, _)| (s + u64::from(*d), n + 1));
+    sum as f64 / n.max(1) as f64
+}
+
+/// Every technique composes the game's translucent objects with water and glass: the exact
+/// ones exactly (within 1/255 of the A-buffer reference), the sorted ones exactly where
+/// their order is (the cases say where), and everywhere only where the object is; the
+/// approximate ones draw the object (its footprint changes) and come nearer to the
+/// reference there than the picture without it.
+#[test]
+fn every_technique_composes_game_objects_with_water_and_glass() {
+    let Some(_ctx) = gpu() else { return };
+    let base = pool();
+    let refc = technique_config(Technique::Reference, W, H);
+    let dir = out_dir("game");
+    let mut failures = Vec::new();
+    let mut report = String::new();
+    for (name, content, exact_sorted, nearest) in cases() {
+        let scene = with(&base, content);
+        let reference = render(&scene, refc.clone());
+        reference
+            .save_png(&dir.join(format!("{name}_reference.png")))
+            .unwrap();
+        // The object's footprint: where it changes the reference.
+        let ref_without = render(&base, refc.clone());
+        let footprint: Vec<bool> = pixel_diffs(&reference, &ref_without)
+            .iter()
+            .map(|&d| d > 2)
+            .collect();
+        let area = footprint.iter().filter(|m| **m).count();
+        assert!(
+            area > 30,
+            "{name}: the object covers {area} px of the reference"
+        );
+        for t in Technique::ALL {
+            if t == Technique::OpaqueOnly || t == Technique::Reference {
+                continue;
+            }
+            let config = technique_config(t, W, H);
+            let img = render(&scene, config.clone());
+            img.save_png(&dir.join(format!("{name}_{}.png", t.name())))
+                .unwrap();
+            let without = render(&base, config);
+            let d = diff(&img, &reference);
+            let err = pixel_diffs(&img, &reference);
+            let err_without = pixel_diffs(&without, &reference);
+            let drawn = pixel_diffs(&img, &without)
+                .iter()
+                .zip(&footprint)
+                .filter(|(d, m)| **m && **d > 2)
+                .count();
+            let (in_with, in_without) = (
+                mean_where(&err, &footprint),
+                mean_where(&err_without, &footprint),
+            );
+            report += &format!(
+                "{name:14} {:15} max {:3} px>1 {:5} footprint {area:4} px, drawn on {drawn:4}, \
+                 error there {in_with:6.2} (without {in_without:6.2})\n",
+                t.name(),
+                d.max,
+                d.over_one
+            );
+            let mut check = |ok: bool, what: &str| {
+                if !ok {
+                    failures.push(format!("{name} {}: {what}", t.name()));
+                }
+            };
+            match t {
+                Technique::PeelReference | Technique::DepthPeeling => {
+                    check(drawn * 2 > area, "not drawn on most of its footprint");
+                    check(d.max <= 1, "an exact technique differs from the reference");
+                }
+                Technique::Sorted | Technique::SortedQuads => {
+                    check(drawn * 2 > area, "not drawn on most of its footprint");
+                    let exact = exact_sorted[usize::from(t == Technique::SortedQuads)];
+                    if exact {
+                        check(
+                            d.max <= 1,
+                            "differs from the reference where the order is exact",
+                        );
+                    }
+                    // Wherever its order is wrong, only the object's pixels are.
+                    let outside = err
+                        .iter()
+                        .zip(&footprint)
+                        .filter(|(e, m)| !**m && **e > 1)
+                        .count();
+                    check(outside == 0, "differs outside the object's footprint");
+                }
+                // A screen door shows a half-opaque object on half its pixels, and none
+                // under a layer more opaque than it (the same Bayer cell hides it).
+                Technique::Stipple => {
+                    if nearest {
+                        check(drawn * 5 > area * 2, "not drawn on 40 % of its footprint");
+                    }
+                }
+                _ => {
+                    check(drawn * 2 > area, "not drawn on most of its footprint");
+                    if nearest {
+                        check(
+                            in_with < in_without,
+                            "not nearer the reference on the object's footprint with it",
+                        );
+                    }
+                }
+            }
+        }
+    }
+    eprint!("{report}");
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// An opaque entity is drawn with the world's opaque geometry: under water and behind
+/// glass every exact and sorted technique shows it as the reference does, and one buried
+/// under the sand changes no pixel.
+#[test]
+fn opaque_entities_are_seen_through_water_and_glass_and_hidden_by_terrain() {
+    let Some(_ctx) = gpu() else { return };
+    let base = pool();
+    let dir = out_dir("game_opaque");
+    let seen = with(
+        &base,
+        entities(vec![
+            plate([5.5, -3.0, 3.0], 1.0),
+            plate([5.5, 3.5, 3.0], 1.0),
+        ]),
+    );
+    let buried = with(&base, entities(vec![plate([5.5, -12.0, 3.0], 1.0)]));
+    let refc = technique_config(Technique::Reference, W, H);
+    let reference = render(&seen, refc.clone());
+    let without = render(&base, refc);
+    let area = pixel_diffs(&reference, &without)
+        .iter()
+        .filter(|&&d| d > 2)
+        .count();
+    assert!(area > 200, "the entities cover {area} px");
+    for t in [
+        Technique::Sorted,
+        Technique::SortedQuads,
+        Technique::DepthPeeling,
+        Technique::PeelReference,
+        Technique::WboitMrt,
+        Technique::Stipple,
+    ] {
+        let config = technique_config(t, W, H);
+        let img = render(&seen, config.clone());
+        img.save_png(&dir.join(format!("{}.png", t.name())))
+            .unwrap();
+        if t.is_exact() || matches!(t, Technique::Sorted | Technique::SortedQuads) {
+            let d = diff(&img, &reference);
+            assert!(d.max <= 1, "{}: {d:?} against the reference", t.name());
+        }
+        let d = diff(&render(&buried, config.clone()), &render(&base, config));
+        assert_eq!(d.differing, 0, "{}: a buried entity shows", t.name());
+    }
+}
+
+/// The game's draws survive what a game does between frames: a technique switch, a resize,
+/// MSAA turned on. Each picture equals a fresh renderer's with the same settings.
+#[test]
+fn game_draws_survive_switches_resizes_and_msaa() {
+    let Some(ctx) = gpu() else { return };
+    let scene = with(
+        &pool(),
+        Content {
+            particles: vec![quad([5.5, 3.5, 3.0]), quad([5.5, -3.5, 3.0])],
+            entities: vec![plate([12.5, 1.0, 3.0], 0.5), plate([8.5, -3.0, 3.0], 1.0)],
+        },
+    );
+    let camera = scene.cameras[0];
+    let mut r =
+        tests::renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, W, H)).unwrap();
+    let shot = |r: &mut voxel_lab::headless::SceneRenderer| {
+        let (w, h) = r.size();
+        let target = tests::Offscreen::new(&ctx, w, h);
+        voxel_lab::headless::render_image(&ctx, r, &target, &camera).unwrap()
+    };
+    let _ = shot(&mut r);
+    for t in [
+        Technique::SortedQuads,
+        Technique::DepthPeeling,
+        Technique::Stipple,
+        Technique::Reference,
+        Technique::WboitTwoPass,
+    ] {
+        r.set_technique(t);
+        let got = shot(&mut r);
+        let fresh = render(&scene, technique_config(t, W, H));
+        let d = diff(&got, &fresh);
+        assert!(d.max <= 1, "after switching to {}: {d:?}", t.name());
+    }
+    r.resize(120, 68).unwrap();
+    let got = shot(&mut r);
+    let fresh = render(&scene, technique_config(Technique::WboitTwoPass, 120, 68));
+    let d = diff(&got, &fresh);
+    assert!(d.max <= 1, "after a resize: {d:?}");
+    r.set_msaa(true).unwrap();
+    let got = shot(&mut r);
+    let mut config = technique_config(Technique::WboitTwoPass, 120, 68);
+    config.msaa = true;
+    let fresh = render(&scene, config);
+    let d = diff(&got, &fresh);
+    assert!(d.max <= 1, "after MSAA on: {d:?}");
+}

@@ -1,0 +1,589 @@
+//! Where the sorted techniques draw a game's translucent objects among the chunks.
+//!
+//! Each object is a ball (its centre and radius, [`crate::stages::TranslucentObject`]).
+//! Against a chunk's translucent quads it is **behind** (drawn before the chunk: no part of
+//! it can cover a quad of the chunk) or **in front** (drawn after: no quad can cover it).
+//! The tests, each sound on its own:
+//! - distance: the ball farther from the eye than every point of the quads' box is
+//!   behind, nearer than every point is in front;
+//! - the box's face planes: the ball outside the box on the eye's side of one of them is in
+//!   front (no segment from the eye to the ball meets the box); the ball outside and the
+//!   eye on the box's side is behind (no segment from the eye to the box meets the ball);
+//! - the quads' planes: the ball on the eye's side of every plane it sees (the planes of
+//!   quads facing away are culled, unless both sides are drawn) is in front, on the far
+//!   side of every one is behind.
+//!
+//! Where none decides (a ball between two layers of a chunk, or through one), `sorted-quads`
+//! places the ball among the chunk's quads in their exact order ([`quad_split`]); `sorted`
+//! lets the centre of the box decide (the ball's centre farther than it is behind). An
+//! object is drawn before the first chunk (in draw order) it is behind or among whose quads
+//! it goes, after every chunk if none; objects at the same place farthest centre first. The
+//! order is exact between chunks and for every object that some test decides against each
+//! chunk it overlaps on screen; not for an object through a chunk's layers (a cube crossing
+//! a water surface), nor between objects that overlap in depth (their centres decide).
+
+use glam::DVec3;
+
+use voxel_mesh::PackedQuad;
+
+use crate::chunks::Surfaces;
+
+/// How a point stands against a chunk's translucent quads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// Drawn before the chunk.
+    Behind,
+    /// Drawn after it.
+    Front,
+}
+
+/// A ball: an object as the order sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ball {
+    /// Centre, world blocks.
+    pub center: DVec3,
+    /// Radius, blocks (0: a point).
+    pub radius: f64,
+}
+
+/// The side of ball `b` where one of the sound tests decides it.
+fn decide(
+    b: Ball,
+    o: f64,
+    eye: DVec3,
+    s: &Surfaces<'_>,
+    [near, _, far]: [f64; 3],
+    two_sided: bool,
+) -> Option<Side> {
+    let (p, r) = (b.center, b.radius);
+    if o - r > far {
+        return Some(Side::Behind);
+    }
+    if o + r < near {
+        return Some(Side::Front);
+    }
+    for a in 0..3 {
+        let (lo, hi, ea) = (s.lo[a], s.hi[a], eye[a]);
+        let (below, above) = (p[a] + r < lo, p[a] - r > hi);
+        if (below && ea <= lo) || (above && ea >= hi) {
+            return Some(Side::Front);
+        }
+        if (below && ea >= lo) || (above && ea <= hi) {
+            return Some(Side::Behind);
+        }
+    }
+    let (mut front, mut behind) = (false, false);
+    for &(face, c) in s.planes {
+        let a = face.axis();
+        let n = if face.is_positive() { 1.0 } else { -1.0 };
+        let plane = s.origin[a] + f64::from(c);
+        let e = (eye[a] - plane) * n;
+        let q = (p[a] - plane) * n;
+        if (!two_sided && e <= 0.0) || e == 0.0 {
+            // Culled or seen edge-on: no constraint.
+            continue;
+        }
+        if q.abs() <= r {
+            // Through the plane: neither.
+            front = true;
+            behind = true;
+        } else if (e > 0.0) == (q > 0.0) {
+            front = true;
+        } else {
+            behind = true;
+        }
+    }
+    match (front, behind) {
+        (_, false) => Some(Side::Front),
+        (false, true) => Some(Side::Behind),
+        (true, true) => None,
+    }
+}
+
+/// Where a run of objects is drawn: after quads `..quad` of chunk `chunk` (its position
+/// in the draw order; quad 0: before the chunk), objects of the order up to `end`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Split {
+    /// The chunk, by its position in the draw order.
+    pub chunk: u32,
+    /// How many of its quads (in their drawn order) come before the objects.
+    pub quad: u32,
+    /// The objects of the order drawn here end at this position.
+    pub end: u32,
+}
+
+/// How strongly a place for an object is ruled out: a chunk-wide sound test against a
+/// single quad's plane.
+const SOUND: i64 = 1 << 24;
+
+/// How one quad's plane orders it against ball `b` (chunk origin `origin`): `Some(true)`
+/// when the ball is on the eye's side (the quad comes before it), `Some(false)` beyond,
+/// `None` when the ball crosses the plane or the quad is culled or seen edge-on.
+fn quad_side(
+    b: Ball,
+    eye: DVec3,
+    origin: [f64; 3],
+    q: PackedQuad,
+    two_sided: bool,
+) -> Option<bool> {
+    let q = q.unpack()?;
+    let a = q.face.axis();
+    let n = if q.face.is_positive() { 1.0 } else { -1.0 };
+    let plane = origin[a] + q.bounds().0[a];
+    let e = (eye[a] - plane) * n;
+    let d = (b.center[a] - plane) * n;
+    if (!two_sided && e <= 0.0) || e == 0.0 || d.abs() <= b.radius {
+        return None;
+    }
+    Some((e > 0.0) == (d > 0.0))
+}
+
+/// The draw order of objects `balls` among `chunks` (in draw order, farthest first: each
+/// chunk's surfaces, if any, and distances `[near, mid, far]` of its box from `eye`).
+/// Returns the objects in draw order and where runs of them are drawn (in draw order; the
+/// objects after the last run come after every chunk).
+///
+/// Each object goes to the place in the sequence of chunks (and, with `split_quads`, of
+/// their quads, which are then in exact back-to-front order) that the fewest constraints
+/// rule out: a chunk a sound test puts wholly behind or in front of the object weighs
+/// [`SOUND`]; in a chunk no test decides, each quad's plane ([`quad_side`]) weighs 1, or
+/// without `split_quads` the box's centre decides with weight 1.
+pub fn interleave(
+    balls: &[Ball],
+    eye: DVec3,
+    chunks: &[(Option<Surfaces<'_>>, [f64; 3])],
+    two_sided: bool,
+    split_quads: bool,
+) -> (Vec<u32>, Vec<Split>) {
+    // (chunk, quad, farthest first, object): the place of each object.
+    let mut places: Vec<(u32, u32, std::cmp::Reverse<u64>, u32)> = Vec::with_capacity(balls.len());
+    let mut items: Vec<(u32, u32, i64)> = Vec::new();
+    let last = chunks.len() as u32;
+    for (i, &b) in balls.iter().enumerate() {
+        let o = b.center.distance(eye);
+        // The constraints in draw order: (chunk, quad after which it applies, weight:
+        // positive when the item must come before the object, negative after it).
+        items.clear();
+        for (c, (surfaces, d)) in chunks.iter().enumerate() {
+            let Some(s) = surfaces else { continue };
+            let c = c as u32;
+            match decide(b, o, eye, s, *d, two_sided) {
+                Some(Side::Front) => items.push((c, 0, SOUND)),
+                Some(Side::Behind) => items.push((c, 0, -SOUND)),
+                None if split_quads => {
+                    for (k, &q) in s.quads.iter().enumerate() {
+                        match quad_side(b, eye, s.origin, q, two_sided) {
+                            Some(true) => items.push((c, k as u32, 1)),
+                            Some(false) => items.push((c, k as u32, -1)),
+                            None => {}
+                        }
+                    }
+                }
+                None => items.push((c, 0, if o > d[1] { -1 } else { 1 })),
+            }
+        }
+        // Before everything, every item that must come before the object is violated;
+        // passing an item changes the cost by its weight.
+        let mut cost: i64 = items.iter().map(|it| it.2.max(0)).sum();
+        let (mut min, mut at) = (cost, (0, 0));
+        for &(c, k, w) in &items {
+            cost -= w;
+            if cost < min {
+                // Just after the item: after the whole chunk where it stood for it.
+                let whole = w.abs() == SOUND || (!split_quads && w.abs() == 1);
+                (min, at) = (cost, if whole { (c + 1, 0) } else { (c, k + 1) });
+            }
+        }
+        let (c, k) = at;
+        // After quads `..k` of chunk `c`; past the end of a chunk is before the next one.
+        let at = match chunks.get(c as usize).and_then(|(s, _)| s.as_ref()) {
+            Some(s) if k as usize >= s.quads.len() && k > 0 => (c + 1, 0),
+            _ => (c, k),
+        };
+        // Chunks with nothing translucent draw nothing: the next one that does.
+        let mut at = at;
+        while at.0 < last && chunks[at.0 as usize].0.is_none() {
+            at = (at.0 + 1, 0);
+        }
+        places.push((at.0, at.1, std::cmp::Reverse(o.to_bits()), i as u32));
+    }
+    places.sort_unstable();
+    let mut order = Vec::with_capacity(balls.len());
+    let mut splits = Vec::new();
+    for (n, &(c, k, _, i)) in places.iter().enumerate() {
+        order.push(i);
+        let next = places.get(n + 1);
+        if c < last && next.is_none_or(|p| (p.0, p.1) != (c, k)) {
+            splits.push(Split {
+                chunk: c,
+                quad: k,
+                end: order.len() as u32,
+            });
+        }
+    }
+    (order, splits)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use voxel_core::Face;
+
+    /// Where ball `b` goes among `quads` (a chunk's quads in their exact back-to-front order):
+    /// the split that the fewest quads' planes disagree with ([`quad_side`]).
+    fn quad_split(
+        b: Ball,
+        eye: DVec3,
+        origin: [f64; 3],
+        quads: &[PackedQuad],
+        two_sided: bool,
+    ) -> u32 {
+        let sides: Vec<Option<bool>> = quads
+            .iter()
+            .map(|&q| quad_side(b, eye, origin, q, two_sided))
+            .collect();
+        let mut cost: i64 = sides.iter().map(|s| i64::from(*s == Some(true))).sum();
+        let (mut min, mut at) = (cost, 0);
+        for (k, side) in sides.iter().enumerate() {
+            cost += match side {
+                Some(true) => -1,
+                Some(false) => 1,
+                None => 0,
+            };
+            if cost < min {
+                (min, at) = (cost, k as u32 + 1);
+            }
+        }
+        at
+    }
+
+    /// The side of ball `b` (its centre at distance `o` from `eye`) against chunk surfaces
+    /// `s`, whose box spans distances `near..=far` from the eye with its centre at `mid`;
+    /// `two_sided` when back faces are drawn too.
+    fn side(b: Ball, o: f64, eye: DVec3, s: &Surfaces<'_>, d: [f64; 3], two_sided: bool) -> Side {
+        decide(b, o, eye, s, d, two_sided).unwrap_or(if o > d[1] {
+            Side::Behind
+        } else {
+            Side::Front
+        })
+    }
+
+    fn surfaces<'a>(lo: [f64; 3], hi: [f64; 3], planes: &'a [(Face, u8)]) -> Surfaces<'a> {
+        Surfaces {
+            lo: DVec3::from(lo),
+            hi: DVec3::from(hi),
+            origin: [0.0; 3],
+            planes,
+            quads: &[],
+        }
+    }
+
+    fn point(center: DVec3) -> Ball {
+        Ball {
+            center,
+            radius: 0.0,
+        }
+    }
+
+    fn distances(s: &Surfaces<'_>, eye: DVec3) -> [f64; 3] {
+        let near = eye.clamp(s.lo, s.hi).distance(eye);
+        let mid = ((s.lo + s.hi) * 0.5).distance(eye);
+        let far = (eye - s.lo).abs().max((eye - s.hi).abs()).length();
+        [near, mid, far]
+    }
+
+    #[test]
+    fn a_point_above_a_water_surface_is_in_front_and_below_it_behind() {
+        // A water surface at y = 8 (the top faces of blocks at y = 7) over the whole
+        // chunk, seen from above at an angle.
+        let planes = [(Face::PosY, 8)];
+        let s = surfaces([0.0, 8.0, 0.0], [32.0, 8.0, 32.0], &planes);
+        let eye = DVec3::new(16.0, 14.0, 40.0);
+        let d = distances(&s, eye);
+        for (p, want) in [
+            (DVec3::new(16.0, 10.0, 20.0), Side::Front),
+            (DVec3::new(16.0, 8.5, 30.0), Side::Front),
+            (DVec3::new(16.0, 4.0, 20.0), Side::Behind),
+            (DVec3::new(16.0, 7.9, 31.0), Side::Behind),
+        ] {
+            let o = p.distance(eye);
+            assert_eq!(side(point(p), o, eye, &s, d, false), want, "{p}");
+        }
+        // Under water looking up (both sides drawn): the surface is in front of a point
+        // above it.
+        let eye = DVec3::new(16.0, 2.0, 20.0);
+        let d = distances(&s, eye);
+        let p = DVec3::new(16.0, 9.0, 18.0);
+        assert_eq!(
+            side(point(p), p.distance(eye), eye, &s, d, true),
+            Side::Behind
+        );
+        // A ball through the surface is decided by the box's centre.
+        let b = Ball {
+            center: DVec3::new(16.0, 8.2, 20.0),
+            radius: 1.0,
+        };
+        assert_eq!(decide(b, b.center.distance(eye), eye, &s, d, true), None);
+    }
+
+    #[test]
+    fn between_two_layers_the_centre_decides() {
+        let planes = [(Face::PosZ, 5), (Face::PosZ, 21)];
+        let s = surfaces([0.0, 0.0, 5.0], [32.0, 32.0, 21.0], &planes);
+        let eye = DVec3::new(16.0, 16.0, 60.0);
+        let d = distances(&s, eye);
+        let p = DVec3::new(16.0, 16.0, 12.0);
+        // In front of the plane at 5, behind the one at 21: the centre (13) decides.
+        assert_eq!(
+            side(point(p), p.distance(eye), eye, &s, d, false),
+            Side::Behind
+        );
+        let p = DVec3::new(16.0, 16.0, 14.0);
+        assert_eq!(
+            side(point(p), p.distance(eye), eye, &s, d, false),
+            Side::Front
+        );
+    }
+
+    /// Random quads of a chunk and random balls: where a sound test decides, the ray from
+    /// the eye through any point of the ball agrees (a quad hit before the point means
+    /// behind, a quad hit beyond it means in front).
+    #[test]
+    fn decided_sides_agree_with_rays() {
+        let mut seed = 0x1234_5678_9abc_def0u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let faces = [
+            Face::PosX,
+            Face::NegX,
+            Face::PosY,
+            Face::NegY,
+            Face::PosZ,
+            Face::NegZ,
+        ];
+        let (mut decided, mut checked) = (0, 0);
+        for round in 0..400 {
+            let two_sided = round % 4 == 0;
+            // A few quads: face, plane coordinate, rectangle on the other two axes.
+            let quads: Vec<(Face, u8, [f64; 2], [f64; 2])> = (0..1 + round % 5)
+                .map(|_| {
+                    let face = faces[(next() * 6.0) as usize % 6];
+                    let c = (next() * 33.0) as u8 % 33;
+                    let a = [next() * 24.0, next() * 24.0];
+                    (
+                        face,
+                        c,
+                        a,
+                        [a[0] + 1.0 + next() * 16.0, a[1] + 1.0 + next() * 16.0],
+                    )
+                })
+                .collect();
+            let origin = [32.0, -32.0, 0.0];
+            let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+            for &(face, c, a, b) in &quads {
+                let k = face.axis();
+                let [u, v] = voxel_mesh::UV_AXES[k];
+                let mut q0 = DVec3::ZERO;
+                let mut q1 = DVec3::ZERO;
+                q0[k] = f64::from(c);
+                q1[k] = f64::from(c);
+                (q0[u], q0[v], q1[u], q1[v]) = (a[0], a[1], b[0], b[1]);
+                let o = DVec3::from(origin);
+                lo = lo.min(q0 + o);
+                hi = hi.max(q1 + o);
+            }
+            let mut planes: Vec<(Face, u8)> = quads.iter().map(|q| (q.0, q.1)).collect();
+            planes.sort_unstable_by_key(|&(f, c)| (f as u8, c));
+            planes.dedup();
+            let s = Surfaces {
+                lo,
+                hi,
+                origin,
+                planes: &planes,
+                quads: &[],
+            };
+            let around = |next: &mut dyn FnMut() -> f64| {
+                DVec3::new(next() * 64.0, next() * 64.0 - 48.0, next() * 64.0 - 16.0)
+            };
+            let eye = around(&mut next);
+            let d = distances(&s, eye);
+            for k in 0..200 {
+                let center = around(&mut next);
+                let radius = if k % 2 == 0 { 0.0 } else { next() * 4.0 };
+                let ball = Ball { center, radius };
+                let o = center.distance(eye);
+                let Some(got) = decide(ball, o, eye, &s, d, two_sided) else {
+                    continue;
+                };
+                decided += 1;
+                // Points of the ball: its centre and points on its surface.
+                let points: Vec<DVec3> = (0..if radius > 0.0 { 7 } else { 1 })
+                    .map(|j| {
+                        if j == 0 {
+                            return center;
+                        }
+                        let v = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+                        center + v.normalize_or(DVec3::X) * radius * 0.999
+                    })
+                    .collect();
+                // Every quad the ray eye -> p crosses, and where (t = 1 at p).
+                for (p, &(face, c, a, b)) in points
+                    .iter()
+                    .flat_map(|p| quads.iter().map(move |q| (*p, q)))
+                {
+                    let k = face.axis();
+                    let [u, v] = voxel_mesh::UV_AXES[k];
+                    let plane = origin[k] + f64::from(c);
+                    let n = if face.is_positive() { 1.0 } else { -1.0 };
+                    if !two_sided && (eye[k] - plane) * n <= 0.0 {
+                        continue;
+                    }
+                    let dir = p - eye;
+                    if dir[k] == 0.0 {
+                        continue;
+                    }
+                    let t = (plane - eye[k]) / dir[k];
+                    if t <= 0.0 {
+                        continue;
+                    }
+                    let x = eye + dir * t;
+                    let inside = x[u] > origin[u] + a[0]
+                        && x[u] < origin[u] + b[0]
+                        && x[v] > origin[v] + a[1]
+                        && x[v] < origin[v] + b[1];
+                    if !inside {
+                        continue;
+                    }
+                    checked += 1;
+                    let want = if t < 1.0 { Side::Behind } else { Side::Front };
+                    assert_eq!(got, want, "p {p} eye {eye} quad {face:?} {c} {a:?} {b:?}");
+                }
+            }
+        }
+        assert!(
+            decided > 20_000 && checked > 1000,
+            "{decided} decided, {checked} checked"
+        );
+    }
+
+    #[test]
+    fn objects_go_before_the_first_chunk_they_are_behind() {
+        let planes = [(Face::PosY, 7)];
+        // Two water chunks in a row along z, the eye above the nearer one.
+        let far = Surfaces {
+            lo: DVec3::new(0.0, 7.0, -64.0),
+            hi: DVec3::new(32.0, 7.0, -32.0),
+            origin: [0.0, 0.0, -64.0],
+            planes: &planes,
+            quads: &[],
+        };
+        let near = Surfaces {
+            lo: DVec3::new(0.0, 7.0, -32.0),
+            hi: DVec3::new(32.0, 7.0, 0.0),
+            origin: [0.0, 0.0, -32.0],
+            planes: &planes,
+            quads: &[],
+        };
+        let eye = DVec3::new(16.0, 12.0, 4.0);
+        let chunks = [
+            (Some(far), distances(&far, eye)),
+            (None, [0.0; 3]),
+            (Some(near), distances(&near, eye)),
+        ];
+        let balls = [
+            DVec3::new(16.0, 3.0, -50.0), // under the far water
+            DVec3::new(16.0, 9.0, -50.0), // over the far water
+            DVec3::new(16.0, 3.0, -10.0), // under the near water
+            DVec3::new(16.0, 9.0, -10.0), // over the near water
+            DVec3::new(16.0, 11.0, 2.0),  // by the eye
+        ]
+        .map(|center| Ball {
+            center,
+            radius: 1.5,
+        });
+        let (order, splits) = interleave(&balls, eye, &chunks, false, false);
+        // Before the far water: what is under it. Before the near water: what is under
+        // it and what lies farther than all of it (over the far water), farthest first.
+        let at = |chunk, end| Split {
+            chunk,
+            quad: 0,
+            end,
+        };
+        assert_eq!(splits, vec![at(0, 1), at(2, 3)]);
+        assert_eq!(order[..1], [0]);
+        assert_eq!(order[1..3], [1, 2]);
+        // Over the near water and by the eye: after every chunk, farthest first.
+        assert_eq!(order[3..], [3, 4]);
+    }
+
+    #[test]
+    fn between_water_and_a_pane_of_one_chunk_an_object_goes_between_their_quads() {
+        use voxel_core::BlockId;
+        use voxel_mesh::Quad;
+        let quad = |pos: [u8; 3], size: [u8; 2], face| {
+            PackedQuad::pack(&Quad {
+                pos,
+                size,
+                face,
+                block: BlockId(1),
+            })
+        };
+        // Back to front for an eye at z = 40 above: the water surface (top faces of
+        // y = 3), then a pane's +z face at z = 21 (blocks z = 20, y 6..10).
+        let quads = [
+            quad([0, 3, 0], [32, 32], Face::PosY),
+            quad([8, 6, 20], [16, 4], Face::PosZ),
+        ];
+        let planes = quad_planes_of(&quads);
+        let s = Surfaces {
+            lo: DVec3::new(0.0, 4.0, 0.0),
+            hi: DVec3::new(32.0, 10.0, 32.0),
+            origin: [0.0; 3],
+            planes: &planes,
+            quads: &quads,
+        };
+        let eye = DVec3::new(16.0, 12.0, 40.0);
+        let d = distances(&s, eye);
+        let ball = |y, z| Ball {
+            center: DVec3::new(16.0, y, z),
+            radius: 1.0,
+        };
+        // Above the water, behind the pane: the planes disagree, the quads split.
+        let b = ball(7.0, 12.0);
+        assert_eq!(decide(b, b.center.distance(eye), eye, &s, d, false), None);
+        assert_eq!(quad_split(b, eye, s.origin, &quads, false), 1);
+        let (order, splits) = interleave(&[b], eye, &[(Some(s), d)], false, true);
+        assert_eq!(order, [0]);
+        let want = Split {
+            chunk: 0,
+            quad: 1,
+            end: 1,
+        };
+        assert_eq!(splits, [want]);
+        // Without splitting, the box's centre decides: the ball is farther, so it is drawn
+        // before the whole chunk (under the water: wrong where they overlap).
+        let (_, splits) = interleave(&[b], eye, &[(Some(s), d)], false, false);
+        assert_eq!(splits, [Split { quad: 0, ..want }]);
+        // Under the water: before both.
+        let b = ball(1.0, 12.0);
+        assert_eq!(quad_split(b, eye, s.origin, &quads, false), 0);
+        // Above the water and in front of the pane: after both.
+        let b = ball(7.0, 30.0);
+        assert_eq!(quad_split(b, eye, s.origin, &quads, false), 2);
+    }
+
+    fn quad_planes_of(quads: &[PackedQuad]) -> Vec<(Face, u8)> {
+        let mut planes: Vec<(Face, u8)> = quads
+            .iter()
+            .filter_map(|q| q.unpack())
+            .map(|q| (q.face, q.bounds().0[q.face.axis()] as u8))
+            .collect();
+        planes.sort_unstable_by_key(|&(f, c)| (f as u8, c));
+        planes.dedup();
+        planes
+    }
+}
