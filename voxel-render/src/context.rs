@@ -128,7 +128,7 @@ impl GpuContext {
                 ..Default::default()
             })
             .await
-            .map_err(|source| Error::NoAdapter { backends, source })?;
+            .map_err(|error| Error::NoAdapter { backends, error })?;
         let (device, queue) = request_device(&adapter).await?;
         Ok(Self::from_device(&adapter, device, queue))
     }

@@ -29,17 +29,17 @@ impl Image {
 
     /// Writes the image as an sRGB PNG, creating parent folders.
     pub fn save_png(&self, path: &Path) -> Result<()> {
-        let io = |source| Error::Io {
+        let io = |error| Error::Io {
             path: path.to_owned(),
-            source,
+            error,
         };
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(io)?;
         }
         let file = std::fs::File::create(path).map_err(io)?;
-        let png = |source| Error::PngEncode {
+        let png = |error| Error::PngEncode {
             path: path.to_owned(),
-            source,
+            error,
         };
         let mut enc = png::Encoder::new(std::io::BufWriter::new(file), self.width, self.height);
         enc.set_color(png::ColorType::Rgba);
@@ -51,13 +51,13 @@ impl Image {
 
     /// Reads an 8-bit PNG (grey, RGB or RGBA; palettes expanded).
     pub fn load_png(path: &Path) -> Result<Self> {
-        let file = std::fs::File::open(path).map_err(|source| Error::Io {
+        let file = std::fs::File::open(path).map_err(|error| Error::Io {
             path: path.to_owned(),
-            source,
+            error,
         })?;
-        let png = |source| Error::PngDecode {
+        let png = |error| Error::PngDecode {
             path: path.to_owned(),
-            source,
+            error,
         };
         let mut dec = png::Decoder::new(std::io::BufReader::new(file));
         dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);

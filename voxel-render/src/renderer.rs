@@ -967,6 +967,7 @@ impl SceneTargets {
                     wgpu::BindingResource::TextureView(&scene.textures.view),
                     wgpu::BindingResource::Sampler(&scene.textures.sampler),
                     wgpu::BindingResource::TextureView(&boundary.view),
+                    scene.textures.layers.as_entire_binding(),
                 ],
             )
         };
