@@ -44,7 +44,7 @@ pub use oit::{
     TranslucentTechnique, WboitReport, WboitSettings, WeightFit, WeightFunction,
 };
 pub use readback::Image;
-pub use renderer::{ChunkMemory, FrameStats, Renderer, RendererConfig};
+pub use renderer::{ChunkMemory, FrameStats, Lighting, OUTPUT_FORMATS, Renderer, RendererConfig};
 pub use stream::{
     ChunkSink, ChunkSource, ChunkStreamer, MAX_VIEW_DISTANCE, StreamConfig, StreamFrame,
 };

@@ -196,9 +196,10 @@ const MAPPED: u8 = 2;
 const FAILED: u8 = 3;
 
 /// A query set whose results are copied to the CPU without stalling: resolved and copied
-/// at the end of a frame's commands, mapped once those are submitted, read a frame or more
-/// later (or at once with [`QueryReadback::wait`]). While one copy is in flight, further
-/// copies are skipped rather than waited for.
+/// at the end of a frame's commands, mapped when those are submitted (nothing to call),
+/// read a frame or more later (or at once with [`QueryReadback::wait`]). While one copy is
+/// in flight, further copies are skipped rather than waited for; a copy whose encoder is
+/// dropped unsubmitted frees the buffer again.
 #[derive(Debug)]
 pub struct QueryReadback {
     set: wgpu::QuerySet,
@@ -206,7 +207,19 @@ pub struct QueryReadback {
     readback: wgpu::Buffer,
     state: std::sync::Arc<std::sync::atomic::AtomicU8>,
     pending: u32,
-    copied: bool,
+}
+
+/// Held by a copy's deferred mapping: dropped without the mapping having run (its encoder
+/// was dropped unsubmitted), it frees the readback buffer for the next copy.
+struct Mapping(std::sync::Arc<std::sync::atomic::AtomicU8>);
+
+impl Drop for Mapping {
+    fn drop(&mut self) {
+        use std::sync::atomic::Ordering;
+        let _ = self
+            .0
+            .compare_exchange(MAPPING, IDLE, Ordering::AcqRel, Ordering::Acquire);
+    }
 }
 
 impl QueryReadback {
@@ -237,7 +250,6 @@ impl QueryReadback {
             ),
             state: std::sync::Arc::new(std::sync::atomic::AtomicU8::new(IDLE)),
             pending: 0,
-            copied: false,
         }
     }
 
@@ -246,37 +258,30 @@ impl QueryReadback {
         &self.set
     }
 
-    /// Records the copy of queries `range` (to be read as results `0..len`), unless a copy
-    /// is already in flight. Returns whether it was recorded.
+    /// Records the copy of queries `range` (to be read as results `0..len`) and its
+    /// mapping when `encoder` is submitted, unless a copy is already in flight. Returns
+    /// whether it was recorded.
     pub fn copy(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         range: std::ops::Range<u32>,
     ) -> bool {
+        use std::sync::atomic::Ordering;
         let n = range.end.saturating_sub(range.start);
-        if n == 0 || self.copied || self.state.load(std::sync::atomic::Ordering::Acquire) != IDLE {
+        if n == 0 || self.state.load(Ordering::Acquire) != IDLE {
             return false;
         }
         encoder.resolve_query_set(&self.set, range, &self.resolve, 0);
         encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, u64::from(n) * 8);
         self.pending = n;
-        self.copied = true;
-        true
-    }
-
-    /// Starts mapping the recorded copy; call once its commands are submitted.
-    pub fn map(&mut self) {
-        if !std::mem::take(&mut self.copied) {
-            return;
-        }
-        use std::sync::atomic::Ordering;
         self.state.store(MAPPING, Ordering::Release);
-        let state = self.state.clone();
-        self.readback
-            .slice(..)
-            .map_async(wgpu::MapMode::Read, move |r| {
-                state.store(if r.is_ok() { MAPPED } else { FAILED }, Ordering::Release);
-            });
+        let mapping = Mapping(self.state.clone());
+        encoder.map_buffer_on_submit(&self.readback, wgpu::MapMode::Read, .., move |r| {
+            mapping
+                .0
+                .store(if r.is_ok() { MAPPED } else { FAILED }, Ordering::Release);
+        });
+        true
     }
 
     /// The results once mapped (`Ok(None)` until then; needs `device.poll` now and then),

@@ -35,8 +35,10 @@ pub struct RendererConfig {
     pub width: u32,
     /// Output height in pixels, like `width`.
     pub height: u32,
-    /// Format of the textures `render` draws into. Default `Rgba8UnormSrgb`, what
-    /// offscreen readback and PNG files want; a window passes its surface format.
+    /// Format of the textures `render` draws into first. Default `Rgba8UnormSrgb`, what
+    /// offscreen readback and PNG files want. Any of [`OUTPUT_FORMATS`] works without
+    /// changing this: an output of another format gets its tonemap pipeline at its first
+    /// frame (once per format), and this field follows it.
     pub output_format: wgpu::TextureFormat,
     /// 4× MSAA for the opaque and cutout passes. Default off: the translucent pass is
     /// single-sampled anyway (seed 000) and lavapipe pays 4× for it.
@@ -160,6 +162,106 @@ struct Post {
 }
 
 const MSAA_SAMPLES: u32 = 4;
+
+/// The formats [`Renderer::render`] draws into: what surfaces offer (BGRA and RGBA, sRGB or
+/// not; 10-bit; half float, written linear) and what offscreen targets use. An sRGB format
+/// is encoded by the GPU, the 8- and 10-bit linear ones by the tonemap shader, so every
+/// one shows the same picture.
+pub const OUTPUT_FORMATS: [wgpu::TextureFormat; 6] = [
+    wgpu::TextureFormat::Rgba8UnormSrgb,
+    wgpu::TextureFormat::Rgba8Unorm,
+    wgpu::TextureFormat::Bgra8UnormSrgb,
+    wgpu::TextureFormat::Bgra8Unorm,
+    wgpu::TextureFormat::Rgb10a2Unorm,
+    wgpu::TextureFormat::Rgba16Float,
+];
+
+/// The format to draw an output texture of `format` with, when the renderer last drew
+/// `current`: `current` when the texture is of `current` or of its sRGB / linear twin
+/// (a view of the twin, as [`Renderer::render`] documents), else the texture's own.
+fn output_format(current: wgpu::TextureFormat, format: wgpu::TextureFormat) -> wgpu::TextureFormat {
+    if format.remove_srgb_suffix() == current.remove_srgb_suffix() {
+        current
+    } else {
+        format
+    }
+}
+
+/// Lighting a renderer draws with ([`Renderer::set_lighting`]); its fields are those of
+/// [`RendererConfig`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lighting {
+    /// Direction towards the sun (normalised on use).
+    pub sun_dir: [f32; 3],
+    /// Ambient share of the lighting, 0 to 1.
+    pub ambient: f32,
+    /// Sky colour (linear), what the background is cleared to.
+    pub sky: [f32; 3],
+}
+
+impl Lighting {
+    /// The first hour [`Lighting::daytime`] draws: sunrise.
+    pub const SUNRISE: f32 = 6.0;
+    /// The last hour [`Lighting::daytime`] draws: sunset.
+    pub const SUNSET: f32 = 18.0;
+
+    /// The lighting of [`RendererConfig::default`].
+    pub fn default_day() -> Self {
+        let c = RendererConfig::default();
+        Self {
+            sun_dir: c.sun_dir,
+            ambient: c.ambient,
+            sky: c.sky,
+        }
+    }
+
+    /// Daylight at `hour` (clamped to [`Lighting::SUNRISE`]..=[`Lighting::SUNSET`]): the
+    /// sun rises in the east (+x), stands highest in the south (+z) at noon and sets in
+    /// the west; the ambient share falls from 0.45 at noon to 0.2 at the horizon, and the
+    /// sky turns from light blue to a dusk orange. A model for a time-of-day control, not
+    /// an atmosphere.
+    pub fn daytime(hour: f32) -> Self {
+        let hour = if hour.is_finite() { hour } else { 12.0 };
+        let h = hour.clamp(Self::SUNRISE, Self::SUNSET);
+        // 0 at sunrise, pi at sunset.
+        let a = (h - Self::SUNRISE) / (Self::SUNSET - Self::SUNRISE) * std::f32::consts::PI;
+        // A path tilted 35 degrees toward the south, a few degrees above the horizon at
+        // either end so that the sides facing the sun keep some light.
+        let elevation = 0.08 + 0.92 * a.sin();
+        let sun = glam::Vec3::new(a.cos(), elevation, 0.7 * elevation).normalize_or(glam::Vec3::Y);
+        let day = glam::Vec3::from([0.45, 0.65, 0.9]);
+        let dusk = glam::Vec3::from([0.85, 0.45, 0.25]);
+        let t = a.sin().clamp(0.0, 1.0).sqrt();
+        Self {
+            sun_dir: sun.to_array(),
+            ambient: 0.2 + 0.25 * t,
+            sky: dusk.lerp(day, t).to_array(),
+        }
+    }
+
+    /// Checks the values: a finite non-zero sun direction, an ambient share from 0 to 1,
+    /// a finite sky colour of non-negative channels.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |what: String| Err(Error::InvalidSetting(what));
+        let sun = glam::Vec3::from(self.sun_dir);
+        if !sun.is_finite() || sun.length_squared() == 0.0 {
+            return bad(format!(
+                "sun direction {:?}: it must be finite and not zero",
+                self.sun_dir
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.ambient) {
+            return bad(format!("ambient {}: it must be from 0 to 1", self.ambient));
+        }
+        if !self.sky.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            return bad(format!(
+                "sky colour {:?}: every channel must be finite and not negative",
+                self.sky
+            ));
+        }
+        Ok(())
+    }
+}
 
 /// Draws a voxel world. See the module docs for the passes.
 #[derive(Debug)]
@@ -382,6 +484,25 @@ impl Renderer {
         config_with(&mut self.config.oit, self.oit.config());
     }
 
+    /// Builds `technique`'s pipelines and targets now, so that a later
+    /// [`Renderer::set_technique`] to it builds nothing and its first frame costs what any
+    /// frame costs (a game prepares the techniques its settings menu offers at loading
+    /// time). It stays built until [`Renderer::release_technique`]; see
+    /// [`OitManager::prebuild`]. Returns the technique built (after its fallback on this
+    /// adapter).
+    pub fn prebuild_technique(&mut self, technique: Technique) -> Result<Technique> {
+        let oit = &mut self.oit;
+        scoped(&self.ctx.device, "building a technique ahead", || {
+            oit.prebuild(technique)
+        })?
+    }
+
+    /// Frees what [`Renderer::prebuild_technique`] built for `technique`, unless it is
+    /// drawing.
+    pub fn release_technique(&mut self, technique: Technique) {
+        self.oit.release(technique);
+    }
+
     /// Changes the WBOIT weight function (a uniform: no pipeline is rebuilt).
     pub fn set_weight(&mut self, weight: WeightFunction) {
         let mut config = self.oit.config().clone();
@@ -420,6 +541,26 @@ impl Renderer {
     pub fn set_ao_strength(&mut self, strength: f32) -> Result<()> {
         check_ao_strength(strength)?;
         self.config.ao_strength = strength;
+        Ok(())
+    }
+
+    /// The sun direction, ambient share and sky in force.
+    pub fn lighting(&self) -> Lighting {
+        Lighting {
+            sun_dir: self.config.sun_dir,
+            ambient: self.config.ambient,
+            sky: self.config.sky,
+        }
+    }
+
+    /// Changes the sun direction, ambient share and sky from the next frame on: they are
+    /// frame uniforms and the clear colour, so nothing is rebuilt and no chunk is uploaded
+    /// again. Invalid values ([`Lighting::validate`]) are an error and change nothing.
+    pub fn set_lighting(&mut self, lighting: Lighting) -> Result<()> {
+        lighting.validate()?;
+        self.config.sun_dir = lighting.sun_dir;
+        self.config.ambient = lighting.ambient;
+        self.config.sky = lighting.sky;
         Ok(())
     }
 
@@ -482,10 +623,12 @@ impl Renderer {
         scoped(&self.ctx.device, "resizing", || oit.resize(width, height))?
     }
 
-    /// GPU milliseconds per pass of the latest timed frame (empty without timestamps).
-    /// Needs `device.poll` now and then.
+    /// GPU milliseconds per pass of the latest timed frame whose results have arrived
+    /// (empty without timestamps). Results arrive a frame or more after submission, once
+    /// wgpu is polled (each `queue.submit` polls).
     pub fn gpu_times(&mut self) -> GpuTimes {
-        self.timer.as_mut().map(Timer::poll).unwrap_or_default()
+        let ctx = &self.ctx;
+        self.timer.as_mut().map(|t| t.poll(ctx)).unwrap_or_default()
     }
 
     /// Like [`Renderer::gpu_times`], but waits for the last submitted frame's results.
@@ -497,14 +640,11 @@ impl Renderer {
             .unwrap_or_default()
     }
 
-    /// Call after submitting a frame's encoder: starts reading its GPU timings (and the
-    /// technique's own counters) back.
-    pub fn after_submit(&mut self) {
-        if let Some(t) = &mut self.timer {
-            t.after_submit();
-        }
-        self.oit.after_submit();
-    }
+    /// Does nothing: GPU timings and a technique's counters are read back once a frame's
+    /// commands are submitted, without a call. Kept so that code written for earlier
+    /// versions, which had to call it after each submit, still builds.
+    #[deprecated(note = "nothing needs calling after a submit: remove the call")]
+    pub fn after_submit(&mut self) {}
 
     /// The HDR scene colour (after the composite, before tonemapping).
     pub fn scene_color(&self) -> &wgpu::Texture {
@@ -517,9 +657,12 @@ impl Renderer {
     }
 
     /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of a
-    /// whole 2D texture of the renderer's size whose format is
-    /// [`RendererConfig::output_format`] (or its sRGB / linear twin, viewed as that format),
-    /// with `RENDER_ATTACHMENT` usage.
+    /// whole 2D texture of the renderer's size, of one of [`OUTPUT_FORMATS`], with
+    /// `RENDER_ATTACHMENT` usage. A view of the texture's sRGB / linear twin format is
+    /// drawn as [`RendererConfig::output_format`] when that is the twin.
+    ///
+    /// Nothing needs calling after the frame's commands are submitted: GPU timings and
+    /// a technique's counters (depth peeling's layers) are read back once they are.
     ///
     /// Fails without recording anything on an invalid camera (NaN, zero direction, bad
     /// planes) or a mismatched output.
@@ -537,7 +680,19 @@ impl Renderer {
         camera.validate()?;
         self.check_output(output)?;
         let start = Instant::now();
-        self.post.make_tonemap(&self.ctx, self.config.output_format);
+        // Ends the last timed frame if it was submitted since; this one is timed unless
+        // it is not.
+        let ctx = &self.ctx;
+        let timed = self.timer.as_mut().is_some_and(|t| t.begin_frame(ctx));
+        let format = output_format(self.config.output_format, output.texture().format());
+        if format != self.config.output_format {
+            log::info!(
+                "drawing into {format:?} from now on (was {:?})",
+                self.config.output_format
+            );
+            self.config.output_format = format;
+        }
+        self.post.make_tonemap(&self.ctx, format);
         self.update_fades();
         // Before any list of this frame takes the meshes' places.
         self.chunks.compact(&self.ctx, encoder);
@@ -579,7 +734,7 @@ impl Renderer {
         };
         let [opaque, cutout, translucent] = &lists;
 
-        let timer = self.timer.as_ref();
+        let timer = self.timer.as_ref().filter(|_| timed);
         let t = &self.targets;
         self.draw_opaque(encoder, &draws, opaque, cutout, timer);
         if medium.is_some() {
@@ -623,8 +778,8 @@ impl Renderer {
             cpu_ms: 0.0,
             technique: TechniqueReport::default(),
         };
-        if let Some(t) = &mut self.timer {
-            t.resolve(encoder);
+        if timed && let Some(t) = &mut self.timer {
+            t.end_frame(&self.ctx, encoder);
         }
         Ok(FrameStats {
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
@@ -657,7 +812,6 @@ impl Renderer {
             });
         let stats = self.render(&mut encoder, output, camera)?;
         self.ctx.queue.submit([encoder.finish()]);
-        self.after_submit();
         Ok(stats)
     }
 
@@ -673,10 +827,11 @@ impl Renderer {
                 t.height()
             )));
         }
-        if t.format() != want && t.format().remove_srgb_suffix() != want.remove_srgb_suffix() {
+        if !OUTPUT_FORMATS.contains(&t.format()) {
             return Err(Error::Output(format!(
-                "format {:?}, but the renderer was made for {want:?} (RendererConfig::output_format)",
-                t.format()
+                "format {:?}: the renderer draws into {} (last {want:?})",
+                t.format(),
+                OUTPUT_FORMATS.map(|f| format!("{f:?}")).join(", ")
             )));
         }
         if !t.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
@@ -894,7 +1049,15 @@ impl Post {
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
                 writes_depth: false,
-                constants: &[("SRGB_ENCODE", if format.is_srgb() { 0.0 } else { 1.0 })],
+                // sRGB formats are encoded by the GPU, a float one is written linear.
+                constants: &[(
+                    "SRGB_ENCODE",
+                    if format.is_srgb() || format == wgpu::TextureFormat::Rgba16Float {
+                        0.0
+                    } else {
+                        1.0
+                    },
+                )],
             }
             .build(&ctx.device)
         });

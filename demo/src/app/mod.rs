@@ -791,10 +791,8 @@ impl Gfx {
             .queue
             .submit(extra.into_iter().chain([encoder.finish()]));
         self.ui.free(&panel.free);
-        self.renderer.after_submit();
-        if let Some(r) = &mut self.reference {
-            r.after_submit();
-        }
+        // Nothing to call after the submit: the renderers read their timings and counters
+        // back once the frame's commands are submitted.
         self.display.window.pre_present_notify();
         self.ctx.queue.present(surface_texture);
         let _ = self.ctx.device.poll(wgpu::PollType::Poll);

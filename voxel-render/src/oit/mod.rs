@@ -39,7 +39,7 @@ pub use wboit::{WboitReport, WboitSettings};
 /// Declares [`Technique`] from the list of techniques: variant, command-line name, and the
 /// type (implementing [`TechniqueKind`]) that draws it.
 macro_rules! techniques {
-    ($( $(#[doc = $doc:literal])* $variant:ident = $name:literal => $kind:ty, )*) => {
+    ($( $(#[doc = $doc:literal])* $variant:ident = $name:literal => $kind:ty $([$stalls:ident])?, )*) => {
         /// A way to draw the translucent meshes.
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
         pub enum Technique {
@@ -52,12 +52,26 @@ macro_rules! techniques {
             $( $variant(<$kind as TechniqueKind>::Key), )*
         }
 
+        impl Key {
+            /// The technique this key builds.
+            fn technique(&self) -> Technique {
+                match self { $( Key::$variant(_) => Technique::$variant, )* }
+            }
+        }
+
         impl Technique {
             /// Number of techniques.
             pub const COUNT: usize = [$( stringify!($variant) ),*].len();
 
             /// Every technique, in the order menus and reports list them.
             pub const ALL: [Technique; Self::COUNT] = [$( Technique::$variant ),*];
+
+            /// Whether the technique waits for GPU results inside [`crate::Renderer::render`]
+            /// (the exact references: hundreds of milliseconds a frame), so that it has no
+            /// place in a game's frame loop.
+            pub const fn stalls(self) -> bool {
+                match self { $( Technique::$variant => stall_flag!($($stalls)?), )* }
+            }
 
             /// The command-line name.
             pub fn name(self) -> &'static str {
@@ -94,6 +108,16 @@ macro_rules! techniques {
     };
 }
 
+/// `true` for a technique marked `[stalls]` in the list below.
+macro_rules! stall_flag {
+    () => {
+        false
+    };
+    (stalls) => {
+        true
+    };
+}
+
 techniques! {
     /// Translucent meshes are not drawn at all.
     OpaqueOnly = "opaque-only" => opaque_only::OpaqueOnly,
@@ -111,10 +135,40 @@ techniques! {
     /// Dual depth peeling of [`PeelingSettings::layers`] layers (seed 004).
     DepthPeeling = "depth-peeling" => peeling::Peeling,
     /// The exact reference: per-pixel sorted fragment lists (A-buffer). Stalls the GPU.
-    Reference = "reference" => reference::Reference,
+    Reference = "reference" => reference::Reference [stalls],
     /// The second exact method: front-to-back depth peeling until a pass writes nothing.
     /// Stalls the GPU once per layer.
-    PeelReference = "peel-reference" => peeling::Peeling,
+    PeelReference = "peel-reference" => peeling::Peeling [stalls],
+}
+
+/// How many techniques never stall.
+const REAL_TIME_COUNT: usize = {
+    let mut n = 0;
+    let mut i = 0;
+    while i < Technique::COUNT {
+        if !Technique::ALL[i].stalls() {
+            n += 1;
+        }
+        i += 1;
+    }
+    n
+};
+
+impl Technique {
+    /// Every technique that never waits for the GPU inside a frame ([`Technique::stalls`]
+    /// is false), in [`Technique::ALL`]'s order: the ones a game offers its players.
+    pub const REAL_TIME: [Technique; REAL_TIME_COUNT] = {
+        let mut out = [Technique::OpaqueOnly; REAL_TIME_COUNT];
+        let (mut i, mut n) = (0, 0);
+        while i < Technique::COUNT {
+            if !Technique::ALL[i].stalls() {
+                out[n] = Technique::ALL[i];
+                n += 1;
+            }
+            i += 1;
+        }
+        out
+    };
 }
 
 impl Technique {
@@ -298,9 +352,6 @@ pub trait TranslucentTechnique: fmt::Debug {
         frame: &TranslucentFrame<'_>,
     ) -> Result<()>;
 
-    /// Called after the frame's commands were submitted (to start reading results back).
-    fn after_submit(&mut self) {}
-
     /// Technique-specific facts about the last frame.
     fn report(&self) -> TechniqueReport {
         TechniqueReport::default()
@@ -324,8 +375,16 @@ pub trait TranslucentTechnique: fmt::Debug {
 pub struct OitManager {
     setup: Setup,
     config: OitConfig,
-    /// Created on the first frame that has translucent meshes in view, with its key.
+    /// Created on the first frame that has translucent meshes in view (or taken from
+    /// `kept`), with its key.
     active: Option<(Key, Box<dyn TranslucentTechnique>)>,
+    /// Techniques built ahead of a switch ([`OitManager::prebuild`]), with their keys.
+    kept: Vec<(Key, Box<dyn TranslucentTechnique>)>,
+    /// The techniques asked for with [`OitManager::prebuild`]: kept built while another
+    /// one is active.
+    prebuilt: Vec<Technique>,
+    /// Techniques built so far.
+    builds: usize,
     prepare_ms: f64,
 }
 
@@ -339,6 +398,9 @@ impl OitManager {
             setup,
             config,
             active: None,
+            kept: Vec::new(),
+            prebuilt: Vec::new(),
+            builds: 0,
             prepare_ms: 0.0,
         };
         m.config.technique = m.supported(m.config.technique);
@@ -387,10 +449,60 @@ impl OitManager {
             .config
             .technique
             .key(&self.config, &self.setup.ctx.caps);
-        if self.active.as_ref().is_some_and(|(k, _)| *k != key) {
-            self.active = None;
+        if self.active.as_ref().is_some_and(|(k, _)| *k != key)
+            && let Some(old) = self.active.take()
+            && self.prebuilt.contains(&old.0.technique())
+        {
+            // A prebuilt technique waits for the next switch back to it.
+            self.kept.push(old);
+        }
+        // Prebuilt techniques whose settings changed are rebuilt now, not at the switch.
+        for (k, t) in &mut self.kept {
+            let technique = k.technique();
+            let new = technique.key(&self.config, &self.setup.ctx.caps);
+            if new != *k {
+                *t = technique.create(&self.setup, &self.config)?;
+                self.builds += 1;
+                *k = new;
+            }
         }
         Ok(())
+    }
+
+    /// Builds `technique`'s pipelines and targets now (with the current settings; after
+    /// its fallback on this adapter), so that switching to it later builds nothing and the
+    /// first frame after the switch costs what any frame costs. It stays built while other
+    /// techniques draw, is resized with the others and rebuilt when a setting it is built
+    /// from changes, until [`OitManager::release`]. Returns the technique built.
+    pub fn prebuild(&mut self, technique: Technique) -> Result<Technique> {
+        let technique = self.supported(technique);
+        if !self.prebuilt.contains(&technique) {
+            self.prebuilt.push(technique);
+        }
+        if !technique.draws() {
+            return Ok(technique);
+        }
+        let key = technique.key(&self.config, &self.setup.ctx.caps);
+        let built = self.active.iter().chain(&self.kept).any(|(k, _)| *k == key);
+        if !built {
+            let t = technique.create(&self.setup, &self.config)?;
+            self.builds += 1;
+            self.kept.push((key, t));
+        }
+        Ok(technique)
+    }
+
+    /// Forgets a [`OitManager::prebuild`]: its resources are freed unless it is active.
+    pub fn release(&mut self, technique: Technique) {
+        let technique = self.supported(technique);
+        self.prebuilt.retain(|t| *t != technique);
+        self.kept.retain(|(k, _)| k.technique() != technique);
+    }
+
+    /// How many times a technique's pipelines and targets were built: a switch to a
+    /// prebuilt technique adds nothing.
+    pub fn builds(&self) -> usize {
+        self.builds
     }
 
     /// Technique-specific facts about the last frame.
@@ -404,17 +516,10 @@ impl OitManager {
         r
     }
 
-    /// Call after the frame's commands were submitted.
-    pub fn after_submit(&mut self) {
-        if let Some((_, t)) = &mut self.active {
-            t.after_submit();
-        }
-    }
-
     /// Resizes the targets (the caller checks that the size is valid and new).
     pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
         self.setup.size = (width, height);
-        if let Some((_, t)) = &mut self.active {
+        for (_, t) in self.active.iter_mut().chain(&mut self.kept) {
             t.resize(&self.setup.ctx, width, height)?;
         }
         Ok(())
@@ -443,7 +548,13 @@ impl OitManager {
         }
         if self.active.is_none() {
             let key = technique.key(&self.config, &self.setup.ctx.caps);
-            let t = technique.create(&self.setup, &self.config)?;
+            let t = match self.kept.iter().position(|(k, _)| *k == key) {
+                Some(i) => self.kept.swap_remove(i).1,
+                None => {
+                    self.builds += 1;
+                    technique.create(&self.setup, &self.config)?
+                }
+            };
             self.active = Some((key, t));
         }
         Ok(self.active.as_mut().map(|(_, t)| t))

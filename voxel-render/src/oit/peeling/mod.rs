@@ -469,7 +469,6 @@ impl Peeling {
             // Wait for this pass's count: zero means every layer has been peeled.
             self.counts.copy(encoder, i..i + 1);
             gpu::flush(ctx, encoder);
-            self.counts.map();
             let written =
                 self.counts.wait(ctx)?.first().copied().ok_or_else(|| {
                     Error::ReadbackData("an occlusion count came back empty".into())
@@ -520,10 +519,6 @@ impl TranslucentTechnique for Peeling {
             PeelMode::Dual { .. } => self.render_dual(encoder, frame),
             PeelMode::Converge => self.render_converge(ctx, encoder, frame),
         }
-    }
-
-    fn after_submit(&mut self) {
-        self.counts.map();
     }
 
     fn report(&self) -> TechniqueReport {
