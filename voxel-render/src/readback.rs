@@ -134,6 +134,33 @@ pub fn read_texture(
     Ok(out)
 }
 
+/// Copies a whole single-sample 2D texture of 8-bit RGBA or BGRA (sRGB or not) to the CPU
+/// as an [`Image`] (BGRA swizzled to RGBA, bytes as stored). Blocks until the GPU is done.
+/// Another format is an error naming it. The texture needs `COPY_SRC` usage.
+pub fn read_image(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Image> {
+    use wgpu::TextureFormat as F;
+    let bgra = match texture.format() {
+        F::Rgba8Unorm | F::Rgba8UnormSrgb => false,
+        F::Bgra8Unorm | F::Bgra8UnormSrgb => true,
+        other => {
+            return Err(Error::Output(format!(
+                "format {other:?}: only 8-bit RGBA and BGRA textures are read as images"
+            )));
+        }
+    };
+    let mut rgba = read_texture(ctx, texture, 4)?;
+    if bgra {
+        for p in rgba.chunks_exact_mut(4) {
+            p.swap(0, 2);
+        }
+    }
+    Ok(Image {
+        width: texture.width(),
+        height: texture.height(),
+        rgba,
+    })
+}
+
 /// Maps a `MAP_READ` buffer, waits, and copies its contents out.
 pub fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();

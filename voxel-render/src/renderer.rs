@@ -35,11 +35,18 @@ pub struct RendererConfig {
     pub width: u32,
     /// Output height in pixels, like `width`.
     pub height: u32,
-    /// Format of the textures `render` draws into first. Default `Rgba8UnormSrgb`, what
-    /// offscreen readback and PNG files want. Any of [`OUTPUT_FORMATS`] works without
-    /// changing this: an output of another format gets its tonemap pipeline at its first
-    /// frame (once per format), and this field follows it.
+    /// Format of the textures `render` draws into first (its tonemap pipeline is built
+    /// with the renderer). Default `Rgba8UnormSrgb`, what offscreen readback and PNG files
+    /// want. Any of [`OUTPUT_FORMATS`] works without changing this: an output of another
+    /// format gets its tonemap pipeline at its first frame (once per format, about a
+    /// millisecond), and this field follows the format drawn last.
     pub output_format: wgpu::TextureFormat,
+    /// The format of the views `render` is given, where they differ from their texture's:
+    /// the sRGB or linear twin of the texture's format (a surface configured with
+    /// `view_formats`). Default `None`: every view has its texture's format, which is
+    /// what wgpu gives unless asked otherwise. A view format the texture cannot have is
+    /// ignored.
+    pub output_view_format: Option<wgpu::TextureFormat>,
     /// 4× MSAA for the opaque and cutout passes. Default off: the translucent pass is
     /// single-sampled anyway (seed 000) and lavapipe pays 4× for it.
     pub msaa: bool,
@@ -76,6 +83,7 @@ impl Default for RendererConfig {
             width: 1280,
             height: 720,
             output_format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            output_view_format: None,
             msaa: false,
             oit: OitConfig::default(),
             sun_dir: [0.35, 0.85, 0.4],
@@ -176,14 +184,16 @@ pub const OUTPUT_FORMATS: [wgpu::TextureFormat; 6] = [
     wgpu::TextureFormat::Rgba16Float,
 ];
 
-/// The format to draw an output texture of `format` with, when the renderer last drew
-/// `current`: `current` when the texture is of `current` or of its sRGB / linear twin
-/// (a view of the twin, as [`Renderer::render`] documents), else the texture's own.
-fn output_format(current: wgpu::TextureFormat, format: wgpu::TextureFormat) -> wgpu::TextureFormat {
-    if format.remove_srgb_suffix() == current.remove_srgb_suffix() {
-        current
-    } else {
-        format
+/// The format to draw an output texture of `format` with: `view` when it is given and is
+/// the texture's sRGB / linear twin ([`RendererConfig::output_view_format`]), else the
+/// texture's own.
+fn output_format(
+    view: Option<wgpu::TextureFormat>,
+    format: wgpu::TextureFormat,
+) -> wgpu::TextureFormat {
+    match view {
+        Some(v) if v.remove_srgb_suffix() == format.remove_srgb_suffix() => v,
+        _ => format,
     }
 }
 
@@ -225,10 +235,11 @@ impl Lighting {
         let h = hour.clamp(Self::SUNRISE, Self::SUNSET);
         // 0 at sunrise, pi at sunset.
         let a = (h - Self::SUNRISE) / (Self::SUNSET - Self::SUNRISE) * std::f32::consts::PI;
-        // A path tilted 35 degrees toward the south, a few degrees above the horizon at
-        // either end so that the sides facing the sun keep some light.
+        // A path leaning toward the south (z = 0.47 y: at 10:30 this is the default
+        // lighting's sun within a few degrees), a few degrees above the horizon at either
+        // end so that the sides facing the sun keep some light.
         let elevation = 0.08 + 0.92 * a.sin();
-        let sun = glam::Vec3::new(a.cos(), elevation, 0.7 * elevation).normalize_or(glam::Vec3::Y);
+        let sun = glam::Vec3::new(a.cos(), elevation, 0.47 * elevation).normalize_or(glam::Vec3::Y);
         let day = glam::Vec3::from([0.45, 0.65, 0.9]);
         let dusk = glam::Vec3::from([0.85, 0.45, 0.25]);
         let t = a.sin().clamp(0.0, 1.0).sqrt();
@@ -300,6 +311,13 @@ impl Renderer {
         check_size(ctx, config.width, config.height)?;
         config.oit.validate()?;
         check_ao_strength(config.ao_strength)?;
+        if !OUTPUT_FORMATS.contains(&config.output_format) {
+            return Err(Error::InvalidSetting(format!(
+                "output format {:?}: the renderer draws into {}",
+                config.output_format,
+                OUTPUT_FORMATS.map(|f| format!("{f:?}")).join(", ")
+            )));
+        }
         if config.msaa && !ctx.caps.msaa4 {
             log::warn!("4x MSAA is not supported for the scene formats: rendering without MSAA");
             config.msaa = false;
@@ -338,7 +356,8 @@ impl Renderer {
             ),
         };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
-        let post = Post::new(device);
+        let mut post = Post::new(device);
+        post.make_tonemap(ctx, config.output_format);
         let medium = MediumPass::new(device, &layouts);
         let size = (config.width, config.height);
         let targets = SceneTargets::new(ctx, &post, &layouts, &scene, &medium, size, config.msaa);
@@ -658,8 +677,8 @@ impl Renderer {
 
     /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of a
     /// whole 2D texture of the renderer's size, of one of [`OUTPUT_FORMATS`], with
-    /// `RENDER_ATTACHMENT` usage. A view of the texture's sRGB / linear twin format is
-    /// drawn as [`RendererConfig::output_format`] when that is the twin.
+    /// `RENDER_ATTACHMENT` usage. The view has its texture's format, or
+    /// [`RendererConfig::output_view_format`] when that is the texture's twin.
     ///
     /// Nothing needs calling after the frame's commands are submitted: GPU timings and
     /// a technique's counters (depth peeling's layers) are read back once they are.
@@ -684,7 +703,7 @@ impl Renderer {
         // it is not.
         let ctx = &self.ctx;
         let timed = self.timer.as_mut().is_some_and(|t| t.begin_frame(ctx));
-        let format = output_format(self.config.output_format, output.texture().format());
+        let format = output_format(self.config.output_view_format, output.texture().format());
         if format != self.config.output_format {
             log::info!(
                 "drawing into {format:?} from now on (was {:?})",
@@ -1159,5 +1178,45 @@ impl SceneTargets {
             tonemap_group,
             depth_resolve_group,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use wgpu::TextureFormat as F;
+
+    #[test]
+    fn a_view_has_its_texture_format_unless_a_twin_is_declared() {
+        assert_eq!(output_format(None, F::Bgra8Unorm), F::Bgra8Unorm);
+        assert_eq!(output_format(None, F::Rgba8UnormSrgb), F::Rgba8UnormSrgb);
+        let srgb = Some(F::Bgra8UnormSrgb);
+        assert_eq!(output_format(srgb, F::Bgra8Unorm), F::Bgra8UnormSrgb);
+        assert_eq!(
+            output_format(srgb, F::Rgba8Unorm),
+            F::Rgba8Unorm,
+            "not its twin"
+        );
+    }
+
+    #[test]
+    fn daytime_lighting_is_valid_and_follows_the_sun() {
+        let noon = Lighting::daytime(12.0);
+        let dusk = Lighting::daytime(Lighting::SUNSET);
+        for hour in [f32::NAN, -5.0, 6.0, 9.0, 12.0, 15.0, 18.0, 30.0] {
+            Lighting::daytime(hour).validate().unwrap();
+        }
+        assert!(noon.sun_dir[1] > 0.9 && dusk.sun_dir[1] < 0.2 && dusk.sun_dir[1] > 0.0);
+        assert!(
+            Lighting::daytime(8.0).sun_dir[0] > 0.0,
+            "morning sun in the east"
+        );
+        assert!(
+            Lighting::daytime(16.0).sun_dir[0] < 0.0,
+            "afternoon sun in the west"
+        );
+        assert!(noon.ambient > dusk.ambient);
+        assert!(dusk.sky[0] > dusk.sky[2] && noon.sky[2] > noon.sky[0]);
+        Lighting::default_day().validate().unwrap();
     }
 }

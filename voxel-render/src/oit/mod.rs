@@ -66,7 +66,7 @@ macro_rules! techniques {
             /// Every technique, in the order menus and reports list them.
             pub const ALL: [Technique; Self::COUNT] = [$( Technique::$variant ),*];
 
-            /// Whether the technique waits for GPU results inside [`crate::Renderer::render`]
+            /// Whether the technique waits for GPU results inside `Renderer::render`
             /// (the exact references: hundreds of milliseconds a frame), so that it has no
             /// place in a game's frame loop.
             pub const fn stalls(self) -> bool {
