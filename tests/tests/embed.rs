@@ -20,7 +20,13 @@ use voxel_render::{Camera, Image, Lighting, RendererConfig, Technique, readback}
 /// An `n` × `n` checker of `a` (where x + y is even) and `b`.
 fn checker(a: [u8; 4], b: [u8; 4], n: u32) -> BlockImage {
     let rgba = (0..n * n)
-        .flat_map(|i| if (i % n + i / n).is_multiple_of(2) { a } else { b })
+        .flat_map(|i| {
+            if (i % n + i / n).is_multiple_of(2) {
+                a
+            } else {
+                b
+            }
+        })
         .collect();
     BlockImage::new(n, n, rgba).unwrap()
 }

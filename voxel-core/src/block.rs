@@ -220,6 +220,16 @@ impl FaceImages {
     }
 }
 
+impl RenderClass {
+    /// Every class that draws something: what stops a ray that picks visible blocks
+    /// (`World::raycast`).
+    pub const VISIBLE: [RenderClass; 3] = [
+        RenderClass::Opaque,
+        RenderClass::Cutout,
+        RenderClass::Translucent,
+    ];
+}
+
 /// One block type.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BlockDef {

@@ -81,6 +81,11 @@ impl WorldPos {
         Self { x, y, z }
     }
 
+    /// The block's lowest corner, in world units (the block fills it to `corner + 1`).
+    pub fn corner(self) -> [f64; 3] {
+        [self.x, self.y, self.z].map(f64::from)
+    }
+
     /// The chunk holding this block and the block's local coordinates in it.
     /// Defined for every `i32` position (floor division, so -1 is in chunk -1 at local 31).
     pub fn split(self) -> (ChunkPos, [usize; 3]) {
@@ -617,11 +622,7 @@ mod tests {
     use super::*;
     use crate::blocks::*;
 
-    const SOLID: [RenderClass; 3] = [
-        RenderClass::Opaque,
-        RenderClass::Cutout,
-        RenderClass::Translucent,
-    ];
+    const SOLID: [RenderClass; 3] = RenderClass::VISIBLE;
 
     /// A 5 x 5 wall of stone at z = -5 with a glass block in front of its centre at z = -3.
     fn wall() -> World {

@@ -675,6 +675,13 @@ impl Renderer {
         &self.targets.depth.texture
     }
 
+    /// A view of [`Renderer::scene_depth`], for a game's pass that draws over the frame
+    /// tested against it (attached read-only, [`gpu::Depth::ReadOnly`], with
+    /// [`gpu::overlay_depth`]). Valid until the next resize.
+    pub fn scene_depth_view(&self) -> &wgpu::TextureView {
+        &self.targets.depth.view
+    }
+
     /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of a
     /// whole 2D texture of the renderer's size, of one of [`OUTPUT_FORMATS`], with
     /// `RENDER_ATTACHMENT` usage. The view has its texture's format, or

@@ -598,12 +598,8 @@ impl Gfx {
             .map(|c| c.forward)
             .unwrap_or(DVec3::NEG_Z);
         let world = self.streaming.streamer.world();
-        let solid = [
-            RenderClass::Opaque,
-            RenderClass::Cutout,
-            RenderClass::Translucent,
-        ];
-        let hit = match world.raycast(f.eye.to_array(), dir.to_array(), 64.0, &solid) {
+        let visible = RenderClass::VISIBLE;
+        let hit = match world.raycast(f.eye.to_array(), dir.to_array(), 64.0, &visible) {
             Ok(Some(hit)) => hit,
             Ok(None) => {
                 self.status.message = "nothing to edit within 64 blocks".into();
