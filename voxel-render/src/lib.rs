@@ -52,6 +52,6 @@ pub use timing::{GpuPass, GpuTimes, Timer};
 
 /// Depth format of every pass: 32-bit float, reverse-Z (1 near, 0 far).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// The HDR scene colour format (seed 003): opaque image, composites, before tonemapping.
+/// The HDR scene colour format: opaque image, composites, before tonemapping.
 pub const SCENE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub use bindings::{AO_DEPTH, OPAQUE_EXPANSION_PX, TONEMAP_SHOULDER};

@@ -1,5 +1,5 @@
-//! The renderer a game embeds: chunks on the GPU and the passes of a frame in seed 000's
-//! order: opaque (optional 4× MSAA, resolved), cutout, translucent (the selected technique,
+//! The renderer a game embeds: chunks on the GPU and the passes of a frame in the usual
+//! forward order: opaque (optional 4× MSAA, resolved), cutout, translucent (the selected technique,
 //! depth-tested read-only against the opaque depth), composite over the opaque colour,
 //! tonemap to the output format.
 
@@ -48,7 +48,7 @@ pub struct RendererConfig {
     /// ignored.
     pub output_view_format: Option<wgpu::TextureFormat>,
     /// 4× MSAA for the opaque and cutout passes. Default off: the translucent pass is
-    /// single-sampled anyway (seed 000) and lavapipe pays 4× for it.
+    /// single-sampled anyway and lavapipe pays 4× for it.
     pub msaa: bool,
     /// Transparency settings (technique and each technique's own settings).
     pub oit: OitConfig,

@@ -1,5 +1,4 @@
-//! Order-independent transparency behind one API: [`OitManager`] (seed 002's OITManager in
-//! Rust form) prepares and records the translucent passes and their composite for the
+//! Order-independent transparency behind one API: [`OitManager`] prepares and records the translucent passes and their composite for the
 //! selected [`Technique`].
 //!
 //! One folder per technique. Its type implements [`TranslucentTechnique`] (the hooks of a
@@ -123,16 +122,17 @@ techniques! {
     OpaqueOnly = "opaque-only" => opaque_only::OpaqueOnly,
     /// Weighted blended OIT, one pass into two targets (MRT) with independent blend states.
     WboitMrt = "wboit-mrt" => wboit::Wboit,
-    /// Weighted blended OIT, two passes (seed 002): one per target. For adapters without
+    /// Weighted blended OIT, two passes: one per target. For adapters without
     /// independent blend.
     WboitTwoPass = "wboit-two-pass" => wboit::Wboit,
-    /// Screen-door transparency with a Bayer pattern (seed 001): the low-end mode.
+    /// Screen-door transparency with a Bayer pattern (Mulder, Groen & van Wijk 1998): the
+    /// low-end mode.
     Stipple = "stipple" => stipple::Stipple,
-    /// Alpha blending of chunks sorted back to front (seed 003): the baseline.
+    /// Alpha blending of chunks sorted back to front (the painter's order): the baseline.
     Sorted = "sorted" => sorted::Sorted,
     /// Like `Sorted`, with the quads inside each chunk sorted back to front too.
     SortedQuads = "sorted-quads" => sorted::Sorted,
-    /// Dual depth peeling of [`PeelingSettings::layers`] layers (seed 004).
+    /// Dual depth peeling of [`PeelingSettings::layers`] layers (Bavoil & Myers 2008).
     DepthPeeling = "depth-peeling" => peeling::Peeling,
     /// The exact reference: per-pixel sorted fragment lists (A-buffer). Stalls the GPU.
     Reference = "reference" => reference::Reference [stalls],
@@ -368,8 +368,8 @@ pub trait TranslucentTechnique: fmt::Debug {
     }
 }
 
-/// Owns the active technique and records its passes (seed 002's OITManager API: created
-/// with the device and a config; `resize`; the accumulation and revealage targets;
+/// Owns the active technique and records its passes (the life cycle of an engine's OIT
+/// manager: created with the device and a config; `resize`; the accumulation and revealage targets;
 /// `render` records the translucent pass and composite; resources freed on drop).
 #[derive(Debug)]
 pub struct OitManager {
