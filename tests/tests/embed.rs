@@ -540,3 +540,49 @@ fn the_ray_march_samples_textures_as_the_gpu_does() {
         "a textured picture"
     );
 }
+
+#[test]
+fn a_game_registry_generates_the_default_terrain_through_a_mapping() {
+    use voxel_core::{ChunkPos, TerrainBlocks, TerrainConfig, TerrainGenerator, TerrainRole};
+    // The game's own blocks, in its own order, none named like a role.
+    let mut game = BlockRegistry::new();
+    game.register(BlockDef::new("amber_glass", [200, 140, 40], 0.5))
+        .unwrap();
+    let defaults = BlockRegistry::default();
+    let map: Vec<(TerrainRole, BlockId)> = TerrainRole::ALL
+        .into_iter()
+        .map(|role| {
+            let def = defaults.get(role.default_block()).unwrap().clone();
+            let name = format!("my_{}", role.name());
+            (role, game.register(BlockDef { name, ..def }).unwrap())
+        })
+        .collect();
+    let config = TerrainConfig::default();
+    let err = TerrainBlocks::from_registry(&game, &config, &map[..3]).unwrap_err();
+    assert!(err.to_string().contains("sand"), "{err}");
+    let blocks = TerrainBlocks::from_registry(&game, &config, &map).unwrap();
+    let (min, max) = (ChunkPos::new(-1, 0, -1), ChunkPos::new(0, 1, 0));
+    let game = Arc::new(game);
+    // A generator of the default blocks refuses the game's registry.
+    let default_generator = TerrainGenerator::new(config.clone());
+    assert!(
+        default_generator
+            .generate_world(game.clone(), min, max)
+            .is_err()
+    );
+    let mapped = TerrainGenerator::with_blocks(config, blocks);
+    let ours = mapped.generate_world(game, min, max).unwrap();
+    let theirs = default_generator
+        .generate_world(Arc::new(defaults), min, max)
+        .unwrap();
+    let role_of = |id: BlockId| map.iter().find(|(_, b)| *b == id).map(|(r, _)| *r);
+    for (pos, chunk) in theirs.iter() {
+        let mine = ours.chunk(pos).unwrap().to_dense();
+        for (a, b) in chunk.to_dense().into_iter().zip(mine) {
+            let want = TerrainRole::ALL
+                .into_iter()
+                .find(|r| r.default_block() == a);
+            assert_eq!(role_of(b), want, "chunk {pos:?}");
+        }
+    }
+}
