@@ -7,59 +7,10 @@
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
 
+use tests::{Xvfb, skip_or_fail};
 use voxel_render::{GpuContext, Image, Technique};
-
-fn skip_or_fail(why: &str) {
-    if std::env::var_os("CI").is_some() {
-        panic!("CI is set but {why}");
-    }
-    eprintln!("\n!!!! SKIPPING WINDOW TEST: {why} !!!!\n");
-}
-
-/// An Xvfb server on a display it picks itself (-displayfd), killed on drop.
-struct Xvfb {
-    child: Child,
-    display: String,
-}
-
-impl Xvfb {
-    fn start() -> Option<Self> {
-        let mut child = Command::new("Xvfb")
-            .args([
-                "-displayfd",
-                "1",
-                "-screen",
-                "0",
-                "1280x800x24",
-                "-nolisten",
-                "tcp",
-            ])
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .ok()?;
-        let mut line = String::new();
-        BufReader::new(child.stdout.take()?)
-            .read_line(&mut line)
-            .ok()?;
-        let n: u32 = line.trim().parse().ok()?;
-        Some(Self {
-            child,
-            display: format!(":{n}"),
-        })
-    }
-}
-
-impl Drop for Xvfb {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
 
 fn out_dir() -> PathBuf {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/test-output/window");
@@ -68,14 +19,10 @@ fn out_dir() -> PathBuf {
     dir
 }
 
-fn demo(display: &str, args: &[&str]) {
-    let runtime = std::env::temp_dir().join(format!("voxel-oit-xdg-{}", std::process::id()));
-    std::fs::create_dir_all(&runtime).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_demo"))
+fn demo(x: &Xvfb, args: &[&str]) {
+    let out = x
+        .command(env!("CARGO_BIN_EXE_demo"))
         .args(args)
-        .env("DISPLAY", display)
-        .env_remove("WAYLAND_DISPLAY")
-        .env("XDG_RUNTIME_DIR", &runtime)
         .output()
         .unwrap();
     assert!(
@@ -145,7 +92,7 @@ fn the_window_runs_every_technique_under_xvfb() {
     };
     let dir = out_dir();
     demo(
-        &x.display,
+        &x,
         &[
             "--size",
             "640x360",
@@ -202,7 +149,7 @@ fn the_window_runs_every_technique_under_xvfb() {
     // block placed on frame 1 is remeshed in the background and shows in the last frame.
     let resized = dir.join("resized.png");
     demo(
-        &x.display,
+        &x,
         &[
             "--size",
             "640x360",
@@ -256,7 +203,7 @@ fn the_window_opens_a_vox_model() {
     let shot = dir.join("harbour.png");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/vox/harbour.toml");
     demo(
-        &x.display,
+        &x,
         &[
             "--size",
             "640x360",

@@ -5,7 +5,9 @@
 
 pub mod vox_models;
 
+use std::io::{BufRead, BufReader};
 use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
 use std::sync::Arc;
 
 use glam::DVec3;
@@ -231,4 +233,68 @@ pub fn dense_sheets(n: i32, opacity: f32) -> Scene {
         voxel_lab::scene::fill_box(&mut world, [-40, -40, z], [40, 40, z], dense).unwrap();
     }
     scene("dense_sheets", world, [0.5, 0.5, 8.0], [0.5, 0.5, -10.0])
+}
+
+/// Skips a test that needs a display or an adapter with a loud message, unless `CI` is set:
+/// then it fails.
+pub fn skip_or_fail(why: &str) {
+    if std::env::var_os("CI").is_some() {
+        panic!("CI is set but {why}");
+    }
+    eprintln!("\n!!!! SKIPPING WINDOW TEST: {why} !!!!\n");
+}
+
+/// An Xvfb server on a display it picks itself (-displayfd), killed on drop.
+#[derive(Debug)]
+pub struct Xvfb {
+    child: Child,
+    /// The display, `:N`.
+    pub display: String,
+}
+
+impl Xvfb {
+    /// Starts a 1280x800 server, or `None` when Xvfb cannot run.
+    pub fn start() -> Option<Self> {
+        let mut child = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1280x800x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .ok()?;
+        let mut line = String::new();
+        BufReader::new(child.stdout.take()?)
+            .read_line(&mut line)
+            .ok()?;
+        let n: u32 = line.trim().parse().ok()?;
+        Some(Self {
+            child,
+            display: format!(":{n}"),
+        })
+    }
+
+    /// A command for `program` on this display (no Wayland, a private runtime folder).
+    pub fn command(&self, program: impl AsRef<std::ffi::OsStr>) -> Command {
+        let runtime = std::env::temp_dir().join(format!("voxel-oit-xdg-{}", std::process::id()));
+        std::fs::create_dir_all(&runtime).unwrap();
+        let mut c = Command::new(program);
+        c.env("DISPLAY", &self.display)
+            .env_remove("WAYLAND_DISPLAY")
+            .env("XDG_RUNTIME_DIR", &runtime);
+        c
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
 }

@@ -86,16 +86,17 @@ fn an_output_of_another_size_or_format_is_an_error() {
         e.to_string().contains("32x48") && e.to_string().contains("64x48"),
         "{e}"
     );
+    // Every format a surface offers is drawn (tests/tests/embed.rs); others are errors.
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
     let other = voxel_render::gpu::target(
         &ctx.device,
-        "bgra",
-        wgpu::TextureFormat::Rgba16Float,
+        "rgba32",
+        wgpu::TextureFormat::Rgba32Float,
         usage,
         (64, 48),
     );
     let e = r.render_and_submit(&other.view, &cam).unwrap_err();
-    assert!(e.to_string().contains("Rgba16Float"), "{e}");
+    assert!(e.to_string().contains("Rgba32Float"), "{e}");
     // The right one still works afterwards.
     frame(&ctx, &mut r, &cam);
 }
@@ -386,13 +387,19 @@ fn output_views_other_than_a_whole_level_0_2d_view_are_errors() {
     };
     assert_close("output_single_layer_array_view", &image, &plain, 0);
 
-    // The allowed twin: a linear texture viewed as the sRGB format the renderer writes.
+    // The allowed twin: a linear texture viewed as the sRGB format, declared in
+    // `output_view_format` (wgpu hides a view's format); undeclared, it is an error.
     let unorm = texture(&ctx, (w, h), 1, 1, F::Rgba8Unorm, &[F::Rgba8UnormSrgb]);
     let srgb = unorm.create_view(&wgpu::TextureViewDescriptor {
         format: Some(F::Rgba8UnormSrgb),
         ..Default::default()
     });
-    r.render_and_submit(&srgb, &cam).unwrap();
+    let msg = expect_output_error(&mut r, &srgb, "an undeclared twin view");
+    assert!(msg.contains("Rgba8Unorm"), "{msg}");
+    let mut config = technique_config(Technique::WboitMrt, w, h);
+    config.output_view_format = Some(F::Rgba8UnormSrgb);
+    let mut declared = renderer_for(&ctx, &scene, config).unwrap();
+    declared.render_and_submit(&srgb, &cam).unwrap();
     let bytes = voxel_render::readback::read_texture(&ctx, &unorm, 4).unwrap();
     let twin_image = voxel_render::Image {
         width: w,

@@ -86,8 +86,7 @@ fn small_eval_of_the_suite() {
     }
 
     // The fitted weight has the lowest suite-mean FLIP of every weight, at most half of
-    // seed 002's weight, alpha-cubed (the goal; 0.42 of it when this test was
-    // written).
+    // the alpha-cubed weight's (the goal; 0.42 of it when this test was written).
     let mean_flip = |w: WeightFunction| {
         let runs: Vec<f64> = summary
             .records
@@ -104,10 +103,10 @@ fn small_eval_of_the_suite() {
             assert!(fitted < mean_flip(w), "fitted {fitted} vs {}", w.name());
         }
     }
-    let seed002 = mean_flip(WeightFunction::AlphaCubed);
+    let alpha_cubed = mean_flip(WeightFunction::AlphaCubed);
     assert!(
-        fitted <= 0.5 * seed002,
-        "fitted {fitted}, seed 002 {seed002}"
+        fitted <= 0.5 * alpha_cubed,
+        "fitted {fitted}, alpha-cubed {alpha_cubed}"
     );
 
     // summary.json: an array of records with the documented keys.

@@ -112,7 +112,7 @@ fn without_translucent_blocks_every_technique_is_identical() {
     }
 }
 
-/// 40 sheets of ice (α 0.92) one block apart in front of the camera: with the seed 000
+/// 40 sheets of ice (α 0.92) one block apart in front of the camera: with the `flat`
 /// weight (about 3000·α) the accumulated α·w reaches 40 × 2760 = 110 000, past fp16's 65504.
 fn overflow_scene() -> Scene {
     let mut boxes = vec![([-30, -30, -90], [30, 30, -88], STONE)];

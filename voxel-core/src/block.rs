@@ -1,9 +1,11 @@
-//! Block ids, render classes and the block registry (seed 000's per-index palette opacity).
+//! Block ids, render classes, how each block looks (a procedural pattern, or images the
+//! game supplies per face group), and the block registry.
 
 use std::collections::HashMap;
 use std::fmt;
+use std::sync::Arc;
 
-use crate::{Error, Result};
+use crate::{Error, Face, Result};
 
 /// Index of a block in a [`BlockRegistry`]. Id 0 is always air.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -39,6 +41,195 @@ pub enum RenderClass {
     Translucent,
 }
 
+/// How a block's texture is drawn where the game gives it no image: procedurally, from
+/// the block's colour and opacity. Chosen by [`BlockDef::pattern`], never by name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Pattern {
+    /// The base colour with a little brightness noise, alpha the block's opacity. What
+    /// [`BlockDef::new`] gives opaque and translucent blocks.
+    Noise,
+    /// Leaves: noise with about a third of the texels fully transparent, for the cutout
+    /// pass to cut. What [`BlockDef::cutout`] gives.
+    Leaves,
+    /// Glass: a one-texel frame, darker and opaque, around a centre of the block's
+    /// opacity.
+    Framed,
+    /// Grass on soil: the top is the base colour with noise; the sides are soil of colour
+    /// `soil` (sRGB) under a fringe of the base colour along their top edge, so that a
+    /// one-block step reads as a step; the bottom is soil.
+    Grass {
+        /// The soil's colour, sRGB.
+        soil: [u8; 3],
+    },
+}
+
+/// The groups of faces a block is textured by: its top (+y), its bottom (−y), and its four
+/// sides.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FaceGroup {
+    /// The +y face.
+    Top = 0,
+    /// The −y face.
+    Bottom = 1,
+    /// The ±x and ±z faces.
+    Side = 2,
+}
+
+impl FaceGroup {
+    /// Every group, indexed by its discriminant.
+    pub const ALL: [FaceGroup; 3] = [FaceGroup::Top, FaceGroup::Bottom, FaceGroup::Side];
+
+    /// The group a face belongs to.
+    pub fn of(face: Face) -> FaceGroup {
+        match face {
+            Face::PosY => FaceGroup::Top,
+            Face::NegY => FaceGroup::Bottom,
+            _ => FaceGroup::Side,
+        }
+    }
+
+    /// The name scene files and messages use: `top`, `bottom` or `side`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FaceGroup::Top => "top",
+            FaceGroup::Bottom => "bottom",
+            FaceGroup::Side => "side",
+        }
+    }
+}
+
+/// The largest side of a [`BlockImage`], in texels. Every block texture is scaled to the
+/// largest image given (nearest texel, so a smaller image keeps its look), and 256 × 256
+/// RGBA with its mipmaps is 341 KiB a layer: 256 layers of it, 85 MiB of GPU memory.
+pub const MAX_IMAGE_SIZE: u32 = 256;
+
+/// A square image for a block's faces: `size` × `size` texels of 8-bit RGBA, rows top to
+/// bottom, colour sRGB-encoded (as PNG files store it), alpha straight (not
+/// premultiplied). The side is a power of two from 1 to [`MAX_IMAGE_SIZE`].
+///
+/// How a face shows it: on a side face the image stands upright (its first row along the
+/// block's top edge) with its x axis running left to right as seen from outside; on the
+/// top and bottom faces its x axis runs along world +x and its y axis along world +z.
+/// Alpha: a cutout block is cut where alpha is below one half; on a translucent block it
+/// is the opacity of each texel; an opaque block ignores it.
+#[derive(Clone, PartialEq, Eq)]
+pub struct BlockImage {
+    size: u32,
+    rgba: Arc<[u8]>,
+}
+
+impl fmt::Debug for BlockImage {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "BlockImage({0}x{0})", self.size)
+    }
+}
+
+impl BlockImage {
+    /// An image of `width` × `height` texels from `rgba` (4 bytes a texel, rows top to
+    /// bottom). Fails when it is not square, its side is not a power of two from 1 to
+    /// [`MAX_IMAGE_SIZE`], or `rgba` does not hold exactly its texels.
+    pub fn new(width: u32, height: u32, rgba: Vec<u8>) -> Result<Self> {
+        let bad = |reason: String| Err(Error::InvalidImage(reason));
+        if width != height {
+            return bad(format!(
+                "{width}x{height} texels: a block image must be square"
+            ));
+        }
+        if !width.is_power_of_two() || width > MAX_IMAGE_SIZE {
+            return bad(format!(
+                "{width}x{height} texels: the side must be a power of two from 1 to {MAX_IMAGE_SIZE}"
+            ));
+        }
+        let want = (width as usize) * (height as usize) * 4;
+        if rgba.len() != want {
+            return bad(format!(
+                "{width}x{height} texels need {want} bytes of RGBA, not {}",
+                rgba.len()
+            ));
+        }
+        Ok(Self {
+            size: width,
+            rgba: rgba.into(),
+        })
+    }
+
+    /// One colour: a 1 × 1 image.
+    pub fn solid(rgba: [u8; 4]) -> Self {
+        Self {
+            size: 1,
+            rgba: Arc::new(rgba),
+        }
+    }
+
+    /// Texels along each side.
+    pub fn size(&self) -> u32 {
+        self.size
+    }
+
+    /// The texels, 4 bytes each, rows top to bottom.
+    pub fn rgba(&self) -> &[u8] {
+        &self.rgba
+    }
+
+    /// The texel at column `x`, row `y` (taken modulo the size: the image repeats).
+    pub fn texel(&self, x: u32, y: u32) -> [u8; 4] {
+        let i = (((y % self.size) * self.size + x % self.size) * 4) as usize;
+        [
+            self.rgba[i],
+            self.rgba[i + 1],
+            self.rgba[i + 2],
+            self.rgba[i + 3],
+        ]
+    }
+}
+
+/// The images a game gives a block's faces, by [`FaceGroup`]; a group without one is drawn
+/// with the block's [`Pattern`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FaceImages {
+    /// The +y face.
+    pub top: Option<BlockImage>,
+    /// The −y face.
+    pub bottom: Option<BlockImage>,
+    /// The four side faces.
+    pub side: Option<BlockImage>,
+}
+
+impl FaceImages {
+    /// The same image on every face.
+    pub fn all(image: BlockImage) -> Self {
+        Self {
+            top: Some(image.clone()),
+            bottom: Some(image.clone()),
+            side: Some(image),
+        }
+    }
+
+    /// The image of `group`, if it has one.
+    pub fn get(&self, group: FaceGroup) -> Option<&BlockImage> {
+        match group {
+            FaceGroup::Top => self.top.as_ref(),
+            FaceGroup::Bottom => self.bottom.as_ref(),
+            FaceGroup::Side => self.side.as_ref(),
+        }
+    }
+
+    /// Whether no group has an image.
+    pub fn is_empty(&self) -> bool {
+        FaceGroup::ALL.iter().all(|&g| self.get(g).is_none())
+    }
+}
+
+impl RenderClass {
+    /// Every class that draws something: what stops a ray that picks visible blocks
+    /// (`World::raycast`).
+    pub const VISIBLE: [RenderClass; 3] = [
+        RenderClass::Opaque,
+        RenderClass::Cutout,
+        RenderClass::Translucent,
+    ];
+}
+
 /// One block type.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BlockDef {
@@ -46,14 +237,22 @@ pub struct BlockDef {
     pub name: String,
     /// Which pass draws it.
     pub class: RenderClass,
-    /// Base colour, sRGB.
+    /// Base colour, sRGB: the procedural pattern's colour, the colour of flat textures and
+    /// of the fog inside a translucent volume.
     pub color: [u8; 3],
-    /// Opacity in `(0, 1]`; below 1 means the block is [`RenderClass::Translucent`].
+    /// Opacity in `(0, 1]`; below 1 means the block is [`RenderClass::Translucent`]. With
+    /// images, each texel's alpha is the opacity drawn; this stays the block's opacity as a
+    /// whole (flat textures, the fog inside it, the WBOIT weight's estimate).
     pub opacity: f32,
+    /// The procedural texture of the face groups without an image.
+    pub pattern: Pattern,
+    /// Images the game supplies, per face group.
+    pub images: FaceImages,
 }
 
 impl BlockDef {
-    /// A block whose class follows from its opacity: translucent below 1, opaque at 1.
+    /// A block whose class follows from its opacity: translucent below 1, opaque at 1;
+    /// pattern [`Pattern::Noise`], no images.
     pub fn new(name: impl Into<String>, color: [u8; 3], opacity: f32) -> Self {
         let class = if opacity < 1.0 {
             RenderClass::Translucent
@@ -65,17 +264,32 @@ impl BlockDef {
             class,
             color,
             opacity,
+            pattern: Pattern::Noise,
+            images: FaceImages::default(),
         }
     }
 
-    /// An alpha-tested block such as leaves (opacity 1 where the texture is solid).
+    /// An alpha-tested block such as leaves (opacity 1 where the texture is solid);
+    /// pattern [`Pattern::Leaves`], no images.
     pub fn cutout(name: impl Into<String>, color: [u8; 3]) -> Self {
         Self {
             name: name.into(),
             class: RenderClass::Cutout,
             color,
             opacity: 1.0,
+            pattern: Pattern::Leaves,
+            images: FaceImages::default(),
         }
+    }
+
+    /// The same block drawn with `pattern` where it has no image.
+    pub fn with_pattern(self, pattern: Pattern) -> Self {
+        Self { pattern, ..self }
+    }
+
+    /// The same block with `images` on its faces.
+    pub fn with_images(self, images: FaceImages) -> Self {
+        Self { images, ..self }
     }
 
     fn validate(&self) -> Result<()> {
@@ -150,6 +364,8 @@ impl BlockRegistry {
             class: RenderClass::Air,
             color: [0, 0, 0],
             opacity: 0.0,
+            pattern: Pattern::Noise,
+            images: FaceImages::default(),
         };
         Self {
             by_name: HashMap::from([(air.name.clone(), BlockId::AIR)]),
@@ -223,24 +439,27 @@ impl BlockRegistry {
 }
 
 impl Default for BlockRegistry {
-    /// The built-in blocks, with the ids of [`blocks`]: soil and rock, leaves (cutout), water,
-    /// clear glass, ice, and three stained glasses of different colour and opacity so that a
-    /// scene can stack translucent layers that differ in both.
+    /// The built-in blocks, with the ids of [`blocks`]: soil and rock, grass with soil
+    /// sides, leaves (cutout), water, clear glass, ice, and three stained glasses of
+    /// different colour and opacity so that a scene can stack translucent layers that
+    /// differ in both. The glasses are framed ([`Pattern::Framed`]); water and ice are not.
     fn default() -> Self {
         let mut r = Self::new();
+        let dirt = [121, 85, 58];
+        let framed = |def: BlockDef| def.with_pattern(Pattern::Framed);
         let defs = [
             BlockDef::new("stone", [125, 125, 128], 1.0),
-            BlockDef::new("dirt", [121, 85, 58], 1.0),
-            BlockDef::new("grass", [96, 160, 64], 1.0),
+            BlockDef::new("dirt", dirt, 1.0),
+            BlockDef::new("grass", [96, 160, 64], 1.0).with_pattern(Pattern::Grass { soil: dirt }),
             BlockDef::new("sand", [219, 205, 150], 1.0),
             BlockDef::new("wood", [110, 80, 45], 1.0),
             BlockDef::cutout("leaves", [60, 130, 45]),
             BlockDef::new("water", [25, 105, 165], 0.7),
-            BlockDef::new("glass", [225, 240, 245], 0.2),
+            framed(BlockDef::new("glass", [225, 240, 245], 0.2)),
             BlockDef::new("ice", [170, 210, 245], 0.92),
-            BlockDef::new("red_glass", [210, 40, 40], 0.5),
-            BlockDef::new("green_glass", [50, 190, 70], 0.35),
-            BlockDef::new("blue_glass", [40, 70, 220], 0.7),
+            framed(BlockDef::new("red_glass", [210, 40, 40], 0.5)),
+            framed(BlockDef::new("green_glass", [50, 190, 70], 0.35)),
+            framed(BlockDef::new("blue_glass", [40, 70, 220], 0.7)),
         ];
         for def in defs {
             // The built-in table is valid by construction; the test below checks it.
@@ -337,6 +556,50 @@ mod tests {
             .register(BlockDef::new("lava", [255, 80, 0], 1.0))
             .unwrap();
         assert_eq!(id, BlockId(13));
+    }
+
+    #[test]
+    fn patterns_are_fields_not_names() {
+        let r = BlockRegistry::default();
+        let pattern = |id| r.get(id).unwrap().pattern;
+        assert_eq!(pattern(blocks::GLASS), Pattern::Framed);
+        assert_eq!(pattern(blocks::BLUE_GLASS), Pattern::Framed);
+        assert_eq!(pattern(blocks::WATER), Pattern::Noise);
+        assert_eq!(pattern(blocks::LEAVES), Pattern::Leaves);
+        assert_eq!(
+            pattern(blocks::GRASS),
+            Pattern::Grass {
+                soil: r.get(blocks::DIRT).unwrap().color
+            }
+        );
+        // A name says nothing about the look.
+        assert_eq!(
+            BlockDef::new("amber_glass", [200, 140, 40], 0.5).pattern,
+            Pattern::Noise
+        );
+    }
+
+    #[test]
+    fn images_must_be_square_powers_of_two_within_the_limit() {
+        let img = |w: u32, h: u32| BlockImage::new(w, h, vec![0; (w * h * 4) as usize]);
+        for (w, h) in [(1, 1), (16, 16), (MAX_IMAGE_SIZE, MAX_IMAGE_SIZE)] {
+            assert_eq!(img(w, h).unwrap().size(), w);
+        }
+        let message = |r: Result<BlockImage>| r.unwrap_err().to_string();
+        assert!(message(img(16, 32)).contains("square"));
+        assert!(message(img(12, 12)).contains("power of two"));
+        assert!(message(img(512, 512)).contains("256"));
+        assert!(message(img(0, 0)).contains("power of two"));
+        assert!(message(BlockImage::new(2, 2, vec![0; 15])).contains("16 bytes"));
+        let checker = BlockImage::new(2, 2, (0..16).collect()).unwrap();
+        assert_eq!(checker.texel(1, 0), [4, 5, 6, 7]);
+        assert_eq!(checker.texel(2, 3), [8, 9, 10, 11], "the image repeats");
+        let all = FaceImages::all(checker.clone());
+        assert!(FaceGroup::ALL.iter().all(|&g| all.get(g) == Some(&checker)));
+        assert!(FaceImages::default().is_empty());
+        assert_eq!(FaceGroup::of(Face::PosY), FaceGroup::Top);
+        assert_eq!(FaceGroup::of(Face::NegY), FaceGroup::Bottom);
+        assert_eq!(FaceGroup::of(Face::NegX), FaceGroup::Side);
     }
 
     #[test]

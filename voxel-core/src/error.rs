@@ -44,6 +44,18 @@ pub enum Error {
     /// More blocks than a 16-bit id can name.
     #[error("the registry is full (65536 blocks)")]
     TooManyBlocks,
+    /// A block image that cannot be a block texture (not square, not a power of two, too
+    /// large, or the wrong number of bytes).
+    #[error("invalid block image: {0}")]
+    InvalidImage(String),
+    /// A terrain generator whose blocks a registry does not hold (it names each role that
+    /// is missing or maps to another block there).
+    #[error("the terrain generator's blocks do not fit this registry: {0}")]
+    TerrainBlocks(String),
+    /// A ray cast with a NaN or infinite origin, a zero or non-finite direction, or a
+    /// maximum distance that is negative, not a number, or beyond the limit.
+    #[error("invalid ray: {0}")]
+    InvalidRay(String),
     /// A MagicaVoxel file that cannot be imported: which file, and what is wrong with it.
     #[error("{file}: {error}")]
     Vox {

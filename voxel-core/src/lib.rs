@@ -12,12 +12,17 @@ mod terrain;
 pub mod vox;
 mod world;
 
-pub use block::{BlockDef, BlockId, BlockRegistry, RenderClass, blocks};
+pub use block::{
+    BlockDef, BlockId, BlockImage, BlockRegistry, FaceGroup, FaceImages, MAX_IMAGE_SIZE, Pattern,
+    RenderClass, blocks,
+};
 pub use chunk::{
     CHUNK_AREA, CHUNK_SIZE, CHUNK_VOLUME, Chunk, ColumnMask, LayerMask, MaskBuffer, Occupancy,
     column_index, row_index,
 };
 pub use error::{Error, Result};
-pub use terrain::{Site, SiteKind, TerrainConfig, TerrainGenerator};
+pub use terrain::{Site, SiteKind, TerrainBlocks, TerrainConfig, TerrainGenerator, TerrainRole};
 pub use vox::{PaletteOverride, VoxError, VoxFile, VoxPlacement};
-pub use world::{ChunkPos, Face, Neighbourhood, World, WorldPos, touched_neighbours};
+pub use world::{
+    ChunkPos, Face, MAX_RAY_DISTANCE, Neighbourhood, RayHit, World, WorldPos, touched_neighbours,
+};

@@ -5,14 +5,224 @@
 //! Every chunk is generated on its own (so chunks can be generated in parallel): trees and
 //! structures that straddle chunk borders are placed by hashing world positions, and each
 //! chunk writes the part that falls inside it.
+//!
+//! The generator fills roles ([`TerrainRole`]: stone, dirt, grass, ...) with the blocks of a
+//! [`TerrainBlocks`] mapping: the default registry's, or a game's own, checked against the
+//! registry the world is made with.
 
 use std::sync::Arc;
 
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 use rayon::prelude::*;
 
-use crate::blocks::*;
-use crate::{BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, World};
+use crate::{BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Error, World, blocks};
+
+/// What the generator places: each role is filled with one block of the game's choice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TerrainRole {
+    /// Rock under the soil.
+    Stone,
+    /// Soil under the grass.
+    Dirt,
+    /// The top block of dry land.
+    Grass,
+    /// Shores and sea floor.
+    Sand,
+    /// The sea, up to the sea level.
+    Water,
+    /// Tree trunks and the frames of structures.
+    Log,
+    /// Tree canopies and the bushes in greenhouses.
+    Leaves,
+    /// Clear glass: greenhouse walls and roofs, a pavilion's wall and skylight.
+    Glass,
+    /// A pavilion's red wall.
+    RedGlass,
+    /// A greenhouse's partition and a pavilion's green wall.
+    GreenGlass,
+    /// A pavilion's blue wall.
+    BlueGlass,
+}
+
+impl TerrainRole {
+    /// Every role, indexed by its discriminant.
+    pub const ALL: [TerrainRole; 11] = [
+        TerrainRole::Stone,
+        TerrainRole::Dirt,
+        TerrainRole::Grass,
+        TerrainRole::Sand,
+        TerrainRole::Water,
+        TerrainRole::Log,
+        TerrainRole::Leaves,
+        TerrainRole::Glass,
+        TerrainRole::RedGlass,
+        TerrainRole::GreenGlass,
+        TerrainRole::BlueGlass,
+    ];
+
+    /// The role's name, which is also the name of its block in the default registry
+    /// (except `log`, the default registry's `wood`).
+    pub fn name(self) -> &'static str {
+        match self {
+            TerrainRole::Stone => "stone",
+            TerrainRole::Dirt => "dirt",
+            TerrainRole::Grass => "grass",
+            TerrainRole::Sand => "sand",
+            TerrainRole::Water => "water",
+            TerrainRole::Log => "log",
+            TerrainRole::Leaves => "leaves",
+            TerrainRole::Glass => "glass",
+            TerrainRole::RedGlass => "red_glass",
+            TerrainRole::GreenGlass => "green_glass",
+            TerrainRole::BlueGlass => "blue_glass",
+        }
+    }
+
+    /// The role's block in [`BlockRegistry::default`].
+    pub fn default_block(self) -> BlockId {
+        match self {
+            TerrainRole::Stone => blocks::STONE,
+            TerrainRole::Dirt => blocks::DIRT,
+            TerrainRole::Grass => blocks::GRASS,
+            TerrainRole::Sand => blocks::SAND,
+            TerrainRole::Water => blocks::WATER,
+            TerrainRole::Log => blocks::WOOD,
+            TerrainRole::Leaves => blocks::LEAVES,
+            TerrainRole::Glass => blocks::GLASS,
+            TerrainRole::RedGlass => blocks::RED_GLASS,
+            TerrainRole::GreenGlass => blocks::GREEN_GLASS,
+            TerrainRole::BlueGlass => blocks::BLUE_GLASS,
+        }
+    }
+
+    /// Whether a generator with `config` places this role: the glass roles only with
+    /// structures.
+    pub fn used_by(self, config: &TerrainConfig) -> bool {
+        config.structures
+            || !matches!(
+                self,
+                TerrainRole::Glass
+                    | TerrainRole::RedGlass
+                    | TerrainRole::GreenGlass
+                    | TerrainRole::BlueGlass
+            )
+    }
+}
+
+/// The block of each [`TerrainRole`], with the name that block had in the registry the
+/// mapping was made from: [`TerrainBlocks::check`] compares them with the registry a world
+/// is made with, so a mapping never silently draws another registry's blocks.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TerrainBlocks {
+    ids: [BlockId; TerrainRole::ALL.len()],
+    names: [String; TerrainRole::ALL.len()],
+}
+
+impl Default for TerrainBlocks {
+    /// The blocks of [`BlockRegistry::default`].
+    fn default() -> Self {
+        let registry = BlockRegistry::default();
+        let ids = TerrainRole::ALL.map(TerrainRole::default_block);
+        Self {
+            names: ids.map(|id| registry.get(id).map_or(String::new(), |d| d.name.clone())),
+            ids,
+        }
+    }
+}
+
+impl TerrainBlocks {
+    /// The blocks of `registry`: each role in `map` takes the block given there; every
+    /// other role takes the block named like the role (`stone`, `dirt`, ..., `log` or
+    /// else `wood`). Fails naming every role the registry has no block for (and ids
+    /// `map` gives that it does not hold); roles a generator with `config` does not place
+    /// may be missing (they stay air).
+    pub fn from_registry(
+        registry: &BlockRegistry,
+        config: &TerrainConfig,
+        map: &[(TerrainRole, BlockId)],
+    ) -> crate::Result<Self> {
+        let mut ids = [BlockId::AIR; TerrainRole::ALL.len()];
+        let mut missing = Vec::new();
+        for role in TerrainRole::ALL {
+            let given = map
+                .iter()
+                .rev()
+                .find(|(r, _)| *r == role)
+                .map(|(_, id)| *id);
+            let found = match given {
+                Some(id) if registry.contains(id) && id != BlockId::AIR => Some(id),
+                Some(id) => {
+                    missing.push(format!("{} (id {id} is not a block of it)", role.name()));
+                    continue;
+                }
+                None => registry.id(role.name()).ok().or_else(|| {
+                    (role == TerrainRole::Log)
+                        .then(|| registry.id("wood").ok())
+                        .flatten()
+                }),
+            };
+            match found {
+                Some(id) => ids[role as usize] = id,
+                None if role.used_by(config) => {
+                    missing.push(format!(
+                        "{} (no block named {:?})",
+                        role.name(),
+                        role.name()
+                    ));
+                }
+                None => {}
+            }
+        }
+        if !missing.is_empty() {
+            return Err(Error::TerrainBlocks(format!(
+                "the registry lacks blocks for the roles {}; map them with TerrainBlocks::from_registry",
+                missing.join(", ")
+            )));
+        }
+        Ok(Self {
+            names: ids.map(|id| registry.get(id).map_or(String::new(), |d| d.name.clone())),
+            ids,
+        })
+    }
+
+    /// The block of `role` (air for a role the mapping left out).
+    pub fn get(&self, role: TerrainRole) -> BlockId {
+        self.ids[role as usize]
+    }
+
+    /// Checks that `registry` holds each role's block under the name it had where the
+    /// mapping was made; fails naming every role that differs (a generator made for the
+    /// default registry, used with a game's registry whose id 8 is `amber_glass`, fails
+    /// here instead of drawing amber glass where glass belongs).
+    pub fn check(&self, registry: &BlockRegistry, config: &TerrainConfig) -> crate::Result<()> {
+        let wrong: Vec<String> = TerrainRole::ALL
+            .into_iter()
+            .filter(|r| r.used_by(config))
+            .filter_map(|role| {
+                let (id, name) = (self.ids[role as usize], &self.names[role as usize]);
+                let here = registry.get(id).ok().map(|d| d.name.as_str());
+                (here != Some(name.as_str())).then(|| match here {
+                    Some(other) => format!(
+                        "{} is block {id} {name:?}, but this registry's {id} is {other:?}",
+                        role.name()
+                    ),
+                    None => format!(
+                        "{} is block {id} {name:?}, which this registry does not hold",
+                        role.name()
+                    ),
+                })
+            })
+            .collect();
+        if wrong.is_empty() {
+            Ok(())
+        } else {
+            Err(Error::TerrainBlocks(format!(
+                "{}; make the generator with TerrainGenerator::with_blocks and TerrainBlocks::from_registry",
+                wrong.join("; ")
+            )))
+        }
+    }
+}
 
 /// Parameters of the generator. `Default` gives the world the demo and tests use.
 #[derive(Clone, Debug, PartialEq)]
@@ -95,6 +305,7 @@ const CLEARING: i64 = 22;
 pub struct TerrainGenerator {
     config: TerrainConfig,
     height: Fbm<Perlin>,
+    blocks: TerrainBlocks,
 }
 
 /// splitmix64 over the seed, a position and a salt: the one source of randomness.
@@ -112,25 +323,64 @@ fn hash(seed: u32, x: i64, z: i64, salt: u64) -> u64 {
 struct WorldBox {
     min: [i64; 3],
     max: [i64; 3],
-    id: BlockId,
+    /// A role, or `None` for air.
+    role: Option<TerrainRole>,
 }
 
-fn bx(min: [i64; 3], max: [i64; 3], id: BlockId) -> WorldBox {
-    WorldBox { min, max, id }
+fn bx(min: [i64; 3], max: [i64; 3], role: TerrainRole) -> WorldBox {
+    WorldBox {
+        min,
+        max,
+        role: Some(role),
+    }
+}
+
+fn air(min: [i64; 3], max: [i64; 3]) -> WorldBox {
+    WorldBox {
+        min,
+        max,
+        role: None,
+    }
 }
 
 impl TerrainGenerator {
-    /// A generator for `config`.
+    /// A generator for `config` placing the blocks of [`BlockRegistry::default`] (a world
+    /// over another registry is checked by [`TerrainGenerator::check`] and refused).
     pub fn new(config: TerrainConfig) -> Self {
+        Self::with_blocks(config, TerrainBlocks::default())
+    }
+
+    /// A generator for `config` placing `blocks` (a game's own, from
+    /// [`TerrainBlocks::from_registry`]).
+    pub fn with_blocks(config: TerrainConfig, blocks: TerrainBlocks) -> Self {
         let height = Fbm::<Perlin>::new(config.seed)
             .set_octaves(4)
             .set_frequency(1.0 / config.hill_size);
-        Self { config, height }
+        Self {
+            config,
+            height,
+            blocks,
+        }
     }
 
     /// The configuration this generator was made with.
     pub fn config(&self) -> &TerrainConfig {
         &self.config
+    }
+
+    /// The blocks it places.
+    pub fn blocks(&self) -> &TerrainBlocks {
+        &self.blocks
+    }
+
+    /// Whether chunks of this generator hold the blocks they mean in `registry`
+    /// ([`TerrainBlocks::check`]): a streamer or world over `registry` should ask first.
+    pub fn check(&self, registry: &BlockRegistry) -> crate::Result<()> {
+        self.blocks.check(registry, &self.config)
+    }
+
+    fn block(&self, role: TerrainRole) -> BlockId {
+        self.blocks.get(role)
     }
 
     /// World y of the top ground block of column `(x, z)`.
@@ -204,19 +454,22 @@ impl TerrainGenerator {
         let mut chunk = Chunk::default();
         let sea = self.sea();
         let local = |y: i64| (y - oy).clamp(0, n) as usize;
+        let [stone, water] = [TerrainRole::Stone, TerrainRole::Water].map(|r| self.block(r));
+        let [sand, grass, dirt] =
+            [TerrainRole::Sand, TerrainRole::Grass, TerrainRole::Dirt].map(|r| self.block(r));
 
         // Ground and sea, a column run at a time.
         for x in 0..CHUNK_SIZE {
             for z in 0..CHUNK_SIZE {
                 let h = self.height_at(ox + x as i64, oz + z as i64);
                 let shore = h <= sea + 1;
-                let top = if shore { SAND } else { GRASS };
-                let soil = if shore { SAND } else { DIRT };
+                let top = if shore { sand } else { grass };
+                let soil = if shore { sand } else { dirt };
                 for (y0, y1, id) in [
-                    (i64::MIN, h - 3, STONE),
+                    (i64::MIN, h - 3, stone),
                     (h - 3, h, soil),
                     (h, h + 1, top),
-                    (h + 1, sea + 1, WATER),
+                    (h + 1, sea + 1, water),
                 ] {
                     let (a, b) = (local(y0.max(oy)), local(y1));
                     if a < b {
@@ -239,7 +492,8 @@ impl TerrainGenerator {
             let max = [b.max[0] - ox, b.max[1] - oy, b.max[2] - oz].map(|v| v.min(n - 1));
             if min.iter().zip(&max).all(|(a, b)| a <= b) {
                 // Clipped to the chunk above, so always in range.
-                let _ = chunk.fill_box(min.map(|v| v as usize), max.map(|v| v as usize), b.id);
+                let id = b.role.map_or(BlockId::AIR, |r| self.block(r));
+                let _ = chunk.fill_box(min.map(|v| v as usize), max.map(|v| v as usize), id);
             }
         }
         chunk
@@ -280,7 +534,7 @@ impl TerrainGenerator {
                 // Corners of the wide layers are cut at random, as trees look less boxy so.
                 for (i, (dx, dz)) in [(-2, -2), (2, -2), (-2, 2), (2, 2)].into_iter().enumerate() {
                     let y = top - 1 - ((r >> (40 + i)) & 1) as i64;
-                    out.push(bx([tx + dx, y, tz + dz], [tx + dx, top - 1, tz + dz], AIR));
+                    out.push(air([tx + dx, y, tz + dz], [tx + dx, top - 1, tz + dz]));
                 }
                 out.push(bx([tx, h + 1, tz], [tx, top, tz], WOOD));
             }
@@ -288,13 +542,15 @@ impl TerrainGenerator {
     }
 
     /// Generates every chunk of the box `min..=max` (chunk coordinates) in parallel into a
-    /// new world over `registry`, which must hold the default blocks' ids.
+    /// new world over `registry`. Fails when `registry` does not hold the generator's
+    /// blocks ([`TerrainGenerator::check`]).
     pub fn generate_world(
         &self,
         registry: Arc<BlockRegistry>,
         min: ChunkPos,
         max: ChunkPos,
     ) -> crate::Result<World> {
+        self.check(&registry)?;
         let mut positions = Vec::new();
         for x in min.x..=max.x {
             for y in min.y..=max.y {
@@ -315,20 +571,29 @@ impl TerrainGenerator {
     }
 }
 
+/// The roles under the names the layouts below were written with.
+const STONE: TerrainRole = TerrainRole::Stone;
+const WOOD: TerrainRole = TerrainRole::Log;
+const LEAVES: TerrainRole = TerrainRole::Leaves;
+const GLASS: TerrainRole = TerrainRole::Glass;
+const RED_GLASS: TerrainRole = TerrainRole::RedGlass;
+const GREEN_GLASS: TerrainRole = TerrainRole::GreenGlass;
+const BLUE_GLASS: TerrainRole = TerrainRole::BlueGlass;
+
 /// The boxes of a structure, in the order they are written.
 fn structure(site: &Site, out: &mut Vec<WorldBox>) {
     let [cx, fy, cz] = site.center;
     let [hx, hz] = site.half_extent();
     let (x0, x1, z0, z1) = (cx - hx, cx + hx, cz - hz, cz + hz);
     // Clear the volume (terrain, stray leaves), then a plinth so nothing floats.
-    out.push(bx([x0 - 1, fy, z0 - 1], [x1 + 1, fy + 9, z1 + 1], AIR));
+    out.push(air([x0 - 1, fy, z0 - 1], [x1 + 1, fy + 9, z1 + 1]));
     match site.kind {
         SiteKind::Greenhouse => {
             let top = fy + 5;
             out.push(bx([x0, fy - 4, z0], [x1, fy - 1, z1], STONE));
             // Glass shell, then the wooden frame on its edges.
             out.push(bx([x0, fy, z0], [x1, top, z1], GLASS));
-            out.push(bx([x0 + 1, fy, z0 + 1], [x1 - 1, top - 1, z1 - 1], AIR));
+            out.push(air([x0 + 1, fy, z0 + 1], [x1 - 1, top - 1, z1 - 1]));
             for (x, z) in [(x0, z0), (x1, z0), (x0, z1), (x1, z1)] {
                 out.push(bx([x, fy, z], [x, top, z], WOOD));
             }
@@ -342,7 +607,7 @@ fn structure(site: &Site, out: &mut Vec<WorldBox>) {
             out.push(bx([cx + 2, fy, z1 - 2], [cx + 3, fy + 1, z1 - 1], LEAVES));
             // Door on the side away from the sea (or -z when the sea lies along x).
             let dz = if site.water_dir[1] > 0 { z0 } else { z1 };
-            out.push(bx([cx - 2, fy, dz], [cx - 2, fy + 1, dz], AIR));
+            out.push(air([cx - 2, fy, dz], [cx - 2, fy + 1, dz]));
         }
         SiteKind::Pavilion => {
             let top = fy + 4;
@@ -363,6 +628,12 @@ fn structure(site: &Site, out: &mut Vec<WorldBox>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::BlockDef;
+    // Named, so that they take precedence over the roles of the same names above.
+    use crate::blocks::{
+        AIR, BLUE_GLASS, DIRT, GLASS, GRASS, GREEN_GLASS, LEAVES, RED_GLASS, SAND, STONE, WATER,
+        WOOD,
+    };
 
     fn generator() -> TerrainGenerator {
         TerrainGenerator::new(TerrainConfig::default())
@@ -458,6 +729,118 @@ mod tests {
             .sum();
         assert!(world_leaves > 100, "{world_leaves} leaves");
         c.check_invariants().unwrap();
+    }
+
+    /// A game's registry: its own names, its own order, an extra block first (so no id is
+    /// the default registry's), and no block named like the roles.
+    fn game_registry() -> (BlockRegistry, Vec<(TerrainRole, BlockId)>) {
+        let mut r = BlockRegistry::new();
+        let _ = r.register(BlockDef::new("amber_glass", [200, 140, 40], 0.5));
+        let mut map = Vec::new();
+        for role in TerrainRole::ALL.into_iter().rev() {
+            let def = BlockRegistry::default()
+                .get(role.default_block())
+                .unwrap()
+                .clone();
+            let id = r
+                .register(BlockDef {
+                    name: format!("game_{}", role.name()),
+                    ..def
+                })
+                .unwrap();
+            map.push((role, id));
+        }
+        (r, map)
+    }
+
+    #[test]
+    fn a_registry_lacking_roles_is_an_error_naming_them() {
+        let mut r = BlockRegistry::new();
+        r.register(BlockDef::new("stone", [1, 2, 3], 1.0)).unwrap();
+        r.register(BlockDef::new("wood", [1, 2, 3], 1.0)).unwrap();
+        let config = TerrainConfig::default();
+        let err = TerrainBlocks::from_registry(&r, &config, &[])
+            .unwrap_err()
+            .to_string();
+        for role in [
+            "dirt",
+            "grass",
+            "sand",
+            "water",
+            "leaves",
+            "glass",
+            "blue_glass",
+        ] {
+            assert!(err.contains(role), "{role} missing from: {err}");
+        }
+        assert!(!err.contains("stone ("), "stone is there: {err}");
+        assert!(!err.contains("log ("), "wood stands in for log: {err}");
+        // An id the registry does not hold is named too.
+        let err = TerrainBlocks::from_registry(&r, &config, &[(TerrainRole::Stone, BlockId(77))])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("stone (id #77"), "{err}");
+        // Without structures the glass roles are not needed.
+        let no_structures = TerrainConfig {
+            structures: false,
+            ..config
+        };
+        let err = TerrainBlocks::from_registry(&r, &no_structures, &[])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("dirt") && !err.contains("glass"), "{err}");
+    }
+
+    #[test]
+    fn the_default_generator_refuses_a_game_registry() {
+        let (r, _) = game_registry();
+        let err = generator()
+            .generate_world(Arc::new(r), ChunkPos::new(0, 0, 0), ChunkPos::new(0, 0, 0))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(r#"glass is block #8 "glass", but this registry's #8 is"#),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_mapped_registry_gives_the_default_world_block_for_block() {
+        let (r, map) = game_registry();
+        let config = TerrainConfig::default();
+        let blocks = TerrainBlocks::from_registry(&r, &config, &map).unwrap();
+        let game = TerrainGenerator::with_blocks(config, blocks);
+        // Around a structure, so that its glass is compared too.
+        let site = generator().sites_in(-384, -384, 384, 384)[0];
+        let c = site.center.map(|v| v.div_euclid(32) as i32);
+        let (min, max) = (
+            ChunkPos::new(c[0] - 1, 0, c[2] - 1),
+            ChunkPos::new(c[0] + 1, 1, c[2] + 1),
+        );
+        let game_world = game.generate_world(Arc::new(r), min, max).unwrap();
+        let default_world = generator()
+            .generate_world(Arc::new(BlockRegistry::default()), min, max)
+            .unwrap();
+        // The game's id of each default id.
+        let to_game = |id: BlockId| {
+            if id == AIR {
+                return AIR;
+            }
+            let role = TerrainRole::ALL
+                .into_iter()
+                .find(|r| r.default_block() == id)
+                .unwrap();
+            map.iter().find(|(r, _)| *r == role).unwrap().1
+        };
+        let mut roles_seen = std::collections::HashSet::new();
+        for (pos, chunk) in default_world.iter() {
+            let theirs = game_world.chunk(pos).unwrap().to_dense();
+            let ours: Vec<BlockId> = chunk.to_dense().iter().map(|&b| to_game(b)).collect();
+            assert!(ours == theirs, "chunk {pos:?} differs");
+            roles_seen.extend(ours);
+        }
+        // The comparison covers the terrain and the structures' glass.
+        assert!(roles_seen.len() >= 10, "{} block types", roles_seen.len());
     }
 
     #[test]

@@ -38,7 +38,9 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use crate::{BlockDef, BlockId, BlockRegistry, Error, RenderClass, Result, World, WorldPos};
+use crate::{
+    BlockDef, BlockId, BlockRegistry, Error, Pattern, RenderClass, Result, World, WorldPos,
+};
 
 /// Largest side of a model, in voxels (MagicaVoxel's limit).
 pub const MAX_MODEL_SIDE: u32 = 256;
@@ -824,21 +826,26 @@ impl VoxFile {
     }
 
     /// The block type colour index `index` becomes, with `overrides` applied, named
-    /// `{name}#{index}` (`{name} glass #{index}` for a glass material, so that the
-    /// renderer frames it like the built-in glass).
+    /// `{name}#{index}` (`{name} glass #{index}` for a glass material). A glass material
+    /// is framed like the built-in glass ([`Pattern::Framed`]); an override gets its
+    /// class's default pattern.
     pub fn block_def(&self, name: &str, index: u8, overrides: &[PaletteOverride]) -> BlockDef {
         let color = self.palette[usize::from(index)];
         if let Some(o) = overrides.iter().rev().find(|o| o.index == index) {
+            let def = match o.class {
+                RenderClass::Cutout => BlockDef::cutout(format!("{name}#{index}"), color),
+                _ => BlockDef::new(format!("{name}#{index}"), color, o.opacity),
+            };
             return BlockDef {
-                name: format!("{name}#{index}"),
                 class: o.class,
-                color,
                 opacity: o.opacity,
+                ..def
             };
         }
         match self.materials[usize::from(index)] {
             VoxMaterial::Opaque => BlockDef::new(format!("{name}#{index}"), color, 1.0),
-            VoxMaterial::Glass(a) => BlockDef::new(format!("{name} glass #{index}"), color, a),
+            VoxMaterial::Glass(a) => BlockDef::new(format!("{name} glass #{index}"), color, a)
+                .with_pattern(Pattern::Framed),
         }
     }
 
@@ -1546,6 +1553,12 @@ mod tests {
             ("m glass #9", RenderClass::Translucent)
         );
         assert!((glass.opacity - 0.4).abs() < 1e-6);
+        assert_eq!(
+            glass.pattern,
+            Pattern::Framed,
+            "glass is framed by its field"
+        );
+        assert_eq!(registry.get(a).unwrap().pattern, Pattern::Noise);
         // Again: the same types. With an override: a new name for the changed one.
         assert_eq!(f.register_blocks("m", &[], &mut registry).unwrap(), blocks);
         let water = PaletteOverride {

@@ -139,7 +139,6 @@ fn measure(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Row, Strin
             let commands = encoder.finish();
             let finish = t.elapsed().as_secs_f64() * 1e3;
             ctx.queue.submit([commands]);
-            renderer.after_submit();
             ctx.device
                 .poll(wgpu::PollType::wait_indefinitely())
                 .map_err(|e| e.to_string())?;

@@ -140,9 +140,9 @@ pub struct RayMarcher {
     /// Bounds of the loaded chunks in blocks: min inclusive, max exclusive.
     bounds: ([i64; 3], [i64; 3]),
     classes: Vec<RenderClass>,
-    /// Per block: level-0 texels (linear RGBA) for [`Texturing::Nearest`], and the flat
-    /// colour and opacity for [`Texturing::Flat`].
-    texels: Vec<Vec<[f32; 4]>>,
+    /// The renderer's block textures (level 0) for [`Texturing::Nearest`], and per block
+    /// the flat colour and opacity for [`Texturing::Flat`].
+    textures: voxel_render::textures::TextureSet,
     flat: Vec<[f64; 4]>,
     /// Per translucent block: linear colour and opacity (the medium's fog).
     looks: Vec<Option<voxel_render::medium::MediumLook>>,
@@ -209,10 +209,7 @@ impl RayMarcher {
             chunks,
             bounds: (lo, hi),
             classes: defs.iter().map(|(_, d)| d.class).collect(),
-            texels: defs
-                .iter()
-                .map(|(id, d)| voxel_render::textures::texels(d, u32::from(id.0)))
-                .collect(),
+            textures: voxel_render::textures::TextureSet::new(registry, false),
             flat: defs
                 .iter()
                 .map(|(_, d)| {
@@ -374,23 +371,19 @@ impl RayMarcher {
         self.class(self.get(p)) == RenderClass::Opaque
     }
 
-    /// Colour (linear) and alpha of block `id`'s face at face coordinates `(u, v)` (in
-    /// blocks along the face's U and V axes).
-    fn albedo(&self, id: BlockId, u: f64, v: f64, texturing: Texturing) -> [f64; 4] {
+    /// Colour (linear) and alpha of face `face` of block `id` at face coordinates `(u, v)`
+    /// (in blocks along the face's U and V axes).
+    fn albedo(&self, id: BlockId, face: Face, u: f64, v: f64, texturing: Texturing) -> [f64; 4] {
         match texturing {
             Texturing::Flat => self.flat[id.index()],
             Texturing::Nearest => {
-                let n = voxel_render::textures::TEXTURE_SIZE as i64;
-                let tx = ((u.rem_euclid(1.0) * n as f64).floor() as i64).clamp(0, n - 1);
-                let ty = ((v.rem_euclid(1.0) * n as f64).floor() as i64).clamp(0, n - 1);
-                let t = self.texels[id.index()][(ty * n + tx) as usize];
                 // Stored as 8-bit sRGB and 8-bit alpha.
-                let q = |c: f32| srgb_to_linear(voxel_render::textures::linear_to_srgb(c));
+                let t = self.textures.texel(id, face, u, v);
                 [
-                    q(t[0]),
-                    q(t[1]),
-                    q(t[2]),
-                    (f64::from(t[3]) * 255.0).round() / 255.0,
+                    srgb_to_linear(t[0]),
+                    srgb_to_linear(t[1]),
+                    srgb_to_linear(t[2]),
+                    f64::from(t[3]) / 255.0,
                 ]
             }
         }
@@ -702,7 +695,7 @@ impl RayMarcher {
                 id: x.to,
             };
             let (u, v) = face_uv(p, x.axis);
-            let a = self.albedo(x.to, u, v, w.shading.texturing);
+            let a = self.albedo(x.to, front_face, u, v, w.shading.texturing);
             match cb {
                 RenderClass::Opaque => ended = true,
                 RenderClass::Cutout => ended = a[3] >= CUTOUT_ALPHA_TEST,
@@ -742,7 +735,7 @@ impl RayMarcher {
             // the first surface of the medium the ray meets.
             if first && cb != RenderClass::Translucent {
                 let (u, v) = face_uv(p, x.axis);
-                let a = self.albedo(x.from, u, v, w.shading.texturing);
+                let a = self.albedo(x.from, back.face, u, v, w.shading.texturing);
                 w.layer(self, back, p, a);
             }
         }

@@ -18,6 +18,10 @@
 //! name = "smoky_glass"
 //! color = [90, 90, 100]             # sRGB
 //! opacity = 0.5                     # below 1: translucent
+//! class = "translucent"             # opaque, cutout or translucent (default: from opacity)
+//! pattern = "framed"                # noise, leaves, framed, grass (with soil = [r, g, b])
+//! texture = "smoky.png"             # a PNG for every face, relative to this file
+//! top = "smoky_top.png"             # top, bottom, side: one face group (over texture)
 //!
 //! [[boxes]]                         # filled boxes, corners inclusive, in order
 //! block = "red_glass"
@@ -70,8 +74,8 @@ use glam::DVec3;
 use serde::Deserialize;
 use toml::Spanned;
 use voxel_core::{
-    BlockDef, BlockRegistry, ChunkPos, PaletteOverride, RenderClass, SiteKind, TerrainConfig,
-    TerrainGenerator, VoxFile, VoxPlacement, World, WorldPos,
+    BlockDef, BlockImage, BlockRegistry, ChunkPos, FaceImages, PaletteOverride, Pattern,
+    RenderClass, SiteKind, TerrainConfig, TerrainGenerator, VoxFile, VoxPlacement, World, WorldPos,
 };
 use voxel_render::{Camera, WORLD_EXTENT};
 
@@ -391,6 +395,89 @@ struct BlockDefFile {
     name: String,
     color: [u8; 3],
     opacity: f32,
+    /// `opaque`, `cutout` or `translucent`; by default from the opacity.
+    class: Option<Spanned<String>>,
+    /// `noise`, `leaves`, `framed` or `grass`; by default the class's.
+    pattern: Option<Spanned<String>>,
+    /// The soil colour of the `grass` pattern.
+    soil: Option<[u8; 3]>,
+    /// A PNG file for every face, relative to the scene file.
+    texture: Option<Spanned<String>>,
+    /// PNG files for the top, bottom and side faces (over `texture`).
+    top: Option<Spanned<String>>,
+    bottom: Option<Spanned<String>>,
+    side: Option<Spanned<String>>,
+}
+
+/// A render class by its scene-file name.
+fn class_named(name: &str) -> Option<RenderClass> {
+    match name {
+        "opaque" => Some(RenderClass::Opaque),
+        "cutout" => Some(RenderClass::Cutout),
+        "translucent" => Some(RenderClass::Translucent),
+        _ => None,
+    }
+}
+
+/// The block a `[[blocks]]` entry declares: class, pattern and images checked, images read
+/// relative to `dir`. Errors read `LINE: blocks.key: message`.
+fn block_def(text: &str, dir: &Path, b: &Spanned<BlockDefFile>) -> Result<BlockDef, String> {
+    let d = b.get_ref();
+    let mut def = BlockDef::new(d.name.clone(), d.color, d.opacity);
+    if let Some(class) = &d.class {
+        def.class = class_named(class.get_ref()).ok_or_else(|| {
+            at_line(
+                text,
+                class.span().start,
+                format!(
+                    "blocks.class: {:?} is not a class: opaque, cutout or translucent",
+                    class.get_ref()
+                ),
+            )
+        })?;
+        if def.class == RenderClass::Cutout {
+            def.pattern = Pattern::Leaves;
+        }
+    }
+    if let Some(pattern) = &d.pattern {
+        let at = pattern.span().start;
+        def.pattern = match pattern.get_ref().as_str() {
+            "noise" => Pattern::Noise,
+            "leaves" => Pattern::Leaves,
+            "framed" => Pattern::Framed,
+            "grass" => Pattern::Grass {
+                soil: d.soil.ok_or_else(|| {
+                    at_line(
+                        text,
+                        at,
+                        "blocks.pattern: \"grass\" needs a soil = [r, g, b] colour",
+                    )
+                })?,
+            },
+            other => {
+                return Err(at_line(
+                    text,
+                    at,
+                    format!(
+                        "blocks.pattern: {other:?} is not a pattern: noise, leaves, framed or grass"
+                    ),
+                ));
+            }
+        };
+    }
+    let image = |key: &str, file: &Option<Spanned<String>>| -> Result<Option<BlockImage>, String> {
+        let Some(file) = file else { return Ok(None) };
+        voxel_render::textures::load_block_image(&dir.join(file.get_ref()))
+            .map(Some)
+            .map_err(|e| at_line(text, file.span().start, format!("blocks.{key}: {e}")))
+    };
+    let all = image("texture", &d.texture)?;
+    def.images = FaceImages {
+        top: image("top", &d.top)?.or_else(|| all.clone()),
+        bottom: image("bottom", &d.bottom)?.or_else(|| all.clone()),
+        side: image("side", &d.side)?.or(all),
+    };
+    Ok(def)
 }
 
 #[derive(Deserialize)]
@@ -484,20 +571,16 @@ fn palette_override(text: &str, p: &Spanned<PaletteDef>) -> Result<PaletteOverri
                 ),
             )
         })?;
-    let class = match d.class.get_ref().as_str() {
-        "opaque" => RenderClass::Opaque,
-        "cutout" => RenderClass::Cutout,
-        "translucent" => RenderClass::Translucent,
-        other => {
-            return Err(at_line(
-                text,
-                d.class.span().start,
-                format!(
-                    "models.palette.class: {other:?} is not a class: opaque, cutout or translucent"
-                ),
-            ));
-        }
-    };
+    let class = class_named(d.class.get_ref()).ok_or_else(|| {
+        at_line(
+            text,
+            d.class.span().start,
+            format!(
+                "models.palette.class: {:?} is not a class: opaque, cutout or translucent",
+                d.class.get_ref()
+            ),
+        )
+    })?;
     let opacity = match (class, d.opacity) {
         (RenderClass::Translucent, Some(a)) if a.is_finite() && a > 0.0 && a < 1.0 => a,
         (RenderClass::Translucent, _) => {
@@ -541,10 +624,10 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
 
     let mut registry = BlockRegistry::default();
     for b in &file.blocks {
-        let (span, def) = (b.span(), b.get_ref());
+        let def = block_def(text, dir, b)?;
         registry
-            .register(BlockDef::new(def.name.clone(), def.color, def.opacity))
-            .map_err(|e| at_line(text, span.start, format!("blocks: {e}")))?;
+            .register(def)
+            .map_err(|e| at_line(text, b.span().start, format!("blocks: {e}")))?;
     }
     // Models are read (and their block types registered) before the world exists: the
     // world's registry is fixed once it is made.
@@ -884,6 +967,63 @@ path_to = [3.0, 1.0, 10.0]
             s.world.get_block(WorldPos::new(4, 2, 0)),
             voxel_core::BlockId::AIR
         );
+    }
+
+    #[test]
+    fn blocks_take_textures_patterns_and_classes_from_the_file() {
+        let dir = std::env::temp_dir().join(format!("voxel_scene_tex_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let png = |name: &str, w: u32, h: u32, rgba: [u8; 4]| {
+            voxel_render::Image {
+                width: w,
+                height: h,
+                rgba: rgba.repeat((w * h) as usize),
+            }
+            .save_png(&dir.join(name))
+            .unwrap();
+        };
+        png("all.png", 8, 8, [200, 10, 10, 255]);
+        png("top.png", 4, 4, [10, 200, 10, 255]);
+        png("wide.png", 8, 4, [0, 0, 0, 255]);
+        let text = |extra: &str| {
+            format!(
+                "name = \"t\"\n[[blocks]]\nname = \"b\"\ncolor = [1, 2, 3]\nopacity = 1.0\n{extra}\n\
+                 [[cameras]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n"
+            )
+        };
+        let block = |extra: &str| {
+            let scene = parse_in(&text(extra), &dir).unwrap();
+            let r = scene.world.registry().clone();
+            r.get(r.id("b").unwrap()).unwrap().clone()
+        };
+        let b = block("texture = \"all.png\"\ntop = \"top.png\"\nclass = \"cutout\"");
+        assert_eq!(b.class, RenderClass::Cutout);
+        assert_eq!(b.pattern, Pattern::Leaves);
+        let top = b.images.top.unwrap();
+        assert_eq!((top.size(), top.texel(0, 0)), (4, [10, 200, 10, 255]));
+        assert_eq!(b.images.side.unwrap().texel(3, 3), [200, 10, 10, 255]);
+        assert_eq!(b.images.bottom.unwrap().size(), 8);
+        let g = block("pattern = \"grass\"\nsoil = [9, 8, 7]");
+        assert_eq!(g.pattern, Pattern::Grass { soil: [9, 8, 7] });
+        assert!(g.images.is_empty());
+        let err = |extra: &str| parse_in(&text(extra), &dir).unwrap_err();
+        let e = err("side = \"wide.png\"");
+        assert!(
+            e.starts_with("6: blocks.side: ") && e.contains("wide.png") && e.contains("square"),
+            "{e}"
+        );
+        let e = err("top = \"missing.png\"");
+        assert!(
+            e.starts_with("6: blocks.top: ") && e.contains("missing.png"),
+            "{e}"
+        );
+        let e = err("pattern = \"marble\"");
+        assert!(e.contains("blocks.pattern") && e.contains("marble"), "{e}");
+        let e = err("pattern = \"grass\"");
+        assert!(e.contains("soil"), "{e}");
+        let e = err("class = \"gas\"");
+        assert!(e.contains("blocks.class") && e.contains("gas"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -321,7 +321,6 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
             .map_err(|e| crate::chain(&e))?;
         let t1 = Instant::now();
         ctx.queue.submit([encoder.finish()]);
-        renderer.after_submit();
         let submit_ms = t1.elapsed().as_secs_f64() * 1e3;
         let cpu_ms = t0.elapsed().as_secs_f64() * 1e3;
         // Wait for the GPU outside the timed part, so frames do not pile up.

@@ -1,4 +1,4 @@
-//! Back-to-front ordering for blended transparency (seed 003's sort, for chunks and quads).
+//! Back-to-front ordering for blended transparency (the painter's order of sorted alpha blending, for chunks and quads).
 //!
 //! Keys are squared distances from the eye, compared through their IEEE bit patterns (which
 //! order non-negative floats correctly), so a NaN eye cannot make the sort panic: NaN keys

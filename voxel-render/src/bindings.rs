@@ -1,5 +1,5 @@
 //! What every chunk pipeline binds: group 0 (the frame: camera, light, sky, viewport, and
-//! the block textures) and group 1 (a chunk mesh's quads and its uniform), with the
+//! the block textures with their table of layers) and group 1 (a chunk mesh's quads and its uniform), with the
 //! structs shared with WGSL (`shaders/common.wgsl`) byte for byte. Techniques add their own
 //! groups from 2 on; nothing here belongs to one technique.
 
@@ -98,7 +98,8 @@ pub struct ChunkUniforms {
 /// Layouts every chunk pipeline is built against.
 #[derive(Debug, Clone)]
 pub struct SharedLayouts {
-    /// Group 0: frame uniforms, block textures, sampler, the medium's boundary depth.
+    /// Group 0: frame uniforms, block textures, sampler, the medium's boundary depth, and
+    /// the layer of each block's face groups in the block textures.
     pub scene: wgpu::BindGroupLayout,
     /// Group 1: a page of the quad arena and the chunk records.
     pub chunk: wgpu::BindGroupLayout,
@@ -131,6 +132,9 @@ impl SharedLayouts {
                     count: None,
                 },
                 gpu::texture_entry(3, wgpu::TextureSampleType::Depth),
+                // Read where the quad is expanded: vertex storage, which every chunk
+                // pipeline needs for its quads anyway (fragment storage is optional).
+                buffer_entry(4, S::VERTEX, B::Storage { read_only: true }),
             ],
         );
         let chunk = gpu::layout(

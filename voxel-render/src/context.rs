@@ -166,6 +166,29 @@ impl GpuContext {
         pollster::block_on(Self::headless_async(backends))
     }
 
+    /// A context on an adapter that can draw to `surface` (a game's window), asking for
+    /// [`WANTED_FEATURES`] where it has them; also returns the adapter, for the surface's
+    /// capabilities and configuration. Blocks until the device exists.
+    pub fn for_surface(
+        instance: &wgpu::Instance,
+        surface: &wgpu::Surface<'_>,
+    ) -> Result<(Self, wgpu::Adapter)> {
+        pollster::block_on(async {
+            let adapter = instance
+                .request_adapter(&wgpu::RequestAdapterOptions {
+                    power_preference: wgpu::PowerPreference::HighPerformance,
+                    compatible_surface: Some(surface),
+                    ..Default::default()
+                })
+                .await
+                .map_err(|e| {
+                    Error::Unsupported(format!("no adapter can draw to the surface: {e}"))
+                })?;
+            let (device, queue) = request_device(&adapter).await?;
+            Ok((Self::from_device(&adapter, device, queue), adapter))
+        })
+    }
+
     async fn headless_async(backends: wgpu::Backends) -> Result<Self> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = backends;
@@ -176,7 +199,7 @@ impl GpuContext {
                 ..Default::default()
             })
             .await
-            .map_err(|source| Error::NoAdapter { backends, source })?;
+            .map_err(|error| Error::NoAdapter { backends, error })?;
         let (device, queue) = request_device(&adapter).await?;
         Ok(Self::from_device(&adapter, device, queue))
     }

@@ -1,5 +1,7 @@
-//! Everything that can go wrong in the renderer. Each variant says what was at fault and
-//! keeps the error it came from as its [`std::error::Error::source`].
+//! Everything that can go wrong in the renderer. Each variant's message carries its whole
+//! detail: what was at fault, and the message of the error it came from. That error is
+//! kept in the variant (to match on), not returned by [`std::error::Error::source`], so
+//! that a report printing the chain of sources does not repeat it.
 
 use std::path::PathBuf;
 
@@ -8,17 +10,16 @@ use std::path::PathBuf;
 #[non_exhaustive]
 pub enum Error {
     /// No adapter of the asked backends was found.
-    #[error("no GPU adapter found for {backends:?}")]
+    #[error("no GPU adapter found for {backends:?}: {error}")]
     NoAdapter {
         /// The backends that were searched.
         backends: wgpu::Backends,
         /// Why wgpu found none.
-        #[source]
-        source: wgpu::RequestAdapterError,
+        error: wgpu::RequestAdapterError,
     },
     /// The adapter refused to create a device.
-    #[error("could not create a device")]
-    Device(#[from] wgpu::RequestDeviceError),
+    #[error("could not create a device: {0}")]
+    Device(wgpu::RequestDeviceError),
     /// A camera with NaN, infinite or contradictory values.
     #[error("invalid camera: {0}")]
     InvalidCamera(String),
@@ -32,9 +33,10 @@ pub enum Error {
         /// The names that exist, comma-separated.
         known: String,
     },
-    /// A block or world error (an unknown block id, a chunk outside the world).
-    #[error("world")]
-    World(#[from] voxel_core::Error),
+    /// A block or world error (an unknown block id, a chunk outside the world, a
+    /// terrain generator whose blocks the registry lacks).
+    #[error("world: {0}")]
+    World(voxel_core::Error),
     /// A setting outside what the renderer supports (the message names the setting and
     /// the allowed range).
     #[error("invalid setting: {0}")]
@@ -58,50 +60,55 @@ pub enum Error {
     #[error("unsupported by this adapter: {0}")]
     Unsupported(String),
     /// A file could not be read or written.
-    #[error("{}", path.display())]
+    #[error("{}: {error}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// What the system said.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// A PNG file could not be encoded.
-    #[error("{}: PNG encoding", path.display())]
+    #[error("{}: PNG encoding: {error}", path.display())]
     PngEncode {
         /// The file.
         path: PathBuf,
         /// What the encoder said.
-        #[source]
-        source: png::EncodingError,
+        error: png::EncodingError,
     },
     /// A PNG file could not be decoded (or holds a layout we do not read).
-    #[error("{}: PNG decoding", path.display())]
+    #[error("{}: PNG decoding: {error}", path.display())]
     PngDecode {
         /// The file.
         path: PathBuf,
         /// What the decoder said.
-        #[source]
-        source: png::DecodingError,
+        error: png::DecodingError,
+    },
+    /// An image file that cannot be a block texture (not square, not a power of two,
+    /// too large).
+    #[error("{}: {error}", path.display())]
+    Image {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        error: voxel_core::Error,
     },
     /// wgpu reported a validation or out-of-memory error for an operation of ours.
-    #[error("GPU {operation} failed")]
+    #[error("GPU {operation} failed: {error}")]
     Gpu {
         /// What we were doing.
         operation: &'static str,
         /// wgpu's error.
-        #[source]
-        source: wgpu::Error,
+        error: wgpu::Error,
     },
     /// Waiting for the GPU failed (device lost, timeout).
-    #[error("waiting for the GPU")]
-    Poll(#[from] wgpu::PollError),
+    #[error("waiting for the GPU: {0}")]
+    Poll(wgpu::PollError),
     /// Mapping a buffer to read results back failed.
-    #[error("reading GPU results back")]
-    Readback(#[from] wgpu::BufferAsyncError),
+    #[error("reading GPU results back: {0}")]
+    Readback(wgpu::BufferAsyncError),
     /// A mapped buffer's contents could not be accessed.
-    #[error("reading GPU results back")]
-    MapRange(#[from] wgpu::MapRangeError),
+    #[error("reading GPU results back: {0}")]
+    MapRange(wgpu::MapRangeError),
     /// A readback finished but its data cannot be what the GPU wrote (wrong length).
     #[error("reading GPU results back: {0}")]
     ReadbackData(String),
@@ -121,6 +128,26 @@ pub enum Error {
         /// What wgpu said: the reason and its message.
         reason: String,
     },
+}
+
+/// The conversions `?` uses; by hand, because `#[from]` would also make the wrapped error
+/// the [`std::error::Error::source`], which the message already carries.
+macro_rules! from {
+    ($($variant:ident($ty:ty),)*) => {$(
+        impl From<$ty> for Error {
+            fn from(e: $ty) -> Self {
+                Error::$variant(e)
+            }
+        }
+    )*};
+}
+
+from! {
+    Device(wgpu::RequestDeviceError),
+    World(voxel_core::Error),
+    Poll(wgpu::PollError),
+    Readback(wgpu::BufferAsyncError),
+    MapRange(wgpu::MapRangeError),
 }
 
 /// `Result` with this crate's [`Error`] as the default error.
@@ -155,7 +182,45 @@ pub fn scoped<T>(
     let validation = pollster::block_on(validation.pop());
     let oom = pollster::block_on(oom.pop());
     match validation.or(oom) {
-        Some(source) => Err(Error::Gpu { operation, source }),
+        Some(error) => Err(Error::Gpu { operation, error }),
         None => Ok(value),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::error::Error as _;
+
+    /// Every message carries its detail, and no source repeats it.
+    #[test]
+    fn messages_carry_their_detail() {
+        let world = Error::from(voxel_core::Error::TooManyBlocks);
+        assert_eq!(
+            world.to_string(),
+            "world: the registry is full (65536 blocks)"
+        );
+        let io = Error::Io {
+            path: "a/b.png".into(),
+            error: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        };
+        assert_eq!(io.to_string(), "a/b.png: no such file");
+        let image = Error::Image {
+            path: "c.png".into(),
+            error: voxel_core::Error::InvalidImage("12x12 texels".into()),
+        };
+        assert_eq!(
+            image.to_string(),
+            "c.png: invalid block image: 12x12 texels"
+        );
+        let decode = Error::PngDecode {
+            path: "d.png".into(),
+            error: png::DecodingError::LimitsExceeded,
+        };
+        assert!(decode.to_string().starts_with("d.png: PNG decoding: "));
+        assert!(decode.to_string().len() > "d.png: PNG decoding: ".len());
+        for e in [world, io, image, decode] {
+            assert!(e.source().is_none(), "{e}");
+        }
     }
 }

@@ -463,7 +463,8 @@ pub enum Depth<'a> {
 }
 
 impl<'a> Depth<'a> {
-    fn attachment(self) -> Option<wgpu::RenderPassDepthStencilAttachment<'a>> {
+    /// The pass attachment (`None` for [`Depth::None`]).
+    pub fn attachment(self) -> Option<wgpu::RenderPassDepthStencilAttachment<'a>> {
         let ops = |load| {
             Some(wgpu::Operations {
                 load,
@@ -549,6 +550,57 @@ impl<'a> Pass<'a> {
             t.end(encoder, q);
         }
     }
+}
+
+/// The depth state of a pipeline a game draws over a finished frame, tested against the
+/// frame's depth (`Renderer::scene_depth`, attached read-only): reverse-Z, so nearer is
+/// greater, and positions camera-relative (`Camera::view_proj` of `Renderer::drawn_camera`).
+pub fn overlay_depth() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: crate::DEPTH_FORMAT,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::GreaterEqual),
+        stencil: wgpu::StencilState::default(),
+        bias: wgpu::DepthBiasState::default(),
+    }
+}
+
+/// A pipeline a game draws over a finished frame into `format` (the renderer's output):
+/// its vertex shader makes positions from vertex indices (no vertex buffers), its bind
+/// groups are laid out from the shader, and with `depth_tested` it is tested against the
+/// frame's depth ([`overlay_depth`]). What the window example's selection box and HUD use.
+pub fn overlay_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    entry_points: (&str, &str),
+    format: wgpu::TextureFormat,
+    topology: wgpu::PrimitiveTopology,
+    depth_tested: bool,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(entry_points.1),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(entry_points.0),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(entry_points.1),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        primitive: wgpu::PrimitiveState {
+            topology,
+            ..Default::default()
+        },
+        depth_stencil: depth_tested.then(overlay_depth),
+        multisample: wgpu::MultisampleState::default(),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// Submits what `encoder` holds and replaces it with a fresh one, so that a technique can

@@ -45,7 +45,7 @@ pub use oit::{
     TranslucentTechnique, WboitReport, WboitSettings, WeightFit, WeightFunction,
 };
 pub use readback::Image;
-pub use renderer::{ChunkMemory, FrameStats, Renderer, RendererConfig};
+pub use renderer::{ChunkMemory, FrameStats, Lighting, OUTPUT_FORMATS, Renderer, RendererConfig};
 pub use stages::{
     DEPTH_COMPARE, GameFrame, GameStages, NoGame, OIT_GROUP, Stages, TranslucentContract,
     TranslucentObject, TranslucentVariant,
@@ -57,6 +57,6 @@ pub use timing::{GpuPass, GpuTimes, Timer};
 
 /// Depth format of every pass: 32-bit float, reverse-Z (1 near, 0 far).
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// The HDR scene colour format (seed 003): opaque image, composites, before tonemapping.
+/// The HDR scene colour format: opaque image, composites, before tonemapping.
 pub const SCENE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub use bindings::{AO_DEPTH, OPAQUE_EXPANSION_PX, TONEMAP_SHOULDER};

@@ -29,16 +29,16 @@ impl Image {
 
     /// Writes the image as an sRGB PNG, creating parent folders.
     pub fn save_png(&self, path: &Path) -> Result<()> {
-        let io = |source| Error::Io {
+        let io = |error| Error::Io {
             path: path.to_owned(),
-            source,
+            error,
         };
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(io)?;
         }
-        let png = |source| Error::PngEncode {
+        let png = |error| Error::PngEncode {
             path: path.to_owned(),
-            source,
+            error,
         };
         // Encoded in memory and written in one call whose result is checked: a buffered
         // file writer dropped at the end would lose the error of its last flush (a full
@@ -56,13 +56,13 @@ impl Image {
 
     /// Reads an 8-bit PNG (grey, RGB or RGBA; palettes expanded).
     pub fn load_png(path: &Path) -> Result<Self> {
-        let file = std::fs::File::open(path).map_err(|source| Error::Io {
+        let file = std::fs::File::open(path).map_err(|error| Error::Io {
             path: path.to_owned(),
-            source,
+            error,
         })?;
-        let png = |source| Error::PngDecode {
+        let png = |error| Error::PngDecode {
             path: path.to_owned(),
-            source,
+            error,
         };
         let mut dec = png::Decoder::new(std::io::BufReader::new(file));
         dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
@@ -154,6 +154,33 @@ pub fn read_texture(
     Ok(out)
 }
 
+/// Copies a whole single-sample 2D texture of 8-bit RGBA or BGRA (sRGB or not) to the CPU
+/// as an [`Image`] (BGRA swizzled to RGBA, bytes as stored). Blocks until the GPU is done.
+/// Another format is an error naming it. The texture needs `COPY_SRC` usage.
+pub fn read_image(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Image> {
+    use wgpu::TextureFormat as F;
+    let bgra = match texture.format() {
+        F::Rgba8Unorm | F::Rgba8UnormSrgb => false,
+        F::Bgra8Unorm | F::Bgra8UnormSrgb => true,
+        other => {
+            return Err(Error::Output(format!(
+                "format {other:?}: only 8-bit RGBA and BGRA textures are read as images"
+            )));
+        }
+    };
+    let mut rgba = read_texture(ctx, texture, 4)?;
+    if bgra {
+        for p in rgba.chunks_exact_mut(4) {
+            p.swap(0, 2);
+        }
+    }
+    Ok(Image {
+        width: texture.width(),
+        height: texture.height(),
+        rgba,
+    })
+}
+
 /// Maps a `MAP_READ` buffer, waits, and copies its contents out.
 pub fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     ctx.check_device()?;
@@ -239,9 +266,10 @@ const MAPPED: u8 = 2;
 const FAILED: u8 = 3;
 
 /// A query set whose results are copied to the CPU without stalling: resolved and copied
-/// at the end of a frame's commands, mapped once those are submitted, read a frame or more
-/// later (or at once with [`QueryReadback::wait`]). While one copy is in flight, further
-/// copies are skipped rather than waited for.
+/// at the end of a frame's commands, mapped when those are submitted (nothing to call),
+/// read a frame or more later (or at once with [`QueryReadback::wait`]). While one copy is
+/// in flight, further copies are skipped rather than waited for; a copy whose encoder is
+/// dropped unsubmitted frees the buffer again.
 #[derive(Debug)]
 pub struct QueryReadback {
     set: wgpu::QuerySet,
@@ -249,7 +277,19 @@ pub struct QueryReadback {
     readback: wgpu::Buffer,
     state: std::sync::Arc<std::sync::atomic::AtomicU8>,
     pending: u32,
-    copied: bool,
+}
+
+/// Held by a copy's deferred mapping: dropped without the mapping having run (its encoder
+/// was dropped unsubmitted), it frees the readback buffer for the next copy.
+struct Mapping(std::sync::Arc<std::sync::atomic::AtomicU8>);
+
+impl Drop for Mapping {
+    fn drop(&mut self) {
+        use std::sync::atomic::Ordering;
+        let _ = self
+            .0
+            .compare_exchange(MAPPING, IDLE, Ordering::AcqRel, Ordering::Acquire);
+    }
 }
 
 impl QueryReadback {
@@ -280,7 +320,6 @@ impl QueryReadback {
             ),
             state: std::sync::Arc::new(std::sync::atomic::AtomicU8::new(IDLE)),
             pending: 0,
-            copied: false,
         }
     }
 
@@ -289,37 +328,30 @@ impl QueryReadback {
         &self.set
     }
 
-    /// Records the copy of queries `range` (to be read as results `0..len`), unless a copy
-    /// is already in flight. Returns whether it was recorded.
+    /// Records the copy of queries `range` (to be read as results `0..len`) and its
+    /// mapping when `encoder` is submitted, unless a copy is already in flight. Returns
+    /// whether it was recorded.
     pub fn copy(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         range: std::ops::Range<u32>,
     ) -> bool {
+        use std::sync::atomic::Ordering;
         let n = range.end.saturating_sub(range.start);
-        if n == 0 || self.copied || self.state.load(std::sync::atomic::Ordering::Acquire) != IDLE {
+        if n == 0 || self.state.load(Ordering::Acquire) != IDLE {
             return false;
         }
         encoder.resolve_query_set(&self.set, range, &self.resolve, 0);
         encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, u64::from(n) * 8);
         self.pending = n;
-        self.copied = true;
-        true
-    }
-
-    /// Starts mapping the recorded copy; call once its commands are submitted.
-    pub fn map(&mut self) {
-        if !std::mem::take(&mut self.copied) {
-            return;
-        }
-        use std::sync::atomic::Ordering;
         self.state.store(MAPPING, Ordering::Release);
-        let state = self.state.clone();
-        self.readback
-            .slice(..)
-            .map_async(wgpu::MapMode::Read, move |r| {
-                state.store(if r.is_ok() { MAPPED } else { FAILED }, Ordering::Release);
-            });
+        let mapping = Mapping(self.state.clone());
+        encoder.map_buffer_on_submit(&self.readback, wgpu::MapMode::Read, .., move |r| {
+            mapping
+                .0
+                .store(if r.is_ok() { MAPPED } else { FAILED }, Ordering::Release);
+        });
+        true
     }
 
     /// The results once mapped (`Ok(None)` until then; needs `device.poll` now and then),

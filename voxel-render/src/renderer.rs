@@ -1,5 +1,5 @@
-//! The renderer a game embeds: chunks on the GPU and the passes of a frame in seed 000's
-//! order: opaque (optional 4× MSAA, resolved), cutout, translucent (the selected technique,
+//! The renderer a game embeds: chunks on the GPU and the passes of a frame in the usual
+//! forward order: opaque (optional 4× MSAA, resolved), cutout, translucent (the selected technique,
 //! depth-tested read-only against the opaque depth), composite over the opaque colour,
 //! tonemap to the output format.
 
@@ -37,14 +37,20 @@ pub struct RendererConfig {
     pub width: u32,
     /// Output height in pixels, like `width`.
     pub height: u32,
-    /// Format of the textures `render` draws into. Default `Rgba8UnormSrgb`, what
-    /// offscreen readback and PNG files want; a window passes its surface format. It
-    /// must be a colour format the tonemap can write: float-sampled (not an integer or
-    /// depth format) and renderable on every adapter; another is an error at
-    /// [`Renderer::new`].
+    /// Format of the textures `render` draws into first (its tonemap pipeline is built
+    /// with the renderer). Default `Rgba8UnormSrgb`, what offscreen readback and PNG files
+    /// want. Any of [`OUTPUT_FORMATS`] works without changing this: an output of another
+    /// format gets its tonemap pipeline at its first frame (once per format, about a
+    /// millisecond), and this field follows the format drawn last.
     pub output_format: wgpu::TextureFormat,
+    /// The format of the views `render` is given, where they differ from their texture's:
+    /// the sRGB or linear twin of the texture's format (a surface configured with
+    /// `view_formats`). Default `None`: every view has its texture's format, which is
+    /// what wgpu gives unless asked otherwise. A view format the texture cannot have is
+    /// ignored.
+    pub output_view_format: Option<wgpu::TextureFormat>,
     /// 4× MSAA for the opaque and cutout passes. Default off: the translucent pass is
-    /// single-sampled anyway (seed 000) and lavapipe pays 4× for it.
+    /// single-sampled anyway and lavapipe pays 4× for it.
     pub msaa: bool,
     /// Transparency settings (technique and each technique's own settings).
     pub oit: OitConfig,
@@ -82,6 +88,7 @@ impl Default for RendererConfig {
             width: 1280,
             height: 720,
             output_format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            output_view_format: None,
             msaa: false,
             oit: OitConfig::default(),
             sun_dir: [0.35, 0.85, 0.4],
@@ -174,6 +181,109 @@ struct Post {
 
 const MSAA_SAMPLES: u32 = 4;
 
+/// The formats [`Renderer::render`] draws into: what surfaces offer (BGRA and RGBA, sRGB or
+/// not; 10-bit; half float, written linear) and what offscreen targets use. An sRGB format
+/// is encoded by the GPU, the 8- and 10-bit linear ones by the tonemap shader, so every
+/// one shows the same picture.
+pub const OUTPUT_FORMATS: [wgpu::TextureFormat; 6] = [
+    wgpu::TextureFormat::Rgba8UnormSrgb,
+    wgpu::TextureFormat::Rgba8Unorm,
+    wgpu::TextureFormat::Bgra8UnormSrgb,
+    wgpu::TextureFormat::Bgra8Unorm,
+    wgpu::TextureFormat::Rgb10a2Unorm,
+    wgpu::TextureFormat::Rgba16Float,
+];
+
+/// The format to draw an output texture of `format` with: `view` when it is given and is
+/// the texture's sRGB / linear twin ([`RendererConfig::output_view_format`]), else the
+/// texture's own.
+fn output_format(
+    view: Option<wgpu::TextureFormat>,
+    format: wgpu::TextureFormat,
+) -> wgpu::TextureFormat {
+    match view {
+        Some(v) if v.remove_srgb_suffix() == format.remove_srgb_suffix() => v,
+        _ => format,
+    }
+}
+
+/// Lighting a renderer draws with ([`Renderer::set_lighting`]); its fields are those of
+/// [`RendererConfig`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lighting {
+    /// Direction towards the sun (normalised on use).
+    pub sun_dir: [f32; 3],
+    /// Ambient share of the lighting, 0 to 1.
+    pub ambient: f32,
+    /// Sky colour (linear), what the background is cleared to.
+    pub sky: [f32; 3],
+}
+
+impl Lighting {
+    /// The first hour [`Lighting::daytime`] draws: sunrise.
+    pub const SUNRISE: f32 = 6.0;
+    /// The last hour [`Lighting::daytime`] draws: sunset.
+    pub const SUNSET: f32 = 18.0;
+
+    /// The lighting of [`RendererConfig::default`].
+    pub fn default_day() -> Self {
+        let c = RendererConfig::default();
+        Self {
+            sun_dir: c.sun_dir,
+            ambient: c.ambient,
+            sky: c.sky,
+        }
+    }
+
+    /// Daylight at `hour` (clamped to [`Lighting::SUNRISE`]..=[`Lighting::SUNSET`]): the
+    /// sun rises in the east (+x), stands highest in the south (+z) at noon and sets in
+    /// the west; the ambient share falls from 0.45 at noon to 0.2 at the horizon, and the
+    /// sky turns from light blue to a dusk orange. A model for a time-of-day control, not
+    /// an atmosphere.
+    pub fn daytime(hour: f32) -> Self {
+        let hour = if hour.is_finite() { hour } else { 12.0 };
+        let h = hour.clamp(Self::SUNRISE, Self::SUNSET);
+        // 0 at sunrise, pi at sunset.
+        let a = (h - Self::SUNRISE) / (Self::SUNSET - Self::SUNRISE) * std::f32::consts::PI;
+        // A path leaning toward the south (z = 0.47 y: at 10:30 this is the default
+        // lighting's sun within a few degrees), a few degrees above the horizon at either
+        // end so that the sides facing the sun keep some light.
+        let elevation = 0.08 + 0.92 * a.sin();
+        let sun = glam::Vec3::new(a.cos(), elevation, 0.47 * elevation).normalize_or(glam::Vec3::Y);
+        let day = glam::Vec3::from([0.45, 0.65, 0.9]);
+        let dusk = glam::Vec3::from([0.85, 0.45, 0.25]);
+        let t = a.sin().clamp(0.0, 1.0).sqrt();
+        Self {
+            sun_dir: sun.to_array(),
+            ambient: 0.2 + 0.25 * t,
+            sky: dusk.lerp(day, t).to_array(),
+        }
+    }
+
+    /// Checks the values: a finite non-zero sun direction, an ambient share from 0 to 1,
+    /// a finite sky colour of non-negative channels.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |what: String| Err(Error::InvalidSetting(what));
+        let sun = glam::Vec3::from(self.sun_dir);
+        if !sun.is_finite() || sun.length_squared() == 0.0 {
+            return bad(format!(
+                "sun direction {:?}: it must be finite and not zero",
+                self.sun_dir
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.ambient) {
+            return bad(format!("ambient {}: it must be from 0 to 1", self.ambient));
+        }
+        if !self.sky.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            return bad(format!(
+                "sky colour {:?}: every channel must be finite and not negative",
+                self.sky
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Draws a voxel world. See the module docs for the passes.
 #[derive(Debug)]
 pub struct Renderer {
@@ -218,6 +328,13 @@ impl Renderer {
         check_lighting(&config)?;
         config.oit.validate()?;
         check_ao_strength(config.ao_strength)?;
+        if !OUTPUT_FORMATS.contains(&config.output_format) {
+            return Err(Error::InvalidSetting(format!(
+                "output format {:?}: the renderer draws into {}",
+                config.output_format,
+                OUTPUT_FORMATS.map(|f| format!("{f:?}")).join(", ")
+            )));
+        }
         if config.msaa && !ctx.caps.msaa4 {
             log::warn!("4x MSAA is not supported for the scene formats: rendering without MSAA");
             config.msaa = false;
@@ -399,6 +516,25 @@ impl Renderer {
         config_with(&mut self.config.oit, self.oit.config());
     }
 
+    /// Builds `technique`'s pipelines and targets now, so that a later
+    /// [`Renderer::set_technique`] to it builds nothing and its first frame costs what any
+    /// frame costs (a game prepares the techniques its settings menu offers at loading
+    /// time). It stays built until [`Renderer::release_technique`]; see
+    /// [`OitManager::prebuild`]. Returns the technique built (after its fallback on this
+    /// adapter).
+    pub fn prebuild_technique(&mut self, technique: Technique) -> Result<Technique> {
+        let oit = &mut self.oit;
+        scoped(&self.ctx.device, "building a technique ahead", || {
+            oit.prebuild(technique)
+        })?
+    }
+
+    /// Frees what [`Renderer::prebuild_technique`] built for `technique`, unless it is
+    /// drawing.
+    pub fn release_technique(&mut self, technique: Technique) {
+        self.oit.release(technique);
+    }
+
     /// Changes the WBOIT weight function (a uniform: no pipeline is rebuilt).
     pub fn set_weight(&mut self, weight: WeightFunction) {
         let mut config = self.oit.config().clone();
@@ -438,6 +574,26 @@ impl Renderer {
         self.ctx.check_device()?;
         check_ao_strength(strength)?;
         self.config.ao_strength = strength;
+        Ok(())
+    }
+
+    /// The sun direction, ambient share and sky in force.
+    pub fn lighting(&self) -> Lighting {
+        Lighting {
+            sun_dir: self.config.sun_dir,
+            ambient: self.config.ambient,
+            sky: self.config.sky,
+        }
+    }
+
+    /// Changes the sun direction, ambient share and sky from the next frame on: they are
+    /// frame uniforms and the clear colour, so nothing is rebuilt and no chunk is uploaded
+    /// again. Invalid values ([`Lighting::validate`]) are an error and change nothing.
+    pub fn set_lighting(&mut self, lighting: Lighting) -> Result<()> {
+        lighting.validate()?;
+        self.config.sun_dir = lighting.sun_dir;
+        self.config.ambient = lighting.ambient;
+        self.config.sky = lighting.sky;
         Ok(())
     }
 
@@ -503,13 +659,15 @@ impl Renderer {
         scoped(&self.ctx.device, "resizing", || oit.resize(width, height))?
     }
 
-    /// GPU milliseconds per pass of the latest timed frame (empty without timestamps, and
-    /// once the device is lost). Needs `device.poll` now and then.
+    /// GPU milliseconds per pass of the latest timed frame whose results have arrived
+    /// (empty without timestamps, and once the device is lost). Results arrive a frame or
+    /// more after submission, once wgpu is polled (each `queue.submit` polls).
     pub fn gpu_times(&mut self) -> GpuTimes {
         if self.ctx.check_device().is_err() {
             return GpuTimes::default();
         }
-        self.timer.as_mut().map(Timer::poll).unwrap_or_default()
+        let ctx = &self.ctx;
+        self.timer.as_mut().map(|t| t.poll(ctx)).unwrap_or_default()
     }
 
     /// Like [`Renderer::gpu_times`], but waits for the last submitted frame's results
@@ -525,19 +683,12 @@ impl Renderer {
             .unwrap_or_default()
     }
 
-    /// Call after submitting a frame's encoder: starts reading its GPU timings (and the
-    /// technique's own counters) back, and frees for reuse the arena places the frame
-    /// drew that were freed meanwhile (without this call, the next `render` frees them).
-    /// Does nothing once the device is lost.
+    /// Optional, after submitting a frame's encoder: frees for reuse now the arena places
+    /// the frame drew that were freed meanwhile (the next `render` frees them otherwise).
+    /// GPU timings and a technique's counters need no call: they are read back once a
+    /// frame's commands are submitted.
     pub fn after_submit(&mut self) {
         self.chunks.frame_submitted(&self.ctx);
-        if self.ctx.check_device().is_err() {
-            return;
-        }
-        if let Some(t) = &mut self.timer {
-            t.after_submit();
-        }
-        self.oit.after_submit();
     }
 
     /// The HDR scene colour (after the composite, before tonemapping).
@@ -550,12 +701,21 @@ impl Renderer {
         &self.targets.depth.texture
     }
 
+    /// A view of [`Renderer::scene_depth`], for a game's pass that draws over the frame
+    /// tested against it (attached read-only, [`gpu::Depth::ReadOnly`], with
+    /// [`gpu::overlay_depth`]). Valid until the next resize.
+    pub fn scene_depth_view(&self) -> &wgpu::TextureView {
+        &self.targets.depth.view
+    }
+
     /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of
-    /// mip level 0 of a single-layer, single-sample 2D texture of the renderer's size
-    /// with `RENDER_ATTACHMENT` usage, whose format is [`RendererConfig::output_format`]
-    /// (or its sRGB / linear twin, viewed as that format): a 2D view of the whole
-    /// texture (a 2D-array view of its one layer draws the same). Anything else is an
-    /// [`Error::Output`] before anything is recorded.
+    /// mip level 0 of a single-layer, single-sample 2D texture of the renderer's size,
+    /// of one of [`OUTPUT_FORMATS`], with `RENDER_ATTACHMENT` usage. The view has its
+    /// texture's format, or [`RendererConfig::output_view_format`] when that is the
+    /// texture's twin. Anything else is an [`Error::Output`] before anything is recorded.
+    ///
+    /// Nothing needs calling after the frame's commands are submitted: GPU timings and
+    /// a technique's counters (depth peeling's layers) are read back once they are.
     ///
     /// Fails without recording anything on an invalid camera (NaN, zero direction, bad
     /// planes), a mismatched output ([`Error::Output`]) or a lost device
@@ -600,8 +760,24 @@ impl Renderer {
     ) -> Result<FrameStats> {
         self.ctx.check_device()?;
         camera.validate()?;
-        self.check_output(output)?;
+        // The output's format (its tonemap pipeline made the first time), checked with it.
+        let format = output_format(self.config.output_view_format, output.texture().format());
+        if OUTPUT_FORMATS.contains(&format) {
+            self.post.make_tonemap(&self.ctx, format);
+        }
+        self.check_output(output, format)?;
+        if format != self.config.output_format {
+            log::info!(
+                "drawing into {format:?} from now on (was {:?})",
+                self.config.output_format
+            );
+            self.config.output_format = format;
+        }
         let start = Instant::now();
+        // Ends the last timed frame if it was submitted since; this one is timed unless
+        // it is not.
+        let ctx = &self.ctx;
+        let timed = self.timer.as_mut().is_some_and(|t| t.begin_frame(ctx));
         self.update_fades();
         // The previous frame is submitted (the contract above): what it drew may be reused.
         self.chunks.frame_submitted(&self.ctx);
@@ -709,7 +885,7 @@ impl Renderer {
         };
         let [opaque, cutout, translucent] = &lists;
 
-        let timer = self.timer.as_ref();
+        let timer = self.timer.as_ref().filter(|_| timed);
         let t = &self.targets;
         let game_opaque = stages.opaque.then_some((game, &game_frame));
         self.draw_opaque(encoder, &draws, opaque, cutout, game_opaque, timer);
@@ -776,8 +952,8 @@ impl Renderer {
             game_objects_sorted: order.len(),
             game_sort_ms,
         };
-        if let Some(t) = &mut self.timer {
-            t.resolve(encoder);
+        if timed && let Some(t) = &mut self.timer {
+            t.end_frame(&self.ctx, encoder);
         }
         Ok(FrameStats {
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
@@ -820,7 +996,6 @@ impl Renderer {
             });
         let stats = self.render_with(&mut encoder, output, camera, game)?;
         self.ctx.queue.submit([encoder.finish()]);
-        self.after_submit();
         Ok(stats)
     }
 
@@ -829,9 +1004,12 @@ impl Renderer {
     /// view knows (its mip level, dimension and format; wgpu does not expose them) by
     /// recording the tonemap's pass into a throwaway encoder inside an error scope, beside
     /// the scene depth (the renderer's size, so that a view of another level fails).
-    fn check_output(&mut self, output: &wgpu::TextureView) -> Result<()> {
+    fn check_output(
+        &mut self,
+        output: &wgpu::TextureView,
+        want: wgpu::TextureFormat,
+    ) -> Result<()> {
         let t = output.texture();
-        let want = self.config.output_format;
         let (w, h) = self.size();
         if (t.width(), t.height()) != (w, h) {
             return Err(Error::Output(format!(
@@ -840,10 +1018,11 @@ impl Renderer {
                 t.height()
             )));
         }
-        if t.format() != want && t.format().remove_srgb_suffix() != want.remove_srgb_suffix() {
+        if !OUTPUT_FORMATS.contains(&t.format()) {
             return Err(Error::Output(format!(
-                "format {:?}, but the renderer was made for {want:?} (RendererConfig::output_format)",
-                t.format()
+                "format {:?}: the renderer draws into {} (last {want:?})",
+                t.format(),
+                OUTPUT_FORMATS.map(|f| format!("{f:?}")).join(", ")
             )));
         }
         if !t.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
@@ -885,7 +1064,7 @@ impl Renderer {
         }
         checked.map_err(|e| {
             let why = match &e {
-                Error::Gpu { source, .. } => source.to_string(),
+                Error::Gpu { error, .. } => error.to_string(),
                 other => other.to_string(),
             };
             Error::Output(format!(
@@ -1153,6 +1332,8 @@ impl Post {
     fn make_tonemap(&mut self, ctx: &GpuContext, format: wgpu::TextureFormat) {
         let layout = &self.tonemap_layout;
         self.tonemap.entry(format).or_insert_with(|| {
+            // sRGB formats are encoded by the GPU, a float one is written linear.
+            let encode = !(format.is_srgb() || format == wgpu::TextureFormat::Rgba16Float);
             let make = |label, writes_depth| {
                 FullscreenPipeline {
                     label,
@@ -1165,7 +1346,7 @@ impl Post {
                         write_mask: wgpu::ColorWrites::ALL,
                     })],
                     writes_depth,
-                    constants: &[("SRGB_ENCODE", if format.is_srgb() { 0.0 } else { 1.0 })],
+                    constants: &[("SRGB_ENCODE", if encode { 1.0 } else { 0.0 })],
                 }
                 .build(&ctx.device)
             };
@@ -1240,6 +1421,7 @@ impl SceneTargets {
                     wgpu::BindingResource::TextureView(&scene.textures.view),
                     wgpu::BindingResource::Sampler(&scene.textures.sampler),
                     wgpu::BindingResource::TextureView(&boundary.view),
+                    scene.textures.layers.as_entire_binding(),
                 ],
             )
         };
@@ -1275,6 +1457,9 @@ impl SceneTargets {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use wgpu::TextureFormat as F;
+
     /// A game moves the renderer to a render thread or keeps it in an ECS resource: it must
     /// be `Send` (this fails to compile otherwise).
     #[test]
@@ -1282,5 +1467,39 @@ mod tests {
         fn send<T: Send>() {}
         send::<super::Renderer>();
         send::<crate::ChunkStreamer>();
+    }
+
+    #[test]
+    fn a_view_has_its_texture_format_unless_a_twin_is_declared() {
+        assert_eq!(output_format(None, F::Bgra8Unorm), F::Bgra8Unorm);
+        assert_eq!(output_format(None, F::Rgba8UnormSrgb), F::Rgba8UnormSrgb);
+        let srgb = Some(F::Bgra8UnormSrgb);
+        assert_eq!(output_format(srgb, F::Bgra8Unorm), F::Bgra8UnormSrgb);
+        assert_eq!(
+            output_format(srgb, F::Rgba8Unorm),
+            F::Rgba8Unorm,
+            "not its twin"
+        );
+    }
+
+    #[test]
+    fn daytime_lighting_is_valid_and_follows_the_sun() {
+        let noon = Lighting::daytime(12.0);
+        let dusk = Lighting::daytime(Lighting::SUNSET);
+        for hour in [f32::NAN, -5.0, 6.0, 9.0, 12.0, 15.0, 18.0, 30.0] {
+            Lighting::daytime(hour).validate().unwrap();
+        }
+        assert!(noon.sun_dir[1] > 0.9 && dusk.sun_dir[1] < 0.2 && dusk.sun_dir[1] > 0.0);
+        assert!(
+            Lighting::daytime(8.0).sun_dir[0] > 0.0,
+            "morning sun in the east"
+        );
+        assert!(
+            Lighting::daytime(16.0).sun_dir[0] < 0.0,
+            "afternoon sun in the west"
+        );
+        assert!(noon.ambient > dusk.ambient);
+        assert!(dusk.sky[0] > dusk.sky[2] && noon.sky[2] > noon.sky[0]);
+        Lighting::default_day().validate().unwrap();
     }
 }

@@ -5,8 +5,18 @@
 //!
 //! Passes are named by [`GpuPass`]; passes of the same kind (the many passes of depth
 //! peeling) add up.
+//!
+//! Nothing needs to be called once a frame is submitted: the frame's encoder carries a
+//! mapping of a small sentinel buffer that wgpu starts when the encoder is submitted
+//! (`map_buffer_on_submit`), and the next frame (or [`Timer::poll`]) sees it and ends the
+//! profiler's frame, which wgpu-profiler allows only after submission. A frame recorded
+//! while the previous one is still unsubmitted (two frames in one encoder) goes untimed;
+//! a frame whose encoder was dropped unsubmitted is ended and its results discarded.
 
+use std::collections::VecDeque;
 use std::fmt;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
 
 use wgpu_profiler::{GpuProfiler, GpuProfilerQuery, GpuProfilerSettings, GpuTimerQueryResult};
 
@@ -101,11 +111,50 @@ impl GpuTimes {
     }
 }
 
+/// A sentinel's state: idle, waiting for its encoder's submission, submitted (its mapping
+/// ran, successfully or not), or dropped with its encoder unsubmitted.
+const IDLE: u8 = 0;
+const WAITING: u8 = 1;
+const MAPPED: u8 = 2;
+const SUBMITTED: u8 = 3;
+const DROPPED: u8 = 4;
+
+/// A frame's submission signal: an 8-byte buffer mapped when the frame's encoder is
+/// submitted.
+#[derive(Debug)]
+struct Sentinel {
+    buffer: wgpu::Buffer,
+    state: Arc<AtomicU8>,
+}
+
+/// Held by the deferred mapping's callback: a callback dropped without running means its
+/// encoder was dropped without being submitted.
+struct Signal(Arc<AtomicU8>);
+
+impl Drop for Signal {
+    fn drop(&mut self) {
+        let _ = self
+            .0
+            .compare_exchange(WAITING, DROPPED, Ordering::AcqRel, Ordering::Acquire);
+    }
+}
+
+/// Profiler frames ended and not yet read back, at most: below wgpu-profiler's
+/// `max_num_pending_frames`, so that it never drops one (our discard flags stay in step).
+const MAX_PENDING_FRAMES: usize = 4;
+
 /// Timestamp queries around the passes of each frame, and the latest results.
 pub struct Timer {
     profiler: GpuProfiler,
     period: f32,
     latest: GpuTimes,
+    /// The last timed frame's signal, until its submission is seen.
+    waiting: Option<Sentinel>,
+    /// Sentinels to reuse.
+    idle: Vec<Sentinel>,
+    /// Per profiler frame ended and not yet read back, oldest first: whether to discard it
+    /// (its encoder was dropped unsubmitted).
+    ended: VecDeque<bool>,
 }
 
 impl fmt::Debug for Timer {
@@ -125,6 +174,7 @@ impl Timer {
         }
         let settings = GpuProfilerSettings {
             enable_debug_groups: false,
+            max_num_pending_frames: MAX_PENDING_FRAMES + 1,
             ..GpuProfilerSettings::default()
         };
         match GpuProfiler::new(&ctx.device, settings) {
@@ -132,6 +182,9 @@ impl Timer {
                 profiler,
                 period: ctx.queue.get_timestamp_period(),
                 latest: GpuTimes::default(),
+                waiting: None,
+                idle: Vec::new(),
+                ended: VecDeque::new(),
             }),
             Err(e) => {
                 log::warn!("GPU pass timing off: {e}");
@@ -155,34 +208,94 @@ impl Timer {
         self.profiler.end_query(encoder, query);
     }
 
-    /// Records the copy of the frame's timestamps at the end of `encoder`.
-    pub fn resolve(&mut self, encoder: &mut wgpu::CommandEncoder) {
+    /// Whether the next frame can be timed: ends the last timed frame if its encoder has
+    /// been submitted (or dropped) since, and reads back what has arrived. False while
+    /// that encoder is still unsubmitted, or too many frames are still in flight.
+    pub fn begin_frame(&mut self, ctx: &GpuContext) -> bool {
+        self.settle(ctx);
+        self.poll_profiler();
+        self.waiting.is_none() && self.ended.len() < MAX_PENDING_FRAMES
+    }
+
+    /// Records the copy of the frame's timestamps at the end of `encoder`, and the signal
+    /// of its submission.
+    pub fn end_frame(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
         self.profiler.resolve_queries(encoder);
+        let sentinel = self.idle.pop().unwrap_or_else(|| Sentinel {
+            buffer: ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("timing_sentinel"),
+                size: 8,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            state: Arc::new(AtomicU8::new(IDLE)),
+        });
+        sentinel.state.store(WAITING, Ordering::Release);
+        let signal = Signal(sentinel.state.clone());
+        encoder.map_buffer_on_submit(&sentinel.buffer, wgpu::MapMode::Read, .., move |r| {
+            let state = if r.is_ok() { MAPPED } else { SUBMITTED };
+            signal.0.store(state, Ordering::Release);
+        });
+        self.waiting = Some(sentinel);
     }
 
-    /// Call once the encoder given to [`Timer::resolve`] is submitted: starts reading the
-    /// frame's timestamps back.
-    pub fn after_submit(&mut self) {
-        if let Err(e) = self.profiler.end_frame() {
-            log::warn!("GPU pass timing lost a frame: {e}");
+    /// Ends the profiler frame of the last timed frame once its encoder was submitted
+    /// (wgpu-profiler maps its buffers then) or dropped (its results are discarded).
+    fn settle(&mut self, ctx: &GpuContext) {
+        let Some(sentinel) = &self.waiting else {
+            return;
+        };
+        if sentinel.state.load(Ordering::Acquire) == WAITING {
+            // A submitted encoder's mapping of the (otherwise unused) sentinel completes
+            // at the next poll.
+            let _ = ctx.device.poll(wgpu::PollType::Poll);
+        }
+        let discard = match sentinel.state.load(Ordering::Acquire) {
+            MAPPED => {
+                sentinel.buffer.unmap();
+                false
+            }
+            SUBMITTED => false,
+            DROPPED => true,
+            _ => return,
+        };
+        if let Some(sentinel) = self.waiting.take() {
+            sentinel.state.store(IDLE, Ordering::Release);
+            self.idle.push(sentinel);
+        }
+        match self.profiler.end_frame() {
+            Ok(()) => self.ended.push_back(discard),
+            Err(e) => log::warn!("GPU pass timing lost a frame: {e}"),
         }
     }
 
-    /// Takes finished frames, if any, and returns the latest results. Needs
-    /// `device.poll` to be called now and then.
-    pub fn poll(&mut self) -> GpuTimes {
+    fn poll_profiler(&mut self) {
         while let Some(results) = self.profiler.process_finished_frame(self.period) {
-            self.latest = Self::sum(&results);
+            if !self.ended.pop_front().unwrap_or(false) {
+                self.latest = Self::sum(&results);
+            }
         }
+    }
+
+    /// Takes finished frames, if any, and returns the latest results. Results arrive
+    /// when the GPU is done and wgpu has been polled (each `queue.submit` polls).
+    pub fn poll(&mut self, ctx: &GpuContext) -> GpuTimes {
+        self.settle(ctx);
+        self.poll_profiler();
         self.latest
     }
 
-    /// Waits for the GPU, then [`Timer::poll`].
+    /// Waits for the GPU, then [`Timer::poll`]: the last submitted frame's results.
     pub fn read_blocking(&mut self, ctx: &GpuContext) -> GpuTimes {
-        if let Err(e) = ctx.device.poll(wgpu::PollType::wait_indefinitely()) {
-            log::warn!("waiting for GPU timings: {e}");
-        }
-        self.poll()
+        let wait = || {
+            if let Err(e) = ctx.device.poll(wgpu::PollType::wait_indefinitely()) {
+                log::warn!("waiting for GPU timings: {e}");
+            }
+        };
+        wait();
+        self.settle(ctx);
+        wait();
+        self.poll(ctx)
     }
 
     fn sum(results: &[GpuTimerQueryResult]) -> GpuTimes {

@@ -10,7 +10,6 @@
 mod display;
 mod panel;
 mod post;
-mod raycast;
 
 use std::collections::HashSet;
 use std::path::PathBuf;
@@ -22,8 +21,8 @@ use voxel_core::{BlockId, BlockRegistry, ChunkPos, RenderClass, TerrainConfig, T
 use voxel_lab::{chain, scene};
 use voxel_mesh::ChunkMeshes;
 use voxel_render::{
-    Camera, ChunkSink, ChunkStreamer, FrameStats, GpuContext, GpuTimes, Image, OitConfig, Renderer,
-    RendererConfig, StreamConfig, StreamFrame, Technique, readback,
+    Camera, ChunkSink, ChunkStreamer, FrameStats, GpuContext, GpuTimes, Image, Lighting, OitConfig,
+    Renderer, RendererConfig, StreamConfig, StreamFrame, Technique, readback,
 };
 use winit::application::ApplicationHandler;
 use winit::event::{DeviceEvent, ElementState, MouseButton, WindowEvent};
@@ -33,7 +32,6 @@ use winit::window::{Window, WindowId};
 
 use display::Display;
 use post::{FRAME_FORMAT, Frames, Post};
-pub use raycast::raycast;
 
 /// How the demo starts, and what a scripted run does.
 #[derive(Clone, Debug)]
@@ -234,6 +232,8 @@ struct Settings {
     view_distance: u32,
     heatmap: bool,
     place: BlockId,
+    /// Time of day in hours (`Lighting::daytime`), or `None` for the default lighting.
+    hour: Option<f32>,
 }
 
 /// egui's state.
@@ -390,6 +390,7 @@ impl Gfx {
             view_distance,
             heatmap: opts.heatmap,
             place: voxel_core::blocks::GLASS,
+            hour: None,
         };
         let (w, h) = display.size();
         let config = RendererConfig {
@@ -597,20 +598,22 @@ impl Gfx {
             .map(|c| c.forward)
             .unwrap_or(DVec3::NEG_Z);
         let world = self.streaming.streamer.world();
-        let registry = world.registry().clone();
-        let solid = |p| {
-            registry
-                .class(world.get_block(p))
-                .is_ok_and(|c| c != RenderClass::Air)
+        let visible = RenderClass::VISIBLE;
+        let hit = match world.raycast(f.eye.to_array(), dir.to_array(), 64.0, &visible) {
+            Ok(Some(hit)) => hit,
+            Ok(None) => {
+                self.status.message = "nothing to edit within 64 blocks".into();
+                return;
+            }
+            Err(e) => {
+                self.status.message = e.to_string();
+                return;
+            }
         };
-        let Some((hit, before)) = raycast(f.eye, dir, 64.0, solid) else {
-            self.status.message = "nothing to edit within 64 blocks".into();
-            return;
-        };
-        let (pos, id) = if place {
-            (before, self.settings.place)
-        } else {
-            (hit, BlockId::AIR)
+        let (pos, id) = match (place, hit.adjacent()) {
+            (true, Some(before)) => (before, self.settings.place),
+            (true, None) => return,
+            (false, _) => (hit.pos, BlockId::AIR),
         };
         if let Err(e) = self.streaming.streamer.set_block(pos, id) {
             self.status.message = chain(&e);
@@ -687,6 +690,13 @@ impl Gfx {
         }
         if s.fade_in_frames != a.fade_in_frames {
             self.renderer.set_fade_in_frames(s.fade_in_frames);
+        }
+        if s.hour != a.hour {
+            // Uniforms only: applied at the next frame, no chunk uploaded again.
+            let lighting = s.hour.map_or_else(Lighting::default_day, Lighting::daytime);
+            for r in std::iter::once(&mut self.renderer).chain(self.reference.as_mut()) {
+                r.set_lighting(lighting).map_err(|e| chain(&e))?;
+            }
         }
         if s.heatmap && self.reference.is_none() {
             self.reference = Some(self.reference_renderer()?);
@@ -791,10 +801,8 @@ impl Gfx {
             .queue
             .submit(extra.into_iter().chain([encoder.finish()]));
         self.ui.free(&panel.free);
-        self.renderer.after_submit();
-        if let Some(r) = &mut self.reference {
-            r.after_submit();
-        }
+        // Nothing to call after the submit: the renderers read their timings and counters
+        // back once the frame's commands are submitted.
         self.display.window.pre_present_notify();
         self.ctx.queue.present(surface_texture);
         let _ = self.ctx.device.poll(wgpu::PollType::Poll);

@@ -6,11 +6,14 @@
 
 use std::path::PathBuf;
 
-use voxel_render::{BayerSize, GpuContext, Technique, WeightFunction};
+use voxel_render::{BayerSize, GpuContext, Lighting, Technique, WeightFunction};
 use winit::window::Window;
 
 use super::post::FRAME_FORMAT;
 use super::{Gfx, PanelFrame, Ui};
+
+/// Where the time-of-day slider starts: mid-morning, close to the default lighting.
+const DEFAULT_HOUR: f32 = 10.5;
 
 impl Ui {
     pub(super) fn new(window: &Window, ctx: &GpuContext) -> Self {
@@ -197,6 +200,13 @@ impl Gfx {
             egui::Slider::new(&mut s.view_distance, 1..=super::MAX_VIEW_DISTANCE)
                 .text("view distance (chunks)"),
         );
+        // The default lighting until the slider is moved; then the sun of that hour.
+        let mut hour = s.hour.unwrap_or(DEFAULT_HOUR);
+        let slider = egui::Slider::new(&mut hour, Lighting::SUNRISE..=Lighting::SUNSET)
+            .text("time of day (h)");
+        if ui.add(slider).changed() {
+            s.hour = Some(hour);
+        }
         let registry = self.streaming.streamer.world().registry().clone();
         egui::ComboBox::from_label("block to place")
             .selected_text(registry.get(s.place).map_or("?", |d| d.name.as_str()))

@@ -1,5 +1,4 @@
-//! Order-independent transparency behind one API: [`OitManager`] (seed 002's OITManager in
-//! Rust form) prepares and records the translucent passes and their composite for the
+//! Order-independent transparency behind one API: [`OitManager`] prepares and records the translucent passes and their composite for the
 //! selected [`Technique`].
 //!
 //! One folder per technique. Its type implements [`TranslucentTechnique`] (the hooks of a
@@ -40,7 +39,7 @@ pub use wboit::{WboitReport, WboitSettings};
 /// Declares [`Technique`] from the list of techniques: variant, command-line name, and the
 /// type (implementing [`TechniqueKind`]) that draws it.
 macro_rules! techniques {
-    ($( $(#[doc = $doc:literal])* $variant:ident = $name:literal => $kind:ty, )*) => {
+    ($( $(#[doc = $doc:literal])* $variant:ident = $name:literal => $kind:ty $([$stalls:ident])?, )*) => {
         /// A way to draw the translucent meshes.
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
         pub enum Technique {
@@ -53,12 +52,26 @@ macro_rules! techniques {
             $( $variant(<$kind as TechniqueKind>::Key), )*
         }
 
+        impl Key {
+            /// The technique this key builds.
+            fn technique(&self) -> Technique {
+                match self { $( Key::$variant(_) => Technique::$variant, )* }
+            }
+        }
+
         impl Technique {
             /// Number of techniques.
             pub const COUNT: usize = [$( stringify!($variant) ),*].len();
 
             /// Every technique, in the order menus and reports list them.
             pub const ALL: [Technique; Self::COUNT] = [$( Technique::$variant ),*];
+
+            /// Whether the technique waits for GPU results inside `Renderer::render`
+            /// (the exact references: hundreds of milliseconds a frame), so that it has no
+            /// place in a game's frame loop.
+            pub const fn stalls(self) -> bool {
+                match self { $( Technique::$variant => stall_flag!($($stalls)?), )* }
+            }
 
             /// The command-line name.
             pub fn name(self) -> &'static str {
@@ -101,27 +114,68 @@ macro_rules! techniques {
     };
 }
 
+/// `true` for a technique marked `[stalls]` in the list below.
+macro_rules! stall_flag {
+    () => {
+        false
+    };
+    (stalls) => {
+        true
+    };
+}
+
 techniques! {
     /// Translucent meshes are not drawn at all.
     OpaqueOnly = "opaque-only" => opaque_only::OpaqueOnly,
     /// Weighted blended OIT, one pass into two targets (MRT) with independent blend states.
     WboitMrt = "wboit-mrt" => wboit::Wboit,
-    /// Weighted blended OIT, two passes (seed 002): one per target. For adapters without
+    /// Weighted blended OIT, two passes: one per target. For adapters without
     /// independent blend.
     WboitTwoPass = "wboit-two-pass" => wboit::Wboit,
-    /// Screen-door transparency with a Bayer pattern (seed 001): the low-end mode.
+    /// Screen-door transparency with a Bayer pattern (Mulder, Groen & van Wijk 1998): the
+    /// low-end mode.
     Stipple = "stipple" => stipple::Stipple,
-    /// Alpha blending of chunks sorted back to front (seed 003): the baseline.
+    /// Alpha blending of chunks sorted back to front (the painter's order): the baseline.
     Sorted = "sorted" => sorted::Sorted,
     /// Like `Sorted`, with the quads inside each chunk sorted back to front too.
     SortedQuads = "sorted-quads" => sorted::Sorted,
-    /// Dual depth peeling of [`PeelingSettings::layers`] layers (seed 004).
+    /// Dual depth peeling of [`PeelingSettings::layers`] layers (Bavoil & Myers 2008).
     DepthPeeling = "depth-peeling" => peeling::Peeling,
     /// The exact reference: per-pixel sorted fragment lists (A-buffer). Stalls the GPU.
-    Reference = "reference" => reference::Reference,
+    Reference = "reference" => reference::Reference [stalls],
     /// The second exact method: front-to-back depth peeling until a pass writes nothing.
     /// Stalls the GPU once per layer.
-    PeelReference = "peel-reference" => peeling::Peeling,
+    PeelReference = "peel-reference" => peeling::Peeling [stalls],
+}
+
+/// How many techniques never stall.
+const REAL_TIME_COUNT: usize = {
+    let mut n = 0;
+    let mut i = 0;
+    while i < Technique::COUNT {
+        if !Technique::ALL[i].stalls() {
+            n += 1;
+        }
+        i += 1;
+    }
+    n
+};
+
+impl Technique {
+    /// Every technique that never waits for the GPU inside a frame ([`Technique::stalls`]
+    /// is false), in [`Technique::ALL`]'s order: the ones a game offers its players.
+    pub const REAL_TIME: [Technique; REAL_TIME_COUNT] = {
+        let mut out = [Technique::OpaqueOnly; REAL_TIME_COUNT];
+        let (mut i, mut n) = (0, 0);
+        while i < Technique::COUNT {
+            if !Technique::ALL[i].stalls() {
+                out[n] = Technique::ALL[i];
+                n += 1;
+            }
+            i += 1;
+        }
+        out
+    };
 }
 
 impl Technique {
@@ -310,9 +364,6 @@ pub trait TranslucentTechnique: fmt::Debug + Send {
         frame: &TranslucentFrame<'_>,
     ) -> Result<()>;
 
-    /// Called after the frame's commands were submitted (to start reading results back).
-    fn after_submit(&mut self) {}
-
     /// The passes a game's translucent pipelines must match (see [`crate::stages`]).
     fn variants(&self) -> Vec<TranslucentVariant>;
 
@@ -332,15 +383,23 @@ pub trait TranslucentTechnique: fmt::Debug + Send {
     }
 }
 
-/// Owns the active technique and records its passes (seed 002's OITManager API: created
-/// with the device and a config; `resize`; the accumulation and revealage targets;
+/// Owns the active technique and records its passes (the life cycle of an engine's OIT
+/// manager: created with the device and a config; `resize`; the accumulation and revealage targets;
 /// `render` records the translucent pass and composite; resources freed on drop).
 #[derive(Debug)]
 pub struct OitManager {
     setup: Setup,
     config: OitConfig,
-    /// Created on the first frame that has translucent meshes in view, with its key.
+    /// Created on the first frame that has translucent meshes in view (or taken from
+    /// `kept`), with its key.
     active: Option<(Key, Box<dyn TranslucentTechnique>)>,
+    /// Techniques built ahead of a switch ([`OitManager::prebuild`]), with their keys.
+    kept: Vec<(Key, Box<dyn TranslucentTechnique>)>,
+    /// The techniques asked for with [`OitManager::prebuild`]: kept built while another
+    /// one is active.
+    prebuilt: Vec<Technique>,
+    /// Techniques built so far.
+    builds: usize,
     prepare_ms: f64,
     /// The game's contract for the active technique, made when first asked for.
     contract: Option<Arc<TranslucentContract>>,
@@ -358,6 +417,9 @@ impl OitManager {
             setup,
             config,
             active: None,
+            kept: Vec::new(),
+            prebuilt: Vec::new(),
+            builds: 0,
             prepare_ms: 0.0,
             contract: None,
             contracts: 0,
@@ -408,8 +470,22 @@ impl OitManager {
             .config
             .technique
             .key(&self.config, &self.setup.ctx.caps);
-        if self.active.as_ref().is_some_and(|(k, _)| *k != key) {
-            self.active = None;
+        if self.active.as_ref().is_some_and(|(k, _)| *k != key)
+            && let Some(old) = self.active.take()
+            && self.prebuilt.contains(&old.0.technique())
+        {
+            // A prebuilt technique waits for the next switch back to it.
+            self.kept.push(old);
+        }
+        // Prebuilt techniques whose settings changed are rebuilt now, not at the switch.
+        for (k, t) in &mut self.kept {
+            let technique = k.technique();
+            let new = technique.key(&self.config, &self.setup.ctx.caps);
+            if new != *k {
+                *t = technique.create(&self.setup, &self.config)?;
+                self.builds += 1;
+                *k = new;
+            }
         }
         if self.active.is_none() {
             self.contract = None;
@@ -440,6 +516,42 @@ impl OitManager {
         Ok(c)
     }
 
+    /// Builds `technique`'s pipelines and targets now (with the current settings; after
+    /// its fallback on this adapter), so that switching to it later builds nothing and the
+    /// first frame after the switch costs what any frame costs. It stays built while other
+    /// techniques draw, is resized with the others and rebuilt when a setting it is built
+    /// from changes, until [`OitManager::release`]. Returns the technique built.
+    pub fn prebuild(&mut self, technique: Technique) -> Result<Technique> {
+        let technique = self.supported(technique);
+        if !self.prebuilt.contains(&technique) {
+            self.prebuilt.push(technique);
+        }
+        if !technique.draws() {
+            return Ok(technique);
+        }
+        let key = technique.key(&self.config, &self.setup.ctx.caps);
+        let built = self.active.iter().chain(&self.kept).any(|(k, _)| *k == key);
+        if !built {
+            let t = technique.create(&self.setup, &self.config)?;
+            self.builds += 1;
+            self.kept.push((key, t));
+        }
+        Ok(technique)
+    }
+
+    /// Forgets a [`OitManager::prebuild`]: its resources are freed unless it is active.
+    pub fn release(&mut self, technique: Technique) {
+        let technique = self.supported(technique);
+        self.prebuilt.retain(|t| *t != technique);
+        self.kept.retain(|(k, _)| k.technique() != technique);
+    }
+
+    /// How many times a technique's pipelines and targets were built: a switch to a
+    /// prebuilt technique adds nothing.
+    pub fn builds(&self) -> usize {
+        self.builds
+    }
+
     /// Technique-specific facts about the last frame.
     pub fn report(&self) -> TechniqueReport {
         let mut r = self
@@ -451,17 +563,10 @@ impl OitManager {
         r
     }
 
-    /// Call after the frame's commands were submitted.
-    pub fn after_submit(&mut self) {
-        if let Some((_, t)) = &mut self.active {
-            t.after_submit();
-        }
-    }
-
     /// Resizes the targets (the caller checks that the size is valid and new).
     pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
         self.setup.size = (width, height);
-        if let Some((_, t)) = &mut self.active {
+        for (_, t) in self.active.iter_mut().chain(&mut self.kept) {
             t.resize(&self.setup.ctx, width, height)?;
         }
         Ok(())
@@ -490,7 +595,13 @@ impl OitManager {
         }
         if self.active.is_none() {
             let key = technique.key(&self.config, &self.setup.ctx.caps);
-            let t = technique.create(&self.setup, &self.config)?;
+            let t = match self.kept.iter().position(|(k, _)| *k == key) {
+                Some(i) => self.kept.swap_remove(i).1,
+                None => {
+                    self.builds += 1;
+                    technique.create(&self.setup, &self.config)?
+                }
+            };
             self.active = Some((key, t));
         }
         Ok(self.active.as_mut().map(|(_, t)| t))

@@ -22,6 +22,8 @@ struct ChunkInfo {
 // Inside a medium: per pixel, the depth of the first surface of the medium's volume the
 // eye's ray meets (or the opaque depth when nearer); see `medium.rs`.
 @group(0) @binding(3) var medium_boundary: texture_depth_2d;
+// Per block id, the texture layers of its top, bottom and side faces (`textures.rs`).
+@group(0) @binding(4) var<storage, read> block_layers: array<u32>;
 
 // Group 1: a page of the quad arena, and every chunk's record by slot (the instance
 // index of its draws).
@@ -44,6 +46,8 @@ struct VsOut {
     @location(5) @interpolate(flat) alpha: f32,
     // Ambient-occlusion brightness, interpolated from the quad's corners.
     @location(6) shade: f32,
+    // The block texture layer of the face: the block's top, bottom or sides.
+    @location(7) @interpolate(flat) layer: u32,
 };
 
 // Corners of the two triangles of a quad, counter-clockwise seen from the side the normal
@@ -156,6 +160,9 @@ fn quad_vertex(vi: u32, slot: u32, grow: bool) -> VsOut {
     }
     out.uv = uv;
     out.block = q.y & 0xffffu;
+    // Face groups: +y top (0), -y bottom (1), the rest sides (2).
+    let group = select(2u, face - 2u, face == 2u || face == 3u);
+    out.layer = block_layers[out.block * 3u + group];
     out.flags = q.y >> 16u;
     out.alpha = chunk.alpha;
     out.face = face;
@@ -183,9 +190,22 @@ fn vs_solid(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) 
     return quad_vertex(vi, slot, true);
 }
 
-// Texture colour (linear) and alpha of a fragment.
+// Image coordinates of face coordinates `uv` (along the face's U and V axes): side faces
+// upright and seen from outside, top and bottom along +x and +z. `image_coords` in
+// `textures.rs` is the Rust twin.
+fn image_uv(uv: vec2<f32>, face: u32) -> vec2<f32> {
+    switch face {
+        case 0u: { return vec2<f32>(-uv.y, -uv.x); }
+        case 1u: { return vec2<f32>(uv.y, -uv.x); }
+        case 2u, 3u: { return uv.yx; }
+        case 4u: { return vec2<f32>(uv.x, -uv.y); }
+        default: { return vec2<f32>(-uv.x, -uv.y); }
+    }
+}
+
+// Texture colour (linear) and alpha of a fragment: its face's layer of the block textures.
 fn albedo(in: VsOut) -> vec4<f32> {
-    return textureSample(block_textures, block_sampler, in.uv, in.block);
+    return textureSample(block_textures, block_sampler, image_uv(in.uv, in.face), in.layer);
 }
 
 // Lambert with the sun plus ambient, times the ambient occlusion.

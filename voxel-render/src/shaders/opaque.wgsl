@@ -10,7 +10,7 @@ fn fs_opaque(in: VsOut) -> @location(0) vec4<f32> {
     return vec4<f32>(light(a.rgb, in), 1.0);
 }
 
-// Alpha test on texture alpha (leaves): seed 001's alpha-test threshold.
+// Alpha test on texture alpha (leaves): one half, the usual threshold.
 const ALPHA_TEST: f32 = 0.5;
 
 @fragment

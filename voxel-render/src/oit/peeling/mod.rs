@@ -1,9 +1,9 @@
-//! Depth peeling (seed 004): dual depth peeling with N layers, and front-to-back peeling
-//! to convergence as a second exact reference.
+//! Depth peeling: dual depth peeling (Bavoil & Myers 2008) with N layers, and
+//! front-to-back peeling (Everitt 2001) to convergence as a second exact reference.
 //!
 //! Dual (N even; presets 4, 6, 8): each iteration peels the nearest remaining layer (front
-//! peel) and the farthest remaining layer strictly behind it (back peel), seed 004's two
-//! renders per pass. Back layers are blended over the opaque image as they come (farthest
+//! peel) and the farthest remaining layer strictly behind it (back peel), in two
+//! renders per iteration (the paper does both in one pass with MAX blending). Back layers are blended over the opaque image as they come (farthest
 //! first); front layers are under-accumulated (nearest first) and composited over the
 //! result at the end, so all 2·(N/2) layers are blended in depth order. Layers beyond N
 //! (between the innermost front and back layers) are lost: the method's failure mode.
@@ -500,7 +500,6 @@ impl Peeling {
             // Wait for this pass's count: zero means every layer has been peeled.
             self.counts.copy(encoder, i..i + 1);
             gpu::flush(ctx, encoder);
-            self.counts.map();
             let written =
                 self.counts.wait(ctx)?.first().copied().ok_or_else(|| {
                     Error::ReadbackData("an occlusion count came back empty".into())
@@ -551,10 +550,6 @@ impl TranslucentTechnique for Peeling {
             PeelMode::Dual { .. } => self.render_dual(encoder, frame),
             PeelMode::Converge => self.render_converge(ctx, encoder, frame),
         }
-    }
-
-    fn after_submit(&mut self) {
-        self.counts.map();
     }
 
     fn variants(&self) -> Vec<TranslucentVariant> {

@@ -5,8 +5,9 @@
 //
 // Depth epsilon: none. Positions are @invariant, so the same fragment has the same depth
 // bits in every pass, and strict comparisons exclude exactly the layer peeled before. (An
-// epsilon, like seed 004's 0.0001, would merge distinct layers closer than it: in
-// reverse-Z a window-depth difference of 1e-4 is many blocks at a distance of 100.)
+// epsilon, like the 0.0001 of common implementations, would merge distinct layers closer
+// than it: in reverse-Z a window-depth difference of 1e-4 is many blocks at a distance of
+// 100.)
 
 @fragment
 fn fs_peel(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {

@@ -1,6 +1,6 @@
-//! Sorted alpha blending (seed 003's forward pass): translucent chunk meshes drawn back to
+//! Sorted alpha blending (the classic forward pass, painter's order): translucent chunk meshes drawn back to
 //! front, blended `SrcAlpha, OneMinusSrcAlpha` into the HDR scene colour, depth tested
-//! without depth write. The test is strictly nearer (reverse-Z `Greater`), not seed 003's
+//! without depth write. The test is strictly nearer (reverse-Z `Greater`), not the usual
 //! nearer-or-equal: a translucent face exactly at the opaque depth (an edge on an opaque
 //! silhouette) is hidden, as in every other technique and the reference.
 //!

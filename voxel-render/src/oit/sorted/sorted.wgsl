@@ -1,4 +1,4 @@
-// Sorted alpha blending (appended to common.wgsl): seed 003's forward pass. Meshes arrive
+// Sorted alpha blending (appended to common.wgsl): the classic forward pass. Meshes arrive
 // farthest first; blending is SrcAlpha, OneMinusSrcAlpha into the HDR scene colour.
 
 @fragment

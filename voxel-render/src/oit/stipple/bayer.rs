@@ -1,4 +1,6 @@
-//! Ordered-dithering (Bayer) matrices and seed 001's packed shading state.
+//! Ordered-dithering matrices (Bayer 1973) and the stipple technique's packed 32-bit
+//! shading state (alpha, transparency mode, pattern: a per-draw word in the style of
+//! retro hardware).
 
 use crate::{Error, Result};
 
@@ -7,7 +9,7 @@ use crate::{Error, Result};
 pub enum BayerSize {
     /// 2×2: 4 levels, "extremely chunky".
     B2 = 2,
-    /// 4×4: 16 levels, seed 001's default ("classic Saturn stipple").
+    /// 4×4: 16 levels, the default: the classic console stipple.
     B4 = 4,
     /// 8×8: 64 levels.
     B8 = 8,
@@ -24,7 +26,7 @@ impl BayerSize {
         self as u32
     }
 
-    /// Seed 001's 2-bit pattern code: 0 = 2×2, 1 = 4×4, 2 = 8×8, 3 = 16×16.
+    /// The state's 2-bit pattern code: 0 = 2×2, 1 = 4×4, 2 = 8×8, 3 = 16×16.
     pub fn code(self) -> u32 {
         self.side().trailing_zeros() - 1
     }
@@ -84,12 +86,12 @@ pub fn bayer_offset(size: BayerSize) -> usize {
         .sum()
 }
 
-/// Seed 001's mode code for stipple in bits 8–9 of the shading state. (Its other modes,
+/// The mode code for stipple in bits 8–9 of the shading state. (The other modes,
 /// 0 opaque and 2 alpha test, are what the opaque and cutout passes do; the stipple
 /// technique always sends this one.)
 pub const STIPPLE_MODE: u32 = 1;
 
-/// Seed 001's 32-bit shading state: bits 0–7 uniform alpha (0–255), bits 8–9 transparency
+/// The 32-bit shading state: bits 0–7 uniform alpha (0–255), bits 8–9 transparency
 /// mode (always [`STIPPLE_MODE`] here), bits 10–11 dither pattern; bits 12–31 are left zero.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ShadingState {
@@ -100,12 +102,12 @@ pub struct ShadingState {
 }
 
 impl ShadingState {
-    /// Packs into seed 001's layout.
+    /// Packs into the 32-bit layout.
     pub fn pack(self) -> u32 {
         u32::from(self.alpha) | STIPPLE_MODE << 8 | self.pattern.code() << 10
     }
 
-    /// Unpacks seed 001's layout (the mode and bits 12–31 are ignored).
+    /// Unpacks the 32-bit layout (the mode and bits 12–31 are ignored).
     pub fn unpack(packed: u32) -> Self {
         Self {
             alpha: (packed & 0xff) as u8,
@@ -118,15 +120,15 @@ impl ShadingState {
 mod tests {
     use super::*;
 
-    // Seed 001's tables, as printed there (numerators over n²).
-    const SEED_2: [u32; 4] = [0, 2, 3, 1];
-    const SEED_4: [u32; 16] = [0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5];
-    const SEED_8: [u32; 64] = [
+    // The Bayer matrices as commonly printed (numerators over n²).
+    const PRINTED_2: [u32; 4] = [0, 2, 3, 1];
+    const PRINTED_4: [u32; 16] = [0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5];
+    const PRINTED_8: [u32; 64] = [
         0, 32, 8, 40, 2, 34, 10, 42, 48, 16, 56, 24, 50, 18, 58, 26, 12, 44, 4, 36, 14, 46, 6, 38,
         60, 28, 52, 20, 62, 30, 54, 22, 3, 35, 11, 43, 1, 33, 9, 41, 51, 19, 59, 27, 49, 17, 57,
         25, 15, 47, 7, 39, 13, 45, 5, 37, 63, 31, 55, 23, 61, 29, 53, 21,
     ];
-    const SEED_16: [u32; 256] = [
+    const PRINTED_16: [u32; 256] = [
         0, 128, 32, 160, 8, 136, 40, 168, 2, 130, 34, 162, 10, 138, 42, 170, //
         192, 64, 224, 96, 200, 72, 232, 104, 194, 66, 226, 98, 202, 74, 234, 106, //
         48, 176, 16, 144, 56, 184, 24, 152, 50, 178, 18, 146, 58, 186, 26, 154, //
@@ -146,11 +148,11 @@ mod tests {
     ];
 
     #[test]
-    fn recursive_matrices_equal_the_seed_tables() {
-        assert_eq!(bayer(2), SEED_2);
-        assert_eq!(bayer(4), SEED_4);
-        assert_eq!(bayer(8), SEED_8);
-        assert_eq!(bayer(16), SEED_16);
+    fn recursive_matrices_equal_the_printed_tables() {
+        assert_eq!(bayer(2), PRINTED_2);
+        assert_eq!(bayer(4), PRINTED_4);
+        assert_eq!(bayer(8), PRINTED_8);
+        assert_eq!(bayer(16), PRINTED_16);
     }
 
     #[test]
@@ -199,7 +201,7 @@ mod tests {
     }
 
     #[test]
-    fn pattern_codes_follow_the_seed() {
+    fn pattern_codes_follow_the_layout() {
         assert_eq!(BayerSize::ALL.map(BayerSize::code), [0, 1, 2, 3]);
         assert_eq!(BayerSize::from_side(8).unwrap(), BayerSize::B8);
         assert!(BayerSize::from_side(3).is_err());

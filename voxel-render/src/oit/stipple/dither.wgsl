@@ -1,17 +1,17 @@
-// Screen-door transparency (seed 001): the technique's own group 2 (appended to
+// Screen-door transparency (Mulder, Groen & van Wijk 1998): the technique's own group 2 (appended to
 // common.wgsl and the constant BAYER_OFFSETS made in Rust).
 
-// Seed 001's packed shading state (`StippleParams` in mod.rs, checked equal by a test).
+// The packed 32-bit shading state (`StippleParams` in mod.rs, checked equal by a test).
 struct StippleParams {
     shading_state: u32,
 };
 
 @group(2) @binding(0) var<uniform> params: StippleParams;
 // The 2×2, 4×4, 8×8 and 16×16 Bayer matrices one after the other, made in Rust
-// (`bayer::bayer_levels`, tested equal to seed 001's tables).
+// (`bayer::bayer_levels`, tested equal to the tables as commonly printed).
 @group(2) @binding(1) var<storage, read> bayer_levels: array<u32>;
 
-// Seed 001's threshold: the Bayer level at the pixel, over n². Pattern codes: 0 = 2×2,
+// The threshold: the Bayer level at the pixel, over n² (Bayer 1973). Pattern codes: 0 = 2×2,
 // 1 = 4×4, 2 = 8×8, 3 = 16×16.
 fn bayer_threshold(pattern: u32, frag_xy: vec2<f32>) -> f32 {
     let n = 2u << (pattern & 3u);
@@ -19,7 +19,7 @@ fn bayer_threshold(pattern: u32, frag_xy: vec2<f32>) -> f32 {
     return f32(bayer_levels[BAYER_OFFSETS[pattern & 3u] + p.y * n + p.x]) / f32(n * n);
 }
 
-// Seed 001's bit layout: bits 0-7 alpha, 8-9 mode (always stipple here), 10-11 pattern.
+// The state's bit layout: bits 0-7 alpha, 8-9 mode (always stipple here), 10-11 pattern.
 struct ShadingParams {
     uniform_alpha: f32,
     dither_pattern: u32,
@@ -29,8 +29,8 @@ fn unpack_shading_state(packed: u32) -> ShadingParams {
     return ShadingParams(f32(packed & 0xffu) / 255.0, (packed >> 10u) & 0x3u);
 }
 
-// Whether a pixel of coverage `alpha` is dropped. Seed 001 writes `alpha < threshold`,
-// which keeps one pixel in n² at alpha 0, against its own "alpha 0 = always discard"; with
+// Whether a pixel of coverage `alpha` is dropped. `alpha < threshold`, as often written,
+// keeps one pixel in n² at alpha 0, where alpha 0 should always discard; with
 // `<=` alpha k/n² keeps exactly k pixels of each n×n tile, 0 keeps none and 1 keeps all.
 fn screen_door(alpha: f32, pattern: u32, frag_xy: vec2<f32>) -> bool {
     return alpha <= bayer_threshold(pattern, frag_xy);

@@ -1,13 +1,14 @@
-//! Stipple (screen-door) transparency, the low-end mode (seed 001): a translucent fragment
+//! Stipple (screen-door) transparency, the low-end mode (Mulder, Groen & van Wijk 1998,
+//! with Bayer's ordered-dither matrices): a translucent fragment
 //! is kept or discarded by comparing its alpha (texture alpha × uniform alpha × chunk
 //! alpha) with a Bayer threshold at its screen position. No targets, no blending, no
-//! sorting; kept pixels write depth unless configured not to (seed 001's open question:
+//! sorting; kept pixels write depth unless configured not to (an open choice:
 //! writing depth makes nearer stippled layers hide farther ones where they are kept, which
 //! is what a screen door does; not writing lets farther layers show through the gaps of
 //! nearer ones even where a nearer pixel was kept, which is wrong but softer).
 //!
-//! Its uniform (seed 001's packed shading state) and the Bayer tables are its own group 2.
-//! The shimmer when the camera moves is the technique's nature (seed 001: intentional).
+//! Its uniform (a packed 32-bit shading state) and the Bayer tables are its own group 2.
+//! The shimmer when the camera moves is the technique's nature, kept as it is.
 
 pub mod bayer;
 
@@ -39,10 +40,10 @@ pub struct StippleSettings {
 impl Default for StippleSettings {
     fn default() -> Self {
         Self {
-            // 4×4: seed 001's default ("era-authentic").
+            // 4×4: the classic console stipple, fine enough to read as a tint.
             bayer: BayerSize::B4,
-            // Seed 001's behaviour ("writes to depth buffer normally"): nearer kept pixels
-            // hide what is behind them.
+            // Depth written as for opaque surfaces: nearer kept pixels hide what is behind
+            // them, as a screen door does.
             depth_write: true,
             // 1: surfaces keep their own opacity.
             alpha: 255,
@@ -51,7 +52,7 @@ impl Default for StippleSettings {
 }
 
 impl StippleSettings {
-    /// Seed 001's packed shading state for these settings.
+    /// The packed 32-bit shading state for these settings.
     pub fn shading_state(&self) -> ShadingState {
         ShadingState {
             alpha: self.alpha,

@@ -1,4 +1,4 @@
-// Stipple (screen-door) transparency, seed 001 (appended to common.wgsl and dither.wgsl).
+// Stipple (screen-door) transparency (appended to common.wgsl and dither.wgsl).
 // No blending, no extra target: a fragment is either kept, fully opaque, or discarded.
 
 @fragment

@@ -22,7 +22,7 @@ struct WboitParams {
 @group(2) @binding(0) var<uniform> params: WboitParams;
 
 // Standard (not reversed) window depth in [0, 1], 0 at the near plane, from the reverse-Z
-// fragment depth: the `gl_FragCoord.z` of the seeds' weight functions.
+// fragment depth: the `gl_FragCoord.z` of the published weight functions.
 fn standard_depth(frag_z: f32) -> f32 {
     return 1.0 - frag_z;
 }

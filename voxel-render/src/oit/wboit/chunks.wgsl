@@ -20,7 +20,8 @@ fn fs_accumulate_mrt(in: VsOut, @builtin(front_facing) front: bool) -> WboitOut 
     return out;
 }
 
-// Two passes (seed 002): accumulation first, revealage second.
+// Two passes (for adapters without independent blend): accumulation first, revealage
+// second.
 @fragment
 fn fs_accumulate(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     return accumulation(in, front);

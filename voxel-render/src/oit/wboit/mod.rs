@@ -1,25 +1,25 @@
 //! Weighted blended OIT (McGuire & Bavoil 2013), single-pass MRT and two-pass variants.
 //!
-//! Seeds 000 and 002 disagree, and each is wrong somewhere:
-//! - Seed 000's accumulation (ONE, ONE on all four channels, output `(C·α·w, α·w)`) and its
+//! Two common ways of writing it are each wrong somewhere:
+//! - The one-pass form's accumulation (ONE, ONE on all four channels, output `(C·α·w, α·w)`) and its
 //!   composite (`avg = accum.rgb / max(accum.a, 1e-5)`, then `mix(avg, opaque, reveal)`) are
 //!   the paper's. Its revealage blend (ZERO, ONE_MINUS_SRC_ALPHA) only works if the shader's
 //!   revealage output carries α in its alpha channel; a scalar `out float` has alpha 1, which
 //!   zeroes the revealage at the first fragment. We write α to every channel and blend with
 //!   ONE_MINUS_SRC (colour), which is right whatever the alpha channel holds.
-//! - Seed 002's first pass blends the accumulation's alpha channel with (ZERO,
+//! - A common two-pass form's first pass blends the accumulation's alpha channel with (ZERO,
 //!   ONE_MINUS_SRC_ALPHA), so `accum.a` holds Π(1 − α) instead of Σ(α·w), and its composite
 //!   divides by that: colours come out scaled by Σ(α·w)/Π(1 − α), wrong for every stack
-//!   (the "very transparent surfaces may appear darker" it reports). We keep its two-pass
-//!   structure (one target per pass, for adapters without independent blend) with seed
-//!   000's blend states, so both variants compute the same thing.
+//!   ("very transparent surfaces may appear darker", as such code reports). We keep the
+//!   two-pass structure (one target per pass, for adapters without independent blend)
+//!   with the one-pass form's blend states, so both variants compute the same thing.
 //!
 //! fp16 overflow: with weights up to 3000·α, 22 near layers of α = 1 exceed 65504 and the
 //! sums become infinite (then NaN in the ratio). Outputs are scaled by 1/64, which cancels
 //! in the ratio and keeps sums finite up to ~1390 such layers; the composite also replaces
 //! a non-finite average (black, coverage kept) so the scene never holds NaN or inf.
 //!
-//! RGBA8 fallback (seed 000): when `Rgba16Float` cannot be blended, the accumulation is
+//! RGBA8 fallback: when `Rgba16Float` cannot be blended, the accumulation is
 //! RGBA8 with outputs scaled so that eight maximum-weight layers fit; the average then has
 //! eight bits of precision at best. Logged when chosen.
 //!
@@ -48,7 +48,7 @@ use crate::{GpuContext, Result};
 use fit::{MeshLayers, PROFILE_LEN, TILES};
 use weights::{MAX_FITTED_DEPTH, WeightFit, WeightFunction};
 
-/// Revealage format (seed 000): one byte of Π(1 − α).
+/// Revealage format: one byte of Π(1 − α).
 pub const REVEALAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 /// Output scale with RGBA16F accumulation and headroom on.
 pub const HEADROOM_SCALE: f32 = 1.0 / 64.0;

@@ -2,8 +2,8 @@
 //! formulas, so that unit tests of these pin the shader's maths too (a GPU test checks the
 //! shader against this file).
 //!
-//! Inputs: `z` is the standard window depth in [0, 1] (0 at the near plane: the seeds'
-//! `gl_FragCoord.z`), `depth` the view-space distance (McGuire & Bavoil's |z|), `alpha`
+//! Inputs: `z` is the standard window depth in [0, 1] (0 at the near plane: OpenGL's
+//! `gl_FragCoord.z`, which the published weights use), `depth` the view-space distance (McGuire & Bavoil's |z|), `alpha`
 //! the fragment's coverage; only the fitted weight uses the last two: `screen`, the
 //! fragment's position on screen (0 to 1, y down), and `fit`, the frame's estimate of the
 //! translucent layers in view ([`WeightFit`]).
@@ -15,10 +15,11 @@ use crate::{Error, Result};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum WeightFunction {
     /// `α · max(1e-2, 3e3 · (1 − 0.001·z)³)` clamped to [1e-2, 3e4], `z` the window depth
-    /// clamped to [1e-5, 3e4] (seed 000's weight). With window depths below 1 this is
+    /// clamped to [1e-5, 3e4] (McGuire & Bavoil's eq. 10 with the depth scaled by 1/1000).
+    /// With window depths below 1 this is
     /// almost `3000·α`: nearly flat, a plain α-weighted average.
     Flat = 0,
-    /// `clamp(α³ · 3000 · (1 − z)³, 0.01, 3000)` (seed 002's weight, Voxelize's): α cubed,
+    /// `clamp(α³ · 3000 · (1 − z)³, 0.01, 3000)` (the Voxelize engine's weight): α cubed,
     /// so that dense layers dominate, falling with the cube of the window depth.
     AlphaCubed = 1,
     /// McGuire & Bavoil 2013 eq. 7: `α · clamp(10 / (1e-5 + (|z|/5)² + (|z|/200)⁶), 1e-2, 3e3)`.
@@ -67,17 +68,11 @@ impl WeightFunction {
         }
     }
 
-    /// Parses a command-line name (the weights of seeds 000 and 002 also answer to
-    /// `seed000` and `seed002`); the error lists the known names.
+    /// Parses a command-line name; the error lists the known names.
     pub fn from_name(name: &str) -> Result<Self> {
-        let name_or_alias = match name {
-            "seed000" => "flat",
-            "seed002" => "alpha-cubed",
-            other => other,
-        };
         Self::ALL
             .into_iter()
-            .find(|w| w.name() == name_or_alias)
+            .find(|w| w.name() == name)
             .ok_or_else(|| Error::unknown_name("weight", name, Self::ALL.map(Self::name)))
     }
 
@@ -269,7 +264,5 @@ mod tests {
                 .to_string()
                 .contains("eq10")
         );
-        assert_eq!(WeightFunction::from_name("seed002").unwrap(), AlphaCubed);
-        assert_eq!(WeightFunction::from_name("seed000").unwrap(), Flat);
     }
 }

@@ -1,0 +1,199 @@
+//! A game's window: the game owns the winit window, device and surface; the renderer draws
+//! into the surface texture (whatever format it has); then the game's own passes
+//! (`window.wgsl`): a box around the block under the crosshair, tested against the frame's
+//! depth (reverse-Z, camera-relative), and a HUD. Keys 1-7 pick a real-time technique
+//! (built ahead: no frame stalls at a switch; the title names it); resizing works. Nothing
+//! is called after the submit. Scripted: `cargo run --release -p voxel-render --example
+//! window -- --frames N --screenshot FILE.png`.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use voxel_core::{BlockRegistry, ChunkPos, RenderClass, TerrainConfig, TerrainGenerator, World};
+use voxel_render::{Camera, GpuContext, Renderer, RendererConfig, Technique, gpu};
+use wgpu::CurrentSurfaceTexture::Success;
+use wgpu::PrimitiveTopology::{LineList, TriangleList};
+use wgpu::util::DeviceExt;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::window::{Window, WindowId};
+
+/// Where the game's camera stands and what it looks at.
+const EYE: DVec3 = DVec3::new(8.5, 33.5, -1.5);
+const TARGET: DVec3 = DVec3::new(10.5, 29.0, -6.5);
+
+struct Gfx {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    ctx: GpuContext,
+    renderer: Renderer,
+    world: World,
+    uniforms: wgpu::Buffer,
+    /// The selection box's pipeline and the HUD's, with their bind groups.
+    passes: [(wgpu::RenderPipeline, wgpu::BindGroup); 2],
+}
+
+#[derive(Default)]
+struct Game {
+    gfx: Option<Gfx>,
+    /// Frames left to draw in a scripted run.
+    frames: Option<u32>,
+    screenshot: Option<String>,
+}
+
+fn setup(window: Arc<Window>, world: World) -> Result<Gfx, Box<dyn std::error::Error>> {
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let surface = instance.create_surface(window.clone())?;
+    let (ctx, adapter) = GpuContext::for_surface(&instance, &surface)?;
+    let (width, height) = window.inner_size().into();
+    let config = surface.get_default_config(&adapter, width, height);
+    let mut config = config.ok_or("the surface offers no format")?;
+    config.usage |= surface.get_capabilities(&adapter).usages & wgpu::TextureUsages::COPY_SRC;
+    surface.configure(&ctx.device, &config);
+    let mut rc = RendererConfig::default();
+    (rc.width, rc.height, rc.output_format) = (config.width, config.height, config.format);
+    let mut renderer = Renderer::new(&ctx, world.registry(), rc)?;
+    for (pos, meshes) in voxel_mesh::mesh_dirty(&mut world.clone())? {
+        renderer.upload_chunk(pos, &meshes)?;
+    }
+    for technique in Technique::REAL_TIME {
+        renderer.prebuild_technique(technique)?;
+    }
+    let d = &ctx.device;
+    let module = gpu::shader(d, "game_overlay", &[include_str!("window.wgsl")]);
+    let uniforms = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("game_uniforms"),
+        contents: &[0; 96],
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+    });
+    let box_pass = (("vs_box", "fs_box"), LineList, true);
+    let passes = [box_pass, (("vs_hud", "fs_hud"), TriangleList, false)];
+    let passes = passes.map(|(entry, topology, depth)| {
+        let p = gpu::overlay_pipeline(d, &module, entry, config.format, topology, depth);
+        let uniform = [uniforms.as_entire_binding()];
+        let group = gpu::bind_group(d, entry.1, &p.get_bind_group_layout(0), &uniform);
+        (p, group)
+    });
+    Ok(Gfx {
+        window,
+        surface,
+        config,
+        ctx,
+        renderer,
+        world,
+        uniforms,
+        passes,
+    })
+}
+
+impl Game {
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<(), Box<dyn std::error::Error>> {
+        let g = self.gfx.as_mut().ok_or("no window yet")?;
+        let Success(frame) = g.surface.get_current_texture() else {
+            // Outdated, lost, timed out or hidden: try again next frame.
+            g.surface.configure(&g.ctx.device, &g.config);
+            return Ok(());
+        };
+        let camera = Camera::look_at(EYE, TARGET, 70.0, 0.1, 400.0)?;
+        let view = frame.texture.create_view(&Default::default());
+        let mut encoder = g.ctx.device.create_command_encoder(&Default::default());
+        g.renderer.render(&mut encoder, &view, &camera)?;
+        // The game's passes see what the renderer drew, from the camera it drew with.
+        let drawn = g.renderer.drawn_camera(&camera);
+        let (eye, forward) = (drawn.eye.to_array(), drawn.forward.to_array());
+        let visible = RenderClass::VISIBLE;
+        let hit = g.world.raycast(eye, forward, 300.0, &visible)?;
+        let block = hit.map_or(DVec3::ZERO, |h| DVec3::from(h.pos.corner()) - drawn.eye);
+        let (w, h) = (g.config.width as f32, g.config.height as f32);
+        // The box's corners relative to the eye; their w: the window size, for the HUD.
+        let lo = (block - 0.01).as_vec3().extend(w);
+        let hi = (block + 1.01).as_vec3().extend(h);
+        let vp = drawn.view_proj(f64::from(w / h));
+        let u = [vp.x_axis, vp.y_axis, vp.z_axis, vp.w_axis, lo, hi];
+        let queue = &g.ctx.queue;
+        queue.write_buffer(&g.uniforms, 0, bytemuck::cast_slice(&u));
+        let counts = [24 * u32::from(hit.is_some()), 12];
+        for (i, (pipeline, group)) in g.passes.iter().enumerate() {
+            // The box tests the frame's depth, read only: nearer blocks hide it.
+            let depth = gpu::Depth::ReadOnly(g.renderer.scene_depth_view());
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                color_attachments: &[gpu::load(&view)],
+                depth_stencil_attachment: depth.attachment().filter(|_| i == 0),
+                ..Default::default()
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, group, &[]);
+            pass.draw(0..counts[i], 0..1);
+        }
+        queue.submit([encoder.finish()]);
+        self.frames = self.frames.map(|n| n.saturating_sub(1));
+        if self.frames == Some(0) {
+            if let Some(path) = &self.screenshot {
+                let image = voxel_render::readback::read_image(&g.ctx, &frame.texture)?;
+                image.save_png(path.as_ref())?;
+                println!("wrote {path}: GPU ms {:?}", g.renderer.gpu_times_blocking());
+            }
+            event_loop.exit();
+        }
+        queue.present(frame);
+        Ok(())
+    }
+}
+
+impl winit::application::ApplicationHandler for Game {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        let size = winit::dpi::PhysicalSize::new(800, 500);
+        let window = event_loop.create_window(Window::default_attributes().with_inner_size(size));
+        let generator = TerrainGenerator::new(TerrainConfig::default());
+        let (min, max) = (ChunkPos::new(-4, 0, -5), ChunkPos::new(2, 1, 1));
+        let world = generator.generate_world(Arc::new(BlockRegistry::default()), min, max);
+        let world = world.expect("terrain of the default blocks");
+        let gfx = setup(Arc::new(window.expect("a window")), world);
+        self.gfx = Some(gfx.expect("a device and a renderer"));
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some(g) = &mut self.gfx else { return };
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) if size.width > 0 && size.height > 0 => {
+                (g.config.width, g.config.height) = (size.width, size.height);
+                g.surface.configure(&g.ctx.device, &g.config);
+                let resized = g.renderer.resize(size.width, size.height);
+                resized.expect("a size the adapter allows");
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state.is_pressed() => {
+                let digit = event.logical_key.to_text().and_then(|c| c.parse().ok());
+                if let Some(&technique) =
+                    digit.and_then(|n: usize| Technique::REAL_TIME.get(n.wrapping_sub(1)))
+                {
+                    g.renderer.set_technique(technique);
+                    g.window.set_title(&format!("window example: {technique}"));
+                }
+            }
+            WindowEvent::RedrawRequested => self.redraw(event_loop).unwrap_or_else(|e| {
+                eprintln!("error: {e}");
+                event_loop.exit();
+            }),
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        self.gfx.iter().for_each(|g| g.window.request_redraw());
+    }
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().collect();
+    let arg = |name| Some(args.windows(2).find(|w| w[0] == name)?[1].clone());
+    let frames = arg("--frames").map(|n| n.parse()).transpose()?;
+    let screenshot = arg("--screenshot");
+    let mut game = Game {
+        frames,
+        screenshot,
+        ..Game::default()
+    };
+    Ok(EventLoop::new()?.run_app(&mut game)?)
+}
