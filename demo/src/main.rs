@@ -186,6 +186,11 @@ struct WindowArgs {
     /// Start with the error map against the reference on.
     #[arg(long)]
     heatmap: bool,
+    /// Show the game content (3 000 bubbles rising through the water, a turning glass
+    /// cube crossing its surface, a boat) from the start: `true` or `false`. Default: on
+    /// in an interactive run, off with --frames. The panel toggles each.
+    #[arg(long)]
+    game: Option<bool>,
     /// Scripted: quit after N frames (per technique with --cycle).
     #[arg(long)]
     frames: Option<u64>,
@@ -744,6 +749,7 @@ fn window(a: WindowArgs) -> Result<(), String> {
         resize: a.resize,
         // Read before the window opens: a broken file is an error, not an empty window.
         scene: a.scene.as_deref().map(scene::Scene::load).transpose()?,
+        game: a.game,
     })
 }
 

@@ -8,6 +8,7 @@
 //! blitted to the surface: one picture for the window and for screenshots.
 
 mod display;
+mod game;
 mod panel;
 mod post;
 
@@ -60,6 +61,9 @@ pub struct DemoOptions {
     /// A scene to show instead of generated terrain (a scene file or a `.vox` model, read
     /// with [`scene::Scene::load`] before the window opens), from its first camera.
     pub scene: Option<scene::Scene>,
+    /// Show the game content (bubbles, the glass cube, the boat) from the start; `None`:
+    /// on in an interactive run, off in a scripted one (whose pictures tests compare).
+    pub game: Option<bool>,
 }
 
 impl Default for DemoOptions {
@@ -76,6 +80,7 @@ impl Default for DemoOptions {
             edit: false,
             resize: false,
             scene: None,
+            game: None,
         }
     }
 }
@@ -234,6 +239,8 @@ struct Settings {
     place: BlockId,
     /// Time of day in hours (`Lighting::daytime`), or `None` for the default lighting.
     hour: Option<f32>,
+    /// The game content shown.
+    game: game::Toggles,
 }
 
 /// egui's state.
@@ -357,6 +364,11 @@ struct Gfx {
     script: Script,
     /// The scene shown instead of terrain, if any.
     scene: Option<OpenScene>,
+    /// The game's own content, drawn through the renderer's stages.
+    game: game::Game,
+    /// Seconds of animation: real time in an interactive run, 1/60 s a frame in a
+    /// scripted one (the same pictures every run).
+    game_time: f64,
 }
 
 impl Gfx {
@@ -391,6 +403,7 @@ impl Gfx {
             heatmap: opts.heatmap,
             place: voxel_core::blocks::GLASS,
             hour: None,
+            game: game::Toggles::all(opts.game.unwrap_or(opts.frames.is_none())),
         };
         let (w, h) = display.size();
         let config = RendererConfig {
@@ -412,6 +425,17 @@ impl Gfx {
             Technique::ALL.to_vec()
         } else {
             Vec::new()
+        };
+        let game = {
+            // The default terrain's water: below the sea level.
+            let terrain = TerrainGenerator::new(TerrainConfig {
+                seed: opts.seed,
+                ..TerrainConfig::default()
+            });
+            let sea = i64::from(terrain.config().sea_level);
+            let water = |x, z| terrain.height_at(x, z) < sea - 1;
+            let water: Option<&dyn Fn(i64, i64) -> bool> = open.is_none().then_some(&water);
+            game::Game::new(&cam, water)
         };
         let mut g = Self {
             display,
@@ -448,6 +472,8 @@ impl Gfx {
                 screenshot_request: None,
             },
             scene: open,
+            game,
+            game_time: 0.0,
         };
         if let Some(t) = g.script.cycle.first() {
             g.settings.oit.technique = *t;
@@ -769,6 +795,11 @@ impl Gfx {
 
     fn frame(&mut self) -> Result<Flow, String> {
         let dt = self.tick();
+        self.game_time += if self.script.opts.frames.is_some() {
+            1.0 / 60.0
+        } else {
+            dt
+        };
         self.fly(dt);
         self.stream()?;
         self.scripted_events()?;
@@ -821,15 +852,36 @@ impl Gfx {
     /// the panel.
     fn draw_scene(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<(), String> {
         let camera = self.camera()?;
+        let toggles = self.settings.game;
+        self.game
+            .update(
+                &self.ctx,
+                &mut self.renderer,
+                self.reference.as_mut(),
+                toggles,
+                self.game_time,
+            )
+            .map_err(|e| chain(&e))?;
+        let (stages, reference_stages) = self.game.stages(toggles);
+        let mut no_game = voxel_render::NoGame;
+        let stages: &mut dyn voxel_render::GameStages = match stages {
+            Some(s) => s,
+            None => &mut no_game,
+        };
         let frames = &self.frames;
         match &mut self.reference {
             Some(reference) => {
                 self.status.stats = self
                     .renderer
-                    .render(encoder, &frames.technique.view, &camera)
+                    .render_with(encoder, &frames.technique.view, &camera, stages)
                     .map_err(|e| chain(&e))?;
+                let mut no_game = voxel_render::NoGame;
+                let reference_stages: &mut dyn voxel_render::GameStages = match reference_stages {
+                    Some(s) => s,
+                    None => &mut no_game,
+                };
                 reference
-                    .render(encoder, &frames.reference.view, &camera)
+                    .render_with(encoder, &frames.reference.view, &camera, reference_stages)
                     .map_err(|e| chain(&e))?;
                 Post::draw(
                     encoder,
@@ -841,7 +893,7 @@ impl Gfx {
             None => {
                 self.status.stats = self
                     .renderer
-                    .render(encoder, &frames.view.view, &camera)
+                    .render_with(encoder, &frames.view.view, &camera, stages)
                     .map_err(|e| chain(&e))?;
             }
         }

@@ -179,6 +179,15 @@ impl Gfx {
             },
         );
         ui.checkbox(&mut s.msaa, "4x MSAA (opaque and cutout)");
+        ui.label("Game content (through the frame stages)");
+        ui.horizontal(|ui| {
+            ui.checkbox(
+                &mut s.game.bubbles,
+                format!("{} bubbles", super::game::BUBBLES),
+            );
+            ui.checkbox(&mut s.game.cube, "glass cube");
+            ui.checkbox(&mut s.game.boat, "boat");
+        });
         ui.add(egui::Slider::new(&mut s.fade_in_frames, 0..=60).text("fade-in frames"));
         ui.checkbox(&mut s.heatmap, "error map against the reference (H)");
     }

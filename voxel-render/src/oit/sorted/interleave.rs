@@ -13,29 +13,25 @@
 //!   quads facing away are culled, unless both sides are drawn) is in front, on the far
 //!   side of every one is behind.
 //!
-//! Where none decides (a ball between two layers of a chunk, or through one), `sorted-quads`
-//! places the ball among the chunk's quads in their exact order ([`quad_split`]); `sorted`
-//! lets the centre of the box decide (the ball's centre farther than it is behind). An
-//! object is drawn before the first chunk (in draw order) it is behind or among whose quads
-//! it goes, after every chunk if none; objects at the same place farthest centre first. The
-//! order is exact between chunks and for every object that some test decides against each
-//! chunk it overlaps on screen; not for an object through a chunk's layers (a cube crossing
-//! a water surface), nor between objects that overlap in depth (their centres decide).
+//! - apart: the cones from the eye around the ball and around the box's bounding ball do
+//!   not meet (or both sides are proven): any order is right, the chunk constrains nothing.
+//!
+//! Where no test decides (a ball between two layers of a chunk, or through one),
+//! `sorted-quads` weighs each quad's plane (in the chunk's exact back-to-front order) and
+//! `sorted` the centre of the box (the ball's centre farther than it: behind). Each object
+//! goes to the place in the sequence of chunks (and quads) that the fewest constraints rule
+//! out, a decided chunk outweighing any number of quads; objects at the same place go
+//! farthest centre first. The order is exact between chunks and for every object that some
+//! test decides against each chunk it overlaps on screen, and for `sorted-quads` also
+//! among the layers of a chunk where the planes agree; not for an object through a layer
+//! (a cube crossing a water surface), nor between objects that overlap in depth (their
+//! centres decide).
 
 use glam::DVec3;
 
 use voxel_mesh::PackedQuad;
 
 use crate::chunks::Surfaces;
-
-/// How a point stands against a chunk's translucent quads.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Side {
-    /// Drawn before the chunk.
-    Behind,
-    /// Drawn after it.
-    Front,
-}
 
 /// A ball: an object as the order sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,33 +42,27 @@ pub struct Ball {
     pub radius: f64,
 }
 
-/// The side of ball `b` where one of the sound tests decides it.
-fn decide(
+/// Which orders of ball `b` and chunk surfaces `s` the sound tests prove right: `[after
+/// the chunk, before it]` (the ball in front, behind). Both: they do not overlap on screen.
+fn safe(
     b: Ball,
     o: f64,
     eye: DVec3,
     s: &Surfaces<'_>,
     [near, _, far]: [f64; 3],
     two_sided: bool,
-) -> Option<Side> {
+) -> [bool; 2] {
     let (p, r) = (b.center, b.radius);
-    if o - r > far {
-        return Some(Side::Behind);
-    }
-    if o + r < near {
-        return Some(Side::Front);
-    }
+    let (mut front, mut behind) = (o + r < near, o - r > far);
     for a in 0..3 {
         let (lo, hi, ea) = (s.lo[a], s.hi[a], eye[a]);
         let (below, above) = (p[a] + r < lo, p[a] - r > hi);
-        if (below && ea <= lo) || (above && ea >= hi) {
-            return Some(Side::Front);
-        }
-        if (below && ea >= lo) || (above && ea <= hi) {
-            return Some(Side::Behind);
-        }
+        front |= (below && ea <= lo) || (above && ea >= hi);
+        behind |= (below && ea >= lo) || (above && ea <= hi);
     }
-    let (mut front, mut behind) = (false, false);
+    // The quads' planes: every seen plane with the ball on the eye's side, or every one
+    // with it beyond.
+    let (mut eye_side, mut beyond) = (false, false);
     for &(face, c) in s.planes {
         let a = face.axis();
         let n = if face.is_positive() { 1.0 } else { -1.0 };
@@ -85,19 +75,30 @@ fn decide(
         }
         if q.abs() <= r {
             // Through the plane: neither.
-            front = true;
-            behind = true;
+            eye_side = true;
+            beyond = true;
         } else if (e > 0.0) == (q > 0.0) {
-            front = true;
+            eye_side = true;
         } else {
-            behind = true;
+            beyond = true;
         }
     }
-    match (front, behind) {
-        (_, false) => Some(Side::Front),
-        (false, true) => Some(Side::Behind),
-        (true, true) => None,
+    front |= !beyond;
+    behind |= !eye_side && beyond;
+    [front, behind || separate(b, eye, s)]
+}
+
+/// Whether ball `b` and the box of `s` are apart as seen from `eye`: the cones from the
+/// eye around their bounding balls do not meet (then either order is right).
+fn separate(b: Ball, eye: DVec3, s: &Surfaces<'_>) -> bool {
+    let (c, big) = ((s.lo + s.hi) * 0.5, (s.hi - s.lo).length() * 0.5);
+    let (u, v) = (c - eye, b.center - eye);
+    let (du, dv) = (u.length(), v.length());
+    if du <= big || dv <= b.radius {
+        return false;
     }
+    let apart = (u.dot(v) / (du * dv)).clamp(-1.0, 1.0).acos();
+    apart > (big / du).asin() + (b.radius / dv).asin()
 }
 
 /// Where a run of objects is drawn: after quads `..quad` of chunk `chunk` (its position
@@ -167,10 +168,12 @@ pub fn interleave(
         for (c, (surfaces, d)) in chunks.iter().enumerate() {
             let Some(s) = surfaces else { continue };
             let c = c as u32;
-            match decide(b, o, eye, s, *d, two_sided) {
-                Some(Side::Front) => items.push((c, 0, SOUND)),
-                Some(Side::Behind) => items.push((c, 0, -SOUND)),
-                None if split_quads => {
+            match safe(b, o, eye, s, *d, two_sided) {
+                // Apart on screen: any place is right.
+                [true, true] => {}
+                [true, false] => items.push((c, 0, SOUND)),
+                [false, true] => items.push((c, 0, -SOUND)),
+                [false, false] if split_quads => {
                     for (k, &q) in s.quads.iter().enumerate() {
                         match quad_side(b, eye, s.origin, q, two_sided) {
                             Some(true) => items.push((c, k as u32, 1)),
@@ -179,7 +182,7 @@ pub fn interleave(
                         }
                     }
                 }
-                None => items.push((c, 0, if o > d[1] { -1 } else { 1 })),
+                [false, false] => items.push((c, 0, if o > d[1] { -1 } else { 1 })),
             }
         }
         // Before everything, every item that must come before the object is violated;
@@ -228,6 +231,31 @@ pub fn interleave(
 mod tests {
     use super::*;
     use voxel_core::Face;
+
+    /// How a point stands against a chunk's translucent quads.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    pub enum Side {
+        /// Drawn before the chunk.
+        Behind,
+        /// Drawn after it.
+        Front,
+    }
+
+    /// The side of ball `b` where one of the sound tests decides it.
+    fn decide(
+        b: Ball,
+        o: f64,
+        eye: DVec3,
+        s: &Surfaces<'_>,
+        d: [f64; 3],
+        two_sided: bool,
+    ) -> Option<Side> {
+        match safe(b, o, eye, s, d, two_sided) {
+            [true, _] => Some(Side::Front),
+            [false, true] => Some(Side::Behind),
+            [false, false] => None,
+        }
+    }
 
     /// Where ball `b` goes among `quads` (a chunk's quads in their exact back-to-front order):
     /// the split that the fewest quads' planes disagree with ([`quad_side`]).
@@ -506,16 +534,16 @@ mod tests {
             radius: 1.5,
         });
         let (order, splits) = interleave(&balls, eye, &chunks, false, false);
-        // Before the far water: what is under it. Before the near water: what is under
-        // it and what lies farther than all of it (over the far water), farthest first.
+        // Before the far water: what is under it, and what is under the near water (the
+        // tests prove it apart from the far water on screen: any place is right, the
+        // first is taken). Before the near water: what lies over the far water.
         let at = |chunk, end| Split {
             chunk,
             quad: 0,
             end,
         };
-        assert_eq!(splits, vec![at(0, 1), at(2, 3)]);
-        assert_eq!(order[..1], [0]);
-        assert_eq!(order[1..3], [1, 2]);
+        assert_eq!(splits, vec![at(0, 2), at(2, 3)]);
+        assert_eq!(order[..3], [0, 2, 1]);
         // Over the near water and by the eye: after every chunk, farthest first.
         assert_eq!(order[3..], [3, 4]);
     }

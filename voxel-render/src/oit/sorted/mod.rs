@@ -13,7 +13,7 @@
 //! pixel except where quads form a cycle (no order exists; counted in [`SortReport`], those
 //! quads drawn farthest centre first).
 //!
-//! A game's translucent objects are drawn among the chunks ([`interleave`]): each before
+//! A game's translucent objects are drawn among the chunks (`interleave`): each before
 //! the first chunk it lies behind, by sound tests of its bounding ball against the box and
 //! the planes of the chunk's translucent quads (distance, the box's faces, the quads'
 //! planes). Where none decides (a bubble between a water surface and a pane of one chunk),
