@@ -298,3 +298,102 @@ fn streamed_edits_everywhere_draw_like_the_true_world() {
         tests::assert_close(&format!("stream_truth_{name}"), &a, &b, 0);
     }
 }
+
+/// A sink that keeps which chunks it holds (no GPU).
+#[derive(Default)]
+struct Held(std::collections::HashSet<ChunkPos>);
+
+impl voxel_render::ChunkSink for Held {
+    fn upload(&mut self, pos: ChunkPos, _: &voxel_mesh::ChunkMeshes) -> voxel_render::Result<()> {
+        self.0.insert(pos);
+        Ok(())
+    }
+    fn remove(&mut self, pos: ChunkPos) {
+        self.0.remove(&pos);
+    }
+}
+
+/// Updates until idle; checks that each update's `uploaded` names what reached the sink.
+fn settle_held(s: &mut ChunkStreamer, eye: DVec3, sink: &mut Held) {
+    for _ in 0..100_000 {
+        let before = sink.0.clone();
+        let f = s.update(eye, sink).unwrap();
+        assert!(f.failed.is_empty(), "{:?}", f.failed);
+        assert_eq!(f.uploaded.len(), f.uploads, "one position per upload");
+        for p in &f.uploaded {
+            assert!(sink.0.contains(p) || before.contains(p), "{p:?} never reached the sink");
+        }
+        if s.is_idle() {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_micros(300));
+    }
+    panic!("the streamer never settled: {s:?}");
+}
+
+/// Issue 23: a game saves the streamer's edits (loaded and unloaded chunks alike) and loads
+/// them into a new streamer: the same edits, and the same blocks wherever it loads, near
+/// and far; a save naming a block the registry lacks is refused whole.
+#[test]
+fn saved_edits_load_back_into_the_same_world() {
+    let g = generator();
+    let registry = Arc::new(BlockRegistry::default());
+    let config = StreamConfig {
+        view_distance: 2,
+        vertical_distance: 1,
+        hysteresis: 1,
+        ..StreamConfig::default()
+    };
+    let ground = |x: i32, z: i32| g.height_at(i64::from(x), i64::from(z)) as i32;
+    let home = DVec3::new(16.0, f64::from(ground(16, 16)) + 20.0, 16.0);
+    let far = home + DVec3::X * 32.0 * 20.0;
+    let mut a = ChunkStreamer::new(registry.clone(), g.clone(), config.clone()).unwrap();
+    let mut sink = Held::default();
+    settle_held(&mut a, home, &mut sink);
+    for z in 0..40 {
+        a.set_block(WorldPos::new(20, ground(20, z) + 1, z), blocks::GLASS)
+            .unwrap();
+    }
+    // Unloaded: 20 chunks east.
+    let fx = 20 * 32 + 7;
+    a.set_block(WorldPos::new(fx, ground(fx, 9) + 1, 9), blocks::ICE)
+        .unwrap();
+    let saved: Vec<_> = a.edits().collect();
+    assert_eq!(saved.len(), 41);
+
+    let mut b = ChunkStreamer::new(registry.clone(), g.clone(), config.clone()).unwrap();
+    let bad = [(WorldPos::new(0, 0, 0), voxel_core::BlockId(9999))];
+    assert!(b.restore_edits(saved.iter().copied().chain(bad)).is_err());
+    assert_eq!(b.edits().count(), 0, "a refused save restores nothing");
+    b.restore_edits(saved.iter().copied()).unwrap();
+    let mut restored: Vec<_> = b.edits().collect();
+    let mut want = saved.clone();
+    restored.sort_by_key(|(p, _)| (p.x, p.y, p.z));
+    want.sort_by_key(|(p, _)| (p.x, p.y, p.z));
+    assert_eq!(restored, want);
+    let mut sink_b = Held::default();
+    settle_held(&mut b, home, &mut sink_b);
+    let (near, far_edits): (Vec<_>, Vec<_>) = saved.iter().partition(|(at, _)| at.x < 600);
+    assert_eq!((near.len(), far_edits.len()), (40, 1));
+    for &(at, id) in &near {
+        assert_eq!(b.world().get_block(at), id, "{at:?}");
+    }
+    assert_eq!(sink_b.0, sink.0, "the same chunks drawn");
+    let mut compared = 0;
+    for (pos, _) in a.world().iter() {
+        if !b.is_resident(pos) {
+            continue;
+        }
+        let o = pos.origin().map(|v| v as i32);
+        for i in 0..32 * 32 * 32 {
+            let at = WorldPos::new(o[0] + i % 32, o[1] + i / 32 % 32, o[2] + i / 1024);
+            assert_eq!(b.world().get_block(at), a.world().get_block(at), "{at:?}");
+        }
+        compared += 1;
+    }
+    assert!(compared > 20, "{compared} chunks compared");
+    // The far edit, once there.
+    settle_held(&mut b, far, &mut sink_b);
+    let (at, id) = far_edits[0];
+    assert_eq!(b.world().get_block(at), id);
+}

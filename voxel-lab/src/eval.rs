@@ -40,6 +40,8 @@ pub struct Measured {
     pub gpu_ms: Option<f64>,
     /// Median CPU ms per frame.
     pub cpu_ms: f64,
+    /// Median CPU ms per frame ordering the game's objects (`FrameStats::game_sort_ms`).
+    pub game_sort_ms: f64,
     /// Non-finite HDR pixels of the last frame.
     pub nan_px: usize,
     /// Stats of the last frame.
@@ -70,6 +72,7 @@ pub fn measure(
         .map_err(|e| crate::chain(&e))?;
     let mut gpu = Vec::new();
     let mut cpu = Vec::new();
+    let mut sort = Vec::new();
     let mut stats = FrameStats::default();
     for i in 0..warmup + frames.max(1) {
         stats = renderer
@@ -78,6 +81,7 @@ pub fn measure(
         let times = renderer.gpu_times_blocking();
         if i >= warmup {
             cpu.push(stats.cpu_ms);
+            sort.push(stats.game_sort_ms);
             if !times.is_empty() {
                 gpu.push(times.translucent_work());
             }
@@ -89,6 +93,7 @@ pub fn measure(
         image,
         gpu_ms: median(gpu),
         cpu_ms: median(cpu).unwrap_or(0.0),
+        game_sort_ms: median(sort).unwrap_or(0.0),
         nan_px: metrics::non_finite_pixels(&hdr),
         stats,
     })
@@ -396,6 +401,8 @@ fn scene_records(
             height: size.1,
             gpu_ms: m.gpu_ms,
             cpu_ms: m.cpu_ms,
+            game_sort_ms: (config.technique.sorts() && !scene.content.is_empty())
+                .then_some(m.game_sort_ms),
             rmse,
             psnr,
             flip_mean,

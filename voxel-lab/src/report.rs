@@ -13,8 +13,12 @@ fn ms(v: Option<f64>) -> String {
 }
 
 fn row(r: &Record) -> String {
+    // A sorted technique's CPU time ordering the game's objects, where there are any.
+    let sort = r
+        .game_sort_ms
+        .map_or(String::new(), |s| format!(" (objects {s:.3})"));
     format!(
-        "| {} | {} | {:.3} | {:.4} | {:.4} | {:.1} | {} | {:.4} | {} | [map]({}) |",
+        "| {} | {} | {:.3}{sort} | {:.4} | {:.4} | {:.1} | {} | {:.4} | {} | [map]({}) |",
         r.technique,
         ms(r.gpu_ms),
         r.cpu_ms,

@@ -61,6 +61,10 @@ pub struct Record {
     pub gpu_ms: Option<f64>,
     /// Median CPU ms to record a frame (quad sorting and the exact methods' waits included).
     pub cpu_ms: f64,
+    /// Median CPU ms of it spent ordering the game's translucent objects with the chunks
+    /// (sorted techniques in scenes with particles or entities; `null` otherwise).
+    #[serde(default)]
+    pub game_sort_ms: Option<f64>,
     /// Root mean square error, [0, 1] units.
     pub rmse: f64,
     /// PSNR in dB (100: identical).

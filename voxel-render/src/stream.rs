@@ -213,6 +213,9 @@ pub struct StreamFrame {
     /// unknown block id: the chunk counts as air) or uploaded, with why. Each failure is
     /// reported once, by the update that learns of it.
     pub failed: Vec<(ChunkPos, String)>,
+    /// The positions uploaded (or dropped from the sink, their meshes empty) in this
+    /// update, in order: what a game mirrors (its own per-chunk data, a minimap).
+    pub uploaded: Vec<ChunkPos>,
 }
 
 /// Bytes counted per edited block ([`ChunkStreamer::memory_bytes`]), an upper bound: a
@@ -610,6 +613,28 @@ impl ChunkStreamer {
                 (WorldPos::new(at(0, x), at(1, y), at(2, z)), id)
             })
         })
+    }
+
+    /// Restores saved edits ([`ChunkStreamer::edits`] of an earlier run, in any order):
+    /// each chunk not loaded keeps them to apply when it loads (no chunk is generated
+    /// here, unlike [`ChunkStreamer::set_block`]); a loaded one is edited now. Fails on
+    /// the first block id the registry does not hold, having restored none of them.
+    pub fn restore_edits(
+        &mut self,
+        edits: impl IntoIterator<Item = (WorldPos, BlockId)>,
+    ) -> Result<()> {
+        let edits: Vec<(WorldPos, BlockId)> = edits.into_iter().collect();
+        if let Some(&(_, id)) = edits.iter().find(|(_, id)| !self.registry.contains(*id)) {
+            return Err(voxel_core::Error::UnknownBlock(id, self.registry.len()).into());
+        }
+        for (pos, id) in edits {
+            if self.slots.contains_key(&pos.split().0) {
+                self.set_block(pos, id)?;
+            } else {
+                self.record_edit(pos, id);
+            }
+        }
+        Ok(())
     }
 
     /// Positions whose meshes are in the sink.
@@ -1073,6 +1098,7 @@ impl ChunkStreamer {
                     sink.remove(r.pos);
                     slot.uploaded = false;
                     frame.uploads += 1;
+                    frame.uploaded.push(r.pos);
                 }
                 continue;
             }
@@ -1081,6 +1107,7 @@ impl ChunkStreamer {
                     slot.uploaded = true;
                     frame.uploads += 1;
                     frame.upload_bytes += bytes;
+                    frame.uploaded.push(r.pos);
                 }
                 Err(e) => {
                     // The sink kept what it had, if anything: take it out, so that it
