@@ -252,9 +252,9 @@ fn every_technique_composes_game_objects_with_water_and_glass() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// An opaque entity is drawn with the world's opaque geometry: under water and behind
-/// glass every exact and sorted technique shows it as the reference does, and one buried
-/// under the sand changes no pixel.
+/// An opaque entity is drawn with the world's opaque geometry: under water, behind glass
+/// and in front of it (hiding it) every exact and sorted technique shows it as the
+/// reference does, and one buried under the sand changes no pixel.
 #[test]
 fn opaque_entities_are_seen_through_water_and_glass_and_hidden_by_terrain() {
     let Some(_ctx) = gpu() else { return };
@@ -263,8 +263,10 @@ fn opaque_entities_are_seen_through_water_and_glass_and_hidden_by_terrain() {
     let seen = with(
         &base,
         entities(vec![
+            // Under water, behind the pane, in front of it.
             plate([5.5, -3.0, 3.0], 1.0),
             plate([5.5, 3.5, 3.0], 1.0),
+            plate([8.0, 3.5, 9.5], 1.0),
         ]),
     );
     let buried = with(&base, entities(vec![plate([5.5, -12.0, 3.0], 1.0)]));
