@@ -321,7 +321,10 @@ fn settle_held(s: &mut ChunkStreamer, eye: DVec3, sink: &mut Held) {
         assert!(f.failed.is_empty(), "{:?}", f.failed);
         assert_eq!(f.uploaded.len(), f.uploads, "one position per upload");
         for p in &f.uploaded {
-            assert!(sink.0.contains(p) || before.contains(p), "{p:?} never reached the sink");
+            assert!(
+                sink.0.contains(p) || before.contains(p),
+                "{p:?} never reached the sink"
+            );
         }
         if s.is_idle() {
             return;

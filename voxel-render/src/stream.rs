@@ -88,11 +88,23 @@ pub trait ChunkSource: Send + Sync + 'static {
     /// unknown id is reported by the update ([`StreamFrame::failed`]) or by
     /// [`ChunkStreamer::set_block`] ([`Error::ChunkSource`]), and counts as air.
     fn generate(&self, pos: ChunkPos) -> Chunk;
+
+    /// Whether its blocks are the registry's: checked by [`ChunkStreamer::new`] (default:
+    /// nothing to check; a wrong id is then found per chunk).
+    fn check(&self, _registry: &BlockRegistry) -> Result<()> {
+        Ok(())
+    }
 }
 
 impl ChunkSource for TerrainGenerator {
     fn generate(&self, pos: ChunkPos) -> Chunk {
         self.generate_chunk(pos)
+    }
+
+    /// A generator made for another registry (its roles' ids name other blocks here) is
+    /// refused, naming each role ([`TerrainGenerator::check`]).
+    fn check(&self, registry: &BlockRegistry) -> Result<()> {
+        Ok(TerrainGenerator::check(self, registry)?)
     }
 }
 
@@ -487,6 +499,7 @@ impl ChunkStreamer {
         config: StreamConfig,
     ) -> Result<Self> {
         config.validate()?;
+        source.check(&registry)?;
         let threads = match config.threads {
             0 => {
                 std::thread::available_parallelism().map_or(1, |n| n.get().saturating_sub(1).max(1))
@@ -1224,6 +1237,29 @@ mod tests {
     use super::*;
     use std::collections::HashSet;
     use voxel_core::blocks;
+
+    /// Issue 23: a streamer over the default terrain with a game's registry whose ids name
+    /// other blocks is refused at `new`, naming the roles; with the default registry it is
+    /// made.
+    #[test]
+    fn a_generator_for_another_registry_is_refused_at_new() {
+        let mut game = BlockRegistry::new();
+        let _ = game.register(voxel_core::BlockDef::new(
+            "amber_glass",
+            [200, 140, 40],
+            0.5,
+        ));
+        for (_, def) in BlockRegistry::default().iter().skip(1) {
+            let _ = game.register(def.clone());
+        }
+        let generator = TerrainGenerator::new(voxel_core::TerrainConfig::default());
+        let config = StreamConfig::default();
+        let err = ChunkStreamer::new(Arc::new(game), generator.clone(), config.clone())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("but this registry's"), "{err}");
+        ChunkStreamer::new(Arc::new(BlockRegistry::default()), generator, config).unwrap();
+    }
 
     /// A sink that records what it holds and checks the streamer's calls.
     #[derive(Default)]
