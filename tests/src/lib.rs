@@ -298,3 +298,30 @@ impl Drop for Xvfb {
         let _ = self.child.wait();
     }
 }
+
+/// The binary of example `name` of `voxel-render`: `cargo test` builds the workspace's
+/// examples beside the tests (`target/release/examples`); a test run alone builds it.
+pub fn example_binary(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("the test's own path");
+    let profile = exe
+        .parent()
+        .and_then(|deps| deps.parent())
+        .expect("target/<profile>/deps");
+    let path = profile.join("examples").join(name);
+    if !path.exists() {
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+        let status = Command::new(cargo)
+            .args([
+                "build",
+                "--release",
+                "-p",
+                "voxel-render",
+                "--example",
+                name,
+            ])
+            .status()
+            .expect("cargo runs");
+        assert!(status.success(), "building the {name} example failed");
+    }
+    path
+}

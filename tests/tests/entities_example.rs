@@ -5,40 +5,15 @@
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use std::path::PathBuf;
 use std::process::Command;
 
-use tests::{diff, distinct_colours, gpu, out_dir};
+use tests::{diff, distinct_colours, example_binary, gpu, out_dir};
 use voxel_render::Image;
-
-/// The example's binary: `cargo test` builds the workspace's examples beside the tests
-/// (`target/release/examples`); run alone, this test builds it.
-fn example() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let profile = exe.parent().and_then(|deps| deps.parent()).unwrap();
-    let path = profile.join("examples").join("entities");
-    if !path.exists() {
-        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-        let status = Command::new(cargo)
-            .args([
-                "build",
-                "--release",
-                "-p",
-                "voxel-render",
-                "--example",
-                "entities",
-            ])
-            .status()
-            .unwrap();
-        assert!(status.success(), "building the entities example failed");
-    }
-    path
-}
 
 fn run(technique: &str) -> Image {
     let out = out_dir("entities_example").join(format!("{technique}.png"));
     let _ = std::fs::remove_file(&out);
-    let result = Command::new(example())
+    let result = Command::new(example_binary("entities"))
         .args(["--frames", "3", "--technique", technique, "--out"])
         .arg(&out)
         .output()

@@ -8,35 +8,8 @@
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use std::path::PathBuf;
-use std::process::Command;
-
-use tests::{Xvfb, distinct_colours, out_dir, skip_or_fail};
+use tests::{Xvfb, distinct_colours, example_binary, out_dir, skip_or_fail};
 use voxel_render::{GpuContext, Image};
-
-/// The example's binary: `cargo test` builds the workspace's examples beside the tests
-/// (`target/release/examples`); run alone, this test builds it.
-fn example() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let profile = exe.parent().and_then(|deps| deps.parent()).unwrap();
-    let path = profile.join("examples").join("window");
-    if !path.exists() {
-        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-        let status = Command::new(cargo)
-            .args([
-                "build",
-                "--release",
-                "-p",
-                "voxel-render",
-                "--example",
-                "window",
-            ])
-            .status()
-            .unwrap();
-        assert!(status.success(), "building the window example failed");
-    }
-    path
-}
 
 #[test]
 fn the_window_example_draws_into_its_own_surface() {
@@ -49,7 +22,7 @@ fn the_window_example_draws_into_its_own_surface() {
     let shot = out_dir("window_example").join("window.png");
     let _ = std::fs::remove_file(&shot);
     let out = x
-        .command(example())
+        .command(example_binary("window"))
         .args(["--frames", "4", "--screenshot", shot.to_str().unwrap()])
         .output()
         .unwrap();
