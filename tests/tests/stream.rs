@@ -350,7 +350,7 @@ fn saved_edits_load_back_into_the_same_world() {
     let ground = |x: i32, z: i32| g.height_at(i64::from(x), i64::from(z)) as i32;
     let home = DVec3::new(16.0, f64::from(ground(16, 16)) + 20.0, 16.0);
     let far = home + DVec3::X * 32.0 * 20.0;
-    let mut a = ChunkStreamer::new(registry.clone(), g.clone(), config.clone()).unwrap();
+    let mut a = ChunkStreamer::new(registry.clone(), g.clone(), config).unwrap();
     let mut sink = Held::default();
     settle_held(&mut a, home, &mut sink);
     for z in 0..40 {
@@ -364,7 +364,7 @@ fn saved_edits_load_back_into_the_same_world() {
     let saved: Vec<_> = a.edits().collect();
     assert_eq!(saved.len(), 41);
 
-    let mut b = ChunkStreamer::new(registry.clone(), g.clone(), config.clone()).unwrap();
+    let mut b = ChunkStreamer::new(registry.clone(), g.clone(), config).unwrap();
     let bad = [(WorldPos::new(0, 0, 0), voxel_core::BlockId(9999))];
     assert!(b.restore_edits(saved.iter().copied().chain(bad)).is_err());
     assert_eq!(b.edits().count(), 0, "a refused save restores nothing");

@@ -1254,7 +1254,7 @@ mod tests {
         }
         let generator = TerrainGenerator::new(voxel_core::TerrainConfig::default());
         let config = StreamConfig::default();
-        let err = ChunkStreamer::new(Arc::new(game), generator.clone(), config.clone())
+        let err = ChunkStreamer::new(Arc::new(game), generator.clone(), config)
             .unwrap_err()
             .to_string();
         assert!(err.contains("but this registry's"), "{err}");
