@@ -21,15 +21,18 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
+use voxel_core::ChunkPos;
+use voxel_mesh::PackedQuad;
 use wgpu::util::DeviceExt;
 
+use crate::chunks::{ChunkStore, PosMap};
 use crate::context::Capabilities;
 use crate::gpu::{self, ChunkPipeline, Depth, FullscreenPipeline, Pass, SidedPipeline};
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
 };
-use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
+use crate::stages::{TranslucentObject, TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{Error, GpuContext, Result};
 
@@ -188,36 +191,36 @@ pub fn transmittance(b0: f64, m: [f64; 4], z: f64, bias: f64, overestimation: f6
     (-b0 * a.clamp(0.0, 1.0)).exp()
 }
 
-/// The view depths the warp spans for `view`: from the nearest to the farthest point
-/// (along the view direction) of the visible translucent chunks' boxes and of the game's
-/// translucent objects' balls, within the camera's near and far planes. A game that draws
+/// The view depths the warp spans: from the nearest to the farthest point (along the
+/// view direction) of `boxes` (world-space boxes around the visible translucent meshes) and
+/// of `game_objects`' balls, within the camera's near and far planes. A game that draws
 /// translucent geometry without declaring its objects gets the whole near-to-far range.
-pub fn depth_range(view: &FrameView<'_>) -> [f32; 2] {
-    let cam = view.camera;
-    let (near, far) = (cam.near, cam.far);
-    if view.game_objects.is_some_and(<[_]>::is_empty) {
+pub fn depth_range(
+    camera: &crate::Camera,
+    boxes: impl IntoIterator<Item = (DVec3, DVec3)>,
+    game_objects: Option<&[TranslucentObject]>,
+) -> [f32; 2] {
+    let (near, far) = (camera.near, camera.far);
+    if game_objects.is_some_and(<[_]>::is_empty) {
         return [near as f32, far as f32];
     }
-    let forward = cam.forward;
-    let side = voxel_core::CHUNK_SIZE as f64;
+    let forward = camera.forward;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for pos in view.translucent {
-        let o = pos.origin().map(|v| v as f64);
-        let min = DVec3::from_array(o) - cam.eye;
-        // The box's extreme depths along `forward`: per axis the corner that lowers
-        // (raises) the dot product.
+    for (min, max) in boxes {
+        let (min, max) = (min - camera.eye, max - camera.eye);
+        // The box's extreme depths along `forward`: per axis the end that lowers (raises)
+        // the dot product.
         let (mut a, mut b) = (0.0, 0.0);
         for k in 0..3 {
-            let lo_k = min[k] * forward[k];
-            let hi_k = (min[k] + side) * forward[k];
-            a += lo_k.min(hi_k);
-            b += lo_k.max(hi_k);
+            let (p, q) = (min[k] * forward[k], max[k] * forward[k]);
+            a += p.min(q);
+            b += p.max(q);
         }
         lo = lo.min(a);
         hi = hi.max(b);
     }
-    for o in view.game_objects.unwrap_or(&[]) {
-        let d = (o.center - cam.eye).dot(forward);
+    for o in game_objects.unwrap_or(&[]) {
+        let d = (o.center - camera.eye).dot(forward);
         let r = if o.radius.is_finite() {
             o.radius.max(0.0)
         } else {
@@ -233,6 +236,20 @@ pub fn depth_range(view: &FrameView<'_>) -> [f32; 2] {
     } else {
         [near as f32, far as f32]
     }
+}
+
+/// The world-space box around the translucent quads of the chunk at `pos` (`None`: none).
+fn mesh_box(pos: ChunkPos, quads: &[PackedQuad]) -> Option<(DVec3, DVec3)> {
+    let o = pos.origin().map(|v| v as f64);
+    let origin = DVec3::from_array(o);
+    quads
+        .iter()
+        .filter_map(|q| q.unpack())
+        .map(|u| {
+            let (min, max) = u.bounds();
+            (origin + DVec3::from(min), origin + DVec3::from(max))
+        })
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
 }
 
 /// The shader of pass 1 (`resolve` false) or pass 2: constants from Rust, the shared
@@ -315,6 +332,8 @@ pub struct Mboit {
     moments_group: wgpu::BindGroup,
     /// The game's group layouts of pass 1 and pass 2.
     game_layouts: [wgpu::BindGroupLayout; 2],
+    /// Per chunk: the mesh generation boxed and the box around its translucent quads.
+    boxes: PosMap<ChunkPos, (u64, Option<(DVec3, DVec3)>)>,
     report: Option<MboitReport>,
 }
 
@@ -410,6 +429,7 @@ impl TechniqueKind for Mboit {
                 game_layout(device, "mboit_moments_game", &group_entries(false)),
                 game_layout(device, "mboit_resolve_game", &group_entries(true)),
             ],
+            boxes: PosMap::default(),
             report: None,
         })
     }
@@ -460,6 +480,34 @@ impl Mboit {
         }
     }
 
+    /// The warp's depth range for `view`, boxing (once per remesh) each visible
+    /// translucent mesh.
+    fn range(&mut self, chunks: &ChunkStore, view: &FrameView<'_>) -> [f32; 2] {
+        for &pos in view.translucent {
+            let Some(chunk) = chunks.get(pos) else {
+                continue;
+            };
+            let fresh = self
+                .boxes
+                .get(&pos)
+                .is_some_and(|(g, _)| *g == chunk.generation());
+            if !fresh {
+                let b = mesh_box(pos, chunk.translucent_quads());
+                self.boxes.insert(pos, (chunk.generation(), b));
+            }
+        }
+        // Forget chunks that were removed or remeshed since (kept bounded by the store).
+        if self.boxes.len() > 2 * chunks.len() + 64 {
+            self.boxes
+                .retain(|pos, (g, _)| chunks.get(*pos).map(|c| c.generation()) == Some(*g));
+        }
+        let boxes = view
+            .translucent
+            .iter()
+            .filter_map(|p| self.boxes.get(p).and_then(|(_, b)| *b));
+        depth_range(view.camera, boxes, view.game_objects)
+    }
+
     fn bias(&self) -> f32 {
         if self.single { BIAS_F32 } else { BIAS_F16 }
     }
@@ -497,10 +545,10 @@ impl TranslucentTechnique for Mboit {
         &mut self,
         ctx: &GpuContext,
         config: &OitConfig,
-        _chunks: &mut crate::chunks::ChunkStore,
+        chunks: &mut ChunkStore,
         view: &FrameView<'_>,
     ) -> Result<()> {
-        let range = depth_range(view);
+        let range = self.range(chunks, view);
         let params = MboitParams::new(range, self.bias(), config.mboit.overestimation);
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
@@ -727,6 +775,29 @@ mod tests {
         // A degenerate range stays finite.
         let q = MboitParams::new([5.0, 5.0], BIAS_F32, 0.25);
         assert!(q.inv_ln_range.is_finite() && q.warp(5.0).is_finite());
+    }
+
+    #[test]
+    fn the_range_spans_the_boxes_and_objects_seen() {
+        let cam =
+            crate::Camera::look_at(DVec3::new(0.0, 0.0, 10.0), DVec3::ZERO, 60.0, 0.1, 1000.0)
+                .unwrap();
+        let sheet = (DVec3::new(-5.0, -5.0, 0.0), DVec3::new(5.0, 5.0, 1.0));
+        let far = (DVec3::new(-5.0, -5.0, -40.0), DVec3::new(5.0, 5.0, -39.0));
+        assert_eq!(depth_range(&cam, [sheet, far], None), [9.0, 50.0]);
+        // A box around the eye starts at the near plane.
+        let around = (DVec3::splat(-20.0), DVec3::splat(20.0));
+        assert_eq!(depth_range(&cam, [around], None), [0.1, 30.0]);
+        // A game's particle nearer than every mesh widens the range; undeclared geometry
+        // takes the camera's.
+        let ball = TranslucentObject {
+            center: DVec3::new(0.0, 0.0, 7.0),
+            radius: 1.0,
+        };
+        assert_eq!(depth_range(&cam, [sheet], Some(&[ball])), [2.0, 10.0]);
+        assert_eq!(depth_range(&cam, [sheet], Some(&[])), [0.1, 1000.0]);
+        // Nothing seen: the camera's range.
+        assert_eq!(depth_range(&cam, [], None), [0.1, 1000.0]);
     }
 
     #[test]
