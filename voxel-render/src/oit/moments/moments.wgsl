@@ -1,5 +1,5 @@
 // Moment-based OIT, shared by both passes (appended to the constants made in Rust:
-// ABSORBANCE_MAX). Münstermann, Krösl, Jendersie & Wimmer 2018, with 4 power moments of
+// ABSORBANCE_MAX). Münstermann, Krumpen, Klein & Peters 2018, with 4 power moments of
 // log-warped depth; the reconstruction is the paper's Hamburger 4-moment bound.
 //
 // Pass 1 (additive blend):  b0 += a,  (b1, b2, b3, b4) += a · (z, z², z³, z⁴),
