@@ -109,6 +109,26 @@ fn small_eval_of_the_suite() {
         "fitted {fitted}, alpha-cubed {alpha_cubed}"
     );
 
+    // Moment-based OIT against the reference on the suite: its mean FLIP is bounded and
+    // below fitted WBOIT's (the same weights' pass, `wboit-mrt`). Measured when written
+    // at this size: 0.0198 against 0.0303; the bound leaves about 30 % for other drivers'
+    // rounding.
+    let suite_mean = |technique: &str| {
+        let runs: Vec<f64> = summary
+            .records
+            .iter()
+            .filter(|r| r.technique == technique)
+            .map(|r| r.flip_mean)
+            .collect();
+        assert_eq!(runs.len(), scenes.len(), "{technique}");
+        runs.iter().sum::<f64>() / runs.len() as f64
+    };
+    let mboit = suite_mean("mboit");
+    let wboit = suite_mean("wboit-mrt");
+    eprintln!("suite mean FLIP: mboit {mboit:.4}, wboit-mrt {wboit:.4}");
+    assert!(mboit < wboit, "mboit {mboit}, wboit-mrt {wboit}");
+    assert!(mboit <= 0.026, "mboit {mboit}");
+
     // summary.json: an array of records with the documented keys.
     let json: Vec<serde_json::Value> =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();

@@ -60,6 +60,7 @@ fn from_under_water_every_technique_draws_the_surface_like_the_reference() {
         Technique::SortedQuads,
         Technique::WboitMrt,
         Technique::WboitTwoPass,
+        Technique::Mboit,
         Technique::DepthPeeling,
         Technique::PeelReference,
     ] {
@@ -87,6 +88,7 @@ fn inside_glass_the_glass_tints_the_view_and_fogs_it() {
     for t in [
         Technique::SortedQuads,
         Technique::WboitMrt,
+        Technique::Mboit,
         Technique::DepthPeeling,
     ] {
         let img = render_with(&ctx, &s, config(t));

@@ -79,6 +79,12 @@ impl Capabilities {
                 .contains(wgpu::Features::INDIRECT_FIRST_INSTANCE)
     }
 
+    /// Whether 32-bit float targets (R32Float, Rgba32Float) can be blended (MBOIT's
+    /// moments; 16-bit ones otherwise).
+    pub fn float32_blendable(&self) -> bool {
+        self.features.contains(wgpu::Features::FLOAT32_BLENDABLE)
+    }
+
     /// Whether fragment shaders may write storage buffers (the A-buffer reference).
     pub fn fragment_storage(&self) -> bool {
         self.downlevel
@@ -100,8 +106,9 @@ pub struct GpuContext {
 }
 
 /// Optional features the renderer uses when the adapter has them.
-pub const WANTED_FEATURES: wgpu::Features =
-    wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::INDIRECT_FIRST_INSTANCE);
+pub const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
+    .union(wgpu::Features::INDIRECT_FIRST_INSTANCE)
+    .union(wgpu::Features::FLOAT32_BLENDABLE);
 
 impl GpuContext {
     /// Wraps a device the embedding game already owns. `adapter` is the one it came from

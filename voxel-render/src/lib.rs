@@ -40,9 +40,9 @@ pub use chunks::{
 pub use context::{Capabilities, GpuContext, WANTED_FEATURES, request_device};
 pub use error::{Error, Result};
 pub use oit::{
-    BayerSize, OitConfig, OitManager, PeelReport, PeelingSettings, ReferenceReport, ShadingState,
-    SortReport, StippleSettings, Technique, TechniqueReport, TranslucentFrame,
-    TranslucentTechnique, WboitReport, WboitSettings, WeightFit, WeightFunction,
+    BayerSize, MboitReport, MboitSettings, OitConfig, OitManager, PeelReport, PeelingSettings,
+    ReferenceReport, ShadingState, SortReport, StippleSettings, Technique, TechniqueReport,
+    TranslucentFrame, TranslucentTechnique, WboitReport, WboitSettings, WeightFit, WeightFunction,
 };
 pub use readback::Image;
 pub use renderer::{ChunkMemory, FrameStats, Lighting, OUTPUT_FORMATS, Renderer, RendererConfig};

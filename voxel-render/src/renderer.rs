@@ -799,12 +799,13 @@ impl Renderer {
         self.chunks.cull(&frustum, &mut self.culled);
         self.chunks.lists_built();
         // The technique's CPU work (it may reorder quads within their places).
+        let stages = game.stages();
         let view = FrameView {
             camera,
             view_proj,
             translucent: self.culled.translucent_positions(),
+            game_objects: stages.translucent.then(|| game.translucent_objects()),
         };
-        let stages = game.stages();
         self.oit
             .prepare(&mut self.chunks, &view, stages.translucent)?;
         // A sorting technique orders the game's objects with the chunks (after `prepare`:

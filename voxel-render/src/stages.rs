@@ -23,7 +23,6 @@ use std::ops::Range;
 
 use glam::{DVec3, Mat4, Vec3};
 
-use crate::oit::sorted::interleave::Split;
 use crate::{Camera, GpuContext};
 
 /// The bind group index the renderer reserves in a game's translucent pipelines (the last
@@ -55,6 +54,19 @@ pub struct TranslucentObject {
     pub center: DVec3,
     /// Radius of a ball holding all of it, blocks (0: order it as a point).
     pub radius: f64,
+}
+
+/// Where a run of objects is drawn: after quads `..quad` of chunk `chunk` (its position
+/// in the draw order; quad 0: before the chunk), objects of the order up to `end`
+/// (made by the sorted techniques, `oit::sorted::interleave`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Split {
+    /// The chunk, by its position in the draw order.
+    pub chunk: u32,
+    /// How many of its quads (in their drawn order) come before the objects.
+    pub quad: u32,
+    /// The objects of the order drawn here end at this position.
+    pub end: u32,
 }
 
 /// What a game needs to draw in a stage.

@@ -8,6 +8,7 @@
 //! is its folder plus one line in the list below (and, if it has settings of its own, their
 //! struct as a field of [`OitConfig`]).
 
+pub mod moments;
 pub mod opaque_only;
 pub mod peeling;
 pub mod reference;
@@ -25,10 +26,11 @@ use crate::bindings::SharedLayouts;
 use crate::chunks::{ChunkStore, DrawList, FrameDraws};
 use crate::context::Capabilities;
 use crate::gpu::Target;
-use crate::stages::{GameDraw, TranslucentContract, TranslucentVariant};
+use crate::stages::{GameDraw, TranslucentContract, TranslucentObject, TranslucentVariant};
 use crate::timing::Timer;
 use crate::{Camera, Error, GpuContext, Result};
 
+pub use moments::{MboitReport, MboitSettings};
 pub use peeling::{PeelReport, PeelingSettings};
 pub use reference::ReferenceReport;
 pub use sorted::SortReport;
@@ -132,6 +134,9 @@ techniques! {
     /// Weighted blended OIT, two passes: one per target. For adapters without
     /// independent blend.
     WboitTwoPass = "wboit-two-pass" => wboit::Wboit,
+    /// Moment-based OIT with 4 power moments of log-warped depth (Münstermann et al. 2018):
+    /// the transmittance in front of each fragment reconstructed from per-pixel moments.
+    Mboit = "mboit" => moments::Mboit,
     /// Screen-door transparency with a Bayer pattern (Mulder, Groen & van Wijk 1998): the
     /// low-end mode.
     Stipple = "stipple" => stipple::Stipple,
@@ -245,6 +250,8 @@ pub struct OitConfig {
     pub technique: Technique,
     /// Weighted blended OIT (both variants).
     pub wboit: WboitSettings,
+    /// Moment-based OIT.
+    pub mboit: MboitSettings,
     /// Stipple.
     pub stipple: StippleSettings,
     /// Depth peeling.
@@ -259,6 +266,7 @@ impl Default for OitConfig {
             technique: Technique::WboitMrt,
             // Each technique's settings carry their own reasoned defaults.
             wboit: WboitSettings::default(),
+            mboit: MboitSettings::default(),
             stipple: StippleSettings::default(),
             peeling: PeelingSettings::default(),
         }
@@ -277,6 +285,7 @@ impl OitConfig {
     /// Checks every setting against what the renderer supports.
     pub fn validate(&self) -> Result<()> {
         self.stipple.validate()?;
+        self.mboit.validate()?;
         self.peeling.validate()
     }
 }
@@ -288,6 +297,8 @@ pub struct TechniqueReport {
     pub prepare_ms: f64,
     /// Weighted blended OIT: what the fitted weight was fitted to.
     pub wboit: Option<WboitReport>,
+    /// Moment-based OIT: the moments' format and the warp's depth range.
+    pub mboit: Option<MboitReport>,
     /// Sorted quads: what was re-sorted.
     pub sort: Option<SortReport>,
     /// Depth peeling: layers found and iterations run.
@@ -305,6 +316,9 @@ pub struct FrameView<'a> {
     pub view_proj: Mat4,
     /// The visible chunks with translucent meshes, farthest first.
     pub translucent: &'a [ChunkPos],
+    /// The game's translucent objects when it draws translucent geometry this frame
+    /// (`None` when it does not; an empty slice when it draws without declaring them).
+    pub game_objects: Option<&'a [TranslucentObject]>,
 }
 
 /// What a technique draws with and into, for one frame.

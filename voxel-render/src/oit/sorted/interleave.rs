@@ -101,17 +101,9 @@ fn separate(b: Ball, eye: DVec3, s: &Surfaces<'_>) -> bool {
     apart > (big / du).asin() + (b.radius / dv).asin()
 }
 
-/// Where a run of objects is drawn: after quads `..quad` of chunk `chunk` (its position
-/// in the draw order; quad 0: before the chunk), objects of the order up to `end`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Split {
-    /// The chunk, by its position in the draw order.
-    pub chunk: u32,
-    /// How many of its quads (in their drawn order) come before the objects.
-    pub quad: u32,
-    /// The objects of the order drawn here end at this position.
-    pub end: u32,
-}
+// `Split` lives with the stages that carry it to the techniques (`GameDraw::splits`), so
+// that `stages` does not reach up into `oit`.
+pub use crate::stages::Split;
 
 /// How strongly a place for an object is ruled out: a chunk-wide sound test against a
 /// single quad's plane.
