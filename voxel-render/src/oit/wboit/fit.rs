@@ -61,6 +61,11 @@ struct Plane {
     tau: f32,
 }
 
+/// A plane's key while summing a mesh up: facing, position along its axis, block.
+type PlaneKey = (usize, u8, u16);
+/// A plane's sum while summing a mesh up: facing, rectangle (chunk-local), optical area.
+type PlaneSum = (Face, DVec3, DVec3, f64);
+
 /// A translucent mesh summed up per plane, facing and block.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshLayers {
@@ -79,7 +84,7 @@ impl MeshLayers {
         let origin = DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
         // By facing, plane position in the chunk and block (ordered: the same sums in the
         // same order every time): the face, the rectangle and the optical area.
-        let mut planes: BTreeMap<(usize, u8, u16), (Face, DVec3, DVec3, f64)> = BTreeMap::new();
+        let mut planes: BTreeMap<PlaneKey, PlaneSum> = BTreeMap::new();
         for q in quads {
             let Some(u) = q.unpack() else { continue };
             let alpha = opacity.get(u.block.index()).copied().unwrap_or(0.0);
@@ -464,7 +469,7 @@ mod tests {
         let mut seen = Vec::new();
         for (pos, quads) in meshes {
             let o = pos.origin().map(|v| v as f64);
-            let mut planes: BTreeMap<(usize, u8, u16), (Face, DVec3, DVec3, f64)> = BTreeMap::new();
+            let mut planes: BTreeMap<PlaneKey, PlaneSum> = BTreeMap::new();
             for q in quads {
                 let u = q.unpack().unwrap();
                 let axis = u.face.axis();
