@@ -325,3 +325,120 @@ fn shader_weights_match_the_rust_formulas() {
     }
     assert_eq!(wboit::RGBA8_SCALE, 1.0 / 24000.0);
 }
+
+/// A small pane of red glass in the middle of the view, in front of a stone wall: its
+/// chunk's translucent box covers a small part of the screen.
+fn pane_scene() -> Scene {
+    let world = box_world(&[
+        ([-40, -20, -2], [40, 20, -1], STONE),
+        ([-3, -2, 6], [3, 2, 6], RED_GLASS),
+    ]);
+    scene("pane", world, [0.5, 0.5, 30.0], [0.5, 0.5, 0.0])
+}
+
+/// The composite covers only the translucent boxes' rectangle, or nothing when no box is
+/// on screen, and the picture is the same as with a composite over the whole screen:
+/// outside the rectangle it would discard every pixel.
+#[test]
+fn the_composite_scissor_keeps_every_picture() {
+    let Some(ctx) = gpu() else { return };
+    let suite = |name: &str| {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../scenes/{name}.toml"));
+        voxel_lab::scene::Scene::load(&path).unwrap()
+    };
+    // The pane, then the pane with the camera turned away from it (its chunk may still
+    // be in view, its box is not on screen), then suite scenes.
+    let pane = pane_scene();
+    let mut away = pane.clone();
+    away.cameras[0] = voxel_render::Camera::look_at(
+        glam::DVec3::new(0.5, 0.5, 30.0),
+        glam::DVec3::new(40.0, 0.5, 60.0),
+        60.0,
+        0.1,
+        500.0,
+    )
+    .unwrap();
+    let scenes = [
+        ("pane", pane),
+        ("away", away),
+        ("stained_glass_corridor", suite("stained_glass_corridor")),
+        ("water_through_glass", suite("water_through_glass")),
+    ];
+    let mut smaller = 0;
+    for (name, scene) in &scenes {
+        for technique in [Technique::WboitMrt, Technique::WboitTwoPass] {
+            let picture = |scissor: bool| {
+                let mut config = technique_config(technique, W, H);
+                config.oit.wboit.composite_scissor = scissor;
+                let mut r = renderer_for(&ctx, scene, config).unwrap();
+                let target = Offscreen::new(&ctx, W, H);
+                let stats = r
+                    .render_and_submit(&target.view, &scene.cameras[0])
+                    .unwrap();
+                // None: WBOIT drew nothing (no translucent chunk in view).
+                let rect = stats.technique.wboit.map(|w| w.composite_rect);
+                (target.read(&ctx).unwrap(), rect)
+            };
+            let (full, none) = picture(false);
+            assert!(
+                none.is_none_or(|r| r.is_none()),
+                "{name}: no scissor asked for"
+            );
+            let (cut, rect) = picture(true);
+            if *name == "away" {
+                assert!(
+                    rect.is_none_or(|r| r.is_some_and(|r| r[2] * r[3] == 0)),
+                    "no pane on screen, no composite: {rect:?}"
+                );
+            }
+            let rect = rect.flatten().unwrap_or([0, 0, W, H]);
+            if rect[2] * rect[3] < W * H {
+                smaller += 1;
+            }
+            if *name == "pane" {
+                assert!(
+                    rect[2] < W / 2 && rect[3] < H / 2 && rect[2] * rect[3] > 0,
+                    "the pane's rectangle: {rect:?}"
+                );
+                let opaque = render(&ctx, scene, Technique::OpaqueOnly, W, H);
+                assert!(diff(&cut, &opaque).differing > 500, "the pane shows");
+            }
+            assert_close(&format!("scissor_{name}_{technique}"), &cut, &full, 0);
+        }
+    }
+    assert!(
+        smaller >= 4,
+        "the rectangle is smaller than the screen somewhere"
+    );
+}
+
+/// A weight change on a running renderer builds that weight's pipelines and draws what a
+/// new renderer with that weight draws; back to the first weight, its kept pipelines draw
+/// the first picture again.
+#[test]
+fn switching_the_weight_draws_what_a_new_renderer_draws() {
+    let Some(ctx) = gpu() else { return };
+    let scene = default_scene();
+    let camera = scene.cameras[0];
+    let with = |weight: WeightFunction| {
+        let mut config = technique_config(Technique::WboitMrt, W, H);
+        config.oit.wboit.weight = weight;
+        config
+    };
+    let fresh = |weight| render_with(&ctx, &scene, with(weight));
+    let mut r = renderer_for(&ctx, &scene, with(WeightFunction::Fitted)).unwrap();
+    let fitted = frame(&ctx, &mut r, &camera);
+    for weight in [WeightFunction::McGuire10, WeightFunction::Fitted] {
+        r.set_oit_config(with(weight).oit).unwrap();
+        let img = frame(&ctx, &mut r, &camera);
+        assert_close(
+            &format!("weight_switch_{}", weight.name()),
+            &img,
+            &fresh(weight),
+            0,
+        );
+    }
+    let eq10 = fresh(WeightFunction::McGuire10);
+    assert!(diff(&fitted, &eq10).differing > 100, "the weights differ");
+}

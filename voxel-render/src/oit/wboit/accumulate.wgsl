@@ -1,6 +1,6 @@
 // Weighted blended OIT, accumulation (appended to common.wgsl and the constants made in
-// Rust: WEIGHT_* ids, TILES, PROFILE_LEN, TABLE_VEC4S, MAX_FITTED_DEPTH). McGuire & Bavoil
-// 2013.
+// Rust: WEIGHT_* ids, WEIGHT_ANY, WEIGHT_SPECIALISED, TILES, PROFILE_LEN, TABLE_VEC4S,
+// MAX_FITTED_DEPTH). McGuire & Bavoil 2013.
 //
 // accumulation (RGBA16F, blend ONE, ONE on all channels) += (C·α, α) · w · scale
 // revealage    (R8,      blend ZERO, ONE_MINUS_SRC)     *= (1 − α)
@@ -15,6 +15,10 @@ struct WboitParams {
     depth_range: vec2<f32>,
     // Optical depth of a layer of the eye's medium (fitted weight; 0 in air).
     medium_depth: f32,
+    // ln of the range's near end, and (PROFILE_LEN - 1) / ln(far / near): the table's index
+    // is an affine function of ln(depth), one log per fragment (fitted weight).
+    log_near: f32,
+    log_scale: f32,
     // Per screen tile, the optical depth in front of log-spaced depths (fitted weight).
     optical_depth: array<vec4<f32>, TABLE_VEC4S>,
 };
@@ -42,9 +46,19 @@ fn medium_in_front(pixel: vec2<f32>, frag_z: f32) -> f32 {
     return params.medium_depth;
 }
 
+// The weight in force: the one a chunk pipeline was built for (WEIGHT_SPECIALISED, a
+// constant, so that the driver keeps only that case of the switch below: a CPU rasteriser
+// runs every case of a switch on a uniform, masked), or the uniform's in games' pipelines.
+fn weight_id() -> u32 {
+    if WEIGHT_SPECIALISED == WEIGHT_ANY {
+        return params.weight_fn;
+    }
+    return WEIGHT_SPECIALISED;
+}
+
 fn weight(pixel: vec2<f32>, frag_z: f32, z: f32, depth: f32, a: f32) -> f32 {
     let d = abs(depth);
-    switch params.weight_fn {
+    switch weight_id() {
         case WEIGHT_FLAT: {
             let zz = clamp(z, 1e-5, 3e4);
             return clamp(a * max(1e-2, 3e3 * cube(1.0 - zz * 0.001)), 1e-2, 3e4);
@@ -84,9 +98,8 @@ fn tile_depth(tile: vec2<u32>, k: u32, t: f32) -> f32 {
 }
 
 fn optical_depth_at(pixel: vec2<f32>, d: f32) -> f32 {
-    let n = max(params.depth_range.x, 1e-4);
-    let f = max(params.depth_range.y, n * 1.001);
-    let x = clamp(log(d / n) / log(f / n), 0.0, 1.0) * f32(PROFILE_LEN - 1u);
+    let last_k = f32(PROFILE_LEN - 1u);
+    let x = clamp((log(d) - params.log_near) * params.log_scale, 0.0, last_k);
     let k = min(u32(floor(x)), PROFILE_LEN - 2u);
     let t = x - f32(k);
     let last = f32(TILES - 1u);

@@ -1,8 +1,8 @@
 // Weighted blended OIT, the chunk pipelines' entries (appended to common.wgsl and
 // accumulate.wgsl).
 
-fn accumulation(in: VsOut, front: bool) -> vec4<f32> {
-    return wboit_accumulation(in.clip, in.view_depth, translucent_color(in, front));
+fn accumulation(in: VsOut, c: vec4<f32>) -> vec4<f32> {
+    return wboit_accumulation(in.clip, in.view_depth, c);
 }
 
 struct WboitOut {
@@ -13,10 +13,12 @@ struct WboitOut {
 // Single pass, two targets (needs independent blend).
 @fragment
 fn fs_accumulate_mrt(in: VsOut, @builtin(front_facing) front: bool) -> WboitOut {
+    // The colour once: a compiler need not merge two calls that each sample a texture.
+    let c = translucent_color(in, front);
     var out: WboitOut;
-    out.accumulation = accumulation(in, front);
+    out.accumulation = accumulation(in, c);
     // α in every channel: the revealage blend multiplies by one minus the source colour.
-    out.revealage = vec4<f32>(translucent_color(in, front).a);
+    out.revealage = vec4<f32>(c.a);
     return out;
 }
 
@@ -24,7 +26,7 @@ fn fs_accumulate_mrt(in: VsOut, @builtin(front_facing) front: bool) -> WboitOut 
 // second.
 @fragment
 fn fs_accumulate(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    return accumulation(in, front);
+    return accumulation(in, translucent_color(in, front));
 }
 
 @fragment

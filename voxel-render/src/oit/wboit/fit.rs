@@ -32,7 +32,7 @@
 
 use std::collections::BTreeMap;
 
-use glam::{DVec3, Mat4, Vec2, Vec3};
+use glam::{DVec3, Mat4, Vec2, Vec3, Vec4};
 use voxel_core::{ChunkPos, Face};
 use voxel_mesh::PackedQuad;
 
@@ -51,16 +51,28 @@ const MAX_LAYER_DEPTH: f64 = 4.605;
 struct Plane {
     /// Which way the quads face.
     face: Face,
-    /// World-space rectangle around the quads (flat along the face's axis).
-    lo: DVec3,
-    hi: DVec3,
-    /// Sum of quad area × optical depth of the quad's block.
-    optical_area: f64,
+    /// Chunk-local rectangle around the quads (flat along the face's axis): small whole
+    /// numbers, exact in `f32`.
+    lo: Vec3,
+    hi: Vec3,
+    /// The optical depth a ray through the rectangle crosses: the quads' area times their
+    /// block's optical depth, over the rectangle's area (view-independent, so summed up
+    /// once per mesh rather than each frame).
+    tau: f32,
 }
+
+/// A plane's key while summing a mesh up: facing, position along its axis, block.
+type PlaneKey = (usize, u8, u16);
+/// A plane's sum while summing a mesh up: facing, rectangle (chunk-local), optical area.
+type PlaneSum = (Face, DVec3, DVec3, f64);
 
 /// A translucent mesh summed up per plane, facing and block.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshLayers {
+    /// The chunk's origin, world blocks.
+    origin: DVec3,
+    /// The planes (a clear block's too, optical depth 0: it is drawn, so the composite's
+    /// rectangle must hold it).
     planes: Vec<Plane>,
 }
 
@@ -71,30 +83,36 @@ impl MeshLayers {
         let o = pos.origin();
         let origin = DVec3::new(o[0] as f64, o[1] as f64, o[2] as f64);
         // By facing, plane position in the chunk and block (ordered: the same sums in the
-        // same order every time).
-        let mut planes: BTreeMap<(usize, u8, u16), Plane> = BTreeMap::new();
+        // same order every time): the face, the rectangle and the optical area.
+        let mut planes: BTreeMap<PlaneKey, PlaneSum> = BTreeMap::new();
         for q in quads {
             let Some(u) = q.unpack() else { continue };
             let alpha = opacity.get(u.block.index()).copied().unwrap_or(0.0);
             let depth = layer_depth(alpha);
             let axis = u.face.axis();
             let (min, max) = u.bounds();
-            let (lo, hi) = (origin + DVec3::from(min), origin + DVec3::from(max));
+            let (lo, hi) = (DVec3::from(min), DVec3::from(max));
             let area = f64::from(q.area());
             let key = (u.face as usize, min[axis] as u8, u.block.0);
-            let plane = planes.entry(key).or_insert(Plane {
-                face: u.face,
-                lo,
-                hi,
-                optical_area: 0.0,
-            });
-            plane.lo = plane.lo.min(lo);
-            plane.hi = plane.hi.max(hi);
-            plane.optical_area += area * depth;
+            let plane = planes.entry(key).or_insert((u.face, lo, hi, 0.0));
+            plane.1 = plane.1.min(lo);
+            plane.2 = plane.2.max(hi);
+            plane.3 += area * depth;
         }
-        Self {
-            planes: planes.into_values().collect(),
-        }
+        let planes = planes
+            .into_values()
+            .map(|(face, lo, hi, optical_area)| {
+                let [ua, va] = voxel_mesh::UV_AXES[face.axis()];
+                let area = (hi[ua] - lo[ua]) * (hi[va] - lo[va]);
+                Plane {
+                    face,
+                    lo: lo.as_vec3(),
+                    hi: hi.as_vec3(),
+                    tau: (optical_area / area.max(1.0)) as f32,
+                }
+            })
+            .collect();
+        Self { origin, planes }
     }
 }
 
@@ -109,17 +127,7 @@ pub fn fit<'a>(
     near: f32,
     far: f32,
 ) -> WeightFit {
-    // Each plane that faces the eye: its optical depth, screen rectangle and depth span.
-    let mut seen = Vec::new();
-    for plane in layers.into_iter().flat_map(|m| &m.planes) {
-        let tau = crossed_optical_depth(plane, eye);
-        if tau > 0.0 {
-            let (rect, span) = projection(plane, view_proj, eye);
-            if rect[1].cmpgt(rect[0]).all() {
-                seen.push((tau as f32, rect, span));
-            }
-        }
-    }
+    let (seen, covered) = visible_planes(layers, view_proj, eye);
     let (mut n, mut f) = seen
         .iter()
         .fold((f32::INFINITY, 0.0f32), |(n, f), (_, _, [a, b])| {
@@ -164,40 +172,75 @@ pub fn fit<'a>(
     WeightFit {
         range,
         optical_depth,
+        covered,
     }
 }
 
-/// The optical depth a ray through the plane's rectangle crosses (its optical area over
-/// its area) when the quads face the eye, else 0 (back faces are not drawn, but for the
-/// medium's, counted per pixel).
-fn crossed_optical_depth(plane: &Plane, eye: DVec3) -> f64 {
-    let axis = plane.face.axis();
-    if (eye[axis] > plane.lo[axis]) != plane.face.is_positive() || eye[axis] == plane.lo[axis] {
-        return 0.0;
+/// A plane seen in a frame: its optical depth, screen rectangle and view depth span.
+type Seen = (f32, [Vec2; 2], [f32; 2]);
+
+/// Each plane of `layers` that faces the eye and covers some of the screen, in order, and
+/// the screen rectangle they cover together ([`WeightFit::covered`]). Projected per
+/// mesh: the chunk's offset from the eye once (in f64, then small enough for f32), then
+/// each corner from the projection's columns (the projection is linear before the
+/// divide), a quarter of the multiplications of four full transforms.
+fn visible_planes<'a>(
+    layers: impl IntoIterator<Item = &'a MeshLayers>,
+    view_proj: Mat4,
+    eye: DVec3,
+) -> (Vec<Seen>, [Vec2; 2]) {
+    let mut seen = Vec::new();
+    let columns = [view_proj.x_axis, view_proj.y_axis, view_proj.z_axis];
+    let (mut min, mut max) = (Vec2::INFINITY, Vec2::NEG_INFINITY);
+    for mesh in layers {
+        let eye_local = eye - mesh.origin;
+        let base = view_proj * (mesh.origin - eye).as_vec3().extend(1.0);
+        for plane in &mesh.planes {
+            if !faces(plane, eye_local) {
+                continue;
+            }
+            let (rect, span) = projection(plane, base, &columns);
+            if rect[1].cmpgt(rect[0]).all() {
+                // A plane wholly behind the eye is not drawn (its rectangle says "the
+                // whole screen" for the estimate, as it always did).
+                if span[1] > 0.0 {
+                    min = min.min(rect[0]);
+                    max = max.max(rect[1]);
+                }
+                // A clear plane dims nothing and leaves the depth range alone.
+                if plane.tau > 0.0 {
+                    seen.push((plane.tau, rect, span));
+                }
+            }
+        }
     }
-    let [ua, va] = voxel_mesh::UV_AXES[axis];
-    let area = (plane.hi[ua] - plane.lo[ua]) * (plane.hi[va] - plane.lo[va]);
-    plane.optical_area / area.max(1.0)
+    (seen, [min, max])
+}
+
+/// Whether the plane's quads face the eye at `eye_local` (chunk-local): only those are
+/// drawn (back faces are culled, but for the medium's, counted per pixel by the shader).
+fn faces(plane: &Plane, eye_local: DVec3) -> bool {
+    let axis = plane.face.axis();
+    let at = f64::from(plane.lo[axis]);
+    (eye_local[axis] > at) == plane.face.is_positive() && eye_local[axis] != at
 }
 
 /// The bounding rectangle of the plane's projection, in screen coordinates (0 to 1, y
 /// down; the whole screen when the plane reaches behind the eye), and the view depths it
-/// spans.
-fn projection(plane: &Plane, view_proj: Mat4, eye: DVec3) -> ([Vec2; 2], [f32; 2]) {
-    let (lo, hi) = ((plane.lo - eye).as_vec3(), (plane.hi - eye).as_vec3());
+/// spans. `base` is the chunk's origin in clip space, `columns` the projection's x, y and
+/// z columns: a chunk-local point `p` lies at `base + Σ columns[i] · p[i]`.
+fn projection(plane: &Plane, base: Vec4, columns: &[Vec4; 3]) -> ([Vec2; 2], [f32; 2]) {
+    let (lo, hi) = (plane.lo, plane.hi);
+    let origin = base + columns[0] * lo.x + columns[1] * lo.y + columns[2] * lo.z;
+    // The rectangle is flat along its face's axis: four corners, spanned along the two
+    // others.
+    let [ua, va] = voxel_mesh::UV_AXES[plane.face.axis()];
+    let du = columns[ua] * (hi[ua] - lo[ua]);
+    let dv = columns[va] * (hi[va] - lo[va]);
     let (mut min, mut max) = (Vec2::splat(f32::INFINITY), Vec2::NEG_INFINITY);
     let (mut near, mut far) = (f32::INFINITY, f32::NEG_INFINITY);
-    // The rectangle is flat along its face's axis: the corners that differ only there are
-    // the same point, so four of the eight give every number.
-    let flat = 1 << plane.face.axis();
-    for i in (0..8).filter(|i| i & flat == 0) {
-        let corner = Vec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        );
+    for clip in [origin, origin + du, origin + dv, origin + du + dv] {
         // Perspective: clip w is the view depth.
-        let clip = view_proj * corner.extend(1.0);
         near = near.min(clip.w);
         far = far.max(clip.w);
         let ndc = clip.truncate().truncate() / clip.w.max(1e-6);
@@ -227,6 +270,11 @@ pub struct WeightFit {
     /// depth in front of [`PROFILE_LEN`] depths spaced evenly in log depth across `range`.
     /// Empty: none anywhere.
     pub optical_depth: Vec<f32>,
+    /// The screen rectangle (0 to 1, y down) around the planes of quads that face the eye
+    /// (the whole screen when one reaches the eye's plane; min > max when none is seen):
+    /// where front faces can be drawn. What the composite's scissor is made from when the
+    /// eye is in air (from inside a medium back faces are drawn too).
+    pub covered: [Vec2; 2],
 }
 
 /// The most optical depth the fitted weight falls by: `e^−12`, 6·10⁻⁶ (the weight must
@@ -241,6 +289,16 @@ pub fn layer_depth(alpha: f32) -> f64 {
 }
 
 impl WeightFit {
+    /// `[ln n, (PROFILE_LEN − 1) / ln(f / n)]` for the range's ends `n` and `f` (kept
+    /// apart and above zero): the table index of view depth `d` is
+    /// `(ln d − ln n) · (PROFILE_LEN − 1) / ln(f / n)`, which the shader computes with
+    /// one log (these two numbers are in its uniform).
+    pub fn log_mapping(&self) -> [f32; 2] {
+        let n = self.range[0].max(1e-4);
+        let f = self.range[1].max(n * 1.001);
+        [n.ln(), (PROFILE_LEN - 1) as f32 / (f / n).ln()]
+    }
+
     /// The optical depth in front of view depth `d` at `screen` (0 to 1, y down):
     /// interpolated in log depth in the tables of the four tiles around `screen`, then
     /// bilinearly between the tiles' centres (no seams at tile edges), and clamped at the
@@ -249,9 +307,8 @@ impl WeightFit {
         if self.optical_depth.len() < TILES * TILES * PROFILE_LEN {
             return 0.0;
         }
-        let n = self.range[0].max(1e-4);
-        let f = self.range[1].max(n * 1.001);
-        let x = ((d / n).ln() / (f / n).ln()).clamp(0.0, 1.0) * (PROFILE_LEN - 1) as f32;
+        let [log_near, log_scale] = self.log_mapping();
+        let x = ((d.ln() - log_near) * log_scale).clamp(0.0, (PROFILE_LEN - 1) as f32);
         let k = (x.floor() as usize).min(PROFILE_LEN - 2);
         let t = x - k as f32;
         let at = |tx: usize, ty: usize| {
@@ -399,5 +456,147 @@ mod tests {
         assert_eq!(fit.range, [0.1, 500.0]);
         assert!(fit.optical_depth.iter().all(|&t| t == 0.0));
         assert_eq!(fit.optical_depth_at([0.5, 0.5], 100.0), 0.0);
+    }
+
+    /// The fit as first written, the oracle of the faster one: each plane's four corners
+    /// transformed in full from world space, its optical depth computed each frame.
+    fn oracle(
+        meshes: &[(ChunkPos, Vec<PackedQuad>)],
+        opacity: &[f32],
+        view_proj: Mat4,
+        eye: DVec3,
+    ) -> Vec<Seen> {
+        let mut seen = Vec::new();
+        for (pos, quads) in meshes {
+            let o = pos.origin().map(|v| v as f64);
+            let mut planes: BTreeMap<PlaneKey, PlaneSum> = BTreeMap::new();
+            for q in quads {
+                let u = q.unpack().unwrap();
+                let axis = u.face.axis();
+                let (min, max) = u.bounds();
+                let lo = DVec3::from(o) + DVec3::from(min);
+                let hi = DVec3::from(o) + DVec3::from(max);
+                let depth = layer_depth(opacity[u.block.index()]);
+                let p = planes
+                    .entry((u.face as usize, min[axis] as u8, u.block.0))
+                    .or_insert((u.face, lo, hi, 0.0));
+                p.1 = p.1.min(lo);
+                p.2 = p.2.max(hi);
+                p.3 += f64::from(q.area()) * depth;
+            }
+            for (face, lo, hi, optical_area) in planes.into_values() {
+                let axis = face.axis();
+                if (eye[axis] > lo[axis]) != face.is_positive() || eye[axis] == lo[axis] {
+                    continue;
+                }
+                let [ua, va] = voxel_mesh::UV_AXES[axis];
+                let tau = optical_area / ((hi[ua] - lo[ua]) * (hi[va] - lo[va])).max(1.0);
+                if tau <= 0.0 {
+                    continue;
+                }
+                let (l, h) = ((lo - eye).as_vec3(), (hi - eye).as_vec3());
+                let (mut min, mut max) = (Vec2::INFINITY, Vec2::NEG_INFINITY);
+                let (mut near, mut far) = (f32::INFINITY, f32::NEG_INFINITY);
+                for i in (0..8).filter(|i| i & (1 << axis) == 0) {
+                    let c = Vec3::new(
+                        if i & 1 == 0 { l.x } else { h.x },
+                        if i & 2 == 0 { l.y } else { h.y },
+                        if i & 4 == 0 { l.z } else { h.z },
+                    );
+                    let clip = view_proj * c.extend(1.0);
+                    near = near.min(clip.w);
+                    far = far.max(clip.w);
+                    let ndc = clip.truncate().truncate() / clip.w.max(1e-6);
+                    let screen = Vec2::new(ndc.x + 1.0, 1.0 - ndc.y) * 0.5;
+                    min = min.min(screen);
+                    max = max.max(screen);
+                }
+                let rect = if near <= 1e-3 {
+                    [Vec2::ZERO, Vec2::ONE]
+                } else {
+                    [
+                        min.clamp(Vec2::ZERO, Vec2::ONE),
+                        max.clamp(Vec2::ZERO, Vec2::ONE),
+                    ]
+                };
+                if rect[1].cmpgt(rect[0]).all() {
+                    seen.push((tau as f32, rect, [near.max(0.0), far.max(0.0)]));
+                }
+            }
+        }
+        seen
+    }
+
+    /// Random translucent quads in four chunks far from the origin, seen from random eyes
+    /// in and around them: the faster fit sees the oracle's planes, with the same optical
+    /// depths, screen rectangles and depth spans within rounding.
+    #[test]
+    fn the_fit_equals_the_full_transform_of_every_corner() {
+        let opacity = opacity();
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: u32| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % u64::from(n)) as u32
+        };
+        let blocks = [blocks::GLASS, blocks::WATER, blocks::ICE, blocks::RED_GLASS];
+        let faces = [
+            Face::PosX,
+            Face::NegX,
+            Face::PosY,
+            Face::NegY,
+            Face::PosZ,
+            Face::NegZ,
+        ];
+        let base = [1000, 2, -3000];
+        let meshes: Vec<(ChunkPos, Vec<PackedQuad>)> = (0..4)
+            .map(|c| {
+                let pos = ChunkPos::new(base[0] + c % 2, base[1], base[2] + c / 2);
+                let quads = (0..60)
+                    .map(|_| {
+                        let (w, h) = (1 + next(8) as usize, 1 + next(8) as usize);
+                        let at = [next(24), next(24), next(24)].map(|v| v as usize);
+                        let face = faces[next(6) as usize];
+                        PackedQuad::new(at, w, h, face, blocks[next(4) as usize])
+                    })
+                    .collect();
+                (pos, quads)
+            })
+            .collect();
+        let layers: Vec<MeshLayers> = meshes
+            .iter()
+            .map(|(p, q)| MeshLayers::new(*p, q, &opacity))
+            .collect();
+        let centre = DVec3::new(32_032.0, 80.0, -95_968.0);
+        let mut compared = 0;
+        for _ in 0..40 {
+            let mut offset = |n: u32| f64::from(next(n)) - f64::from(n / 2) + 0.37;
+            let eye = centre + DVec3::new(offset(160), offset(100), offset(160));
+            let target = centre + DVec3::new(offset(40), offset(40), offset(40));
+            let Ok(cam) = Camera::look_at(eye, target, 70.0, 0.1, 1000.0) else {
+                continue;
+            };
+            let vp = cam.view_proj(16.0 / 9.0);
+            let (fast, _) = visible_planes(&layers, vp, eye);
+            let want = oracle(&meshes, &opacity, vp, eye);
+            assert_eq!(fast.len(), want.len(), "the same planes are seen");
+            compared += usize::from(!want.is_empty());
+            for ((t, r, s), (wt, wr, ws)) in fast.iter().zip(&want) {
+                assert!((t - wt).abs() <= 1e-6 * wt, "tau {t} != {wt}");
+                for k in 0..2 {
+                    // Rounding of the corners' transform: far below a pixel.
+                    assert!(
+                        (r[k] - wr[k]).abs().max_element() <= 1e-4,
+                        "{r:?} != {wr:?}"
+                    );
+                    assert!(
+                        (s[k] - ws[k]).abs() <= 1e-4 * ws[k].max(1.0),
+                        "{s:?} != {ws:?}"
+                    );
+                }
+            }
+        }
+        assert!(compared > 20, "only {compared} views saw a plane");
     }
 }

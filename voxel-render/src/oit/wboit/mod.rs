@@ -23,9 +23,15 @@
 //! RGBA8 with outputs scaled so that eight maximum-weight layers fit; the average then has
 //! eight bits of precision at best. Logged when chosen.
 //!
-//! The weight and its parameters (the fitted weight's table, [`fit`]) are the technique's
-//! own uniform, group 2: written each frame by [`Wboit::prepare`](TranslucentTechnique::prepare),
-//! so changing the weight rebuilds nothing.
+//! The weight's parameters (the fitted weight's table, [`fit`]) are the technique's own
+//! uniform, group 2, written each frame by [`Wboit::prepare`](TranslucentTechnique::prepare).
+//! The chunk pipelines are built per weight (the weight a shader constant, so that no
+//! fragment pays for the other weights' code), the first time a frame draws with it, and
+//! kept; games' pipelines read the weight from the uniform.
+//!
+//! With the fitted weight the composite covers only the screen rectangle of the visible
+//! translucent planes ([`WboitSettings::composite_scissor`]); the accumulation targets are
+//! cleared by the accumulation pass's load ops (no clear pass).
 
 pub mod fit;
 pub mod weights;
@@ -67,6 +73,13 @@ pub struct WboitSettings {
     /// Scale accumulation by 1/64 so that fp16 sums stay finite up to ~1390 layers of the
     /// maximum weight (without it, 22 such layers reach 65504).
     pub headroom: bool,
+    /// With the fitted weight, composite only within the screen rectangle of the
+    /// translucent planes facing the eye (the fit projects them anyway), and not at all
+    /// when it is empty; the whole screen when a game draws translucent geometry (whose
+    /// extent the renderer does not know) or the eye is inside a medium (back faces are
+    /// drawn). Outside it the composite would discard every pixel (revealage 1), so the
+    /// picture is the same.
+    pub composite_scissor: bool,
 }
 
 impl Default for WboitSettings {
@@ -79,6 +92,8 @@ impl Default for WboitSettings {
             force_rgba8_accum: false,
             // On: turn off only to test the composite's guard against non-finite sums.
             headroom: true,
+            // On: the same picture for fewer composited pixels; off only to test that.
+            composite_scissor: true,
         }
     }
 }
@@ -92,6 +107,9 @@ pub struct WboitReport {
     pub accumulation: wgpu::TextureFormat,
     /// What the fitted weight was fitted to (`None` with another weight).
     pub fit: Option<WeightFit>,
+    /// The pixels the composite covered, `[x, y, width, height]` (zero size: it was
+    /// skipped); `None`: the whole screen.
+    pub composite_rect: Option<[u32; 4]>,
 }
 
 /// The technique's uniform (`WboitParams` in `accumulate.wgsl`).
@@ -107,8 +125,14 @@ pub struct WboitParams {
     /// Optical depth of one layer of the eye's medium (fitted weight; 0 in air): it dims
     /// every fragment behind the medium's surface at its pixel.
     pub medium_depth: f32,
+    /// `ln` of the near end of `depth_range` and `(PROFILE_LEN − 1) / ln(far / near)`
+    /// ([`WeightFit::log_mapping`]): the table index of view depth `d` is
+    /// `(ln d − log_near) · log_scale`, one log per fragment instead of two and a divide.
+    pub log_near: f32,
+    /// See `log_near`.
+    pub log_scale: f32,
     /// Padding (the table is 16-byte aligned).
-    pub _pad: [f32; 3],
+    pub _pad: f32,
     /// Per screen tile, the optical depth in front of log-spaced depths (fitted weight).
     pub optical_depth: [[f32; 4]; TABLE_VEC4S],
 }
@@ -133,11 +157,11 @@ pub fn accum_scale(caps: &Capabilities, settings: &WboitSettings) -> f32 {
     }
 }
 
-/// The accumulation shader: constants from Rust, the shared code, the weights, the chunk
-/// entries.
-pub fn accumulate_wgsl() -> String {
+/// The accumulation shader for chunk pipelines drawing with `weight` (`None`: any, read
+/// from the uniform): constants from Rust, the shared code, the weights, the chunk entries.
+pub fn accumulate_wgsl(weight: Option<WeightFunction>) -> String {
     [
-        weight_consts().as_str(),
+        weight_consts(weight).as_str(),
         &crate::bindings::common_wgsl(),
         include_str!("accumulate.wgsl"),
         include_str!("chunks.wgsl"),
@@ -145,8 +169,17 @@ pub fn accumulate_wgsl() -> String {
     .concat()
 }
 
-fn weight_consts() -> String {
+/// `WEIGHT_SPECIALISED` when a pipeline serves any weight (games' pipelines).
+const WEIGHT_ANY: u32 = u32::MAX;
+
+/// The shader's constants; `WEIGHT_SPECIALISED` is `weight`'s id, or [`WEIGHT_ANY`].
+fn weight_consts(weight: Option<WeightFunction>) -> String {
     WeightFunction::wgsl_ids()
+        .u32("WEIGHT_ANY", WEIGHT_ANY)
+        .u32(
+            "WEIGHT_SPECIALISED",
+            weight.map_or(WEIGHT_ANY, WeightFunction::id),
+        )
         .u32("TILES", TILES as u32)
         .u32("PROFILE_LEN", PROFILE_LEN as u32)
         .u32("TABLE_VEC4S", TABLE_VEC4S as u32)
@@ -227,6 +260,64 @@ enum Accumulate {
     },
 }
 
+/// What the chunk pipelines of a weight are built from.
+#[derive(Debug)]
+struct AccumulateBuilder {
+    two_pass: bool,
+    layouts: crate::SharedLayouts,
+    params_layout: wgpu::BindGroupLayout,
+    /// The accumulation and revealage target states.
+    targets: [Option<wgpu::ColorTargetState>; 2],
+}
+
+impl AccumulateBuilder {
+    /// The chunk pipelines for `weight`, whose shader has the weight as a constant: a
+    /// driver drops the other weights' code, where a switch on the uniform leaves it in
+    /// every fragment of a CPU rasteriser (lavapipe runs every case of a switch, masked:
+    /// `results/wboit-passes/report.md`).
+    fn build(&self, device: &wgpu::Device, weight: WeightFunction) -> Accumulate {
+        let module = gpu::shader(
+            device,
+            "wboit_accumulate",
+            &[&accumulate_wgsl(Some(weight))],
+        );
+        let groups = self.layouts.with(&[&self.params_layout]);
+        let chunk = |label, fragment_entry, targets: &[Option<wgpu::ColorTargetState>]| {
+            ChunkPipeline {
+                label,
+                module: &module,
+                fragment_entry,
+                groups: &groups,
+                targets,
+                depth: gpu::DepthMode::ReadOnly,
+                samples: 1,
+            }
+            .build_sided(device)
+        };
+        let [accum, reveal] = &self.targets;
+        if self.two_pass {
+            Accumulate::TwoPass {
+                accumulate: chunk(
+                    "wboit_accumulate",
+                    "fs_accumulate",
+                    std::slice::from_ref(accum),
+                ),
+                revealage: chunk(
+                    "wboit_revealage",
+                    "fs_revealage",
+                    std::slice::from_ref(reveal),
+                ),
+            }
+        } else {
+            Accumulate::Mrt(chunk(
+                "wboit_accumulate_mrt",
+                "fs_accumulate_mrt",
+                &[accum.clone(), reveal.clone()],
+            ))
+        }
+    }
+}
+
 #[derive(Debug)]
 struct Targets {
     accumulation: Target,
@@ -238,7 +329,11 @@ struct Targets {
 /// weight's summary of each translucent mesh.
 #[derive(Debug)]
 pub struct Wboit {
-    accumulate: Accumulate,
+    /// The chunk pipelines of each weight drawn with so far (built when first needed; a
+    /// frame draws with the last one `prepare` asked for).
+    accumulate: Vec<(WeightFunction, Accumulate)>,
+    /// What a weight's pipelines are built from.
+    builder: AccumulateBuilder,
     composite: wgpu::RenderPipeline,
     composite_layout: wgpu::BindGroupLayout,
     accum_format: wgpu::TextureFormat,
@@ -251,6 +346,11 @@ pub struct Wboit {
     block_opacity: std::sync::Arc<[f32]>,
     /// Per chunk: the generation summed up and its layers.
     layers: PosMap<ChunkPos, (u64, MeshLayers)>,
+    /// The weight of this frame's chunk pipelines.
+    weight: WeightFunction,
+    /// The composite's scissor rectangle for this frame's chunks (`[x, y, w, h]`), `None`
+    /// for the whole screen ([`WboitSettings::composite_scissor`]).
+    composite_rect: Option<[u32; 4]>,
     report: Option<WboitReport>,
 }
 
@@ -285,8 +385,6 @@ impl TechniqueKind for Wboit {
             &params_layout,
             &[params.as_entire_binding()],
         );
-        let module = gpu::shader(device, "wboit_accumulate", &[&accumulate_wgsl()]);
-        let groups = setup.layouts.with(&[&params_layout]);
         let target = |format, blend| {
             Some(wgpu::ColorTargetState {
                 format,
@@ -296,38 +394,14 @@ impl TechniqueKind for Wboit {
         };
         let accum_target = target(accum_format, ADDITIVE);
         let reveal_target = target(REVEALAGE_FORMAT, MULTIPLY_ONE_MINUS_SRC);
-        let chunk = |label, fragment_entry, targets: &[Option<wgpu::ColorTargetState>]| {
-            ChunkPipeline {
-                label,
-                module: &module,
-                fragment_entry,
-                groups: &groups,
-                targets,
-                depth: gpu::DepthMode::ReadOnly,
-                samples: 1,
-            }
-            .build_sided(device)
+        let builder = AccumulateBuilder {
+            two_pass: technique == Technique::WboitTwoPass,
+            layouts: setup.layouts.clone(),
+            params_layout: params_layout.clone(),
+            targets: [accum_target.clone(), reveal_target.clone()],
         };
-        let accumulate = if technique == Technique::WboitTwoPass {
-            Accumulate::TwoPass {
-                accumulate: chunk(
-                    "wboit_accumulate",
-                    "fs_accumulate",
-                    std::slice::from_ref(&accum_target),
-                ),
-                revealage: chunk(
-                    "wboit_revealage",
-                    "fs_revealage",
-                    std::slice::from_ref(&reveal_target),
-                ),
-            }
-        } else {
-            Accumulate::Mrt(chunk(
-                "wboit_accumulate_mrt",
-                "fs_accumulate_mrt",
-                &[accum_target.clone(), reveal_target.clone()],
-            ))
-        };
+        let weight = config.wboit.weight;
+        let accumulate = vec![(weight, builder.build(device, weight))];
         let float = wgpu::TextureSampleType::Float { filterable: false };
         let composite_layout = gpu::textures_layout(device, "wboit_composite_layout", float, 2);
         let composite = FullscreenPipeline {
@@ -343,6 +417,8 @@ impl TechniqueKind for Wboit {
         let targets = Self::targets(device, &composite_layout, accum_format, setup.size);
         Ok(Self {
             accumulate,
+            builder,
+            weight,
             composite,
             composite_layout,
             accum_format,
@@ -353,6 +429,7 @@ impl TechniqueKind for Wboit {
             target_states: [accum_target, reveal_target],
             block_opacity: setup.block_opacity.clone(),
             layers: PosMap::default(),
+            composite_rect: None,
             report: None,
         })
     }
@@ -417,6 +494,25 @@ impl Wboit {
     }
 }
 
+/// The pixels `[x, y, width, height]` of a `size` target around the screen rectangle
+/// `min`–`max` (0 to 1, y down), grown by a pixel (the rasteriser's vertex snapping, and
+/// a projection on the CPU in f32 against the shader's); zero size when it is empty or
+/// off screen.
+fn pixel_rect(min: glam::Vec2, max: glam::Vec2, (width, height): (u32, u32)) -> [u32; 4] {
+    let size = glam::Vec2::new(width as f32, height as f32);
+    let lo = (min * size - 1.0).floor().clamp(glam::Vec2::ZERO, size);
+    let hi = (max * size + 1.0).ceil().clamp(glam::Vec2::ZERO, size);
+    if !(lo.x < hi.x && lo.y < hi.y) {
+        return [0; 4];
+    }
+    [
+        lo.x as u32,
+        lo.y as u32,
+        (hi.x - lo.x) as u32,
+        (hi.y - lo.y) as u32,
+    ]
+}
+
 impl TranslucentTechnique for Wboit {
     fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
         self.targets = Self::targets(
@@ -436,6 +532,11 @@ impl TranslucentTechnique for Wboit {
         view: &FrameView<'_>,
     ) -> Result<()> {
         let settings = &config.wboit;
+        self.weight = settings.weight;
+        if !self.accumulate.iter().any(|(w, _)| *w == settings.weight) {
+            let built = self.builder.build(&ctx.device, settings.weight);
+            self.accumulate.push((settings.weight, built));
+        }
         let fit = (settings.weight == WeightFunction::Fitted).then(|| self.fit(chunks, view));
         let mut params = WboitParams {
             weight_fn: settings.weight.id(),
@@ -446,21 +547,34 @@ impl TranslucentTechnique for Wboit {
                 .medium
                 .and_then(|b| self.block_opacity.get(b.index()))
                 .map_or(0.0, |&a| fit::layer_depth(a) as f32),
-            _pad: [0.0; 3],
+            log_near: 0.0,
+            log_scale: 0.0,
+            _pad: 0.0,
             optical_depth: [[0.0; 4]; TABLE_VEC4S],
         };
         if let Some(fit) = &fit {
             params.depth_range = fit.range;
+            [params.log_near, params.log_scale] = fit.log_mapping();
             let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut params.optical_depth);
             let n = fit.optical_depth.len().min(flat.len());
             flat[..n].copy_from_slice(&fit.optical_depth[..n]);
         }
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let size = self.targets.accumulation.texture.size();
+        let size = (size.width, size.height);
+        // The fit projected every plane drawn (front faces, with the eye in air) already;
+        // other weights, and frames in a medium, composite the whole screen (projecting
+        // every chunk's box again cost more CPU time than the composite it saved).
+        self.composite_rect = fit
+            .as_ref()
+            .filter(|_| settings.composite_scissor && view.camera.medium.is_none())
+            .map(|fit| pixel_rect(fit.covered[0], fit.covered[1], size));
         self.report = Some(WboitReport {
             weight: settings.weight,
             accumulation: self.accum_format,
             fit,
+            composite_rect: self.composite_rect,
         });
         Ok(())
     }
@@ -490,7 +604,11 @@ impl TranslucentTechnique for Wboit {
                 g.draw_all(pass, variant, group);
             }
         };
-        match &self.accumulate {
+        let Some((_, accumulate)) = self.accumulate.iter().find(|(w, _)| *w == self.weight) else {
+            // `prepare` builds the weight's pipelines before every frame.
+            return Ok(());
+        };
+        match accumulate {
             Accumulate::Mrt(pipeline) => {
                 let colors = [
                     gpu::clear(accum, wgpu::Color::TRANSPARENT),
@@ -523,6 +641,19 @@ impl TranslucentTechnique for Wboit {
                 }
             }
         }
+        // A game's translucent geometry may lie anywhere: then the whole screen.
+        let rect = if frame.game.is_some() {
+            None
+        } else {
+            self.composite_rect
+        };
+        if let Some(report) = &mut self.report {
+            report.composite_rect = rect;
+        }
+        if rect.is_some_and(|[_, _, w, h]| w == 0 || h == 0) {
+            // No translucent box on screen: every pixel would be discarded.
+            return Ok(());
+        }
         let colors = [gpu::load(&frame.target.view)];
         Pass::new("wboit_composite", GpuPass::Composite, &colors).record(
             encoder,
@@ -530,6 +661,9 @@ impl TranslucentTechnique for Wboit {
             |pass| {
                 pass.set_pipeline(&self.composite);
                 pass.set_bind_group(0, &t.composite_group, &[]);
+                if let Some([x, y, w, h]) = rect {
+                    pass.set_scissor_rect(x, y, w, h);
+                }
                 pass.draw(0..3, 0..1);
             },
         );
@@ -548,7 +682,8 @@ impl TranslucentTechnique for Wboit {
     }
 
     fn variants(&self) -> Vec<TranslucentVariant> {
-        let own = weight_consts() + include_str!("accumulate.wgsl");
+        // Games' pipelines serve every weight: theirs reads it from the uniform.
+        let own = weight_consts(None) + include_str!("accumulate.wgsl");
         let [accum, reveal] = self.target_states.clone();
         let variant = |name, accumulation, revealage, targets| TranslucentVariant {
             name,
@@ -557,17 +692,18 @@ impl TranslucentTechnique for Wboit {
             depth_stencil: gpu::depth_state(gpu::DepthMode::ReadOnly),
             layout: self.game_layout.clone(),
         };
-        match self.accumulate {
-            Accumulate::Mrt(_) => vec![variant(
+        if self.builder.two_pass {
+            vec![
+                variant("wboit_accumulate", true, false, vec![accum]),
+                variant("wboit_revealage", false, true, vec![reveal]),
+            ]
+        } else {
+            vec![variant(
                 "wboit_accumulate_mrt",
                 true,
                 true,
                 vec![accum, reveal],
-            )],
-            Accumulate::TwoPass { .. } => vec![
-                variant("wboit_accumulate", true, false, vec![accum]),
-                variant("wboit_revealage", false, true, vec![reveal]),
-            ],
+            )]
         }
     }
 
@@ -584,13 +720,15 @@ mod tests {
     #[test]
     fn params_match_their_wgsl() {
         assert_layout::<WboitParams>(
-            &parse(&accumulate_wgsl()),
+            &parse(&accumulate_wgsl(None)),
             "WboitParams",
             &[
                 field!(WboitParams, weight_fn),
                 field!(WboitParams, accum_scale),
                 field!(WboitParams, depth_range),
                 field!(WboitParams, medium_depth),
+                field!(WboitParams, log_near),
+                field!(WboitParams, log_scale),
                 field!(WboitParams, optical_depth),
             ],
         );

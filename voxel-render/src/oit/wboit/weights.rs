@@ -129,6 +129,7 @@ mod tests {
     const R: &WeightFit = &WeightFit {
         range: [0.1, 100.0],
         optical_depth: Vec::new(),
+        covered: [glam::Vec2::ZERO; 2],
     };
 
     fn close(a: f32, b: f32) {
@@ -199,6 +200,7 @@ mod tests {
         WeightFit {
             range: [10.0, 1000.0],
             optical_depth,
+            covered: [glam::Vec2::ZERO; 2],
         }
     }
 
