@@ -576,6 +576,7 @@ impl Gfx {
             KeyCode::Digit7,
             KeyCode::Digit8,
             KeyCode::Digit9,
+            KeyCode::Digit0,
         ];
         if let Some(t) = digits
             .iter()

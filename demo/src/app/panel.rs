@@ -124,7 +124,7 @@ impl Gfx {
 
     fn technique_settings(&mut self, ui: &mut egui::Ui) {
         let s = &mut self.settings;
-        ui.label("Technique (keys 1-9)");
+        ui.label("Technique (keys 1-9, 0)");
         egui::ComboBox::from_id_salt("technique")
             .selected_text(s.oit.technique.name())
             .show_ui(ui, |ui| {
