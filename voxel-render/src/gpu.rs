@@ -306,6 +306,30 @@ pub fn layout(
     })
 }
 
+/// A full-screen pass running `source`'s `fs_composite` over the scene colour with
+/// `ALPHA_BLENDING`, reading two unfilterable float textures: how the weighted (WBOIT) and
+/// moment-based (MBOIT) techniques lay their sums over the opaque image. Returns the
+/// textures' layout and the pipeline.
+pub fn composite_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    source: &str,
+) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline) {
+    let float = wgpu::TextureSampleType::Float { filterable: false };
+    let layout = textures_layout(device, &format!("{label}_layout"), float, 2);
+    let pipeline = FullscreenPipeline {
+        label,
+        source,
+        fragment_entry: "fs_composite",
+        groups: &[Some(&layout)],
+        targets: &[scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
+        writes_depth: false,
+        constants: &[],
+    }
+    .build(device);
+    (layout, pipeline)
+}
+
 /// A layout of `count` fragment textures at bindings 0, 1, ... of `sample_type`.
 pub fn textures_layout(
     device: &wgpu::Device,

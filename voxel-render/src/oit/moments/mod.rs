@@ -27,7 +27,7 @@ use wgpu::util::DeviceExt;
 
 use crate::chunks::{ChunkStore, PosMap};
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, FullscreenPipeline, Pass, SidedPipeline};
+use crate::gpu::{self, ChunkPipeline, Depth, Pass, SidedPipeline};
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -399,18 +399,8 @@ impl TechniqueKind for Mboit {
             &resolve_layout,
             &[additive_target(ACCUMULATION_FORMAT)],
         );
-        let float = wgpu::TextureSampleType::Float { filterable: false };
-        let composite_layout = gpu::textures_layout(device, "mboit_composite_layout", float, 2);
-        let composite = FullscreenPipeline {
-            label: "mboit_composite",
-            source: include_str!("composite.wgsl"),
-            fragment_entry: "fs_composite",
-            groups: &[Some(&composite_layout)],
-            targets: &[gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
-            writes_depth: false,
-            constants: &[],
-        }
-        .build(device);
+        let (composite_layout, composite) =
+            gpu::composite_pipeline(device, "mboit_composite", include_str!("composite.wgsl"));
         let targets = Self::targets(
             device,
             [&resolve_layout, &composite_layout],

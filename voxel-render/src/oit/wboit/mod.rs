@@ -42,7 +42,7 @@ use wgpu::util::DeviceExt;
 
 use crate::chunks::{ChunkStore, PosMap};
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, FullscreenPipeline, Pass, SidedPipeline, Target};
+use crate::gpu::{self, ChunkPipeline, Depth, Pass, SidedPipeline, Target};
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -402,18 +402,8 @@ impl TechniqueKind for Wboit {
         };
         let weight = config.wboit.weight;
         let accumulate = vec![(weight, builder.build(device, weight))];
-        let float = wgpu::TextureSampleType::Float { filterable: false };
-        let composite_layout = gpu::textures_layout(device, "wboit_composite_layout", float, 2);
-        let composite = FullscreenPipeline {
-            label: "wboit_composite",
-            source: include_str!("composite.wgsl"),
-            fragment_entry: "fs_composite",
-            groups: &[Some(&composite_layout)],
-            targets: &[gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
-            writes_depth: false,
-            constants: &[],
-        }
-        .build(device);
+        let (composite_layout, composite) =
+            gpu::composite_pipeline(device, "wboit_composite", include_str!("composite.wgsl"));
         let targets = Self::targets(device, &composite_layout, accum_format, setup.size);
         Ok(Self {
             accumulate,
