@@ -1,7 +1,7 @@
 //! A game's window: the game owns the winit window, device and surface; the renderer draws
 //! into the surface texture (whatever format it has); then the game's own passes
 //! (`window.wgsl`): a box around the block under the crosshair, tested against the frame's
-//! depth (reverse-Z, camera-relative), and a HUD. Keys 1-7 pick a real-time technique
+//! depth (reverse-Z, camera-relative), and a HUD. Keys 1-8 pick a real-time technique
 //! (built ahead: no frame stalls at a switch; the title names it); resizing works. Nothing
 //! is called after the submit. Scripted: `cargo run --release -p voxel-render --example
 //! window -- --frames N --screenshot FILE.png`.
