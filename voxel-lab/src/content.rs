@@ -184,6 +184,31 @@ struct Buffer {
     count: u32,
 }
 
+impl Buffer {
+    /// A storage buffer of room for `prims` primitives (at least one), bound alone in a
+    /// group of `layout`.
+    fn new(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        label: &str,
+        prims: usize,
+    ) -> Self {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: (prims.max(1) * std::mem::size_of::<Prim>()) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group =
+            voxel_render::gpu::bind_group(device, label, layout, &[buffer.as_entire_binding()]);
+        Self {
+            buffer,
+            group,
+            count: 0,
+        }
+    }
+}
+
 const CONTENT_WGSL: &str = include_str!("content.wgsl");
 
 /// Vertices drawn per primitive: a box's 36 (a particle uses the first 6, the rest
@@ -236,27 +261,7 @@ impl ContentStages {
             }],
         });
         let config = renderer.config();
-        let buffer = |label, n: usize| {
-            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: (n.max(1) * std::mem::size_of::<Prim>()) as u64,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout: &prims_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: buffer.as_entire_binding(),
-                }],
-            });
-            Buffer {
-                buffer,
-                group,
-                count: 0,
-            }
-        };
+        let buffer = |label, n: usize| Buffer::new(device, &prims_layout, label, n);
         let opaque_count = content.entities.iter().filter(|e| e.is_opaque()).count();
         let translucent_count = content.particles.len() + content.entities.len() - opaque_count;
         let objects = Self::objects(&content);
@@ -292,34 +297,13 @@ impl ContentStages {
         let fits =
             |b: &Buffer, n: usize| b.buffer.size() >= (n * std::mem::size_of::<Prim>()) as u64;
         if !fits(&self.opaque, opaque) || !fits(&self.translucent, translucent) {
-            let rebuilt = {
-                let device = &ctx.device;
-                let make = |label, n: usize| {
-                    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some(label),
-                        size: (n.max(1) * 2 * std::mem::size_of::<Prim>()) as u64,
-                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    });
-                    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some(label),
-                        layout: &self.prims_layout,
-                        entries: &[wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: buffer.as_entire_binding(),
-                        }],
-                    });
-                    Buffer {
-                        buffer,
-                        group,
-                        count: 0,
-                    }
-                };
-                (
-                    make("content_opaque", opaque),
-                    make("content_translucent", translucent),
-                )
-            };
+            // Twice what is needed, so that content growing a little rebuilds nothing.
+            let make =
+                |label, n: usize| Buffer::new(&ctx.device, &self.prims_layout, label, 2 * n.max(1));
+            let rebuilt = (
+                make("content_opaque", opaque),
+                make("content_translucent", translucent),
+            );
             (self.opaque, self.translucent) = rebuilt;
         }
         self.objects = Self::objects(&content);
