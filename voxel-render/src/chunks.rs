@@ -183,6 +183,16 @@ pub struct Surfaces<'a> {
     pub quads: &'a [PackedQuad],
 }
 
+impl Surfaces<'_> {
+    /// Distances from `eye` to the box: its nearest point, its centre, its farthest corner.
+    pub fn distances(&self, eye: DVec3) -> [f64; 3] {
+        let near = eye.clamp(self.lo, self.hi).distance(eye);
+        let mid = ((self.lo + self.hi) * 0.5).distance(eye);
+        let far = (eye - self.lo).abs().max((eye - self.hi).abs()).length();
+        [near, mid, far]
+    }
+}
+
 /// The distinct planes of a set of quads, sorted.
 fn quad_planes(quads: &[PackedQuad]) -> Vec<(Face, u8)> {
     let mut planes: Vec<(Face, u8)> = quads

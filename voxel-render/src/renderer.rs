@@ -825,26 +825,15 @@ impl Renderer {
                     },
                 })
                 .collect();
-            // Each visible translucent chunk, in draw order: its surfaces and the
-            // distances of their box (nearest point, centre, farthest point).
-            let eye = camera.eye;
+            // Each visible translucent chunk's surfaces, in draw order.
             let chunks: Vec<_> = self
                 .culled
                 .translucent_positions()
                 .iter()
-                .map(|&p| {
-                    let s = self.chunks.get(p).and_then(|c| c.translucent_surfaces());
-                    let d = s.map_or([0.0; 3], |s| {
-                        let near = eye.clamp(s.lo, s.hi).distance(eye);
-                        let mid = ((s.lo + s.hi) * 0.5).distance(eye);
-                        let far = (eye - s.lo).abs().max((eye - s.hi).abs()).length();
-                        [near, mid, far]
-                    });
-                    (s, d)
-                })
+                .map(|&p| self.chunks.get(p).and_then(|c| c.translucent_surfaces()))
                 .collect();
             let split_quads = self.oit.technique() == Technique::SortedQuads;
-            interleave(&balls, eye, &chunks, medium.is_some(), split_quads)
+            interleave(&balls, camera.eye, &chunks, medium.is_some(), split_quads)
         } else {
             (Vec::new(), Vec::new())
         };

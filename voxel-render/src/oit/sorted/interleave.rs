@@ -85,7 +85,9 @@ fn safe(
     }
     front |= !beyond;
     behind |= !eye_side && beyond;
-    [front, behind || separate(b, eye, s)]
+    // Apart on screen: both orders are right.
+    let apart = (front && behind) || separate(b, eye, s);
+    [front || apart, behind || apart]
 }
 
 /// Whether ball `b` and the box of `s` are apart as seen from `eye`: the cones from the
@@ -132,7 +134,7 @@ fn quad_side(
 }
 
 /// The draw order of objects `balls` among `chunks` (in draw order, farthest first: each
-/// chunk's surfaces, if any, and distances `[near, mid, far]` of its box from `eye`).
+/// chunk's surfaces, if any) seen from `eye`.
 /// Returns the objects in draw order and where runs of them are drawn (in draw order; the
 /// objects after the last run come after every chunk).
 ///
@@ -144,10 +146,15 @@ fn quad_side(
 pub fn interleave(
     balls: &[Ball],
     eye: DVec3,
-    chunks: &[(Option<Surfaces<'_>>, [f64; 3])],
+    chunks: &[Option<Surfaces<'_>>],
     two_sided: bool,
     split_quads: bool,
 ) -> (Vec<u32>, Vec<Split>) {
+    // Distances `[near, mid, far]` of each chunk's box, once.
+    let distances: Vec<[f64; 3]> = chunks
+        .iter()
+        .map(|s| s.as_ref().map_or([0.0; 3], |s| s.distances(eye)))
+        .collect();
     // (chunk, quad, farthest first, object): the place of each object.
     let mut places: Vec<(u32, u32, std::cmp::Reverse<u64>, u32)> = Vec::with_capacity(balls.len());
     let mut items: Vec<(u32, u32, i64)> = Vec::new();
@@ -157,7 +164,7 @@ pub fn interleave(
         // The constraints in draw order: (chunk, quad after which it applies, weight:
         // positive when the item must come before the object, negative after it).
         items.clear();
-        for (c, (surfaces, d)) in chunks.iter().enumerate() {
+        for (c, (surfaces, d)) in chunks.iter().zip(&distances).enumerate() {
             let Some(s) = surfaces else { continue };
             let c = c as u32;
             match safe(b, o, eye, s, *d, two_sided) {
@@ -191,13 +198,13 @@ pub fn interleave(
         }
         let (c, k) = at;
         // After quads `..k` of chunk `c`; past the end of a chunk is before the next one.
-        let at = match chunks.get(c as usize).and_then(|(s, _)| s.as_ref()) {
+        let at = match chunks.get(c as usize).and_then(Option::as_ref) {
             Some(s) if k as usize >= s.quads.len() && k > 0 => (c + 1, 0),
             _ => (c, k),
         };
         // Chunks with nothing translucent draw nothing: the next one that does.
         let mut at = at;
-        while at.0 < last && chunks[at.0 as usize].0.is_none() {
+        while at.0 < last && chunks[at.0 as usize].is_none() {
             at = (at.0 + 1, 0);
         }
         places.push((at.0, at.1, std::cmp::Reverse(o.to_bits()), i as u32));
@@ -305,13 +312,6 @@ mod tests {
         }
     }
 
-    fn distances(s: &Surfaces<'_>, eye: DVec3) -> [f64; 3] {
-        let near = eye.clamp(s.lo, s.hi).distance(eye);
-        let mid = ((s.lo + s.hi) * 0.5).distance(eye);
-        let far = (eye - s.lo).abs().max((eye - s.hi).abs()).length();
-        [near, mid, far]
-    }
-
     #[test]
     fn a_point_above_a_water_surface_is_in_front_and_below_it_behind() {
         // A water surface at y = 8 (the top faces of blocks at y = 7) over the whole
@@ -319,7 +319,7 @@ mod tests {
         let planes = [(Face::PosY, 8)];
         let s = surfaces([0.0, 8.0, 0.0], [32.0, 8.0, 32.0], &planes);
         let eye = DVec3::new(16.0, 14.0, 40.0);
-        let d = distances(&s, eye);
+        let d = s.distances(eye);
         for (p, want) in [
             (DVec3::new(16.0, 10.0, 20.0), Side::Front),
             (DVec3::new(16.0, 8.5, 30.0), Side::Front),
@@ -332,7 +332,7 @@ mod tests {
         // Under water looking up (both sides drawn): the surface is in front of a point
         // above it.
         let eye = DVec3::new(16.0, 2.0, 20.0);
-        let d = distances(&s, eye);
+        let d = s.distances(eye);
         let p = DVec3::new(16.0, 9.0, 18.0);
         assert_eq!(
             side(point(p), p.distance(eye), eye, &s, d, true),
@@ -351,7 +351,7 @@ mod tests {
         let planes = [(Face::PosZ, 5), (Face::PosZ, 21)];
         let s = surfaces([0.0, 0.0, 5.0], [32.0, 32.0, 21.0], &planes);
         let eye = DVec3::new(16.0, 16.0, 60.0);
-        let d = distances(&s, eye);
+        let d = s.distances(eye);
         let p = DVec3::new(16.0, 16.0, 12.0);
         // In front of the plane at 5, behind the one at 21: the centre (13) decides.
         assert_eq!(
@@ -430,7 +430,7 @@ mod tests {
                 DVec3::new(next() * 64.0, next() * 64.0 - 48.0, next() * 64.0 - 16.0)
             };
             let eye = around(&mut next);
-            let d = distances(&s, eye);
+            let d = s.distances(eye);
             for k in 0..200 {
                 let center = around(&mut next);
                 let radius = if k % 2 == 0 { 0.0 } else { next() * 4.0 };
@@ -509,11 +509,7 @@ mod tests {
             quads: &[],
         };
         let eye = DVec3::new(16.0, 12.0, 4.0);
-        let chunks = [
-            (Some(far), distances(&far, eye)),
-            (None, [0.0; 3]),
-            (Some(near), distances(&near, eye)),
-        ];
+        let chunks = [Some(far), None, Some(near)];
         let balls = [
             DVec3::new(16.0, 3.0, -50.0), // under the far water
             DVec3::new(16.0, 9.0, -50.0), // over the far water
@@ -567,7 +563,7 @@ mod tests {
             quads: &quads,
         };
         let eye = DVec3::new(16.0, 12.0, 40.0);
-        let d = distances(&s, eye);
+        let d = s.distances(eye);
         let ball = |y, z| Ball {
             center: DVec3::new(16.0, y, z),
             radius: 1.0,
@@ -576,7 +572,7 @@ mod tests {
         let b = ball(7.0, 12.0);
         assert_eq!(decide(b, b.center.distance(eye), eye, &s, d, false), None);
         assert_eq!(quad_split(b, eye, s.origin, &quads, false), 1);
-        let (order, splits) = interleave(&[b], eye, &[(Some(s), d)], false, true);
+        let (order, splits) = interleave(&[b], eye, &[Some(s)], false, true);
         assert_eq!(order, [0]);
         let want = Split {
             chunk: 0,
@@ -586,7 +582,7 @@ mod tests {
         assert_eq!(splits, [want]);
         // Without splitting, the box's centre decides: the ball is farther, so it is drawn
         // before the whole chunk (under the water: wrong where they overlap).
-        let (_, splits) = interleave(&[b], eye, &[(Some(s), d)], false, false);
+        let (_, splits) = interleave(&[b], eye, &[Some(s)], false, false);
         assert_eq!(splits, [Split { quad: 0, ..want }]);
         // Under the water: before both.
         let b = ball(1.0, 12.0);
