@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 /// voxel-render, bottom up (its lib.rs docs give the same order).
 const RENDER: &[&str] = &[
     "error", "context", "camera", "readback", "timing", "gpu", "bindings", "textures", "arena",
-    "chunks", "medium", "stages", "oit", "renderer", "stream",
+    "layers", "chunks", "medium", "stages", "oit", "renderer", "stream",
 ];
 
 /// voxel-lab, bottom up: the model, then the runs, then the report (its lib.rs docs).

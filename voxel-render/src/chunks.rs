@@ -13,11 +13,14 @@
 //! test).
 //!
 //! Each upload of a chunk gets a new *generation* number, so that what a technique derives
-//! from a chunk's quads (a sort structure, a summary of its layers) can be cached by
-//! position and generation and recomputed only when the chunk is remeshed.
+//! from a chunk's quads (a sort structure) can be cached by position and generation and
+//! recomputed only when the chunk is remeshed. The planes of its translucent mesh
+//! ([`crate::layers`]) are summed up at the upload and kept with the region's records, so
+//! that the culling hands them over in its walk when asked to.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{DVec3, Mat4, Vec3, Vec4};
@@ -27,6 +30,7 @@ use voxel_mesh::{ChunkMeshes, PackedQuad};
 use crate::arena::{Alloc, ArenaStats, QuadArena};
 use crate::bindings::ChunkUniforms;
 use crate::gpu;
+use crate::layers::{self, LayerBuffer, Plane, VisibleLayers};
 use crate::{Error, GpuContext, Result};
 
 /// A fast hasher for small keys of integers (chunk positions): a multiply-rotate per word
@@ -437,6 +441,8 @@ struct Member {
     pos: ChunkPos,
     slot: u32,
     meshes: [Option<Alloc>; 3],
+    /// Where its translucent mesh's planes lie in its region's `planes`.
+    planes: [u32; 2],
 }
 
 /// The chunks of one region.
@@ -447,6 +453,45 @@ struct Region {
     /// Block coordinates of the region's lowest corner.
     origin: [i64; 3],
     members: Vec<Member>,
+    /// The translucent planes of the members ([`crate::layers`]), member by member, and
+    /// how many of them belong to no member any more (compacted when more than half).
+    planes: Vec<Plane>,
+    garbage: usize,
+}
+
+impl Region {
+    /// Member `index`'s planes.
+    fn planes_of(&self, index: usize) -> &[Plane] {
+        let [start, end] = self.members[index].planes;
+        &self.planes[start as usize..end as usize]
+    }
+
+    /// Puts `planes` at the end for member `index` (its old ones become garbage).
+    fn set_planes(&mut self, index: usize, planes: &[Plane]) {
+        let [start, end] = self.members[index].planes;
+        self.garbage += (end - start) as usize;
+        let at = self.planes.len() as u32;
+        self.planes.extend_from_slice(planes);
+        self.members[index].planes = [at, at + planes.len() as u32];
+        self.compact_planes();
+    }
+
+    /// Copies the members' planes into a new buffer, in member order, when more than half
+    /// of the old one is garbage.
+    fn compact_planes(&mut self) {
+        if self.garbage * 2 <= self.planes.len() {
+            return;
+        }
+        let mut planes = Vec::with_capacity(self.planes.len() - self.garbage);
+        for m in &mut self.members {
+            let [start, end] = m.planes;
+            let at = planes.len() as u32;
+            planes.extend_from_slice(&self.planes[start as usize..end as usize]);
+            m.planes = [at, planes.len() as u32];
+        }
+        self.planes = planes;
+        self.garbage = 0;
+    }
 }
 
 /// Where a slot's member is: its region and its index there.
@@ -474,17 +519,27 @@ impl Regions {
         ]
     }
 
-    /// Adds the chunk of `slot`, or updates its meshes (the position of a slot never
-    /// changes while it is held).
-    fn set(&mut self, slot: u32, pos: ChunkPos, meshes: [Option<Alloc>; 3]) {
+    /// Adds the chunk of `slot`, or updates its meshes and, when given, the planes of its
+    /// translucent mesh (`None` keeps them: the meshes moved, the quads did not change; the
+    /// position of a slot never changes while it is held).
+    fn set(
+        &mut self,
+        slot: u32,
+        pos: ChunkPos,
+        meshes: [Option<Alloc>; 3],
+        planes: Option<&[Plane]>,
+    ) {
         let s = slot as usize;
         if s >= self.places.len() {
             self.places.resize(s + 1, None);
         }
         if let Some(p) = self.places[s] {
-            let m = &mut self.regions[p.region as usize].members[p.index as usize];
-            if m.pos == pos {
-                m.meshes = meshes;
+            let region = &mut self.regions[p.region as usize];
+            if region.members[p.index as usize].pos == pos {
+                region.members[p.index as usize].meshes = meshes;
+                if let Some(planes) = planes {
+                    region.set_planes(p.index as usize, planes);
+                }
                 return;
             }
             self.remove(slot);
@@ -496,15 +551,25 @@ impl Regions {
                 key,
                 origin: [0, 1, 2].map(|k| i64::from(key[k]) * i64::from(REGION_CHUNKS[k]) * n),
                 members: Vec::new(),
+                planes: Vec::new(),
+                garbage: 0,
             });
             self.regions.len() as u32 - 1
         });
-        let members = &mut self.regions[region as usize].members;
+        let r = &mut self.regions[region as usize];
+        let index = r.members.len();
         self.places[s] = Some(Place {
             region,
-            index: members.len() as u32,
+            index: index as u32,
         });
-        members.push(Member { pos, slot, meshes });
+        let at = r.planes.len() as u32;
+        r.members.push(Member {
+            pos,
+            slot,
+            meshes,
+            planes: [at, at],
+        });
+        r.set_planes(index, planes.unwrap_or_default());
     }
 
     /// Removes the chunk of `slot` (an empty region goes with it).
@@ -512,12 +577,14 @@ impl Regions {
         let Some(p) = self.places.get_mut(slot as usize).and_then(Option::take) else {
             return;
         };
-        let members = &mut self.regions[p.region as usize].members;
-        members.swap_remove(p.index as usize);
-        if let Some(moved) = members.get(p.index as usize) {
+        let region = &mut self.regions[p.region as usize];
+        let [start, end] = region.members.swap_remove(p.index as usize).planes;
+        region.garbage += (end - start) as usize;
+        if let Some(moved) = region.members.get(p.index as usize) {
             self.places[moved.slot as usize] = Some(p);
         }
-        if !members.is_empty() {
+        if !region.members.is_empty() {
+            region.compact_planes();
             return;
         }
         // The last region takes the empty one's index.
@@ -534,22 +601,22 @@ impl Regions {
     }
 
     /// Calls `visit` with every chunk whose box is not wholly outside one of the frustum's
-    /// planes, and its distance ([`Frustum::chunk_distance`]: the same chunks, the same
-    /// numbers), region by region.
-    fn cull(&self, frustum: &Frustum, mut visit: impl FnMut(&Member, f64)) {
+    /// planes, its distance ([`Frustum::chunk_distance`]: the same chunks, the same
+    /// numbers) and its translucent planes, region by region.
+    fn cull(&self, frustum: &Frustum, mut visit: impl FnMut(&Member, f64, &[Plane])) {
         let size = REGION_CHUNKS.map(|c| i64::from(c) * CHUNK_SIZE as i64);
         for r in &self.regions {
             match frustum.region_cover(r.origin, size) {
                 Cover::Outside => {}
                 Cover::Inside => {
-                    for m in &r.members {
-                        visit(m, frustum.centre_distance(m.pos));
+                    for (i, m) in r.members.iter().enumerate() {
+                        visit(m, frustum.centre_distance(m.pos), r.planes_of(i));
                     }
                 }
                 Cover::Partial => {
-                    for m in &r.members {
+                    for (i, m) in r.members.iter().enumerate() {
                         if let Some(d) = frustum.chunk_distance(m.pos) {
-                            visit(m, d);
+                            visit(m, d, r.planes_of(i));
                         }
                     }
                 }
@@ -586,6 +653,8 @@ pub struct Culled {
     near: [Vec<NearEntry>; 2],
     far: Vec<FarEntry>,
     positions: Vec<ChunkPos>,
+    /// The visible translucent chunks' planes, when asked for.
+    layers: LayerBuffer,
 }
 
 impl Culled {
@@ -604,6 +673,12 @@ impl Culled {
     /// The positions of the visible translucent meshes, farthest first.
     pub fn translucent_positions(&self) -> &[ChunkPos] {
         &self.positions
+    }
+
+    /// The planes of the visible translucent meshes ([`crate::layers`]; in no particular
+    /// order), when [`ChunkStore::cull`] was asked for them (else empty).
+    pub fn translucent_layers(&self) -> VisibleLayers<'_> {
+        self.layers.view()
     }
 }
 
@@ -638,6 +713,8 @@ pub struct ChunkStore {
     /// submitted, so that nothing written before its submit changes what it draws.
     retired: Vec<Alloc>,
     retired_slots: Vec<u32>,
+    /// Opacity by block id, for the planes of translucent meshes.
+    block_opacity: Arc<[f32]>,
 }
 
 const FIRST_SLOTS: usize = 1024;
@@ -645,7 +722,9 @@ const FIRST_SLOTS: usize = 1024;
 impl ChunkStore {
     /// An empty store whose bind groups use `layout` (group 1 of
     /// [`crate::SharedLayouts`]).
-    pub fn new(ctx: &GpuContext, layout: wgpu::BindGroupLayout) -> Self {
+    /// `block_opacity` (by block id) weighs the planes of translucent meshes
+    /// ([`crate::layers`]).
+    pub fn new(ctx: &GpuContext, layout: wgpu::BindGroupLayout, block_opacity: Arc<[f32]>) -> Self {
         let l = &ctx.caps.limits;
         let infos = Self::infos_buffer(&ctx.device, FIRST_SLOTS);
         let indirect = Self::indirect_buffer(&ctx.device, FIRST_SLOTS);
@@ -664,6 +743,7 @@ impl ChunkStore {
             in_flight: false,
             retired: Vec::new(),
             retired_slots: Vec::new(),
+            block_opacity,
         }
     }
 
@@ -848,7 +928,8 @@ impl ChunkStore {
         };
         let origin = pos.origin().map(|v| v as i32);
         self.write_info(ctx, slot, ChunkUniforms { origin, alpha });
-        self.regions.set(slot, pos, allocs);
+        let planes = layers::planes(&meshes.translucent, &self.block_opacity);
+        self.regions.set(slot, pos, allocs, Some(&planes));
         self.slots[slot as usize] = Some(GpuChunk {
             pos,
             meshes: allocs,
@@ -956,17 +1037,20 @@ impl ChunkStore {
 
     /// Finds the visible meshes of every kind in one pass over the regions (see the module
     /// docs) and puts them in draw order into `out` (see [`Culled`]): the meshes of every
-    /// chunk whose box [`Frustum::chunk_distance`] does not put outside the frustum.
-    pub fn cull(&self, frustum: &Frustum, out: &mut Culled) {
+    /// chunk whose box [`Frustum::chunk_distance`] does not put outside the frustum. With
+    /// `layers`, it also copies the visible translucent meshes' planes
+    /// ([`Culled::translucent_layers`]).
+    pub fn cull(&self, frustum: &Frustum, layers: bool, out: &mut Culled) {
         for list in &mut out.near {
             list.clear();
         }
         out.far.clear();
         out.positions.clear();
+        out.layers.clear();
         let eye = frustum.eye.to_array();
         let [opaque, cutout] = &mut out.near;
-        let far = &mut out.far;
-        self.regions.cull(frustum, |m, distance| {
+        let (far, buffer) = (&mut out.far, &mut out.layers);
+        self.regions.cull(frustum, |m, distance, planes| {
             for (list, mesh) in [(&mut *opaque, m.meshes[0]), (&mut *cutout, m.meshes[1])] {
                 if let Some(mesh) = mesh {
                     list.push(NearEntry {
@@ -982,6 +1066,9 @@ impl ChunkStore {
                     slot: m.slot,
                     mesh,
                 });
+                if layers {
+                    buffer.push(m.pos, planes);
+                }
             }
         });
         // Every key is unique (it holds the slot, or the position): an unstable sort gives
@@ -1047,7 +1134,7 @@ impl ChunkStore {
         for ((s, k, _), to) in moving.iter().zip(placed) {
             if let Some(c) = self.slots[*s].as_mut() {
                 c.meshes[*k] = Some(to);
-                self.regions.set(*s as u32, c.pos, c.meshes);
+                self.regions.set(*s as u32, c.pos, c.meshes, None);
             }
         }
         self.remake_groups(&ctx.device);
@@ -1205,12 +1292,33 @@ mod tests {
         })
     }
 
+    /// `n` planes marked with `mark` (their optical depths).
+    fn marked_planes(n: u64, mark: u32) -> Vec<Plane> {
+        (0..n)
+            .map(|k| Plane {
+                face: Face::PosY,
+                lo: Vec3::ZERO,
+                hi: Vec3::ONE,
+                tau: (mark * 4 + k as u32) as f32,
+            })
+            .collect()
+    }
+
     /// Every place points at its slot's member, every region is non-empty and found by its
-    /// key, and the members are exactly the chunks held.
-    fn check_bookkeeping(regions: &Regions, held: &[Option<ChunkPos>]) {
+    /// key, the members are exactly the chunks held, each with its planes, and at most half
+    /// of a region's planes are garbage.
+    fn check_bookkeeping(regions: &Regions, held: &[Option<(ChunkPos, Vec<Plane>)>]) {
         let mut members = 0;
         for (i, r) in regions.regions.iter().enumerate() {
             assert!(!r.members.is_empty(), "empty region {:?} kept", r.key);
+            let live: usize = (0..r.members.len()).map(|j| r.planes_of(j).len()).sum();
+            assert_eq!(live + r.garbage, r.planes.len());
+            assert!(
+                r.garbage * 2 <= r.planes.len(),
+                "{} of {}",
+                r.garbage,
+                r.planes.len()
+            );
             assert_eq!(regions.by_key.get(&r.key), Some(&(i as u32)));
             for (j, m) in r.members.iter().enumerate() {
                 assert_eq!(Regions::key(m.pos), r.key);
@@ -1219,7 +1327,9 @@ mod tests {
                     index: j as u32,
                 };
                 assert_eq!(regions.places[m.slot as usize], Some(place));
-                assert_eq!(held[m.slot as usize], Some(m.pos));
+                let (pos, planes) = held[m.slot as usize].as_ref().unwrap();
+                assert_eq!(*pos, m.pos);
+                assert_eq!(r.planes_of(j), &planes[..]);
                 members += 1;
             }
         }
@@ -1231,7 +1341,7 @@ mod tests {
     fn regions_follow_uploads_and_removals() {
         let mut next = rng(0x0dd_ba11_5eed);
         let mut regions = Regions::default();
-        let mut held: Vec<Option<ChunkPos>> = vec![None; 600];
+        let mut held: Vec<Option<(ChunkPos, Vec<Plane>)>> = vec![None; 600];
         for step in 0..6000 {
             let slot = (next() % held.len() as u64) as u32;
             if next().is_multiple_of(3) {
@@ -1239,11 +1349,26 @@ mod tests {
                 held[slot as usize] = None;
             } else {
                 let c = |n: u64| (n % 40) as i32 - 20;
-                let pos = held[slot as usize]
+                let same = held[slot as usize]
+                    .as_ref()
                     .filter(|_| next().is_multiple_of(2))
-                    .unwrap_or_else(|| ChunkPos::new(c(next()), c(next()) / 4, c(next())));
-                regions.set(slot, pos, [mesh(0, step), None, mesh(1, step)]);
-                held[slot as usize] = Some(pos);
+                    .map(|h| h.0);
+                let pos =
+                    same.unwrap_or_else(|| ChunkPos::new(c(next()), c(next()) / 4, c(next())));
+                // A chunk that stays may keep its planes (its meshes moved).
+                let planes = if same.is_some() && next().is_multiple_of(2) {
+                    None
+                } else {
+                    Some(marked_planes(next() % 4, step))
+                };
+                regions.set(
+                    slot,
+                    pos,
+                    [mesh(0, step), None, mesh(1, step)],
+                    planes.as_deref(),
+                );
+                let kept = held[slot as usize].take().map(|h| h.1);
+                held[slot as usize] = Some((pos, planes.or(kept).unwrap_or_default()));
             }
             if step % 500 == 0 {
                 check_bookkeeping(&regions, &held);
@@ -1281,8 +1406,9 @@ mod tests {
                 if regions.by_key.contains_key(&Regions::key(pos)) && unit() < 0.05 {
                     continue;
                 }
-                regions.set(slot, pos, [mesh(0, slot), None, None]);
-                held.push((slot, pos));
+                let planes = marked_planes(u64::from(slot % 3), slot);
+                regions.set(slot, pos, [mesh(0, slot), None, None], Some(&planes));
+                held.push((slot, pos, planes));
             }
             for _ in 0..40 {
                 let s = CHUNK_SIZE as f64;
@@ -1307,11 +1433,20 @@ mod tests {
                     covers[f.region_cover(r.origin, size) as usize] += 1;
                 }
                 let mut found = Vec::new();
-                regions.cull(&f, |m, d| found.push((m.slot, m.pos, d.to_bits())));
-                found.sort_unstable();
+                regions.cull(&f, |m, d, planes| {
+                    found.push((m.slot, m.pos, d.to_bits(), planes.to_vec()));
+                });
+                found.sort_unstable_by_key(|e| e.0);
                 let every: Vec<_> = held
                     .iter()
-                    .filter_map(|&(slot, pos)| Some((slot, pos, f.chunk_distance(pos)?.to_bits())))
+                    .filter_map(|(slot, pos, planes)| {
+                        Some((
+                            *slot,
+                            *pos,
+                            f.chunk_distance(*pos)?.to_bits(),
+                            planes.clone(),
+                        ))
+                    })
                     .collect();
                 assert_eq!(found, every, "eye {eye:?}");
             }

@@ -9,7 +9,7 @@
 //!
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `camera`,
 //! `readback`, `timing` → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
-//! pipeline binds), `textures`, `arena` (the quad arena) → `chunks` → `medium` (translucent volumes seen from
+//! pipeline binds), `textures`, `arena` (the quad arena), `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
 //! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` → `stream` (chunks loaded around a moving eye). A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
@@ -20,6 +20,7 @@ mod chunks;
 mod context;
 mod error;
 pub mod gpu;
+pub mod layers;
 pub mod medium;
 pub mod oit;
 pub mod readback;

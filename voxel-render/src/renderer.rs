@@ -371,20 +371,21 @@ impl Renderer {
         let medium = MediumPass::new(device, &layouts);
         let size = (config.width, config.height);
         let targets = SceneTargets::new(ctx, &post, &layouts, &scene, &medium, size, config.msaa);
+        let block_opacity = registry
+            .iter()
+            .map(|(_, def)| def.opacity)
+            .collect::<Arc<[f32]>>();
         let setup = Setup {
             ctx: ctx.clone(),
             layouts: layouts.clone(),
             size,
-            block_opacity: registry
-                .iter()
-                .map(|(_, def)| def.opacity)
-                .collect::<Arc<[f32]>>(),
+            block_opacity: block_opacity.clone(),
         };
         let oit = OitManager::new(setup, config.oit.clone())?;
         config_with(&mut config.oit, oit.config());
         Ok(Self {
             ctx: ctx.clone(),
-            chunks: ChunkStore::new(ctx, layouts.chunk.clone()),
+            chunks: ChunkStore::new(ctx, layouts.chunk.clone(), block_opacity),
             layouts,
             scene,
             opaque,
@@ -796,7 +797,8 @@ impl Renderer {
         // translucent chunks farthest first, by the integer key that is exact for a grid of
         // equal cubes (`voxel_mesh::order`); opaque and cutout meshes grouped by page, front
         // to back (early depth rejection).
-        self.chunks.cull(&frustum, &mut self.culled);
+        let layers = self.oit.wants_layers();
+        self.chunks.cull(&frustum, layers, &mut self.culled);
         self.chunks.lists_built();
         // The technique's CPU work (it may reorder quads within their places).
         let stages = game.stages();
@@ -804,6 +806,7 @@ impl Renderer {
             camera,
             view_proj,
             translucent: self.culled.translucent_positions(),
+            layers: self.culled.translucent_layers(),
             game_objects: stages.translucent.then(|| game.translucent_objects()),
         };
         self.oit

@@ -26,6 +26,7 @@ use crate::bindings::SharedLayouts;
 use crate::chunks::{ChunkStore, DrawList, FrameDraws};
 use crate::context::Capabilities;
 use crate::gpu::Target;
+use crate::layers::VisibleLayers;
 use crate::stages::{GameDraw, TranslucentContract, TranslucentObject, TranslucentVariant};
 use crate::timing::Timer;
 use crate::{Camera, Error, GpuContext, Result};
@@ -316,6 +317,9 @@ pub struct FrameView<'a> {
     pub view_proj: Mat4,
     /// The visible chunks with translucent meshes, farthest first.
     pub translucent: &'a [ChunkPos],
+    /// Their planes, when the technique asked for them ([`OitManager::wants_layers`];
+    /// else empty).
+    pub layers: VisibleLayers<'a>,
     /// The game's translucent objects when it draws translucent geometry this frame
     /// (`None` when it does not; an empty slice when it draws without declaring them).
     pub game_objects: Option<&'a [TranslucentObject]>,
@@ -461,6 +465,16 @@ impl OitManager {
     /// The active technique.
     pub fn technique(&self) -> Technique {
         self.config.technique
+    }
+
+    /// Whether the technique in force reads the planes of the visible translucent meshes
+    /// ([`FrameView::layers`]): WBOIT with the fitted weight. The renderer's culling copies
+    /// them only then.
+    pub fn wants_layers(&self) -> bool {
+        matches!(
+            self.config.technique,
+            Technique::WboitMrt | Technique::WboitTwoPass
+        ) && self.config.wboit.weight == WeightFunction::Fitted
     }
 
     /// Switches technique at run time; the old one's resources are freed at once.

@@ -37,10 +37,9 @@ pub mod fit;
 pub mod weights;
 
 use bytemuck::{Pod, Zeroable};
-use voxel_core::ChunkPos;
 use wgpu::util::DeviceExt;
 
-use crate::chunks::{ChunkStore, PosMap};
+use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
 use crate::gpu::{self, ChunkPipeline, Depth, Pass, SidedPipeline, Target};
 use crate::oit::{
@@ -51,7 +50,7 @@ use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{GpuContext, Result};
 
-use fit::{MeshLayers, PROFILE_LEN, TILES};
+use fit::{PROFILE_LEN, TILES};
 use weights::{MAX_FITTED_DEPTH, WeightFit, WeightFunction};
 
 /// Revealage format: one byte of Π(1 − α).
@@ -344,10 +343,10 @@ pub struct Wboit {
     /// The accumulation and revealage target states (for games' pipelines).
     target_states: [Option<wgpu::ColorTargetState>; 2],
     block_opacity: std::sync::Arc<[f32]>,
-    /// Per chunk: the generation summed up and its layers.
-    layers: PosMap<ChunkPos, (u64, MeshLayers)>,
     /// The weight of this frame's chunk pipelines.
     weight: WeightFunction,
+    /// Room the fitted weight's estimate reuses each frame.
+    fit_scratch: fit::FitScratch,
     /// The composite's scissor rectangle for this frame's chunks (`[x, y, w, h]`), `None`
     /// for the whole screen ([`WboitSettings::composite_scissor`]).
     composite_rect: Option<[u32; 4]>,
@@ -418,7 +417,7 @@ impl TechniqueKind for Wboit {
             game_layout: game_layout(device, "wboit_game", &params_entries()),
             target_states: [accum_target, reveal_target],
             block_opacity: setup.block_opacity.clone(),
-            layers: PosMap::default(),
+            fit_scratch: fit::FitScratch::default(),
             composite_rect: None,
             report: None,
         })
@@ -449,33 +448,12 @@ impl Wboit {
         }
     }
 
-    /// Fits the weight to the visible translucent meshes, summing up (once per remesh) the
-    /// layers of each.
-    fn fit(&mut self, chunks: &ChunkStore, view: &FrameView<'_>) -> WeightFit {
-        let opacity = &self.block_opacity;
-        for &pos in view.translucent {
-            let Some(chunk) = chunks.get(pos) else {
-                continue;
-            };
-            let fresh = self
-                .layers
-                .get(&pos)
-                .is_some_and(|(g, _)| *g == chunk.generation());
-            if !fresh {
-                let layers = MeshLayers::new(pos, chunk.translucent_quads(), opacity);
-                self.layers.insert(pos, (chunk.generation(), layers));
-            }
-        }
-        // Forget chunks that were removed or remeshed since (kept bounded by the store).
-        if self.layers.len() > 2 * chunks.len() + 64 {
-            self.layers
-                .retain(|pos, (g, _)| chunks.get(*pos).map(|c| c.generation()) == Some(*g));
-        }
+    /// Fits the weight to the visible translucent meshes' planes.
+    fn fit(&mut self, view: &FrameView<'_>) -> WeightFit {
         let cam = view.camera;
-        fit::fit(
-            view.translucent
-                .iter()
-                .filter_map(|p| self.layers.get(p).map(|(_, l)| l)),
+        fit::fit_with(
+            &mut self.fit_scratch,
+            view.layers.iter(),
             view.view_proj,
             cam.eye,
             cam.near as f32,
@@ -518,7 +496,7 @@ impl TranslucentTechnique for Wboit {
         &mut self,
         ctx: &GpuContext,
         config: &OitConfig,
-        chunks: &mut ChunkStore,
+        _chunks: &mut ChunkStore,
         view: &FrameView<'_>,
     ) -> Result<()> {
         let settings = &config.wboit;
@@ -527,7 +505,10 @@ impl TranslucentTechnique for Wboit {
             let built = self.builder.build(&ctx.device, settings.weight);
             self.accumulate.push((settings.weight, built));
         }
-        let fit = (settings.weight == WeightFunction::Fitted).then(|| self.fit(chunks, view));
+        if let Some(WboitReport { fit: Some(old), .. }) = self.report.take() {
+            self.fit_scratch.recycle(old);
+        }
+        let fit = (settings.weight == WeightFunction::Fitted).then(|| self.fit(view));
         let mut params = WboitParams {
             weight_fn: settings.weight.id(),
             accum_scale: accum_scale(&ctx.caps, settings),
