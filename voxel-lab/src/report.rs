@@ -349,7 +349,7 @@ fn weights(s: &mut String, summary: &Summary) {
     let _ = writeln!(s, "\n## WBOIT weight functions\n");
     let _ = writeln!(
         s,
-        "The same WBOIT pass (single MRT) with each weight; the cost is the same for all of them.\n"
+        "The same WBOIT pass (single MRT) with each weight, a constant of its own pipeline: the fitted one reads its table, a log and an exp per fragment, which a CPU rasteriser feels.\n"
     );
     let scenes: Vec<&str> = summary
         .reference_checks

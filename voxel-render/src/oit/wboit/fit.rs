@@ -45,54 +45,48 @@ pub const PROFILE_LEN: usize = 32;
 /// The screen is cut into `TILES × TILES` tiles, each with its own profile.
 pub const TILES: usize = 8;
 
-/// Fits the weight to the meshes in `layers` seen through `view_proj` (camera-relative:
-/// the eye at the origin) from `eye`, with the camera's `near` and `far` planes: the view
-/// depths the meshes span and, for each screen tile, the expected optical depth in front of
-/// [`PROFILE_LEN`] depths spaced evenly in log depth across them.
-pub fn fit<'a>(
-    layers: impl IntoIterator<Item = (ChunkPos, &'a [Plane])>,
-    view_proj: Mat4,
-    eye: DVec3,
-    near: f32,
-    far: f32,
-) -> WeightFit {
-    fit_with(
-        &mut FitScratch::default(),
-        layers,
-        view_proj,
-        eye,
-        near,
-        far,
-    )
-}
-
-/// What [`fit_with`] keeps from one frame to the next: room for the planes seen, and for
-/// the next table (fresh allocations of these cost more, in page faults, than the fit's
-/// arithmetic: 2 000 planes at view distance 32).
+/// The fitted weight's estimate, with room it keeps from one frame to the next: for the
+/// planes seen, and for the next table (fresh allocations of these cost more, in page
+/// faults, than the arithmetic: 2 000 planes at view distance 32). A technique keeps one.
 #[derive(Debug, Default)]
-pub struct FitScratch {
+pub struct Fitter {
     seen: Vec<Seen>,
     table: Vec<f32>,
 }
 
-impl FitScratch {
+impl Fitter {
     /// Gives back the table of an earlier fit, to be filled by the next.
     pub fn recycle(&mut self, fit: WeightFit) {
         self.table = fit.optical_depth;
     }
+
+    /// Fits the weight to the meshes in `layers` seen through `view_proj`
+    /// (camera-relative: the eye at the origin) from `eye`, with the camera's `near` and
+    /// `far` planes: the view depths the meshes span and, for each screen tile, the
+    /// expected optical depth in front of [`PROFILE_LEN`] depths spaced evenly in log depth
+    /// across them.
+    pub fn fit<'a>(
+        &mut self,
+        layers: impl IntoIterator<Item = (ChunkPos, &'a [Plane])>,
+        view_proj: Mat4,
+        eye: DVec3,
+        near: f32,
+        far: f32,
+    ) -> WeightFit {
+        let covered = visible_planes(layers, view_proj, eye, &mut self.seen);
+        let table = std::mem::take(&mut self.table);
+        fit_planes(&self.seen, covered, table, near, far)
+    }
 }
 
-/// [`fit`], with the room of `scratch` (a technique keeps one).
-pub fn fit_with<'a>(
-    scratch: &mut FitScratch,
-    layers: impl IntoIterator<Item = (ChunkPos, &'a [Plane])>,
-    view_proj: Mat4,
-    eye: DVec3,
+/// The fit of the planes `seen`, covering `covered`, into `table` (its room reused).
+fn fit_planes(
+    seen: &[Seen],
+    covered: [Vec2; 2],
+    table: Vec<f32>,
     near: f32,
     far: f32,
 ) -> WeightFit {
-    let covered = visible_planes(layers, view_proj, eye, &mut scratch.seen);
-    let seen = &scratch.seen;
     let (mut n, mut f) = seen
         .iter()
         .fold((f32::INFINITY, 0.0f32), |(n, f), (_, _, [a, b])| {
@@ -104,7 +98,7 @@ pub fn fit_with<'a>(
     let range = [n.clamp(near, far), f.clamp(near, far)];
     let step = (range[1] / range[0]).max(1.0).ln() / (PROFILE_LEN - 1) as f32;
     let depths: [f32; PROFILE_LEN] = std::array::from_fn(|k| range[0] * (step * k as f32).exp());
-    let mut optical_depth = std::mem::take(&mut scratch.table);
+    let mut optical_depth = table;
     optical_depth.clear();
     optical_depth.resize(TILES * TILES * PROFILE_LEN, 0.0);
     let tiles = TILES as f32;
@@ -331,7 +325,7 @@ mod tests {
         .unwrap();
         let planes = layers::planes(quads, &opacity());
         let origin = ChunkPos::new(0, 0, 0);
-        fit(
+        Fitter::default().fit(
             [(origin, &planes[..])],
             cam.view_proj(1.0),
             cam.eye,
@@ -427,7 +421,7 @@ mod tests {
         )];
         let planes = layers::planes(&quads, &opacity());
         let origin = ChunkPos::new(0, 0, 0);
-        let fit = fit(
+        let fit = Fitter::default().fit(
             [(origin, &planes[..])],
             cam.view_proj(1.0),
             cam.eye,

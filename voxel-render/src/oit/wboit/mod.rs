@@ -345,8 +345,8 @@ pub struct Wboit {
     block_opacity: std::sync::Arc<[f32]>,
     /// The weight of this frame's chunk pipelines.
     weight: WeightFunction,
-    /// Room the fitted weight's estimate reuses each frame.
-    fit_scratch: fit::FitScratch,
+    /// The fitted weight's estimate (and the room it reuses each frame).
+    fitter: fit::Fitter,
     /// The composite's scissor rectangle for this frame's chunks (`[x, y, w, h]`), `None`
     /// for the whole screen ([`WboitSettings::composite_scissor`]).
     composite_rect: Option<[u32; 4]>,
@@ -417,7 +417,7 @@ impl TechniqueKind for Wboit {
             game_layout: game_layout(device, "wboit_game", &params_entries()),
             target_states: [accum_target, reveal_target],
             block_opacity: setup.block_opacity.clone(),
-            fit_scratch: fit::FitScratch::default(),
+            fitter: fit::Fitter::default(),
             composite_rect: None,
             report: None,
         })
@@ -451,8 +451,7 @@ impl Wboit {
     /// Fits the weight to the visible translucent meshes' planes.
     fn fit(&mut self, view: &FrameView<'_>) -> WeightFit {
         let cam = view.camera;
-        fit::fit_with(
-            &mut self.fit_scratch,
+        self.fitter.fit(
             view.layers.iter(),
             view.view_proj,
             cam.eye,
@@ -506,7 +505,7 @@ impl TranslucentTechnique for Wboit {
             self.accumulate.push((settings.weight, built));
         }
         if let Some(WboitReport { fit: Some(old), .. }) = self.report.take() {
-            self.fit_scratch.recycle(old);
+            self.fitter.recycle(old);
         }
         let fit = (settings.weight == WeightFunction::Fitted).then(|| self.fit(view));
         let mut params = WboitParams {
