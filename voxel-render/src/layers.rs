@@ -1,10 +1,10 @@
 //! A chunk's translucent quads summed up per plane, facing and block: what the fitted
-//! WBOIT weight's per-frame estimate reads ([`crate::oit::wboit::fit`]).
+//! WBOIT weight's per-frame estimate reads (`oit::wboit::fit`, a module above this one).
 //!
 //! The chunk store sums each translucent mesh up once, when it is uploaded, and keeps the
-//! planes region by region next to the records its culling walks
-//! ([`crate::ChunkStore::cull`]); a frame that asks for them gets the visible chunks'
-//! planes copied into one buffer ([`VisibleLayers`]) by that same walk. So the estimate
+//! planes region by region next to the records its culling walks (`ChunkStore::cull`); a
+//! frame that asks for them gets the visible chunks' planes copied into one buffer
+//! ([`VisibleLayers`]) by that same walk. So the estimate
 //! reads memory in order, with no lookup per chunk: at view distance 32 a lookup per
 //! chunk in a hash map cost more than the estimate itself.
 
@@ -80,7 +80,7 @@ pub fn planes(quads: &[PackedQuad], opacity: &[f32]) -> Vec<Plane> {
 }
 
 /// The planes of a frame's visible translucent chunks, chunk by chunk, in one buffer
-/// (filled by [`crate::ChunkStore::cull`] when asked for).
+/// (filled by the chunk store's culling when asked for).
 #[derive(Clone, Debug, Default)]
 pub struct LayerBuffer {
     /// Each chunk and the end of its planes in `planes` (its start is the previous end).
