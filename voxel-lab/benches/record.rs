@@ -16,15 +16,14 @@
 
 use std::fmt::Write as _;
 use std::path::Path;
-use std::sync::Arc;
 use std::time::Instant;
 
-use glam::DVec3;
-use rayon::prelude::*;
-use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, World};
 use voxel_lab::headless::{self, Offscreen};
-use voxel_mesh::mesh_chunks;
-use voxel_render::{Camera, DrawMode, FrameStats, GpuContext, Renderer, RendererConfig, Technique};
+use voxel_render::{DrawMode, FrameStats, GpuContext, Technique};
+
+#[path = "common/record_world.rs"]
+mod record_world;
+use record_world::{H, LAYERS, SEED, W, camera, renderer};
 
 const WARMUP: usize = 4;
 /// Frames measured per mode (RECORD_FRAMES overrides, for profiling).
@@ -34,67 +33,10 @@ fn frames() -> usize {
         .and_then(|v| v.parse().ok())
         .unwrap_or(40)
 }
-const SEED: u32 = 1;
-const W: u32 = 640;
-const H: u32 = 360;
-/// Chunk layers generated: the terrain's ground lies in 0 and 1 (heights 8 to 44, trees and
-/// structures below 64); -2 and -1 are solid stone, 2 and 3 air.
-const LAYERS: std::ops::RangeInclusive<i32> = -2..=3;
-
 fn percentile(v: &[f64], p: f64) -> f64 {
     let mut v = v.to_vec();
     v.sort_by(f64::total_cmp);
     v[((v.len() - 1) as f64 * p).round() as usize]
-}
-
-/// The terrain of the disc of radius `vd` chunks, meshed and uploaded into a new renderer.
-fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Renderer, String> {
-    let registry = Arc::new(BlockRegistry::default());
-    let generator = TerrainGenerator::new(TerrainConfig {
-        seed: SEED,
-        ..TerrainConfig::default()
-    });
-    let mut positions = Vec::new();
-    for dx in -vd..=vd {
-        for dz in -vd..=vd {
-            if dx * dx + dz * dz <= vd * vd {
-                positions.extend(LAYERS.map(|y| ChunkPos::new(dx, y, dz)));
-            }
-        }
-    }
-    let chunks: Vec<_> = positions
-        .par_iter()
-        .map(|&p| (p, generator.generate_chunk(p)))
-        .collect();
-    let mut world = World::new(registry.clone());
-    for (p, c) in chunks {
-        world.insert_chunk(p, c).map_err(|e| e.to_string())?;
-    }
-    let mut config = RendererConfig {
-        width: W,
-        height: H,
-        ..RendererConfig::default()
-    };
-    config.oit.technique = technique;
-    let mut renderer = Renderer::new(ctx, &registry, config).map_err(|e| voxel_lab::chain(&e))?;
-    for (pos, meshes) in mesh_chunks(&world, &positions).map_err(|e| e.to_string())? {
-        renderer
-            .upload_chunk(pos, &meshes)
-            .map_err(|e| voxel_lab::chain(&e))?;
-    }
-    Ok(renderer)
-}
-
-fn camera(vd: i32) -> Result<Camera, String> {
-    let generator = TerrainGenerator::new(TerrainConfig {
-        seed: SEED,
-        ..TerrainConfig::default()
-    });
-    let eye = DVec3::new(0.5, generator.height_at(0, 0) as f64 + 40.0, 0.5);
-    let pitch: f64 = -0.25;
-    let dir = DVec3::new(pitch.cos(), pitch.sin(), 0.0);
-    Camera::look_at(eye, eye + dir, 70.0, 0.1, f64::from(vd) * 32.0 * 1.5)
-        .map_err(|e| voxel_lab::chain(&e))
 }
 
 /// One row: what a frame drew, and the CPU ms of each mode.

@@ -6,78 +6,20 @@
 //! ms. Prints figures; asserts nothing about time.
 //! `cargo bench -p voxel-lab --bench wboit_fit` (FIT_VD=8,32 picks view distances).
 
-use std::sync::Arc;
-
-use glam::DVec3;
-use rayon::prelude::*;
-use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, World};
 use voxel_lab::eval::oit_config;
 use voxel_lab::headless::{self, Offscreen};
-use voxel_mesh::mesh_chunks;
-use voxel_render::{Camera, GpuContext, Renderer, RendererConfig, Technique, WeightFunction};
+use voxel_render::{Technique, WeightFunction};
+
+#[path = "common/record_world.rs"]
+mod record_world;
+use record_world::{H, LAYERS, SEED, W, camera, renderer};
 
 const WARMUP: usize = 4;
 const FRAMES: usize = 40;
-const SEED: u32 = 1;
-const W: u32 = 640;
-const H: u32 = 360;
-/// The record bench's chunk layers (the ground lies in 0 and 1).
-const LAYERS: std::ops::RangeInclusive<i32> = -2..=3;
 
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
-}
-
-/// The terrain of the disc of radius `vd` chunks in a `wboit-mrt` renderer.
-fn renderer(ctx: &GpuContext, vd: i32) -> Result<Renderer, String> {
-    let registry = Arc::new(BlockRegistry::default());
-    let generator = TerrainGenerator::new(TerrainConfig {
-        seed: SEED,
-        ..TerrainConfig::default()
-    });
-    let mut positions = Vec::new();
-    for dx in -vd..=vd {
-        for dz in -vd..=vd {
-            if dx * dx + dz * dz <= vd * vd {
-                positions.extend(LAYERS.map(|y| ChunkPos::new(dx, y, dz)));
-            }
-        }
-    }
-    let chunks: Vec<_> = positions
-        .par_iter()
-        .map(|&p| (p, generator.generate_chunk(p)))
-        .collect();
-    let mut world = World::new(registry.clone());
-    for (p, c) in chunks {
-        world.insert_chunk(p, c).map_err(|e| e.to_string())?;
-    }
-    let mut config = RendererConfig {
-        width: W,
-        height: H,
-        ..RendererConfig::default()
-    };
-    config.oit.technique = Technique::WboitMrt;
-    let mut renderer = Renderer::new(ctx, &registry, config).map_err(|e| voxel_lab::chain(&e))?;
-    for (pos, meshes) in mesh_chunks(&world, &positions).map_err(|e| e.to_string())? {
-        renderer
-            .upload_chunk(pos, &meshes)
-            .map_err(|e| voxel_lab::chain(&e))?;
-    }
-    Ok(renderer)
-}
-
-/// The record bench's camera.
-fn camera(vd: i32) -> Result<Camera, String> {
-    let generator = TerrainGenerator::new(TerrainConfig {
-        seed: SEED,
-        ..TerrainConfig::default()
-    });
-    let eye = DVec3::new(0.5, generator.height_at(0, 0) as f64 + 40.0, 0.5);
-    let pitch: f64 = -0.25;
-    let dir = DVec3::new(pitch.cos(), pitch.sin(), 0.0);
-    Camera::look_at(eye, eye + dir, 70.0, 0.1, f64::from(vd) * 32.0 * 1.5)
-        .map_err(|e| voxel_lab::chain(&e))
 }
 
 fn main() -> Result<(), String> {
@@ -88,18 +30,20 @@ fn main() -> Result<(), String> {
         .unwrap_or_else(|| vec![8, 16, 32]);
     println!(
         "# Fitted WBOIT weight, CPU (cargo bench -p voxel-lab --bench wboit_fit)\n\n\
-         {} at {W}x{H}, the record bench's worlds and camera; `wboit-mrt`, frames alternating \
+         {} at {W}x{H}, the record bench's worlds (terrain seed {SEED}, layers y {}..={}) and camera; `wboit-mrt`, frames alternating \
          between the fitted and the flat weight; median of {FRAMES} frames each after {WARMUP} \
          warm-up frames. prepare = the technique's CPU work before recording (the fit, the \
          uniform's upload); render = `Renderer::render`.\n",
-        ctx.caps.adapter_name
+        ctx.caps.adapter_name,
+        LAYERS.start(),
+        LAYERS.end(),
     );
     println!(
         "| VD | translucent meshes | prepare fitted ms | prepare flat ms | fit ms (difference) | render fitted ms | render flat ms |"
     );
     println!("|---:|---:|---:|---:|---:|---:|---:|");
     for vd in vds {
-        let mut renderer = renderer(&ctx, vd)?;
+        let mut renderer = renderer(&ctx, vd, Technique::WboitMrt)?;
         let target = Offscreen::new(&ctx, W, H);
         let camera = camera(vd)?;
         let weights = [WeightFunction::Fitted, WeightFunction::Flat];

@@ -377,14 +377,7 @@ mod tests {
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let faces = [
-            Face::PosX,
-            Face::NegX,
-            Face::PosY,
-            Face::NegY,
-            Face::PosZ,
-            Face::NegZ,
-        ];
+        let faces = Face::ALL;
         let (mut decided, mut checked) = (0, 0);
         for round in 0..400 {
             let two_sided = round % 4 == 0;

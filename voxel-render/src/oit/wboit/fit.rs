@@ -525,14 +525,7 @@ mod tests {
             (state % u64::from(n)) as u32
         };
         let blocks = [blocks::GLASS, blocks::WATER, blocks::ICE, blocks::RED_GLASS];
-        let faces = [
-            Face::PosX,
-            Face::NegX,
-            Face::PosY,
-            Face::NegY,
-            Face::PosZ,
-            Face::NegZ,
-        ];
+        let faces = Face::ALL;
         let base = [1000, 2, -3000];
         let meshes: Vec<(ChunkPos, Vec<PackedQuad>)> = (0..4)
             .map(|c| {
