@@ -197,27 +197,24 @@ impl Surfaces<'_> {
     }
 }
 
-/// The distinct planes of a set of quads, sorted.
-fn quad_planes(quads: &[PackedQuad]) -> Vec<(Face, u8)> {
-    let mut planes: Vec<(Face, u8)> = quads
+/// The distinct planes (facing, position along its axis) of a translucent mesh, sorted,
+/// from its layers (a layer is a plane, facing and block: every quad lies in one).
+fn distinct_planes(layers: &[Plane]) -> Vec<(Face, u8)> {
+    let mut planes: Vec<(Face, u8)> = layers
         .iter()
-        .filter_map(|q| q.unpack())
-        .map(|q| {
-            let (lo, _) = q.bounds();
-            (q.face, lo[q.face.axis()] as u8)
-        })
+        .map(|p| (p.face, p.lo[p.face.axis()] as u8))
         .collect();
     planes.sort_unstable_by_key(|&(f, c)| (f as u8, c));
     planes.dedup();
     planes
 }
 
-/// The box a set of quads spans, chunk-local blocks.
-fn quad_bounds(quads: &[PackedQuad]) -> Option<([f64; 3], [f64; 3])> {
-    quads
+/// The box a translucent mesh spans, chunk-local blocks: around its layers' rectangles
+/// (each the box of its quads).
+fn layers_bounds(layers: &[Plane]) -> Option<([f64; 3], [f64; 3])> {
+    layers
         .iter()
-        .filter_map(|q| q.unpack())
-        .map(|q| q.bounds())
+        .map(|p| (p.lo.as_dvec3().to_array(), p.hi.as_dvec3().to_array()))
         .reduce(|(lo, hi), (a, b)| {
             (
                 [0, 1, 2].map(|k| lo[k].min(a[k])),
@@ -928,14 +925,15 @@ impl ChunkStore {
         };
         let origin = pos.origin().map(|v| v as i32);
         self.write_info(ctx, slot, ChunkUniforms { origin, alpha });
+        // One pass over the translucent quads; their box and distinct planes follow.
         let planes = layers::planes(&meshes.translucent, &self.block_opacity);
         self.regions.set(slot, pos, allocs, Some(&planes));
         self.slots[slot as usize] = Some(GpuChunk {
             pos,
             meshes: allocs,
             translucent: meshes.translucent.clone(),
-            translucent_bounds: quad_bounds(&meshes.translucent),
-            translucent_planes: quad_planes(&meshes.translucent),
+            translucent_bounds: layers_bounds(&planes),
+            translucent_planes: distinct_planes(&planes),
             generation: self.next_generation,
         });
         self.next_generation += 1;
@@ -1380,6 +1378,50 @@ mod tests {
         }
         check_bookkeeping(&regions, &[]);
         assert!(regions.regions.is_empty());
+    }
+
+    /// The box and distinct planes of a mesh derived from its layers are what its quads
+    /// give directly.
+    #[test]
+    fn bounds_and_planes_from_layers_are_those_of_the_quads() {
+        let mut next = rng(0x1a7e_5eed);
+        let blocks = [
+            voxel_core::blocks::GLASS,
+            voxel_core::blocks::WATER,
+            voxel_core::blocks::ICE,
+            voxel_core::BlockId(999),
+        ];
+        let opacity = [0.5f32; 8];
+        for round in 0..200 {
+            let quads: Vec<PackedQuad> = (0..round % 40)
+                .map(|_| {
+                    let mut n = |m: u64| (next() % m) as usize;
+                    let (w, h) = (1 + n(8), 1 + n(8));
+                    let at = [n(24), n(24), n(24)];
+                    PackedQuad::new(at, w, h, Face::ALL[n(6)], blocks[n(4)])
+                })
+                .collect();
+            let layers = layers::planes(&quads, &opacity);
+            let mut want: Vec<(Face, u8)> = quads
+                .iter()
+                .filter_map(|q| q.unpack())
+                .map(|q| (q.face, q.bounds().0[q.face.axis()] as u8))
+                .collect();
+            want.sort_unstable_by_key(|&(f, c)| (f as u8, c));
+            want.dedup();
+            assert_eq!(distinct_planes(&layers), want);
+            let bounds = quads
+                .iter()
+                .filter_map(|q| q.unpack())
+                .map(|q| q.bounds())
+                .reduce(|(lo, hi), (a, b)| {
+                    (
+                        [0, 1, 2].map(|k| lo[k].min(a[k])),
+                        [0, 1, 2].map(|k| hi[k].max(b[k])),
+                    )
+                });
+            assert_eq!(layers_bounds(&layers), bounds);
+        }
     }
 
     #[test]
