@@ -97,6 +97,11 @@ macro_rules! techniques {
                 match self { $( Technique::$variant => <$kind as TechniqueKind>::SORTS, )* }
             }
 
+            /// Whether the technique with `config` reads [`FrameView::layers`].
+            fn reads_layers(self, config: &OitConfig) -> bool {
+                match self { $( Technique::$variant => <$kind as TechniqueKind>::reads_layers(config), )* }
+            }
+
             /// What replaces the technique on an adapter that cannot run it.
             fn fallback(self, caps: &Capabilities) -> Option<Technique> {
                 match self { $( Technique::$variant => <$kind as TechniqueKind>::fallback(self, caps), )* }
@@ -214,6 +219,12 @@ pub trait TechniqueKind: TranslucentTechnique + Sized + 'static {
 
     /// Whether `technique` (one this type draws) computes the exact blend.
     fn is_exact(_technique: Technique) -> bool {
+        false
+    }
+
+    /// Whether it reads the visible translucent meshes' planes ([`FrameView::layers`])
+    /// with `config`: the culling copies them only then.
+    fn reads_layers(_config: &OitConfig) -> bool {
         false
     }
 
@@ -468,13 +479,10 @@ impl OitManager {
     }
 
     /// Whether the technique in force reads the planes of the visible translucent meshes
-    /// ([`FrameView::layers`]): WBOIT with the fitted weight. The renderer's culling copies
+    /// ([`FrameView::layers`]; WBOIT with the fitted weight). The renderer's culling copies
     /// them only then.
     pub fn wants_layers(&self) -> bool {
-        matches!(
-            self.config.technique,
-            Technique::WboitMrt | Technique::WboitTwoPass
-        ) && self.config.wboit.weight == WeightFunction::Fitted
+        self.config.technique.reads_layers(&self.config)
     }
 
     /// Switches technique at run time; the old one's resources are freed at once.

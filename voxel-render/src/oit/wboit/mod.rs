@@ -357,6 +357,11 @@ impl TechniqueKind for Wboit {
     /// MRT or two passes, and the accumulation format.
     type Key = (Technique, wgpu::TextureFormat);
 
+    /// The fitted weight is estimated from the visible planes.
+    fn reads_layers(config: &OitConfig) -> bool {
+        config.wboit.weight == WeightFunction::Fitted
+    }
+
     fn fallback(technique: Technique, caps: &Capabilities) -> Option<Technique> {
         (technique == Technique::WboitMrt && !caps.independent_blend())
             .then_some(Technique::WboitTwoPass)
