@@ -209,18 +209,10 @@ fn distinct_planes(layers: &[Plane]) -> Vec<(Face, u8)> {
     planes
 }
 
-/// The box a translucent mesh spans, chunk-local blocks: around its layers' rectangles
-/// (each the box of its quads).
+/// The box a translucent mesh spans, chunk-local blocks, from its layers.
 fn layers_bounds(layers: &[Plane]) -> Option<([f64; 3], [f64; 3])> {
-    layers
-        .iter()
-        .map(|p| (p.lo.as_dvec3().to_array(), p.hi.as_dvec3().to_array()))
-        .reduce(|(lo, hi), (a, b)| {
-            (
-                [0, 1, 2].map(|k| lo[k].min(a[k])),
-                [0, 1, 2].map(|k| hi[k].max(b[k])),
-            )
-        })
+    let (lo, hi) = layers::bounds(layers)?;
+    Some((lo.as_dvec3().to_array(), hi.as_dvec3().to_array()))
 }
 
 /// One draw command, as `multi_draw_indirect` reads it.

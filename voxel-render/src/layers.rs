@@ -1,5 +1,6 @@
 //! A chunk's translucent quads summed up per plane, facing and block: what the fitted
-//! WBOIT weight's per-frame estimate reads (`oit::wboit::fit`, a module above this one).
+//! WBOIT weight's per-frame estimate reads (`oit::wboit::fit`, a module above this one),
+//! and the boxes MBOIT's depth warp spans.
 //!
 //! The chunk store sums each translucent mesh up once, when it is uploaded, and keeps the
 //! planes region by region next to the records its culling walks (`ChunkStore::cull`); a
@@ -79,6 +80,15 @@ pub fn planes(quads: &[PackedQuad], opacity: &[f32]) -> Vec<Plane> {
         .collect()
 }
 
+/// The box around `planes` (each the box of its quads), chunk-local blocks: the box of the
+/// mesh they sum up.
+pub fn bounds(planes: &[Plane]) -> Option<(Vec3, Vec3)> {
+    planes
+        .iter()
+        .map(|p| (p.lo, p.hi))
+        .reduce(|(lo, hi), (a, b)| (lo.min(a), hi.max(b)))
+}
+
 /// The planes of a frame's visible translucent chunks, chunk by chunk, in one buffer
 /// (filled by the chunk store's culling when asked for).
 #[derive(Clone, Debug, Default)]
@@ -128,6 +138,15 @@ impl<'a> VisibleLayers<'a> {
             let run = &planes[start as usize..end as usize];
             start = end;
             (pos, run)
+        })
+    }
+
+    /// The box of each chunk's translucent mesh, world blocks.
+    pub fn boxes(&self) -> impl Iterator<Item = (DVec3, DVec3)> + 'a {
+        self.iter().filter_map(|(pos, planes)| {
+            let origin = DVec3::from(pos.origin().map(|v| v as f64));
+            let (lo, hi) = bounds(planes)?;
+            Some((origin + lo.as_dvec3(), origin + hi.as_dvec3()))
         })
     }
 

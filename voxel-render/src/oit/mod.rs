@@ -479,7 +479,7 @@ impl OitManager {
     }
 
     /// Whether the technique in force reads the planes of the visible translucent meshes
-    /// ([`FrameView::layers`]; WBOIT with the fitted weight). The renderer's culling copies
+    /// ([`FrameView::layers`]; WBOIT with the fitted weight, MBOIT). The renderer's culling copies
     /// them only then.
     pub fn wants_layers(&self) -> bool {
         self.config.technique.reads_layers(&self.config)

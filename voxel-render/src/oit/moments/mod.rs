@@ -21,11 +21,9 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
-use voxel_core::ChunkPos;
-use voxel_mesh::PackedQuad;
 use wgpu::util::DeviceExt;
 
-use crate::chunks::{ChunkStore, PosMap};
+use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
 use crate::gpu::{self, ChunkPipeline, Depth, Pass, SidedPipeline};
 use crate::oit::{
@@ -241,20 +239,6 @@ pub fn depth_range(
     }
 }
 
-/// The world-space box around the translucent quads of the chunk at `pos` (`None`: none).
-fn mesh_box(pos: ChunkPos, quads: &[PackedQuad]) -> Option<(DVec3, DVec3)> {
-    let o = pos.origin().map(|v| v as f64);
-    let origin = DVec3::from_array(o);
-    quads
-        .iter()
-        .filter_map(|q| q.unpack())
-        .map(|u| {
-            let (min, max) = u.bounds();
-            (origin + DVec3::from(min), origin + DVec3::from(max))
-        })
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
-}
-
 /// The shader of pass 1 (`resolve` false) or pass 2: constants from Rust, the shared
 /// code, the moments' maths, the chunk entries.
 pub fn mboit_wgsl(resolve: bool) -> String {
@@ -335,8 +319,6 @@ pub struct Mboit {
     moments_group: wgpu::BindGroup,
     /// The game's group layouts of pass 1 and pass 2.
     game_layouts: [wgpu::BindGroupLayout; 2],
-    /// Per chunk: the mesh generation boxed and the box around its translucent quads.
-    boxes: PosMap<ChunkPos, (u64, Option<(DVec3, DVec3)>)>,
     report: Option<MboitReport>,
 }
 
@@ -350,6 +332,11 @@ impl TechniqueKind for Mboit {
 
     fn key(_: Technique, config: &OitConfig, caps: &Capabilities) -> bool {
         single_precision(caps, &config.mboit)
+    }
+
+    /// The warp's depth range comes from the boxes of the visible translucent meshes.
+    fn reads_layers(_: &OitConfig) -> bool {
+        true
     }
 
     fn create(setup: &Setup, _: Technique, config: &OitConfig) -> Result<Self> {
@@ -422,7 +409,6 @@ impl TechniqueKind for Mboit {
                 game_layout(device, "mboit_moments_game", &group_entries(false)),
                 game_layout(device, "mboit_resolve_game", &group_entries(true)),
             ],
-            boxes: PosMap::default(),
             report: None,
         })
     }
@@ -473,34 +459,6 @@ impl Mboit {
         }
     }
 
-    /// The warp's depth range for `view`, boxing (once per remesh) each visible
-    /// translucent mesh.
-    fn range(&mut self, chunks: &ChunkStore, view: &FrameView<'_>) -> [f32; 2] {
-        for &pos in view.translucent {
-            let Some(chunk) = chunks.get(pos) else {
-                continue;
-            };
-            let fresh = self
-                .boxes
-                .get(&pos)
-                .is_some_and(|(g, _)| *g == chunk.generation());
-            if !fresh {
-                let b = mesh_box(pos, chunk.translucent_quads());
-                self.boxes.insert(pos, (chunk.generation(), b));
-            }
-        }
-        // Forget chunks that were removed or remeshed since (kept bounded by the store).
-        if self.boxes.len() > 2 * chunks.len() + 64 {
-            self.boxes
-                .retain(|pos, (g, _)| chunks.get(*pos).map(|c| c.generation()) == Some(*g));
-        }
-        let boxes = view
-            .translucent
-            .iter()
-            .filter_map(|p| self.boxes.get(p).and_then(|(_, b)| *b));
-        depth_range(view.camera, boxes, view.game_objects)
-    }
-
     fn bias(&self) -> f32 {
         if self.single { BIAS_F32 } else { BIAS_F16 }
     }
@@ -538,10 +496,10 @@ impl TranslucentTechnique for Mboit {
         &mut self,
         ctx: &GpuContext,
         config: &OitConfig,
-        chunks: &mut ChunkStore,
+        _chunks: &mut ChunkStore,
         view: &FrameView<'_>,
     ) -> Result<()> {
-        let range = self.range(chunks, view);
+        let range = depth_range(view.camera, view.layers.boxes(), view.game_objects);
         let params = MboitParams::new(range, self.bias(), config.mboit.overestimation);
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
