@@ -886,10 +886,11 @@ impl ChunkStreamer {
                     sink.remove(pos);
                     slot.uploaded = false;
                 }
-                if matches!(slot.state, State::Meshing | State::Ready) {
-                    slot.version = self.next_version();
-                    slot.state = State::Generated;
-                }
+                // Whatever it had (a mesh drawn, in flight or waiting), it has none now:
+                // if it stays resident (a neighbour needs its blocks) and is wanted again,
+                // it must be meshed and uploaded again, not taken as done.
+                slot.version = self.next_version();
+                slot.state = State::Generated;
                 self.slots.insert(pos, slot);
                 worked = true;
                 // Its neighbours past the margin may leave memory now.
@@ -906,6 +907,21 @@ impl ChunkStreamer {
                 // Its edits stay in `edits`: it comes back as the source plus them.
                 self.world.remove_chunk(pos);
                 worked = true;
+                // A neighbour meshed to nothing from its blocks (none of them needs
+                // neighbours, see `may_leave`) is not done any more: the blocks it was
+                // meshed against may come back different (a source that changes).
+                for d in Neighbourhood::OFFSETS {
+                    if let Some(n) = pos.offset(d) {
+                        let version = self.next_version();
+                        if let Some(s) = self.slots.get_mut(&n)
+                            && s.state == State::Meshed
+                            && !s.failed
+                        {
+                            s.version = version;
+                            s.state = State::Generated;
+                        }
+                    }
+                }
             }
             // A chunk still needed stays resident, out of the queue: the neighbour that
             // needs it queues it again when it leaves the sink.
@@ -1838,9 +1854,22 @@ mod tests {
 
     /// For a source that answers differently each call there is no true world beyond what
     /// the streamer holds: every drawn chunk equals a fresh mesh of the streamer's own
-    /// resident blocks, all 26 of its neighbours resident.
-    fn check_against_own_world(s: &ChunkStreamer, sink: &Holder, what: &str) {
+    /// resident blocks, all 26 of its neighbours resident, and every chunk within the view
+    /// distance whose fresh mesh of those blocks has faces is drawn.
+    fn check_against_own_world(s: &ChunkStreamer, sink: &Holder, eye: DVec3, what: &str) {
         let chunk_at = |p: ChunkPos| s.world().chunk(p).cloned();
+        let centre = ChunkStreamer::centre_of(eye).unwrap();
+        for o in &s.offsets {
+            let pos = ChunkPos::new(centre.x + o[0], centre.y + o[1], centre.z + o[2]);
+            if !sink.held.contains_key(&pos) {
+                let fresh = fresh_mesh(pos, &chunk_at);
+                assert!(
+                    fresh.is_empty(),
+                    "{what}: {pos:?} within the view distance not drawn ({} quads)",
+                    fresh.len()
+                );
+            }
+        }
         for (&pos, meshes) in &sink.held {
             for d in Neighbourhood::OFFSETS {
                 let n = pos.offset(d).unwrap();
@@ -1918,11 +1947,14 @@ mod tests {
                         eye += DVec3::new(d(next()), d(next()) / 4.0, d(next()));
                     }
                     15..=19 => {
-                        // Away, or back home (flying away and back).
-                        eye = if next().is_multiple_of(2) {
-                            home + DVec3::new(32.0 * 40.0, 0.0, -32.0 * 25.0)
-                        } else {
-                            home
+                        // Far away, a few chunks away (past the view distance, within
+                        // or past the margin: chunks leave the sink but stay resident
+                        // for their neighbours), or back home (flying away and back).
+                        let k = f64::from(1 + (next() % 8) as u32) * 32.0;
+                        eye = match next() % 3 {
+                            0 => home + DVec3::new(32.0 * 40.0, 0.0, -32.0 * 25.0),
+                            1 => home + DVec3::new(k, 0.0, -((next() % 2) as f64) * k),
+                            _ => home,
                         };
                     }
                     20..=22 => {
@@ -2002,7 +2034,7 @@ mod tests {
                     let idle = run_to_idle(&mut s, eye, &mut sink, &mut failed, 20_000);
                     assert!(idle.is_some(), "{what}: never idle: {s:?}");
                     if changing {
-                        check_against_own_world(&s, &sink, &what);
+                        check_against_own_world(&s, &sink, eye, &what);
                     } else {
                         check_against_truth(&s, &sink, &truth, eye, &failed, &what);
                     }
@@ -2103,6 +2135,41 @@ mod tests {
         settle_and_check(&mut s, &mut sink, &truth, home, 5_000, "home again");
     }
 
+    /// Return trips of every length, at view distances 3, 8 and 16 (vertical 1, default
+    /// hysteresis): from home the eye flies `k` chunks away (along an axis or a diagonal),
+    /// settles, flies back and settles, for every `k` from 1 to past the margin. Each stop
+    /// is checked against the true world. Chunks past the view distance leave the sink but
+    /// stay resident while a neighbour still needs their blocks; once wanted again they
+    /// must be meshed and uploaded again (they were left as done: a hole beside the eye).
+    #[test]
+    fn return_trips_of_every_length_hold_the_truth() {
+        for view_distance in [3u32, 8, 16] {
+            let (mut s, truth) = deterministic(view_distance, StreamConfig::default().hysteresis);
+            let mut sink = Holder::default();
+            let home = eye_in(ChunkPos::new(0, 0, 0));
+            let what = format!("view distance {view_distance}");
+            settle_and_check(&mut s, &mut sink, &truth, home, 50_000, &what);
+            let reach = view_distance as i32 + 2 * 2 + 2;
+            for k in 1..=reach {
+                let away = if k % 2 == 0 {
+                    ChunkPos::new(k, 0, 0)
+                } else {
+                    ChunkPos::new(-k, 0, k / 2)
+                };
+                let what = format!("view distance {view_distance}, {away:?} and back");
+                // The far stop is checked where the margin can matter; every return is.
+                if view_distance < 16 || k > view_distance as i32 {
+                    settle_and_check(&mut s, &mut sink, &truth, eye_in(away), 50_000, &what);
+                } else {
+                    let mut failed = HashSet::new();
+                    let idle = run_to_idle(&mut s, eye_in(away), &mut sink, &mut failed, 50_000);
+                    assert!(idle.is_some(), "{what}: not idle away: {s:?}");
+                }
+                settle_and_check(&mut s, &mut sink, &truth, home, 50_000, &what);
+            }
+        }
+    }
+
     /// Issue 26, row 2: a chunk drawn at the edge of the margin, whose outer neighbour lies
     /// past it, is edited: it is meshed again (its neighbour stayed resident for it) and the
     /// streamer becomes idle (it never did: it waited for a neighbour nobody loaded).
@@ -2201,7 +2268,7 @@ mod tests {
             let idle = run_to_idle(&mut s, eye, &mut sink, &mut failed, limit);
             if limit == 20_000 {
                 assert!(idle.is_some(), "not idle: {s:?}");
-                check_against_own_world(&s, &sink, &format!("stop {i}"));
+                check_against_own_world(&s, &sink, eye, &format!("stop {i}"));
             }
         }
     }
