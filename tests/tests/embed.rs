@@ -11,7 +11,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::DVec3;
-use tests::{Offscreen, Scene, diff, frame, gpu, out_dir, renderer_for, technique_config};
+use tests::{
+    Offscreen, Scene, diff, frame, gpu, out_dir, png_header_bomb, renderer_for, technique_config,
+};
 use voxel_core::{BlockDef, BlockId, BlockImage, BlockRegistry, FaceImages, World, blocks};
 use voxel_lab::raymarch::{RayMarcher, Shading};
 use voxel_render::textures::{load_block_image, srgb_to_linear};
@@ -245,6 +247,51 @@ fn bad_images_are_clear_errors() {
     // In memory: the wrong number of bytes.
     let e = BlockImage::new(4, 4, vec![0; 63]).unwrap_err().to_string();
     assert!(e.contains("64 bytes"), "{e}");
+}
+
+/// PNG header bombs (a few bytes whose header claims a huge image) are refused from the
+/// header, before anything is allocated, through the library and through a scene file's
+/// `texture =` key; so is a real image larger than a block image may be.
+#[test]
+fn png_header_bombs_are_refused_before_decoding() {
+    let dir = out_dir("embed_png_bombs");
+    for (w, h) in [(100_000, 100_000), (16_384, 16_384), (257, 257), (4096, 1)] {
+        let path = dir.join(format!("bomb_{w}x{h}.png"));
+        png_header_bomb(&path, w, h);
+        assert!(std::fs::metadata(&path).unwrap().len() < 100);
+        let start = std::time::Instant::now();
+        let e = load_block_image(&path).unwrap_err();
+        assert!(matches!(e, voxel_render::Error::Image { .. }), "{e:?}");
+        let e = e.to_string();
+        assert!(
+            e.contains(&format!("bomb_{w}x{h}.png")) && e.contains(&format!("{w}x{h} pixels")),
+            "{e}"
+        );
+        assert!(e.contains("at most 256"), "{e}");
+        // Refused from the header: no decoding of a gigabyte (generous for a loaded CI).
+        assert!(start.elapsed().as_secs() < 5, "{e}");
+        // The general reader has its own bound, from the header too.
+        let e = Image::load_png(&path);
+        if w > Image::MAX_PNG_SIDE {
+            assert!(e.unwrap_err().to_string().contains("at most 16384"));
+        } else {
+            // Within the bound: decoding starts and finds the data missing.
+            assert!(e.unwrap_err().to_string().contains("PNG decoding"));
+        }
+    }
+    let scene = dir.join("bomb.toml");
+    std::fs::write(
+        &scene,
+        "name = \"bomb\"\n[[blocks]]\nname = \"b\"\ncolor = [1, 2, 3]\nopacity = 1.0\n\
+         texture = \"bomb_100000x100000.png\"\n\
+         [[cameras]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n",
+    )
+    .unwrap();
+    let e = Scene::load(&scene).unwrap_err();
+    assert!(
+        e.contains("blocks.texture") && e.contains("100000x100000 pixels"),
+        "{e}"
+    );
 }
 
 /// Grass, water and glass on stone: lit faces of every direction.

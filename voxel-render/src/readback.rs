@@ -51,11 +51,24 @@ impl Image {
         let mut w = enc.write_header().map_err(png)?;
         w.write_image_data(&self.rgba).map_err(png)?;
         w.finish().map_err(png)?;
-        std::fs::write(path, &bytes).map_err(io)
+        write_file(path, &bytes)
     }
 
-    /// Reads an 8-bit PNG (grey, RGB or RGBA; palettes expanded).
+    /// The largest side [`Image::load_png`] reads: wgpu's 2D texture limit on every
+    /// backend's top tier (a 16 384² RGBA image is 1 GiB decoded).
+    pub const MAX_PNG_SIDE: u32 = 16_384;
+
+    /// Reads an 8-bit PNG (grey, RGB or RGBA; palettes expanded) of at most
+    /// [`Image::MAX_PNG_SIDE`] a side (see [`Image::load_png_within`]).
     pub fn load_png(path: &Path) -> Result<Self> {
+        Self::load_png_within(path, Self::MAX_PNG_SIDE)
+    }
+
+    /// Reads a PNG whose header says it is at most `max_side` pixels wide and high; a
+    /// larger one is an [`Error::Image`] naming its size, found from the header before
+    /// anything is allocated, so a small file claiming a huge image costs nothing. The
+    /// decoder's own allocation limit is set to what such an image needs.
+    pub fn load_png_within(path: &Path, max_side: u32) -> Result<Self> {
         let file = std::fs::File::open(path).map_err(|error| Error::Io {
             path: path.to_owned(),
             error,
@@ -64,9 +77,23 @@ impl Image {
             path: path.to_owned(),
             error,
         };
-        let mut dec = png::Decoder::new(std::io::BufReader::new(file));
+        // Room for the decoded frame (16-bit samples, 4 channels, before stripping)
+        // plus the decoder's own buffers.
+        let side = u64::from(max_side);
+        let bytes = usize::try_from(side * side * 8 + (1 << 20)).unwrap_or(usize::MAX);
+        let mut dec =
+            png::Decoder::new_with_limits(std::io::BufReader::new(file), png::Limits { bytes });
         dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
         let mut reader = dec.read_info().map_err(png)?;
+        let (width, height) = (reader.info().width, reader.info().height);
+        if width > max_side || height > max_side {
+            return Err(Error::Image {
+                path: path.to_owned(),
+                error: voxel_core::Error::InvalidImage(format!(
+                    "{width}x{height} pixels (from the PNG header): at most {max_side} a side"
+                )),
+            });
+        }
         let size = reader
             .output_buffer_size()
             .ok_or_else(|| png(png::DecodingError::LimitsExceeded))?;
@@ -93,6 +120,22 @@ impl Image {
             rgba,
         })
     }
+}
+
+/// Writes `bytes` to `path` in one checked call; when the write fails part way (a full
+/// disk), the partial file is removed rather than left looking like a result. The error
+/// names the file.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    std::fs::write(path, bytes).map_err(|error| {
+        // Only a regular file is removed (never a device such as `/dev/full`).
+        if std::fs::metadata(path).is_ok_and(|m| m.is_file()) {
+            let _ = std::fs::remove_file(path);
+        }
+        Error::Io {
+            path: path.to_owned(),
+            error,
+        }
+    })
 }
 
 /// Copies a whole single-sample 2D texture to the CPU, row padding removed. Blocks until

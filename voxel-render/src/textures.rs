@@ -331,7 +331,7 @@ pub fn image_coords(face: Face, u: f64, v: f64) -> (f64, f64) {
 /// [`voxel_core::MAX_IMAGE_SIZE`] a side; 8-bit grey, RGB or RGBA, palettes expanded,
 /// 16-bit reduced to 8). Errors name the file and say what is wrong.
 pub fn load_block_image(path: &Path) -> Result<BlockImage> {
-    let image = Image::load_png(path)?;
+    let image = Image::load_png_within(path, voxel_core::MAX_IMAGE_SIZE)?;
     BlockImage::new(image.width, image.height, image.rgba).map_err(|e| Error::Image {
         path: path.to_owned(),
         error: e,
