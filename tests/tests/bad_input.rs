@@ -471,3 +471,78 @@ fn bad_output_formats_and_lighting_are_errors_at_new() {
     let img = frame(&ctx, &mut r, &scene.cameras[0]);
     assert!(distinct_colours(&img) > 4);
 }
+
+/// Finite directions of any length are directions: a sun of `[1e38; 3]` or `[f32::MAX, 0,
+/// 0]` lights as the same direction of length 1, a camera looking along a direction of
+/// length 1e160 (or 1e-300) draws what the unit direction draws; zero and non-finite ones
+/// are errors that say which.
+#[test]
+fn huge_and_tiny_directions_draw_as_their_unit_direction() {
+    let Some(ctx) = gpu() else { return };
+    let mut world = box_world(&[
+        ([-12, -2, -12], [12, -1, 12], voxel_core::blocks::STONE),
+        ([-4, 0, -4], [4, 3, -2], voxel_core::blocks::STONE),
+        ([-2, 0, 0], [2, 2, 2], voxel_core::blocks::WATER),
+    ]);
+    voxel_lab::scene::fill_box(&mut world, [5, 0, 3], [6, 4, 4], voxel_core::blocks::GRASS)
+        .unwrap();
+    let scene = scene("directions", world, [9.5, 7.5, 11.0], [0.0, 0.0, -2.0]);
+    let cam = scene.cameras[0];
+    let config = technique_config(Technique::SortedQuads, 96, 64);
+    let mut r = renderer_for(&ctx, &scene, config).unwrap();
+    let base = r.lighting();
+    for (huge, unit) in [
+        ([1e38f32; 3], [1.0f32; 3]),
+        ([f32::MAX, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        ([f32::MAX, f32::MAX, -f32::MAX], [1.0, 1.0, -1.0]),
+        ([0.0, 1e-44, 1e-44], [0.0, 1.0, 1.0]),
+    ] {
+        r.set_lighting(voxel_render::Lighting {
+            sun_dir: unit,
+            ..base
+        })
+        .unwrap();
+        let expected = frame(&ctx, &mut r, &cam);
+        r.set_lighting(voxel_render::Lighting {
+            sun_dir: huge,
+            ..base
+        })
+        .unwrap();
+        let got = frame(&ctx, &mut r, &cam);
+        assert!(distinct_colours(&got) > 8);
+        assert_close(&format!("sun_{huge:?}"), &got, &expected, 0);
+    }
+    for bad in [[0.0f32; 3], [f32::NAN, 1.0, 0.0], [f32::INFINITY, 0.0, 0.0]] {
+        let e = r
+            .set_lighting(voxel_render::Lighting {
+                sun_dir: bad,
+                ..base
+            })
+            .unwrap_err()
+            .to_string();
+        let why = if bad[0] == 0.0 { "zero" } else { "finite" };
+        assert!(e.contains(why), "{bad:?}: {e}");
+    }
+    r.set_lighting(base).unwrap();
+    let expected = frame(&ctx, &mut r, &cam);
+    for scale in [1e160, 1e300, 1e-300, f64::MAX] {
+        let stretched = voxel_render::Camera {
+            forward: cam.forward * scale,
+            ..cam
+        };
+        let got = frame(&ctx, &mut r, &stretched);
+        assert_close(&format!("camera_x{scale:e}"), &got, &expected, 0);
+    }
+    for (forward, why) in [
+        (glam::DVec3::ZERO, "zero"),
+        (glam::DVec3::new(f64::NAN, 0.0, 1.0), "finite"),
+    ] {
+        let bad = voxel_render::Camera { forward, ..cam };
+        let target = Offscreen::new(&ctx, 96, 64);
+        let e = r
+            .render_and_submit(&target.view, &bad)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(why), "{forward}: {e}");
+    }
+}

@@ -25,4 +25,5 @@ pub use terrain::{Site, SiteKind, TerrainBlocks, TerrainConfig, TerrainGenerator
 pub use vox::{PaletteOverride, VoxError, VoxFile, VoxPlacement};
 pub use world::{
     ChunkPos, Face, MAX_RAY_DISTANCE, Neighbourhood, RayHit, World, WorldPos, touched_neighbours,
+    unit_direction,
 };

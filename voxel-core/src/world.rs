@@ -254,6 +254,23 @@ pub fn touched_neighbours(local: [usize; 3]) -> impl Iterator<Item = [i32; 3]> {
     })
 }
 
+/// `v` scaled to length 1, computed so that no finite non-zero vector overflows or
+/// underflows on the way (`[1e300; 3]`, `[f64::MAX, 0, 0]` and `[1e-320, 0, 0]` all have a
+/// direction): first divided by its largest component, then by its length. An error that
+/// says what is wrong for a vector with a NaN or infinite component, or all zero.
+pub fn unit_direction(v: [f64; 3]) -> std::result::Result<[f64; 3], &'static str> {
+    if !v.iter().all(|c| c.is_finite()) {
+        return Err("every component must be finite");
+    }
+    let largest = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    if largest == 0.0 {
+        return Err("it is zero: a direction needs a non-zero component");
+    }
+    let scaled = v.map(|c| c / largest);
+    let length = scaled.iter().map(|c| c * c).sum::<f64>().sqrt();
+    Ok(scaled.map(|c| c / length))
+}
+
 /// The farthest [`World::raycast`] looks, in blocks: 2^16, 32 times the largest view
 /// distance (64 chunks, 2048 blocks), and at most about 200 000 steps (a few milliseconds).
 pub const MAX_RAY_DISTANCE: f64 = 65_536.0;
@@ -526,18 +543,15 @@ impl World {
                 "origin {origin:?} must be finite and inside the i32 world"
             ));
         }
-        let length = direction.iter().map(|d| d * d).sum::<f64>().sqrt();
-        if !length.is_finite() || length == 0.0 {
-            return bad(format!(
-                "direction {direction:?} must be finite and not zero"
-            ));
-        }
+        let dir = match unit_direction(direction) {
+            Ok(dir) => dir,
+            Err(why) => return bad(format!("direction {direction:?}: {why}")),
+        };
         if !(0.0..=MAX_RAY_DISTANCE).contains(&max_distance) {
             return bad(format!(
                 "max distance {max_distance} must be from 0 to {MAX_RAY_DISTANCE} blocks"
             ));
         }
-        let dir = direction.map(|d| d / length);
         let mut cell = origin.map(|v| v.floor() as i64);
         let step = dir.map(|d| if d > 0.0 { 1 } else { -1 });
         // Distance along the ray to the next cell boundary on each axis, and between
@@ -689,6 +703,36 @@ mod tests {
     }
 
     #[test]
+    fn unit_directions_survive_any_finite_length() {
+        for (v, want) in [
+            ([3.0, 0.0, -4.0], [0.6, 0.0, -0.8]),
+            ([1e38, 1e38, 1e38], [1.0 / 3f64.sqrt(); 3]),
+            ([f64::MAX, 0.0, 0.0], [1.0, 0.0, 0.0]),
+            (
+                [f64::MAX, f64::MAX, 0.0],
+                [0.5f64.sqrt(), 0.5f64.sqrt(), 0.0],
+            ),
+            ([0.0, -5e-324, 0.0], [0.0, -1.0, 0.0]),
+        ] {
+            let u = unit_direction(v).unwrap();
+            for k in 0..3 {
+                assert!((u[k] - want[k]).abs() < 1e-15, "{v:?}: {u:?}");
+            }
+        }
+        assert!(unit_direction([0.0; 3]).unwrap_err().contains("zero"));
+        assert!(
+            unit_direction([f64::INFINITY, 0.0, 0.0])
+                .unwrap_err()
+                .contains("finite")
+        );
+        assert!(
+            unit_direction([f64::NAN, 1.0, 0.0])
+                .unwrap_err()
+                .contains("finite")
+        );
+    }
+
+    #[test]
     fn raycast_refuses_bad_rays_and_stops_at_the_world_edge() {
         let w = wall();
         for (origin, dir, max) in [
@@ -702,6 +746,31 @@ mod tests {
         ] {
             let err = w.raycast(origin, dir, max, &SOLID).unwrap_err();
             assert!(matches!(err, Error::InvalidRay(_)), "{err}");
+        }
+        let e = w
+            .raycast([0.0; 3], [0.0, f64::NAN, -1.0], 5.0, &SOLID)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("finite") && !e.contains("zero"), "{e}");
+        let e = w
+            .raycast([0.0; 3], [0.0; 3], 5.0, &SOLID)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("zero"), "{e}");
+        // Finite directions whose squared length overflows or underflows are directions.
+        let o = [0.5, 0.5, 0.5];
+        for dir in [
+            [0.0, 0.0, -1e300],
+            [0.0, 0.0, -f64::MAX],
+            [0.0, 0.0, -1e-320],
+        ] {
+            let hit = w.raycast(o, dir, 20.0, &SOLID).unwrap().unwrap();
+            assert_eq!(hit.pos, WorldPos::new(0, 0, -3), "{dir:?}");
+            assert!(
+                (hit.distance - 2.5).abs() < 1e-12,
+                "{dir:?}: {}",
+                hit.distance
+            );
         }
         let edge = f64::from(i32::MAX) - 3.5;
         assert_eq!(

@@ -507,9 +507,13 @@ impl GameStages for ContentStages {
         &self.objects
     }
 
+    fn translucent_contract_id(&self) -> Option<u64> {
+        self.translucent_pipelines.as_ref().map(|(id, _)| *id)
+    }
+
     fn prepare(&mut self, ctx: &GpuContext, frame: &GameFrame<'_>) {
         // The camera's right and up, for particles: the basis of `Camera::view_proj`.
-        let f = frame.camera.forward.normalize();
+        let f = frame.camera.unit_forward();
         let up = if f.y.abs() > 0.999 {
             DVec3::Z
         } else {

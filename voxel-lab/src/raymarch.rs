@@ -857,7 +857,7 @@ struct Projection {
 
 impl Projection {
     fn new(camera: &Camera, width: u32, height: u32) -> Self {
-        let f = camera.forward.normalize();
+        let f = camera.unit_forward();
         // The view basis of `Camera::view_proj`.
         let up = if f.y.abs() > 0.999 {
             DVec3::Z
@@ -1051,7 +1051,7 @@ impl Light {
                     density: -transmit.ln() / voxel_render::medium::FOG_BLOCKS,
                 }
             });
-        let f = camera.forward.normalize();
+        let f = camera.unit_forward();
         let up = if f.y.abs() > 0.999 {
             DVec3::Z
         } else {

@@ -45,14 +45,14 @@ impl Camera {
     pub fn look_at(eye: DVec3, target: DVec3, fov_y_deg: f64, near: f64, far: f64) -> Result<Self> {
         let c = Self {
             eye,
-            forward: (target - eye).normalize_or_zero(),
+            forward: (target - eye),
             fov_y_deg,
             near,
             far,
             medium: None,
         };
         c.validate()?;
-        Ok(c)
+        Ok(c.normalized())
     }
 
     /// The same camera immersed in `medium` (see [`Camera::medium`]).
@@ -93,11 +93,16 @@ impl Camera {
     /// [`MAX_FAR`], and a field of view from [`MIN_FOV_DEG`] to [`MAX_FOV_DEG`] degrees.
     pub fn validate(&self) -> Result<()> {
         let bad = |why: String| Err(Error::InvalidCamera(format!("{why}: {self:?}")));
-        if !self.eye.is_finite() || !self.forward.is_finite() {
-            return bad("eye and direction must be finite".into());
+        if !self.eye.is_finite() {
+            return bad("the eye must be finite".into());
         }
-        if self.forward.length_squared() < 1e-12 {
-            return bad("the view direction is zero (eye equals target?)".into());
+        if let Err(why) = voxel_core::unit_direction(self.forward.to_array()) {
+            let hint = if self.forward.is_finite() {
+                " (eye equals target?)"
+            } else {
+                ""
+            };
+            return bad(format!("the view direction: {why}{hint}"));
         }
         if self.eye.abs().max_element() >= WORLD_EXTENT {
             return bad(format!(
@@ -119,9 +124,23 @@ impl Camera {
         Ok(())
     }
 
+    /// The view direction at length 1, whatever finite length `forward` has (zero for a
+    /// zero or non-finite one, which [`Camera::validate`] refuses).
+    pub fn unit_forward(&self) -> DVec3 {
+        voxel_core::unit_direction(self.forward.to_array()).map_or(DVec3::ZERO, DVec3::from)
+    }
+
+    /// The same camera with [`Camera::forward`] at length 1 ([`Camera::unit_forward`]).
+    pub fn normalized(self) -> Self {
+        Self {
+            forward: self.unit_forward(),
+            ..self
+        }
+    }
+
     /// Yaw and pitch of the view direction (inverse of [`Camera::from_yaw_pitch`]).
     pub fn yaw_pitch(&self) -> (f64, f64) {
-        let f = self.forward.normalize_or_zero();
+        let f = self.unit_forward();
         (f.x.atan2(-f.z), f.y.clamp(-1.0, 1.0).asin())
     }
 
@@ -135,7 +154,7 @@ impl Camera {
     /// View rotation (eye at the origin) times a reverse-Z perspective projection
     /// (depth 1 at the near plane, 0 at the far plane) for `aspect` = width / height.
     pub fn view_proj(&self, aspect: f64) -> Mat4 {
-        let f = self.forward.normalize();
+        let f = self.unit_forward();
         // Looking straight up or down: pick another up vector so the basis stays defined.
         let up = if f.y.abs() > 0.999 {
             DVec3::Z
