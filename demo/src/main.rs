@@ -310,8 +310,8 @@ struct EvalArgs {
     /// Points per stability sweep, 2 to 9.
     #[arg(long, value_parser = clap::value_parser!(u32).range(i64::from(voxel_lab::limits::MIN_SWEEP_POINTS)..=i64::from(voxel_lab::limits::MAX_SWEEP_POINTS)), default_value_t = 9)]
     sweep_points: u32,
-    /// Width of the saved heat maps (downscaled; default full size).
-    #[arg(long)]
+    /// Width of the saved heat maps (downscaled; default full size), 16 to 8192.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(i64::from(voxel_lab::limits::MIN_HEATMAP_WIDTH)..=i64::from(voxel_lab::limits::MAX_SIDE)))]
     heatmap_width: Option<u32>,
     /// Output folder.
     #[arg(long)]

@@ -183,3 +183,56 @@ fn render_and_eval_accept_the_same_scene_files() {
     assert!(e.status.success(), "{}", String::from_utf8_lossy(&e.stderr));
     assert!(out.join("stability/stability.json").exists());
 }
+
+/// A write that fails part way (the file size limit of the process: what a full disk does
+/// to a file) leaves no partial file behind, and fails naming it.
+#[test]
+fn a_write_that_fails_part_way_leaves_no_partial_file() {
+    if !have_gpu() {
+        return;
+    }
+    let d = dir("writes-partial");
+    let scene = scene(&d);
+    let png = d.join("big.png");
+    // Files of this process may not pass 1 KiB; the signal that limit raises is ignored,
+    // so the write fails with an error instead.
+    let cmd = format!(
+        "trap '' XFSZ; ulimit -f 1; exec '{}' render --scene '{scene}' --size 320x200 --out '{}'",
+        env!("CARGO_BIN_EXE_demo"),
+        png.display()
+    );
+    let out = Command::new("bash")
+        .args(["-c", &cmd])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    failed_naming(&out, &["big.png"]);
+    assert!(!png.exists(), "a partial file was left behind");
+}
+
+/// `--heatmap-width` below what can be shrunk to is refused before anything renders.
+#[test]
+fn a_heat_map_too_narrow_is_refused_before_rendering() {
+    let d = dir("writes-heatmap-width");
+    let scene = scene(&d);
+    let out = d.join("out");
+    let run = demo(&[
+        "eval",
+        "--scenes",
+        &scene,
+        "--size",
+        "32x24",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--no-stability",
+        "--heatmap-width",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    failed_naming(&run, &["heatmap-width"]);
+    assert!(!out.exists(), "something was written");
+}

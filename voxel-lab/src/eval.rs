@@ -293,6 +293,14 @@ impl EvalOptions {
         }
         check_range("--frames", self.frames as u64, 1, limits::MAX_FRAMES.into())?;
         check_range("--warmup", self.warmup as u64, 0, limits::MAX_WARMUP.into())?;
+        if let Some(w) = self.heatmap_width {
+            check_range(
+                "--heatmap-width",
+                w.into(),
+                limits::MIN_HEATMAP_WIDTH.into(),
+                limits::MAX_SIDE.into(),
+            )?;
+        }
         if self.stability {
             check_range(
                 "--flicker-frames",

@@ -47,6 +47,12 @@ pub fn chain(e: &dyn std::error::Error) -> String {
     s
 }
 
+/// Writes a result file in one checked call, removing what a failed write left
+/// ([`voxel_render::readback::write_file`]); the error names the file.
+pub(crate) fn write_file(path: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
+    voxel_render::readback::write_file(path, bytes).map_err(|e| e.to_string())
+}
+
 /// Runs the evaluation `opts` asks for and writes every file into `opts.out`:
 /// `summary.json`, `reference_checks.json`, heat maps, the speed-against-accuracy chart,
 /// the stability sweeps (when asked) and `report.md`. On random scenes

@@ -22,6 +22,9 @@ pub const MAX_FLICKER_FRAMES: u32 = 240;
 pub const MAX_SWEEP_POINTS: u32 = 9;
 /// Fewest points per stability sweep: its two ends.
 pub const MIN_SWEEP_POINTS: u32 = 2;
+/// Narrowest heat map saved (`eval --heatmap-width`): a picture is shrunk by a whole
+/// factor to at most this width, so narrower would leave rows of no pixel at all.
+pub const MIN_HEATMAP_WIDTH: u32 = 16;
 /// Largest scene file read, in bytes (the suite's largest is under 8 KiB): a path to
 /// `/dev/zero` or a huge file is an error after this many bytes, not a read until memory
 /// runs out.

@@ -136,6 +136,11 @@ pub fn thumbnail(img: &Image, width: Option<u32>) -> Image {
     };
     let f = img.width.div_ceil(w);
     let (nw, nh) = (img.width / f, img.height / f);
+    if nw == 0 || nh == 0 {
+        // Too small to shrink by a whole factor (a picture wider than it is tall, shrunk
+        // to a handful of pixels): kept as it is.
+        return img.clone();
+    }
     let mut rgba = Vec::with_capacity((nw * nh * 4) as usize);
     for y in 0..nh {
         for x in 0..nw {

@@ -297,13 +297,36 @@ pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene, String
     })
 }
 
+/// A fixed-length array in a scene file: exactly `N` values (serde's arrays take the first
+/// `N` of a longer list and ignore the rest).
+fn exact<'de, D, T, const N: usize>(d: D) -> Result<[T; N], D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let v = Vec::<T>::deserialize(d)?;
+    let n = v.len();
+    v.try_into().map_err(|_| {
+        serde::de::Error::invalid_length(n, &format!("an array of length {N}").as_str())
+    })
+}
+
+/// [`exact`] for an optional array.
+fn exact_opt<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    exact(d).map(Some)
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SceneFile {
     name: String,
     #[serde(default)]
     description: String,
-    size: Option<Spanned<[u32; 2]>>,
+    size: Option<Spanned<Vec<u32>>>,
     terrain: Option<Spanned<TerrainDef>>,
     #[serde(default)]
     blocks: Vec<Spanned<BlockDefFile>>,
@@ -322,13 +345,16 @@ struct SceneFile {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ParticlesDef {
+    #[serde(deserialize_with = "exact")]
     min: [f64; 3],
+    #[serde(deserialize_with = "exact")]
     max: [f64; 3],
     count: usize,
     #[serde(default = "default_particle_seed")]
     seed: u64,
     #[serde(default = "default_particle_size")]
     size: f32,
+    #[serde(deserialize_with = "exact")]
     color: [u8; 3],
     opacity: f32,
 }
@@ -344,10 +370,13 @@ fn default_particle_size() -> f32 {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct EntityDef {
+    #[serde(deserialize_with = "exact")]
     center: [f64; 3],
+    #[serde(deserialize_with = "exact")]
     size: [f32; 3],
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact")]
     rotation: [f64; 3],
+    #[serde(deserialize_with = "exact")]
     color: [u8; 3],
     #[serde(default = "default_entity_opacity")]
     opacity: f32,
@@ -361,7 +390,7 @@ fn default_entity_opacity() -> f32 {
 #[serde(deny_unknown_fields)]
 struct ModelDef {
     file: Spanned<String>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact")]
     at: [i32; 3],
     rotate: Option<Spanned<i64>>,
     #[serde(default)]
@@ -381,7 +410,9 @@ struct PaletteDef {
 struct TerrainDef {
     #[serde(default = "default_seed")]
     seed: u32,
+    #[serde(deserialize_with = "exact")]
     min_chunk: [i32; 3],
+    #[serde(deserialize_with = "exact")]
     max_chunk: [i32; 3],
 }
 
@@ -393,6 +424,7 @@ fn default_seed() -> u32 {
 #[serde(deny_unknown_fields)]
 struct BlockDefFile {
     name: String,
+    #[serde(deserialize_with = "exact")]
     color: [u8; 3],
     opacity: f32,
     /// `opaque`, `cutout` or `translucent`; by default from the opacity.
@@ -400,6 +432,7 @@ struct BlockDefFile {
     /// `noise`, `leaves`, `framed` or `grass`; by default the class's.
     pattern: Option<Spanned<String>>,
     /// The soil colour of the `grass` pattern.
+    #[serde(default, deserialize_with = "exact_opt")]
     soil: Option<[u8; 3]>,
     /// A PNG file for every face, relative to the scene file.
     texture: Option<Spanned<String>>,
@@ -484,14 +517,18 @@ fn block_def(text: &str, dir: &Path, b: &Spanned<BlockDefFile>) -> Result<BlockD
 #[serde(deny_unknown_fields)]
 struct BoxDef {
     block: Spanned<String>,
+    #[serde(deserialize_with = "exact")]
     min: [i32; 3],
+    #[serde(deserialize_with = "exact")]
     max: [i32; 3],
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CameraDef {
+    #[serde(deserialize_with = "exact")]
     eye: [f64; 3],
+    #[serde(deserialize_with = "exact")]
     target: [f64; 3],
     #[serde(default = "default_fov")]
     fov: f64,
@@ -499,6 +536,7 @@ struct CameraDef {
     near: f64,
     #[serde(default = "default_far")]
     far: f64,
+    #[serde(default, deserialize_with = "exact_opt")]
     path_to: Option<[f64; 3]>,
 }
 
@@ -535,12 +573,18 @@ fn field_at(text: &str, at: usize) -> String {
     let at = at.min(text.len());
     let start = text[..at].rfind('\n').map_or(0, |i| i + 1);
     let line = text[start..].lines().next().unwrap_or("");
-    let key = line.split_once('=').map(|(k, _)| k.trim()).unwrap_or("");
-    let table = text[..start]
+    let header = |l: &str| l.trim().starts_with('[');
+    // On a table's own header (a table missing a field): that table, no key.
+    let key = if header(line) {
+        ""
+    } else {
+        line.split_once('=').map(|(k, _)| k.trim()).unwrap_or("")
+    };
+    let table = text[..start + line.len()]
         .lines()
         .rev()
         .map(str::trim)
-        .find(|l| l.starts_with('['))
+        .find(|l| header(l))
         .map(|l| l.trim_matches(|c| c == '[' || c == ']'))
         .unwrap_or("");
     match (table, key) {
@@ -821,7 +865,17 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
     }
     let size = match &file.size {
         Some(s) => {
-            let size = (s.get_ref()[0], s.get_ref()[1]);
+            let &[w, h] = s.get_ref().as_slice() else {
+                return Err(at_line(
+                    text,
+                    s.span().start,
+                    format!(
+                        "size: {} values, expected 2 (width and height)",
+                        s.get_ref().len()
+                    ),
+                ));
+            };
+            let size = (w, h);
             crate::limits::check_size("size", size)
                 .map_err(|e| at_line(text, s.span().start, e))?;
             Some(size)
@@ -1095,6 +1149,54 @@ path_to = [3.0, 1.0, 10.0]
         assert!(e.contains("target"), "missing keys are named: {e}");
         let e = parse("name = \"x\"\nsize = [64, 32\n").unwrap_err();
         assert!(e.starts_with("2:") || e.starts_with("3:"), "{e}");
+    }
+
+    /// Fixed-length arrays take exactly their length (a longer list is an error naming
+    /// the field, not its first values), and a table missing a field names that table.
+    #[test]
+    fn arrays_of_the_wrong_length_and_missing_fields_name_their_table() {
+        for (from, to, field) in [
+            (
+                "eye = [0.5, 1.0, 10.0]",
+                "eye = [0.5, 1.0, 10.0, 4.0]",
+                "cameras.eye",
+            ),
+            ("size = [64, 32]", "size = [64, 32, 3]", "size"),
+            ("max = [3, 2, 0]", "max = [3, 2, 0, 0]", "boxes.max"),
+            (
+                "color = [90, 90, 100]",
+                "color = [90, 90, 100, 1]",
+                "blocks.color",
+            ),
+        ] {
+            assert!(GOOD.contains(from), "{from}");
+            let e = parse(&GOOD.replace(from, to)).unwrap_err();
+            assert!(
+                e.contains(field) && (e.contains('3') || e.contains('2')),
+                "{to}: {e}"
+            );
+        }
+        let particles = |extra: &str| {
+            format!(
+                "{GOOD}\n[[particles]]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\n\
+                 color = [1, 2, 3]\nopacity = 0.5\n{extra}"
+            )
+        };
+        parse(&particles("count = 3")).unwrap();
+        let e = parse(&particles("")).unwrap_err();
+        assert!(e.contains("particles") && e.contains("count"), "{e}");
+        assert!(!e.contains("boxes") && !e.contains("cameras"), "{e}");
+        let e = parse(&particles("count = 3").replace("color = [1, 2, 3]", "color = [1, 2, 3, 4]"))
+            .unwrap_err();
+        assert!(
+            e.contains("particles.color") && e.contains("length 3"),
+            "{e}"
+        );
+        let e = parse(&format!(
+            "{GOOD}\n[[entities]]\ncenter = [0.0, 0.0, 0.0]\nsize = [1.0, 1.0]\ncolor = [1, 2, 3]\n"
+        ))
+        .unwrap_err();
+        assert!(e.contains("entities.size") && e.contains("length 3"), "{e}");
     }
 
     #[test]
