@@ -346,3 +346,72 @@ fn game_draws_survive_switches_resizes_and_msaa() {
     let d = diff(&got, &fresh);
     assert!(d.max <= 1, "after MSAA on: {d:?}");
 }
+
+/// A game that keeps pipelines built for another technique's contract (it switched and
+/// did not rebuild) gets `Error::StaleContract` before anything is recorded, under wgpu's
+/// default (panicking) error handler; rebuilt, it draws what a fresh renderer draws. The
+/// same technique and settings keep their contract id, so a switch back needs no rebuild.
+#[test]
+fn stale_game_pipelines_are_refused_before_recording() {
+    let Some(ctx) = gpu() else { return };
+    let scene = with(
+        &pool(),
+        Content {
+            particles: vec![quad([5.5, 3.5, 3.0])],
+            entities: vec![plate([12.5, 1.0, 3.0], 0.5)],
+        },
+    );
+    let camera = scene.cameras[0];
+    let mut r =
+        tests::renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, W, H)).unwrap();
+    let target = tests::Offscreen::new(&ctx, W, H);
+    let mut content = r.content.take().unwrap();
+    content.update_pipelines(&mut r.renderer).unwrap();
+    let wboit = r.translucent_contract().unwrap().id;
+    assert_eq!(
+        voxel_render::GameStages::translucent_contract_id(&content),
+        Some(wboit)
+    );
+    r.renderer
+        .render_and_submit_with(&target.view, &camera, &mut content)
+        .unwrap();
+
+    r.set_technique(Technique::SortedQuads);
+    let quads = r.translucent_contract().unwrap().id;
+    assert_ne!(quads, wboit);
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    let e = r
+        .renderer
+        .render_with(&mut encoder, &target.view, &camera, &mut content)
+        .unwrap_err();
+    match &e {
+        voxel_render::Error::StaleContract {
+            built_for, current, ..
+        } => assert_eq!((*built_for, *current), (Some(wboit), quads)),
+        other => panic!("{other:?}"),
+    }
+    assert!(e.to_string().contains("sorted-quads"), "{e}");
+    // Nothing was recorded: the encoder submits as an empty one.
+    ctx.queue.submit([encoder.finish()]);
+
+    content.update_pipelines(&mut r.renderer).unwrap();
+    r.renderer
+        .render_and_submit_with(&target.view, &camera, &mut content)
+        .unwrap();
+    let got = target.read(&ctx).unwrap();
+    let fresh = render(&scene, technique_config(Technique::SortedQuads, W, H));
+    let d = diff(&got, &fresh);
+    assert!(d.max <= 1, "rebuilt: {d:?}");
+
+    // Back to WBOIT: the same id again, so pipelines a game kept for it are valid.
+    r.set_technique(Technique::WboitMrt);
+    assert_eq!(r.translucent_contract().unwrap().id, wboit);
+    let e = r
+        .renderer
+        .render_and_submit_with(&target.view, &camera, &mut content)
+        .unwrap_err();
+    assert!(
+        matches!(e, voxel_render::Error::StaleContract { .. }),
+        "{e:?}"
+    );
+}

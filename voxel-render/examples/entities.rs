@@ -252,6 +252,10 @@ impl GameStages for Game {
         &self.objects
     }
 
+    fn translucent_contract_id(&self) -> Option<u64> {
+        self.translucent.as_ref().map(|(id, _)| *id)
+    }
+
     fn prepare(&mut self, ctx: &GpuContext, frame: &GameFrame<'_>) {
         // The camera's basis (particles face it) and a fixed sun.
         let f = frame.camera.forward.normalize();

@@ -101,8 +101,13 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     /// What the adapter can do.
     pub caps: Capabilities,
-    /// Set by the device-lost callback: why the device was lost.
+    /// Set by the device-lost callback (or by [`GpuContext::check_device`]): why the
+    /// device was lost.
     lost: Arc<Mutex<Option<String>>>,
+    /// Four bytes [`GpuContext::check_device`] writes to learn whether the device is
+    /// still valid: wgpu calls the lost callback only once the device's queue has
+    /// drained, but refuses a write at once on a destroyed or lost device.
+    probe: wgpu::Buffer,
 }
 
 /// Optional features the renderer uses when the adapter has them.
@@ -131,26 +136,39 @@ impl GpuContext {
             };
             *flag.lock().unwrap_or_else(PoisonError::into_inner) = Some(why);
         });
+        let probe = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("device_probe"),
+            size: 4,
+            usage: wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         Self {
             device,
             queue,
             caps,
             lost,
+            probe,
         }
     }
 
     /// [`Error::DeviceLost`] once the device is lost, else `Ok`. Polls the device first
     /// (without waiting), because wgpu runs the lost callback only when it maintains the
-    /// device: a device destroyed since the last poll is noticed here.
+    /// device; and since it runs it only once the device's queue has drained, a device
+    /// destroyed or lost with work in flight is found by a four-byte queue write, which
+    /// wgpu refuses at once on such a device (a few microseconds; the write lands in a
+    /// buffer of the context's own at the next submit).
     pub fn check_device(&self) -> Result<()> {
         // A poll error on a lost device says no more than the callback does.
         let _ = self.device.poll(wgpu::PollType::Poll);
-        match self
-            .lost
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .as_ref()
-        {
+        let mut lost = self.lost.lock().unwrap_or_else(PoisonError::into_inner);
+        if lost.is_none() {
+            let size = wgpu::BufferSize::new(4).expect("4 is not zero");
+            if self.queue.write_buffer_with(&self.probe, 0, size).is_none() {
+                *lost =
+                    Some("destroyed or lost (wgpu reports why once the GPU's queue drains)".into());
+            }
+        }
+        match lost.as_ref() {
             Some(reason) => Err(Error::DeviceLost {
                 reason: reason.clone(),
             }),

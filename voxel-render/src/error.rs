@@ -121,6 +121,22 @@ pub enum Error {
         /// What went wrong.
         why: String,
     },
+    /// A game draws translucent geometry with pipelines built for another contract than
+    /// the technique's in force (a technique switch or a setting changed it): it must
+    /// rebuild them for `Renderer::translucent_contract` and say so through
+    /// `GameStages::translucent_contract_id`. Nothing of the frame was recorded.
+    #[error(
+        "the game's translucent pipelines were built for contract {}, but {technique}'s contract in force is {current}: rebuild them for Renderer::translucent_contract and return its id from GameStages::translucent_contract_id",
+        built_for.map_or_else(|| "none (translucent_contract_id returned None)".to_owned(), |id| id.to_string())
+    )]
+    StaleContract {
+        /// The id the game's pipelines were built for (`None`: not said).
+        built_for: Option<u64>,
+        /// The id of the contract in force.
+        current: u64,
+        /// The technique in force.
+        technique: &'static str,
+    },
     /// The device is lost (destroyed, reset, driver failure): nothing made on it can be
     /// used again. Make a new `GpuContext` (a new device) and a new renderer on it.
     #[error("the GPU device is lost ({reason}); make a new device and renderer")]

@@ -630,7 +630,11 @@ pub fn overlay_pipeline(
 /// Submits what `encoder` holds and replaces it with a fresh one, so that a technique can
 /// wait for GPU results in the middle of a frame (the exact methods do; real-time ones
 /// never do). Commands keep their order: the rest of the frame follows in the new encoder.
-pub fn flush(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+/// On a device lost meanwhile (a game's draw can land anywhere) nothing is submitted and
+/// the error says so: what was recorded after the loss may refer to resources the lost
+/// device never made.
+pub fn flush(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) -> crate::Result<()> {
+    ctx.check_device()?;
     let fresh = ctx
         .device
         .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -638,4 +642,5 @@ pub fn flush(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
         });
     let done = std::mem::replace(encoder, fresh);
     ctx.queue.submit([done.finish()]);
+    Ok(())
 }

@@ -8,7 +8,7 @@
 //!   rayon's workers.
 //!
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `camera`,
-//! `readback`, `timing` → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
+//! `readback`, `submission`, `timing` → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
 //! pipeline binds), `textures`, `arena` (the quad arena), `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
 //! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` → `stream` (chunks loaded around a moving eye). A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
@@ -27,6 +27,7 @@ pub mod readback;
 mod renderer;
 pub mod stages;
 pub mod stream;
+mod submission;
 pub mod textures;
 mod timing;
 #[cfg(test)]

@@ -264,12 +264,8 @@ impl Lighting {
     /// a finite sky colour of non-negative channels.
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(Error::InvalidSetting(what));
-        let sun = glam::Vec3::from(self.sun_dir);
-        if !sun.is_finite() || sun.length_squared() == 0.0 {
-            return bad(format!(
-                "sun direction {:?}: it must be finite and not zero",
-                self.sun_dir
-            ));
+        if let Err(why) = voxel_core::unit_direction(self.sun_dir.map(f64::from)) {
+            return bad(format!("sun direction {:?}: {why}", self.sun_dir));
         }
         if !(0.0..=1.0).contains(&self.ambient) {
             return bad(format!("ambient {}: it must be from 0 to 1", self.ambient));
@@ -301,6 +297,9 @@ pub struct Renderer {
     targets: SceneTargets,
     oit: OitManager,
     timer: Option<Timer>,
+    /// What became of each frame's encoder (timings, and flushing a dropped frame's
+    /// queue writes).
+    submissions: Submissions,
     frame_index: u32,
     /// Chunks fading in, with the frame they appeared.
     fading: PosMap<ChunkPos, u32>,
@@ -396,6 +395,7 @@ impl Renderer {
             targets,
             oit,
             timer: Timer::new(ctx),
+            submissions: Submissions::default(),
             frame_index: 0,
             fading: PosMap::default(),
             culled: Culled::default(),
@@ -524,6 +524,7 @@ impl Renderer {
     /// [`OitManager::prebuild`]. Returns the technique built (after its fallback on this
     /// adapter).
     pub fn prebuild_technique(&mut self, technique: Technique) -> Result<Technique> {
+        self.ctx.check_device()?;
         let oit = &mut self.oit;
         scoped(&self.ctx.device, "building a technique ahead", || {
             oit.prebuild(technique)
@@ -667,8 +668,12 @@ impl Renderer {
         if self.ctx.check_device().is_err() {
             return GpuTimes::default();
         }
+        let last = self.settle_submission();
         let ctx = &self.ctx;
-        self.timer.as_mut().map(|t| t.poll(ctx)).unwrap_or_default()
+        self.timer
+            .as_mut()
+            .map(|t| t.poll(ctx, last))
+            .unwrap_or_default()
     }
 
     /// Like [`Renderer::gpu_times`], but waits for the last submitted frame's results
@@ -678,10 +683,22 @@ impl Renderer {
             return GpuTimes::default();
         }
         let ctx = self.ctx.clone();
-        self.timer
-            .as_mut()
-            .map(|t| t.read_blocking(&ctx))
-            .unwrap_or_default()
+        let Some(mut timer) = self.timer.take() else {
+            return GpuTimes::default();
+        };
+        let times = timer.read_blocking(&ctx, || self.settle_submission());
+        self.timer = Some(timer);
+        times
+    }
+
+    /// What became of the last frame's encoder; a dropped one's queue writes are flushed
+    /// by an empty submit (wgpu keeps them, and their staging memory, until a submit).
+    fn settle_submission(&mut self) -> Outcome {
+        let last = self.submissions.settle(&self.ctx);
+        if last == Outcome::Dropped && self.ctx.check_device().is_ok() {
+            self.ctx.queue.submit([]);
+        }
+        last
     }
 
     /// Optional, after submitting a frame's encoder: frees for reuse now the arena places
@@ -767,6 +784,18 @@ impl Renderer {
             self.post.make_tonemap(&self.ctx, format);
         }
         self.check_output(output, format)?;
+        let stages = game.stages();
+        if stages.translucent {
+            let current = self.oit.contract()?.id;
+            let built_for = game.translucent_contract_id();
+            if built_for != Some(current) {
+                return Err(Error::StaleContract {
+                    built_for,
+                    current,
+                    technique: self.oit.technique().name(),
+                });
+            }
+        }
         if format != self.config.output_format {
             log::info!(
                 "drawing into {format:?} from now on (was {:?})",
@@ -777,8 +806,12 @@ impl Renderer {
         let start = Instant::now();
         // Ends the last timed frame if it was submitted since; this one is timed unless
         // it is not.
+        let last = self.settle_submission();
         let ctx = &self.ctx;
-        let timed = self.timer.as_mut().is_some_and(|t| t.begin_frame(ctx));
+        let timed = self
+            .timer
+            .as_mut()
+            .is_some_and(|t| t.begin_frame(ctx, last));
         self.update_fades();
         // The previous frame is submitted (the contract above): what it drew may be reused.
         self.chunks.frame_submitted(&self.ctx);
@@ -801,7 +834,6 @@ impl Renderer {
         self.chunks.cull(&frustum, layers, &mut self.culled);
         self.chunks.lists_built();
         // The technique's CPU work (it may reorder quads within their places).
-        let stages = game.stages();
         let view = FrameView {
             camera,
             view_proj,
@@ -860,6 +892,9 @@ impl Renderer {
         };
         if stages != crate::stages::Stages::default() {
             game.prepare(&self.ctx, &game_frame);
+            // A device lost now (a reset can land in the game's code) makes nothing valid:
+            // nothing more is recorded.
+            self.ctx.check_device()?;
         }
         let game = &*game;
 
@@ -882,6 +917,9 @@ impl Renderer {
         let t = &self.targets;
         let game_opaque = stages.opaque.then_some((game, &game_frame));
         self.draw_opaque(encoder, &draws, opaque, cutout, game_opaque, timer);
+        if stages.opaque {
+            self.ctx.check_device()?;
+        }
         if medium.is_some() {
             let scene = &t.boundary_scene_group;
             self.medium.boundary_pass(
@@ -915,8 +953,11 @@ impl Renderer {
                 game: game_draw.as_ref(),
             },
         )?;
+        if stages.translucent {
+            self.ctx.check_device()?;
+        }
         if let Some((_, look)) = &medium {
-            let sun = glam::Vec3::from(self.config.sun_dir).normalize_or(glam::Vec3::Y);
+            let sun = sun_unit(self.config.sun_dir);
             let light = self.config.ambient + (1.0 - self.config.ambient) * sun.y.max(0.0);
             let params = medium::fog_params(look, camera, aspect, [w as f32, h as f32], light);
             self.ctx
@@ -929,12 +970,14 @@ impl Renderer {
             Pass::new("game_hdr_overlay", GpuPass::Game, &colors)
                 .depth(Depth::ReadOnly(&t.depth.view))
                 .record(encoder, timer, |pass| game.hdr_overlay(pass, &game_frame));
+            self.ctx.check_device()?;
         }
         self.tonemap(encoder, output, timer);
         if stages.overlay {
             let colors = [gpu::load(output)];
             Pass::new("game_overlay", GpuPass::Game, &colors)
                 .record(encoder, timer, |pass| game.overlay(pass, &game_frame));
+            self.ctx.check_device()?;
         }
         let stats = FrameStats {
             meshes_drawn: lists.each_ref().map(DrawList::meshes),
@@ -948,6 +991,7 @@ impl Renderer {
         if timed && let Some(t) = &mut self.timer {
             t.end_frame(&self.ctx, encoder);
         }
+        self.submissions.attach(&self.ctx, encoder);
         Ok(FrameStats {
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
             technique: self.oit.report(),
@@ -962,7 +1006,11 @@ impl Renderer {
     /// edges) use this one.
     pub fn drawn_camera(&self, camera: &Camera) -> Camera {
         let (w, h) = self.size();
-        medium::guard(camera, f64::from(w) / f64::from(h), &self.chunks)
+        medium::guard(
+            &camera.normalized(),
+            f64::from(w) / f64::from(h),
+            &self.chunks,
+        )
     }
 
     /// Renders one frame into `output` and submits it (for tools and tests).
@@ -988,7 +1036,10 @@ impl Renderer {
                 label: Some("frame"),
             });
         let stats = self.render_with(&mut encoder, output, camera, game)?;
+        self.ctx.check_device()?;
         self.ctx.queue.submit([encoder.finish()]);
+        // A loss during the submission is this frame's too.
+        self.ctx.check_device()?;
         Ok(stats)
     }
 
@@ -1091,7 +1142,7 @@ impl Renderer {
 
     fn write_frame_uniforms(&self, camera: &Camera, view_proj: Mat4, medium: Option<BlockId>) {
         let (eye_int, eye_frac) = camera.eye_split();
-        let sun = glam::Vec3::from(self.config.sun_dir).normalize_or(glam::Vec3::Y);
+        let sun = sun_unit(self.config.sun_dir);
         let (w, h) = self.size();
         let uniforms = FrameUniforms {
             view_proj: view_proj.to_cols_array_2d(),
@@ -1233,10 +1284,19 @@ fn check_output_format(ctx: &GpuContext, format: wgpu::TextureFormat) -> Result<
     Ok(())
 }
 
+/// The sun direction at length 1, normalised in f64 so that any finite non-zero
+/// direction (`[1e38; 3]`, `[f32::MAX, 0, 0]`) is the same direction at length 1; a zero
+/// one (accepted by `Renderer::new`, refused by `set_lighting`) is straight up.
+fn sun_unit(sun: [f32; 3]) -> glam::Vec3 {
+    voxel_core::unit_direction(sun.map(f64::from))
+        .map_or(glam::Vec3::Y, |d| glam::DVec3::from(d).as_vec3())
+}
+
 /// Lighting values must be numbers the shaders can use: NaN or infinity would reach
 /// every pixel.
 fn check_lighting(config: &RendererConfig) -> Result<()> {
     let bad = |m: String| Err(Error::InvalidSetting(m));
+    // A zero sun direction is the documented fallback here: straight up.
     if !config.sun_dir.iter().all(|v| v.is_finite()) {
         return bad(format!(
             "sun_dir {:?}: every component must be finite",

@@ -135,7 +135,10 @@ pub struct TranslucentVariant {
 /// Every pass of the active technique a game's translucent geometry is drawn in.
 #[derive(Clone, Debug)]
 pub struct TranslucentContract {
-    /// Changes whenever the variants do: a game rebuilds its pipelines then.
+    /// Changes whenever the variants do: a game rebuilds its pipelines then. The same
+    /// technique with the same settings keeps its id on a renderer (switching away and
+    /// back, pipelines built for it are still right). The game tells the renderer which
+    /// id its pipelines were built for ([`GameStages::translucent_contract_id`]).
     pub id: u64,
     /// The name of the technique in force (`Technique::name`).
     pub technique: &'static str,
@@ -153,6 +156,14 @@ pub trait GameStages {
     /// drawn after the chunks, in one call).
     fn translucent_objects(&self) -> &[TranslucentObject] {
         &[]
+    }
+
+    /// The [`TranslucentContract::id`] its translucent pipelines were built for. A frame
+    /// whose game declares the translucent stage with another id (or none: the default)
+    /// is refused before anything is recorded (`Error::StaleContract`): its pipelines
+    /// would not match the technique's passes.
+    fn translucent_contract_id(&self) -> Option<u64> {
+        None
     }
 
     /// Before any pass is recorded: write uniforms and instance buffers (`frame.order`

@@ -6,21 +6,19 @@
 //! Passes are named by [`GpuPass`]; passes of the same kind (the many passes of depth
 //! peeling) add up.
 //!
-//! Nothing needs to be called once a frame is submitted: the frame's encoder carries a
-//! mapping of a small sentinel buffer that wgpu starts when the encoder is submitted
-//! (`map_buffer_on_submit`), and the next frame (or [`Timer::poll`]) sees it and ends the
+//! Nothing needs to be called once a frame is submitted: the renderer learns of the
+//! submission from the next frame ([`crate::submission`]) and only then ends the
 //! profiler's frame, which wgpu-profiler allows only after submission. A frame recorded
 //! while the previous one is still unsubmitted (two frames in one encoder) goes untimed;
 //! a frame whose encoder was dropped unsubmitted is ended and its results discarded.
 
 use std::collections::VecDeque;
 use std::fmt;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicU8, Ordering};
 
 use wgpu_profiler::{GpuProfiler, GpuProfilerQuery, GpuProfilerSettings, GpuTimerQueryResult};
 
 use crate::GpuContext;
+use crate::submission::Outcome;
 
 /// The kinds of GPU work a frame is timed by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -111,34 +109,6 @@ impl GpuTimes {
     }
 }
 
-/// A sentinel's state: idle, waiting for its encoder's submission, submitted (its mapping
-/// ran, successfully or not), or dropped with its encoder unsubmitted.
-const IDLE: u8 = 0;
-const WAITING: u8 = 1;
-const MAPPED: u8 = 2;
-const SUBMITTED: u8 = 3;
-const DROPPED: u8 = 4;
-
-/// A frame's submission signal: an 8-byte buffer mapped when the frame's encoder is
-/// submitted.
-#[derive(Debug)]
-struct Sentinel {
-    buffer: wgpu::Buffer,
-    state: Arc<AtomicU8>,
-}
-
-/// Held by the deferred mapping's callback: a callback dropped without running means its
-/// encoder was dropped without being submitted.
-struct Signal(Arc<AtomicU8>);
-
-impl Drop for Signal {
-    fn drop(&mut self) {
-        let _ = self
-            .0
-            .compare_exchange(WAITING, DROPPED, Ordering::AcqRel, Ordering::Acquire);
-    }
-}
-
 /// Profiler frames ended and not yet read back, at most: below wgpu-profiler's
 /// `max_num_pending_frames`, so that it never drops one (our discard flags stay in step).
 const MAX_PENDING_FRAMES: usize = 4;
@@ -148,10 +118,8 @@ pub struct Timer {
     profiler: GpuProfiler,
     period: f32,
     latest: GpuTimes,
-    /// The last timed frame's signal, until its submission is seen.
-    waiting: Option<Sentinel>,
-    /// Sentinels to reuse.
-    idle: Vec<Sentinel>,
+    /// Whether the last timed frame's submission is still to be learnt of.
+    unsettled: bool,
     /// Per profiler frame ended and not yet read back, oldest first: whether to discard it
     /// (its encoder was dropped unsubmitted).
     ended: VecDeque<bool>,
@@ -182,8 +150,7 @@ impl Timer {
                 profiler,
                 period: ctx.queue.get_timestamp_period(),
                 latest: GpuTimes::default(),
-                waiting: None,
-                idle: Vec::new(),
+                unsettled: false,
                 ended: VecDeque::new(),
             }),
             Err(e) => {
@@ -208,61 +175,46 @@ impl Timer {
         self.profiler.end_query(encoder, query);
     }
 
-    /// Whether the next frame can be timed: ends the last timed frame if its encoder has
-    /// been submitted (or dropped) since, and reads back what has arrived. False while
-    /// that encoder is still unsubmitted, or too many frames are still in flight.
-    pub fn begin_frame(&mut self, ctx: &GpuContext) -> bool {
-        self.settle(ctx);
+    /// Whether the next frame can be timed, given what became of the last frame's
+    /// encoder (`last`): ends the last timed frame if it was submitted (or dropped) since,
+    /// and reads back what has arrived. False while that encoder is still unsubmitted, or
+    /// too many frames are still in flight.
+    pub(crate) fn begin_frame(&mut self, ctx: &GpuContext, last: Outcome) -> bool {
+        if ctx.check_device().is_err() {
+            return false;
+        }
+        self.settle(ctx, last);
         self.poll_profiler();
-        self.waiting.is_none() && self.ended.len() < MAX_PENDING_FRAMES
+        !self.unsettled && self.ended.len() < MAX_PENDING_FRAMES
     }
 
-    /// Records the copy of the frame's timestamps at the end of `encoder`, and the signal
-    /// of its submission.
-    pub fn end_frame(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+    /// Records the copy of the frame's timestamps at the end of `encoder`.
+    pub(crate) fn end_frame(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
+        if ctx.check_device().is_err() {
+            // Nothing of a lost device is read back: its buffers may not even exist.
+            return;
+        }
         self.profiler.resolve_queries(encoder);
-        let sentinel = self.idle.pop().unwrap_or_else(|| Sentinel {
-            buffer: ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("timing_sentinel"),
-                size: 8,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }),
-            state: Arc::new(AtomicU8::new(IDLE)),
-        });
-        sentinel.state.store(WAITING, Ordering::Release);
-        let signal = Signal(sentinel.state.clone());
-        encoder.map_buffer_on_submit(&sentinel.buffer, wgpu::MapMode::Read, .., move |r| {
-            let state = if r.is_ok() { MAPPED } else { SUBMITTED };
-            signal.0.store(state, Ordering::Release);
-        });
-        self.waiting = Some(sentinel);
+        self.unsettled = true;
     }
 
     /// Ends the profiler frame of the last timed frame once its encoder was submitted
     /// (wgpu-profiler maps its buffers then) or dropped (its results are discarded).
-    fn settle(&mut self, ctx: &GpuContext) {
-        let Some(sentinel) = &self.waiting else {
+    fn settle(&mut self, ctx: &GpuContext, last: Outcome) {
+        if !self.unsettled {
             return;
-        };
-        if sentinel.state.load(Ordering::Acquire) == WAITING {
-            // A submitted encoder's mapping of the (otherwise unused) sentinel completes
-            // at the next poll.
-            let _ = ctx.device.poll(wgpu::PollType::Poll);
         }
-        let discard = match sentinel.state.load(Ordering::Acquire) {
-            MAPPED => {
-                sentinel.buffer.unmap();
-                false
-            }
-            SUBMITTED => false,
-            DROPPED => true,
-            _ => return,
-        };
-        if let Some(sentinel) = self.waiting.take() {
-            sentinel.state.store(IDLE, Ordering::Release);
-            self.idle.push(sentinel);
+        // The profiler maps its buffers when its frame ends: never on a lost device, whose
+        // buffers made after the loss are invalid (wgpu's handler would panic).
+        if ctx.check_device().is_err() {
+            return;
         }
+        let discard = match last {
+            Outcome::Pending | Outcome::Nothing => return,
+            Outcome::Dropped => true,
+            Outcome::Submitted => false,
+        };
+        self.unsettled = false;
         match self.profiler.end_frame() {
             Ok(()) => self.ended.push_back(discard),
             Err(e) => log::warn!("GPU pass timing lost a frame: {e}"),
@@ -277,25 +229,32 @@ impl Timer {
         }
     }
 
-    /// Takes finished frames, if any, and returns the latest results. Results arrive
-    /// when the GPU is done and wgpu has been polled (each `queue.submit` polls).
-    pub fn poll(&mut self, ctx: &GpuContext) -> GpuTimes {
-        self.settle(ctx);
+    /// Takes finished frames, if any, and returns the latest results, given what became
+    /// of the last frame's encoder. Results arrive when the GPU is done and wgpu has been
+    /// polled (each `queue.submit` polls).
+    pub(crate) fn poll(&mut self, ctx: &GpuContext, last: Outcome) -> GpuTimes {
+        self.settle(ctx, last);
         self.poll_profiler();
         self.latest
     }
 
     /// Waits for the GPU, then [`Timer::poll`]: the last submitted frame's results.
-    pub fn read_blocking(&mut self, ctx: &GpuContext) -> GpuTimes {
+    /// `settle` learns what became of the last frame's encoder.
+    pub(crate) fn read_blocking(
+        &mut self,
+        ctx: &GpuContext,
+        mut settle: impl FnMut() -> Outcome,
+    ) -> GpuTimes {
         let wait = || {
             if let Err(e) = ctx.device.poll(wgpu::PollType::wait_indefinitely()) {
                 log::warn!("waiting for GPU timings: {e}");
             }
         };
         wait();
-        self.settle(ctx);
+        let last = settle();
+        self.settle(ctx, last);
         wait();
-        self.poll(ctx)
+        self.poll(ctx, Outcome::Nothing)
     }
 
     fn sum(results: &[GpuTimerQueryResult]) -> GpuTimes {

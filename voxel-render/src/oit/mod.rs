@@ -432,8 +432,10 @@ pub struct OitManager {
     prepare_ms: f64,
     /// The game's contract for the active technique, made when first asked for.
     contract: Option<Arc<TranslucentContract>>,
-    /// Contracts made so far (the next one's id).
-    contracts: u64,
+    /// The key of every contract made so far: a contract's id is its key's place here
+    /// plus one, so the same technique with the same settings always has the same id and
+    /// a game's pipelines built for it stay valid across switches away and back.
+    contract_keys: Vec<Key>,
 }
 
 impl OitManager {
@@ -451,7 +453,7 @@ impl OitManager {
             builds: 0,
             prepare_ms: 0.0,
             contract: None,
-            contracts: 0,
+            contract_keys: Vec::new(),
         };
         m.config.technique = m.supported(m.config.technique);
         Ok(m)
@@ -542,9 +544,16 @@ impl OitManager {
             Some(t) => t.variants(),
             None => Vec::new(),
         };
-        self.contracts += 1;
+        let key = technique.key(&self.config, &self.setup.ctx.caps);
+        let place = match self.contract_keys.iter().position(|k| *k == key) {
+            Some(i) => i,
+            None => {
+                self.contract_keys.push(key);
+                self.contract_keys.len() - 1
+            }
+        };
         let c = Arc::new(TranslucentContract {
-            id: self.contracts,
+            id: place as u64 + 1,
             technique: technique.name(),
             variants,
         });

@@ -499,7 +499,7 @@ impl Peeling {
             self.front_iteration(encoder, frame, i, &self.targets.converge_limits[cur]);
             // Wait for this pass's count: zero means every layer has been peeled.
             self.counts.copy(encoder, i..i + 1);
-            gpu::flush(ctx, encoder);
+            gpu::flush(ctx, encoder)?;
             let written =
                 self.counts.wait(ctx)?.first().copied().ok_or_else(|| {
                     Error::ReadbackData("an occlusion count came back empty".into())

@@ -549,7 +549,7 @@ impl TranslucentTechnique for Reference {
         loop {
             attempts += 1;
             let tiles_recorded = self.record(ctx, encoder, frame);
-            gpu::flush(ctx, encoder);
+            gpu::flush(ctx, encoder)?;
             let (lost, needed, capped, capped_visible) = self.read_counters(ctx, tiles_recorded)?;
             let capacity = self.buffers.as_ref().map_or(0, |b| u64::from(b.capacity));
             let give_up = capacity >= max && self.tiles >= MAX_TILES;
