@@ -642,6 +642,7 @@ pub struct Culled {
     near: [Vec<NearEntry>; 2],
     far: Vec<FarEntry>,
     positions: Vec<ChunkPos>,
+    keys: Vec<u128>,
     /// The visible translucent chunks' planes, when asked for.
     layers: LayerBuffer,
 }
@@ -662,6 +663,12 @@ impl Culled {
     /// The positions of the visible translucent meshes, farthest first.
     pub fn translucent_positions(&self) -> &[ChunkPos] {
         &self.positions
+    }
+
+    /// The [`voxel_mesh::order::chunk_order_key`] of each visible translucent mesh, in
+    /// the order of [`Culled::translucent_positions`] (largest first).
+    pub fn translucent_keys(&self) -> &[u128] {
+        &self.keys
     }
 
     /// The planes of the visible translucent meshes ([`crate::layers`]; in no particular
@@ -1036,6 +1043,7 @@ impl ChunkStore {
         }
         out.far.clear();
         out.positions.clear();
+        out.keys.clear();
         out.layers.clear();
         let eye = frustum.eye.to_array();
         let [opaque, cutout] = &mut out.near;
@@ -1069,6 +1077,7 @@ impl ChunkStore {
         out.far
             .sort_unstable_by(|a, b| b.key.cmp(&a.key).then(a.pos.cmp(&b.pos)));
         out.positions.extend(out.far.iter().map(|e| e.pos));
+        out.keys.extend(out.far.iter().map(|e| e.key));
     }
 
     /// Uploads a frame's draw commands to the indirect buffer (growing it when needed).

@@ -19,12 +19,13 @@ use crate::chunks::{
 use crate::error::scoped;
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
 use crate::medium::{self, MediumLook, MediumPass};
-use crate::oit::sorted::interleave::{Ball, interleave};
+use crate::oit::sorted::interleave::{Ball, ChunkSequence, interleave};
 use crate::oit::{
     FrameView, OitConfig, OitManager, Setup, Technique, TechniqueReport, TranslucentFrame,
     WeightFunction,
 };
 use crate::stages::{GameDraw, GameFrame, GameStages, NoGame, TranslucentContract};
+use crate::submission::{Outcome, Submissions};
 use crate::textures::BlockTextures;
 use crate::timing::{GpuPass, GpuTimes, Timer};
 use crate::{Camera, DEPTH_FORMAT, Error, GpuContext, Result, SCENE_FORMAT};
@@ -868,7 +869,12 @@ impl Renderer {
                 .map(|&p| self.chunks.get(p).and_then(|c| c.translucent_surfaces()))
                 .collect();
             let split_quads = self.oit.technique() == Technique::SortedQuads;
-            interleave(&balls, camera.eye, &chunks, medium.is_some(), split_quads)
+            let sequence = ChunkSequence {
+                surfaces: &chunks,
+                keys: self.culled.translucent_keys(),
+                positions: self.culled.translucent_positions(),
+            };
+            interleave(&balls, camera.eye, &sequence, medium.is_some(), split_quads)
         } else {
             (Vec::new(), Vec::new())
         };

@@ -29,6 +29,8 @@
 
 use glam::DVec3;
 
+use voxel_core::{ChunkPos, Face};
+#[cfg(test)]
 use voxel_mesh::PackedQuad;
 
 use crate::chunks::Surfaces;
@@ -114,6 +116,7 @@ const SOUND: i64 = 1 << 24;
 /// How one quad's plane orders it against ball `b` (chunk origin `origin`): `Some(true)`
 /// when the ball is on the eye's side (the quad comes before it), `Some(false)` beyond,
 /// `None` when the ball crosses the plane or the quad is culled or seen edge-on.
+#[cfg(test)]
 fn quad_side(
     b: Ball,
     eye: DVec3,
@@ -133,89 +136,241 @@ fn quad_side(
     Some((e > 0.0) == (d > 0.0))
 }
 
-/// The draw order of objects `balls` among `chunks` (in draw order, farthest first: each
-/// chunk's surfaces, if any) seen from `eye`.
-/// Returns the objects in draw order and where runs of them are drawn (in draw order; the
-/// objects after the last run come after every chunk).
+/// The visible translucent chunks of a frame in draw order, as [`interleave`] reads them.
+#[derive(Clone, Copy, Debug)]
+pub struct ChunkSequence<'a> {
+    /// Each chunk's surfaces (`None`: it draws nothing translucent).
+    pub surfaces: &'a [Option<Surfaces<'a>>],
+    /// Each chunk's [`voxel_mesh::order::chunk_order_key`] for the frame's eye: the
+    /// sequence is sorted by it, largest first (equal keys by position).
+    pub keys: &'a [u128],
+    /// Each chunk's position.
+    pub positions: &'a [ChunkPos],
+}
+
+/// The chunk cells a ball touches, inclusive per axis (a ball touching a cell's face
+/// touches both cells), and their keys' range for an eye in cell `eye`: the least and
+/// the greatest [`voxel_mesh::order::chunk_order_key`] among them.
+fn cells_and_keys(b: Ball, eye: [i64; 3]) -> ([[i64; 2]; 3], [u128; 2]) {
+    let s = voxel_core::CHUNK_SIZE as f64;
+    let mut cells = [[0i64; 2]; 3];
+    let (mut kmin, mut kmax) = (0u128, 0u128);
+    for a in 0..3 {
+        // `ceil(x) - 1` is `floor(x)` except on a border, where it is the cell below.
+        let lo = (((b.center[a] - b.radius) / s).ceil() - 1.0)
+            .clamp(f64::from(i32::MIN) - 1.0, f64::from(i32::MAX) + 1.0) as i64;
+        let hi = ((b.center[a] + b.radius) / s)
+            .floor()
+            .clamp(f64::from(i32::MIN) - 1.0, f64::from(i32::MAX) + 1.0) as i64;
+        cells[a] = [lo, hi];
+        let (dl, dh) = (lo - eye[a], hi - eye[a]);
+        let sq = |d: i64| u128::from(d.unsigned_abs()) * u128::from(d.unsigned_abs());
+        kmin += if dl <= 0 && dh >= 0 {
+            0
+        } else {
+            sq(dl).min(sq(dh))
+        };
+        kmax += sq(dl).max(sq(dh));
+    }
+    (cells, [kmin, kmax])
+}
+
+/// The eye's chunk cell, as [`voxel_mesh::order::chunk_order_key`] takes it.
+fn eye_cell(eye: DVec3) -> [i64; 3] {
+    let s = voxel_core::CHUNK_SIZE as f64;
+    [0, 1, 2].map(|k| {
+        ((eye[k] / s).floor() as i64).clamp(i64::from(i32::MIN) - 1, i64::from(i32::MAX) + 1)
+    })
+}
+
+/// A chunk's quads as runs of one plane in their drawn order (index into
+/// [`Surfaces::planes`], count): every quad of a plane stands alike against a ball
+/// ([`quad_side`] depends only on the plane), so a split is chosen per run boundary.
+fn plane_runs(s: &Surfaces<'_>, out: &mut Vec<(u32, u32)>) {
+    out.clear();
+    for q in s.quads {
+        let Some(q) = q.unpack() else { continue };
+        let plane = (q.face, q.bounds().0[q.face.axis()] as u8);
+        let Ok(i) = s
+            .planes
+            .binary_search_by_key(&(plane.0 as u8, plane.1), |&(f, c)| (f as u8, c))
+        else {
+            continue;
+        };
+        match out.last_mut() {
+            Some((p, n)) if *p == i as u32 => *n += 1,
+            _ => out.push((i as u32, 1)),
+        }
+    }
+}
+
+/// How a plane orders ball `b` (see [`quad_side`]), as a weight: 1 when the plane's quads
+/// come before the ball, -1 after it, 0 when it does not say.
+fn plane_weight(
+    b: Ball,
+    eye: DVec3,
+    origin: [f64; 3],
+    (face, c): (Face, u8),
+    two_sided: bool,
+) -> i64 {
+    let a = face.axis();
+    let n = if face.is_positive() { 1.0 } else { -1.0 };
+    let plane = origin[a] + f64::from(c);
+    let e = (eye[a] - plane) * n;
+    let d = (b.center[a] - plane) * n;
+    if (!two_sided && e <= 0.0) || e == 0.0 || d.abs() <= b.radius {
+        return 0;
+    }
+    if (e > 0.0) == (d > 0.0) { 1 } else { -1 }
+}
+
+/// Per frame, what [`interleave`] learns of a chunk the first time an object needs it.
+#[derive(Default)]
+struct ChunkFacts {
+    /// `[near, mid, far]` distances of its box ([`Surfaces::distances`]).
+    distances: Option<[f64; 3]>,
+    /// Its quads as plane runs ([`plane_runs`]), for `split_quads`.
+    runs: Option<Vec<(u32, u32)>>,
+}
+
+/// The draw order of objects `balls` among the visible translucent `chunks` seen from
+/// `eye`. Returns the objects in draw order and where runs of them are drawn (in draw
+/// order; the objects after the last run come after every chunk).
 ///
-/// Each object goes to the place in the sequence of chunks (and, with `split_quads`, of
-/// their quads, which are then in exact back-to-front order) that the fewest constraints
-/// rule out: a chunk a sound test puts wholly behind or in front of the object weighs
-/// [`SOUND`]; in a chunk no test decides, each quad's plane ([`quad_side`]) weighs 1, or
-/// without `split_quads` the box's centre decides with weight 1.
+/// **Which chunks an object is tested against.** The chunks are drawn by
+/// [`voxel_mesh::order::chunk_order_key`], which is exact for a grid of equal cubes:
+/// a chunk that hides part of another has the smaller key (Theorem 3 of
+/// [`voxel_mesh::order`]). A chunk that hides part of the ball hides part of a cell the
+/// ball touches, so its key is below the greatest key of those cells; a chunk the ball
+/// hides part of has a key above their least. So every chunk whose key lies above that
+/// range is rightly drawn before the object, every one below it after, and only the
+/// chunks with keys in the range can constrain it: for a ball inside one cell, that cell's
+/// chunk alone (others of the same key neither hide it nor are hidden); for a ball across
+/// cell borders, the thin shell of chunks at about its distance. Their places in the
+/// sequence are found by binary search. The cost grows with objects (plus the chunks of
+/// each shell, mostly proven apart on screen at once), not with objects times chunks.
+///
+/// **Where, among those.** Each object goes to the place in that part of the sequence
+/// (and, with `split_quads`, among the quads of its chunks, which are then in exact
+/// back-to-front order) that the fewest constraints rule out: a chunk a sound test puts
+/// wholly behind or in front of the object weighs [`SOUND`]; in a chunk no test decides,
+/// each quad's plane ([`quad_side`]) weighs 1, or without `split_quads` the box's centre
+/// decides with weight 1. Objects at one place go farthest centre first, so those that
+/// share a place are one run: one draw of the game's instances.
+///
+/// An object whose centre or radius is not finite goes after every chunk.
 pub fn interleave(
     balls: &[Ball],
     eye: DVec3,
-    chunks: &[Option<Surfaces<'_>>],
+    chunks: &ChunkSequence<'_>,
     two_sided: bool,
     split_quads: bool,
 ) -> (Vec<u32>, Vec<Split>) {
-    // Distances `[near, mid, far]` of each chunk's box, once.
-    let distances: Vec<[f64; 3]> = chunks
-        .iter()
-        .map(|s| s.as_ref().map_or([0.0; 3], |s| s.distances(eye)))
-        .collect();
-    // (chunk, quad, farthest first, object): the place of each object.
-    let mut places: Vec<(u32, u32, std::cmp::Reverse<u64>, u32)> = Vec::with_capacity(balls.len());
+    let last = chunks.surfaces.len() as u32;
+    let e = eye_cell(eye);
+    let mut facts: Vec<ChunkFacts> = Vec::new();
+    facts.resize_with(chunks.surfaces.len(), ChunkFacts::default);
+    // The place of each object: chunk, quad, farthest first (bits of a non-negative
+    // distance order like the number), packed into one key; then the object.
+    let mut places: Vec<(u128, u32)> = Vec::with_capacity(balls.len());
     let mut items: Vec<(u32, u32, i64)> = Vec::new();
-    let last = chunks.len() as u32;
+    let mut weights: Vec<i64> = Vec::new();
     for (i, &b) in balls.iter().enumerate() {
         let o = b.center.distance(eye);
+        if !o.is_finite() || !b.radius.is_finite() {
+            places.push((place_key(last, 0, 0.0), i as u32));
+            continue;
+        }
+        let (cells, [kmin, kmax]) = cells_and_keys(b, e);
+        // The part of the sequence whose keys lie in [kmin, kmax] (largest first).
+        let first = chunks.keys.partition_point(|&k| k > kmax);
+        let end = first + chunks.keys[first..].partition_point(|&k| k >= kmin);
+        let single = (0..3).all(|a| cells[a][0] == cells[a][1]);
+        let range = if single {
+            // One cell: its chunk, if it is in the sequence; else no chunk constrains.
+            let cell = ChunkPos::new(cells[0][0] as i32, cells[1][0] as i32, cells[2][0] as i32);
+            let at = first + chunks.positions[first..end].partition_point(|&p| p < cell);
+            if chunks.positions.get(at) == Some(&cell) && at < end {
+                at..at + 1
+            } else {
+                at..at
+            }
+        } else {
+            first..end
+        };
         // The constraints in draw order: (chunk, quad after which it applies, weight:
         // positive when the item must come before the object, negative after it).
         items.clear();
-        for (c, (surfaces, d)) in chunks.iter().zip(&distances).enumerate() {
-            let Some(s) = surfaces else { continue };
-            let c = c as u32;
-            match safe(b, o, eye, s, *d, two_sided) {
+        for c in range.clone() {
+            let Some(s) = &chunks.surfaces[c] else {
+                continue;
+            };
+            let f = &mut facts[c];
+            let d = *f.distances.get_or_insert_with(|| s.distances(eye));
+            let c32 = c as u32;
+            match safe(b, o, eye, s, d, two_sided) {
                 // Apart on screen: any place is right.
                 [true, true] => {}
-                [true, false] => items.push((c, 0, SOUND)),
-                [false, true] => items.push((c, 0, -SOUND)),
+                [true, false] => items.push((c32, 0, SOUND)),
+                [false, true] => items.push((c32, 0, -SOUND)),
                 [false, false] if split_quads => {
-                    for (k, &q) in s.quads.iter().enumerate() {
-                        match quad_side(b, eye, s.origin, q, two_sided) {
-                            Some(true) => items.push((c, k as u32, 1)),
-                            Some(false) => items.push((c, k as u32, -1)),
-                            None => {}
+                    let runs = f.runs.get_or_insert_with(|| {
+                        let mut r = Vec::new();
+                        plane_runs(s, &mut r);
+                        r
+                    });
+                    weights.clear();
+                    weights.extend(
+                        s.planes
+                            .iter()
+                            .map(|&p| plane_weight(b, eye, s.origin, p, two_sided)),
+                    );
+                    let mut k = 0u32;
+                    for &(p, n) in runs.iter() {
+                        let w = weights[p as usize];
+                        if w != 0 {
+                            // A run weighs its count; the place after it is after its
+                            // last quad.
+                            items.push((c32, k + n - 1, w * i64::from(n)));
                         }
+                        k += n;
                     }
                 }
-                [false, false] => items.push((c, 0, if o > d[1] { -1 } else { 1 })),
+                [false, false] => items.push((c32, 0, if o > d[1] { -1 } else { 1 })),
             }
         }
-        // Before everything, every item that must come before the object is violated;
-        // passing an item changes the cost by its weight.
+        // Before everything in range, every item that must come before the object is
+        // violated; passing an item changes the cost by its weight.
         let mut cost: i64 = items.iter().map(|it| it.2.max(0)).sum();
-        let (mut min, mut at) = (cost, (0, 0));
+        let (mut min, mut at) = (cost, (range.start as u32, 0));
         for &(c, k, w) in &items {
             cost -= w;
             if cost < min {
                 // Just after the item: after the whole chunk where it stood for it.
-                let whole = w.abs() == SOUND || (!split_quads && w.abs() == 1);
+                let whole = w.abs() == SOUND || !split_quads;
                 (min, at) = (cost, if whole { (c + 1, 0) } else { (c, k + 1) });
             }
         }
         let (c, k) = at;
         // After quads `..k` of chunk `c`; past the end of a chunk is before the next one.
-        let at = match chunks.get(c as usize).and_then(Option::as_ref) {
+        let mut at = match chunks.surfaces.get(c as usize).and_then(Option::as_ref) {
             Some(s) if k as usize >= s.quads.len() && k > 0 => (c + 1, 0),
             _ => (c, k),
         };
         // Chunks with nothing translucent draw nothing: the next one that does.
-        let mut at = at;
-        while at.0 < last && chunks[at.0 as usize].is_none() {
+        while at.0 < last && chunks.surfaces[at.0 as usize].is_none() {
             at = (at.0 + 1, 0);
         }
-        places.push((at.0, at.1, std::cmp::Reverse(o.to_bits()), i as u32));
+        places.push((place_key(at.0, at.1, o), i as u32));
     }
     places.sort_unstable();
     let mut order = Vec::with_capacity(balls.len());
     let mut splits = Vec::new();
-    for (n, &(c, k, _, i)) in places.iter().enumerate() {
+    for (n, &(key, i)) in places.iter().enumerate() {
         order.push(i);
-        let next = places.get(n + 1);
-        if c < last && next.is_none_or(|p| (p.0, p.1) != (c, k)) {
+        let (c, k) = ((key >> 96) as u32, (key >> 64) as u32);
+        let next = places.get(n + 1).map(|p| p.0 >> 64);
+        if c < last && next != Some(key >> 64) {
             splits.push(Split {
                 chunk: c,
                 quad: k,
@@ -226,10 +381,14 @@ pub fn interleave(
     (order, splits)
 }
 
+/// The sort key of an object's place: chunk, quad, then farther first.
+fn place_key(chunk: u32, quad: u32, distance: f64) -> u128 {
+    (u128::from(chunk) << 96) | (u128::from(quad) << 64) | u128::from(!distance.max(0.0).to_bits())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use voxel_core::Face;
 
     /// How a point stands against a chunk's translucent quads.
     #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -503,6 +662,18 @@ mod tests {
         };
         let eye = DVec3::new(16.0, 12.0, 4.0);
         let chunks = [Some(far), None, Some(near)];
+        // The middle one draws nothing translucent; its key lies between the others'.
+        let positions = [
+            ChunkPos::new(0, 0, -2),
+            ChunkPos::new(0, 1, -1),
+            ChunkPos::new(0, 0, -1),
+        ];
+        let keys = keys_of(&positions, eye);
+        let chunks = ChunkSequence {
+            surfaces: &chunks,
+            keys: &keys,
+            positions: &positions,
+        };
         let balls = [
             DVec3::new(16.0, 3.0, -50.0), // under the far water
             DVec3::new(16.0, 9.0, -50.0), // over the far water
@@ -515,16 +686,17 @@ mod tests {
             radius: 1.5,
         });
         let (order, splits) = interleave(&balls, eye, &chunks, false, false);
-        // Before the far water: what is under it, and what is under the near water (the
-        // tests prove it apart from the far water on screen: any place is right, the
-        // first is taken). Before the near water: what lies over the far water.
+        // Before the far water: what is under it. Before the near water: what lies over
+        // the far water and what lies under the near water (each ball lies in one chunk
+        // cell: only that cell's chunk is tested; farther chunks come before it, nearer
+        // ones after), farthest first.
         let at = |chunk, end| Split {
             chunk,
             quad: 0,
             end,
         };
-        assert_eq!(splits, vec![at(0, 2), at(2, 3)]);
-        assert_eq!(order[..3], [0, 2, 1]);
+        assert_eq!(splits, vec![at(0, 1), at(2, 3)]);
+        assert_eq!(order[..3], [0, 1, 2]);
         // Over the near water and by the eye: after every chunk, farthest first.
         assert_eq!(order[3..], [3, 4]);
     }
@@ -565,7 +737,15 @@ mod tests {
         let b = ball(7.0, 12.0);
         assert_eq!(decide(b, b.center.distance(eye), eye, &s, d, false), None);
         assert_eq!(quad_split(b, eye, s.origin, &quads, false), 1);
-        let (order, splits) = interleave(&[b], eye, &[Some(s)], false, true);
+        let positions = [ChunkPos::new(0, 0, 0)];
+        let keys = keys_of(&positions, eye);
+        let one = [Some(s)];
+        let seq = ChunkSequence {
+            surfaces: &one,
+            keys: &keys,
+            positions: &positions,
+        };
+        let (order, splits) = interleave(&[b], eye, &seq, false, true);
         assert_eq!(order, [0]);
         let want = Split {
             chunk: 0,
@@ -575,7 +755,7 @@ mod tests {
         assert_eq!(splits, [want]);
         // Without splitting, the box's centre decides: the ball is farther, so it is drawn
         // before the whole chunk (under the water: wrong where they overlap).
-        let (_, splits) = interleave(&[b], eye, &[Some(s)], false, false);
+        let (_, splits) = interleave(&[b], eye, &seq, false, false);
         assert_eq!(splits, [Split { quad: 0, ..want }]);
         // Under the water: before both.
         let b = ball(1.0, 12.0);
@@ -583,6 +763,14 @@ mod tests {
         // Above the water and in front of the pane: after both.
         let b = ball(7.0, 30.0);
         assert_eq!(quad_split(b, eye, s.origin, &quads, false), 2);
+    }
+
+    /// The chunk order keys of `positions` for `eye`.
+    fn keys_of(positions: &[ChunkPos], eye: DVec3) -> Vec<u128> {
+        positions
+            .iter()
+            .map(|&p| voxel_mesh::order::chunk_order_key(p, eye.to_array()))
+            .collect()
     }
 
     fn quad_planes_of(quads: &[PackedQuad]) -> Vec<(Face, u8)> {
@@ -594,5 +782,296 @@ mod tests {
         planes.sort_unstable_by_key(|&(f, c)| (f as u8, c));
         planes.dedup();
         planes
+    }
+}
+
+/// The fast order against the all-pairs one it replaces, on random scenes of chunks with
+/// meshed water and glass and random objects (points, small balls, balls across chunk
+/// borders, large ones), with one- and two-sided drawing, with and without splitting
+/// quads.
+#[cfg(test)]
+mod against_all_pairs {
+    use super::*;
+    use std::sync::Arc;
+    use voxel_core::{BlockRegistry, Chunk, Neighbourhood, blocks};
+    use voxel_mesh::Mesher;
+    use voxel_mesh::order::{QuadOrder, chunk_order_key};
+
+    /// The order before: every object against every chunk (the oracle of this test).
+    /// Each object's place, and what decided it: `(chunk, None)` for a chunk a sound test
+    /// decided, `(chunk, Some(quad))` for a quad whose plane did.
+    fn all_pairs(
+        balls: &[Ball],
+        eye: DVec3,
+        chunks: &[Option<Surfaces<'_>>],
+        two_sided: bool,
+        split_quads: bool,
+    ) -> Vec<((u32, u32), Vec<(u32, Option<u32>)>)> {
+        let mut out = Vec::new();
+        for &b in balls {
+            let o = b.center.distance(eye);
+            let mut items: Vec<(u32, u32, i64)> = Vec::new();
+            for (c, s) in chunks.iter().enumerate() {
+                let Some(s) = s else { continue };
+                let c = c as u32;
+                let d = s.distances(eye);
+                match safe(b, o, eye, s, d, two_sided) {
+                    [true, true] => {}
+                    [true, false] => items.push((c, 0, SOUND)),
+                    [false, true] => items.push((c, 0, -SOUND)),
+                    [false, false] if split_quads => {
+                        for (k, &q) in s.quads.iter().enumerate() {
+                            match quad_side(b, eye, s.origin, q, two_sided) {
+                                Some(true) => items.push((c, k as u32, 1)),
+                                Some(false) => items.push((c, k as u32, -1)),
+                                None => {}
+                            }
+                        }
+                    }
+                    [false, false] => items.push((c, 0, if o > d[1] { -1 } else { 1 })),
+                }
+            }
+            let mut cost: i64 = items.iter().map(|it| it.2.max(0)).sum();
+            let (mut min, mut at) = (cost, (0, 0));
+            for &(c, k, w) in &items {
+                cost -= w;
+                if cost < min {
+                    let whole = w.abs() == SOUND || !split_quads;
+                    (min, at) = (cost, if whole { (c + 1, 0) } else { (c, k + 1) });
+                }
+            }
+            let decided = items
+                .iter()
+                .map(|&(c, k, w)| (c, (w.abs() == 1 && split_quads).then_some(k)))
+                .collect();
+            out.push((at, decided));
+        }
+        out
+    }
+
+    /// What rays from `eye` through points of ball `b` (its centre and points on its
+    /// surface) demand of its place among `chunks`: `(chunk, quad, before)` for each quad
+    /// a ray crosses, `before` when it crosses it in front of the point (the object must
+    /// be drawn before that quad), else after it.
+    fn witnessed(
+        b: Ball,
+        eye: DVec3,
+        chunks: &[Option<Surfaces<'_>>],
+        two_sided: bool,
+        next: &mut impl FnMut() -> u64,
+    ) -> Vec<(u32, u32, bool)> {
+        let points: Vec<DVec3> = (0..if b.radius > 0.0 { 9 } else { 1 })
+            .map(|j| {
+                if j == 0 {
+                    return b.center;
+                }
+                let r = |n: u64| (n % 2001) as f64 / 1000.0 - 1.0;
+                let v = DVec3::new(r(next()), r(next()), r(next()));
+                b.center + v.normalize_or(DVec3::X) * b.radius * 0.999
+            })
+            .collect();
+        let mut out = Vec::new();
+        for (c, s) in chunks.iter().enumerate() {
+            let Some(s) = s else { continue };
+            for (k, q) in s.quads.iter().enumerate() {
+                let Some(q) = q.unpack() else { continue };
+                let (lo, hi) = q.bounds();
+                let a = q.face.axis();
+                let [u, v] = voxel_mesh::UV_AXES[a];
+                let plane = s.origin[a] + lo[a];
+                let n = if q.face.is_positive() { 1.0 } else { -1.0 };
+                if !two_sided && (eye[a] - plane) * n <= 0.0 {
+                    continue;
+                }
+                for p in &points {
+                    let dir = *p - eye;
+                    if dir[a] == 0.0 {
+                        continue;
+                    }
+                    let t = (plane - eye[a]) / dir[a];
+                    if t <= 0.0 || (t - 1.0).abs() < 1e-9 {
+                        continue;
+                    }
+                    let x = eye + dir * t;
+                    let inside = x[u] > s.origin[u] + lo[u]
+                        && x[u] < s.origin[u] + hi[u]
+                        && x[v] > s.origin[v] + lo[v]
+                        && x[v] < s.origin[v] + hi[v];
+                    if inside {
+                        out.push((c as u32, k as u32, t < 1.0));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Whether place `p` (after quads `..p.1` of chunk `p.0`) meets every demand.
+    fn meets(p: (u32, u32), demands: &[(u32, u32, bool)]) -> bool {
+        demands.iter().all(|&(c, k, before)| {
+            if before {
+                p.0 < c || (p.0 == c && p.1 <= k)
+            } else {
+                p.0 > c || (p.0 == c && p.1 > k)
+            }
+        })
+    }
+
+    #[test]
+    fn where_the_sound_tests_decide_the_fast_order_agrees_with_all_pairs() {
+        let registry = Arc::new(BlockRegistry::default());
+        let mut mesher = Mesher::new(&registry);
+        let mut seed = 0x0bad_cafe_1234_5678u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let (mut checked, mut decided, mut straddling) = (0, 0, 0);
+        for round in 0..64u64 {
+            let two_sided = round % 3 == 0;
+            let split_quads = round % 2 == 0;
+            let eye = DVec3::new(
+                (next() % 96) as f64 - 48.0 + 0.37,
+                (next() % 64) as f64 - 16.0 + 0.61,
+                (next() % 96) as f64 - 48.0 + 0.13,
+            );
+            // Chunks around the eye with a few boxes of water and glass each.
+            let mut meshes = Vec::new();
+            for x in -2..=2 {
+                for y in -1..=1 {
+                    for z in -2..=2 {
+                        if next() % 3 != 0 {
+                            continue;
+                        }
+                        let mut c = Chunk::default();
+                        for _ in 0..1 + next() % 3 {
+                            let id = [blocks::WATER, blocks::GLASS, blocks::RED_GLASS]
+                                [(next() % 3) as usize];
+                            let lo = [0, 1, 2].map(|_| (next() % 32) as usize);
+                            let size = [0, 1, 2].map(|_| (next() % 12) as usize);
+                            for bx in lo[0]..(lo[0] + size[0] + 1).min(32) {
+                                for by in lo[1]..(lo[1] + size[1] + 1).min(32) {
+                                    for bz in lo[2]..(lo[2] + size[2] + 1).min(32) {
+                                        c.set(bx, by, bz, id).unwrap();
+                                    }
+                                }
+                            }
+                        }
+                        let m = mesher.mesh(&c, Neighbourhood::from_fn(|_| None)).unwrap();
+                        if m.translucent.is_empty() {
+                            continue;
+                        }
+                        meshes.push((ChunkPos::new(x, y, z), m.translucent));
+                    }
+                }
+            }
+            meshes
+                .sort_by_key(|(p, _)| (std::cmp::Reverse(chunk_order_key(*p, eye.to_array())), *p));
+            // Each chunk's quads in exact back-to-front order, its planes and box.
+            let mut sorted = Vec::new();
+            for (p, quads) in &meshes {
+                let origin = p.origin().map(|v| v as f64);
+                let local = [0, 1, 2].map(|k| eye[k] - origin[k]);
+                let mut out = Vec::new();
+                QuadOrder::new(quads).sort_into(local, &mut out);
+                let mut planes: Vec<(Face, u8)> = out
+                    .iter()
+                    .filter_map(|q| q.unpack())
+                    .map(|q| (q.face, q.bounds().0[q.face.axis()] as u8))
+                    .collect();
+                planes.sort_unstable_by_key(|&(f, c)| (f as u8, c));
+                planes.dedup();
+                let (mut lo, mut hi) =
+                    (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+                for q in out.iter().filter_map(|q| q.unpack()) {
+                    let (a, b) = q.bounds();
+                    lo = lo.min(DVec3::from(a) + DVec3::from(origin));
+                    hi = hi.max(DVec3::from(b) + DVec3::from(origin));
+                }
+                sorted.push((origin, out, planes, lo, hi));
+            }
+            let surfaces: Vec<Option<Surfaces<'_>>> = sorted
+                .iter()
+                .map(|(origin, quads, planes, lo, hi)| {
+                    Some(Surfaces {
+                        lo: *lo,
+                        hi: *hi,
+                        origin: *origin,
+                        planes,
+                        quads,
+                    })
+                })
+                .collect();
+            let positions: Vec<ChunkPos> = meshes.iter().map(|m| m.0).collect();
+            let keys: Vec<u128> = positions
+                .iter()
+                .map(|&p| chunk_order_key(p, eye.to_array()))
+                .collect();
+            let seq = ChunkSequence {
+                surfaces: &surfaces,
+                keys: &keys,
+                positions: &positions,
+            };
+            let balls: Vec<Ball> = (0..200)
+                .map(|k| Ball {
+                    center: DVec3::new(
+                        (next() % 128) as f64 - 64.0 + (next() % 1000) as f64 / 1000.0,
+                        (next() % 96) as f64 - 32.0 + (next() % 1000) as f64 / 1000.0,
+                        (next() % 128) as f64 - 64.0 + (next() % 1000) as f64 / 1000.0,
+                    ),
+                    radius: [0.0, 0.3, 2.5, 9.0][k % 4],
+                })
+                .collect();
+            let old = all_pairs(&balls, eye, &surfaces, two_sided, split_quads);
+            let (order, splits) = interleave(&balls, eye, &seq, two_sided, split_quads);
+            // The new place of each object, from the splits.
+            let mut new = vec![(surfaces.len() as u32, 0u32); balls.len()];
+            let mut start = 0;
+            for s in &splits {
+                for &i in &order[start..s.end as usize] {
+                    new[i as usize] = (s.chunk, s.quad);
+                }
+                start = s.end as usize;
+            }
+            for (i, &b) in balls.iter().enumerate() {
+                if !(0..3).all(|a| {
+                    (b.center[a] - b.radius).div_euclid(32.0)
+                        == (b.center[a] + b.radius).div_euclid(32.0)
+                }) {
+                    straddling += 1;
+                }
+                // What rays demand where the all-pairs order had a decision.
+                let (old_place, decisions) = &old[i];
+                let demands: Vec<(u32, u32, bool)> =
+                    witnessed(b, eye, &surfaces, two_sided, &mut next)
+                        .into_iter()
+                        .filter(|&(c, k, _)| {
+                            decisions.contains(&(c, None)) || decisions.contains(&(c, Some(k)))
+                        })
+                        .collect();
+                decided += demands.len();
+                // Places past the last quad of a chunk mean before the next one.
+                let norm = |p: (u32, u32)| match surfaces.get(p.0 as usize) {
+                    Some(Some(s)) if p.1 as usize >= s.quads.len() && p.1 > 0 => (p.0 + 1, 0),
+                    _ => p,
+                };
+                if !demands.is_empty() && meets(norm(*old_place), &demands) {
+                    checked += 1;
+
+                    assert!(
+                        meets(new[i], &demands),
+                        "round {round}, ball {b:?}, eye {eye}: all pairs {:?} meets what rays demand, the fast order {:?} does not ({demands:?})",
+                        norm(*old_place),
+                        new[i]
+                    );
+                }
+            }
+        }
+        assert!(
+            checked > 1500 && decided > 8000 && straddling > 2000,
+            "{checked} {decided} {straddling}"
+        );
     }
 }
