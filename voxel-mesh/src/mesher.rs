@@ -51,7 +51,7 @@ use voxel_core::{
     Neighbourhood, Occupancy, RenderClass, row_index,
 };
 
-use crate::ao::{AO_NONE, Buckets, Pad, split_by_ao};
+use crate::ao::{AO_NONE, Pad, cover_occluded};
 use crate::bits::{greedy_rects_live, live_rows};
 use crate::{Error, PackedQuad, Result};
 
@@ -156,8 +156,6 @@ pub struct Mesher {
     built: MaskBuffer,
     /// Opaque blocks of the chunk and the shell around it, for ambient occlusion.
     pad: Box<Pad>,
-    /// Faces of one plane grouped by their occlusion.
-    buckets: Buckets,
     /// An edge neighbour's touching layer, per type.
     edge_layers: Vec<(BlockId, LayerMask)>,
 }
@@ -166,7 +164,7 @@ pub struct Mesher {
 /// chunk with the scratch to group faces by them.
 struct Sink<'a> {
     out: &'a mut Vec<PackedQuad>,
-    ao: Option<(&'a Pad, &'a mut Buckets)>,
+    ao: Option<&'a Pad>,
 }
 
 impl std::fmt::Debug for Mesher {
@@ -189,8 +187,8 @@ fn or_into(dst: &mut [u32], src: &[u32]) {
 }
 
 /// Emits the rectangles covering the faces in `rows` (layer `layer` of `face`) as quads
-/// with `flags`; with ambient occlusion, faces an occluder touches are grouped by their
-/// corner values first and each group covered on its own.
+/// with `flags`; with ambient occlusion, faces an occluder touches are covered first, by
+/// rectangles of equal corner values ([`cover_occluded`]).
 #[inline]
 fn emit_plane(
     rows: &mut Plane,
@@ -200,20 +198,39 @@ fn emit_plane(
     flags: u32,
     sink: &mut Sink<'_>,
 ) {
-    let occluders = sink
-        .ao
-        .as_ref()
-        .and_then(|(pad, _)| pad.occluders(face, layer));
-    if let (Some(occ), Some((_, buckets))) = (occluders, sink.ao.as_mut()) {
+    if let Some(occ) = sink.ao.and_then(|pad| pad.occluders(face, layer)) {
         let out = &mut *sink.out;
-        split_by_ao(rows, occ, face.axis(), buckets, |ao, live, plane| {
-            cover(plane, live, face, layer, block, flags, ao, out);
+        cover_occluded(rows, occ, face.axis(), |r, h, b, w, ao| {
+            out.push(quad(face, layer, r, h, b, w, block, flags, ao));
         });
     }
     if rows.iter().fold(0, |acc, &r| acc | r) != 0 {
         let live = live_rows(rows);
         cover(rows, live, face, layer, block, flags, AO_NONE, sink.out);
     }
+}
+
+/// The quad of the rectangle of `h` rows from `r` and `w` bits from `b` in layer `layer`
+/// of `face`'s plane.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn quad(
+    face: Face,
+    layer: usize,
+    r: usize,
+    h: usize,
+    b: usize,
+    w: usize,
+    block: BlockId,
+    flags: u32,
+    ao: u8,
+) -> PackedQuad {
+    let q = match face.axis() {
+        0 => PackedQuad::new([layer, b, r], w, h, face, block),
+        1 => PackedQuad::new([b, layer, r], h, w, face, block),
+        _ => PackedQuad::new([b, r, layer], w, h, face, block),
+    };
+    q.with_flags(flags).with_ao(ao)
 }
 
 /// Covers the faces in `rows` (whose rows holding any are `live`) with rectangles, emitted
@@ -231,12 +248,7 @@ fn cover(
     out: &mut Vec<PackedQuad>,
 ) {
     greedy_rects_live(rows, live, |r, h, b, w| {
-        let q = match face.axis() {
-            0 => PackedQuad::new([layer, b, r], w, h, face, block),
-            1 => PackedQuad::new([b, layer, r], h, w, face, block),
-            _ => PackedQuad::new([b, r, layer], w, h, face, block),
-        };
-        out.push(q.with_flags(flags).with_ao(ao));
+        out.push(quad(face, layer, r, h, b, w, block, flags, ao));
     });
 }
 
@@ -290,7 +302,6 @@ impl Mesher {
             classes: registry.iter().map(|(_, d)| d.class).collect(),
             options,
             pad: Pad::new(),
-            buckets: Buckets::new(),
             edge_layers: Vec::new(),
             s: Box::new(Scratch {
                 opaque: EMPTY_OCCUPANCY,
@@ -360,7 +371,6 @@ impl Mesher {
             s,
             built,
             pad,
-            buckets,
             edge_layers,
         } = self;
         let classes = &*classes;
@@ -500,7 +510,7 @@ impl Mesher {
                 && (class != RenderClass::Translucent || options.translucent_occlusion);
             let mut sink = Sink {
                 out: out.for_class(class),
-                ao: occludes.then_some((&**pad, &mut *buckets)),
+                ao: occludes.then_some(&**pad),
             };
             if chunk.as_uniform().is_some() {
                 // One block type everywhere. An opaque or translucent type hides itself, so
@@ -515,10 +525,8 @@ impl Mesher {
                     };
                     if class == RenderClass::Cutout {
                         for l in (0..CHUNK_SIZE).filter(|&l| l != border) {
-                            let shaded = sink
-                                .ao
-                                .as_ref()
-                                .is_some_and(|(pad, _)| pad.occluders(face, l).is_some());
+                            let shaded =
+                                sink.ao.is_some_and(|pad| pad.occluders(face, l).is_some());
                             if shaded {
                                 emit_plane(&mut [u32::MAX; CHUNK_SIZE], face, l, id, 0, &mut sink);
                             } else {
