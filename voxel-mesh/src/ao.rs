@@ -85,42 +85,47 @@ impl Pad {
         is_opaque: &dyn Fn(BlockId) -> bool,
         layers: &mut Vec<(BlockId, LayerMask)>,
     ) {
-        for row in self.by_y.iter_mut().chain(self.by_x.iter_mut()) {
-            row.fill(0);
-        }
-        for a in 0..CHUNK_SIZE {
-            for z in 0..CHUNK_SIZE {
-                self.by_y[a + 1][z + 1] = u64::from(opaque.by_y[column_index(a, z)]) << 1;
-                self.by_x[a + 1][z + 1] = u64::from(opaque.by_x[row_index(a, z)]) << 1;
+        let [px, nx, py, ny, pz, nz] = faces;
+        // Every entry is written below but the four corner columns of each layout (x or y
+        // outside and z outside), which only edge and corner neighbours fill.
+        for plane in [&mut self.by_y, &mut self.by_x] {
+            for out in [0, P - 1] {
+                plane[out][0] = 0;
+                plane[out][P - 1] = 0;
             }
         }
-        // Face neighbours: one layout is a copy of the layer, the other a transpose.
-        for face in Face::ALL {
-            let plane = &faces[face as usize];
-            let out = if face.is_positive() { P - 1 } else { 0 };
-            match face.axis() {
-                // Rows z, bits y.
-                0 => {
-                    copy_shifted(&mut self.by_y[out][1..], plane);
-                    for y in 0..CHUNK_SIZE {
-                        or_bit(&mut self.by_x[y + 1], plane, y, out);
-                    }
-                }
-                // Rows z, bits x.
-                1 => {
-                    copy_shifted(&mut self.by_x[out][1..], plane);
-                    for x in 0..CHUNK_SIZE {
-                        or_bit(&mut self.by_y[x + 1], plane, x, out);
-                    }
-                }
-                // Rows y, bits x: its transpose has rows x, bits y.
-                _ => {
-                    let columns = crate::bits::transpose32(plane);
-                    for (a, (&row, &column)) in plane.iter().zip(&columns).enumerate() {
-                        self.by_x[a + 1][out] = u64::from(row) << 1;
-                        self.by_y[a + 1][out] = u64::from(column) << 1;
-                    }
-                }
+        // The chunk's columns, with the ±y neighbours' cells at y = -1 and 32 (their layers:
+        // rows z, bits x), and its rows along x, with the ±x neighbours' cells at x = -1 and
+        // 32 (rows z, bits y).
+        for a in 0..CHUNK_SIZE {
+            let columns = &opaque.by_y[column_index(a, 0)..][..CHUNK_SIZE];
+            let out = &mut self.by_y[a + 1][1..=CHUNK_SIZE];
+            for (z, (o, &c)) in out.iter_mut().zip(columns).enumerate() {
+                *o = u64::from(c) << 1
+                    | u64::from(ny[z] >> a & 1)
+                    | u64::from(py[z] >> a & 1) << (CHUNK_SIZE + 1);
+            }
+            let rows = &opaque.by_x[row_index(a, 0)..][..CHUNK_SIZE];
+            let out = &mut self.by_x[a + 1][1..=CHUNK_SIZE];
+            for (z, (o, &r)) in out.iter_mut().zip(rows).enumerate() {
+                *o = u64::from(r) << 1
+                    | u64::from(nx[z] >> a & 1)
+                    | u64::from(px[z] >> a & 1) << (CHUNK_SIZE + 1);
+            }
+        }
+        // The ±x neighbours' layers are the columns at x = -1 and 32, the ±y ones the rows
+        // at y = -1 and 32.
+        copy_shifted(&mut self.by_y[0][1..], nx);
+        copy_shifted(&mut self.by_y[P - 1][1..], px);
+        copy_shifted(&mut self.by_x[0][1..], ny);
+        copy_shifted(&mut self.by_x[P - 1][1..], py);
+        // The ±z neighbours' layers (rows y, bits x) are the rows at z = -1 and 32, and
+        // their transposes (rows x, bits y) the columns there.
+        for (plane, out) in [(nz, 0), (pz, P - 1)] {
+            let columns = crate::bits::transpose32(plane);
+            for (a, (&row, &column)) in plane.iter().zip(&columns).enumerate() {
+                self.by_x[a + 1][out] = u64::from(row) << 1;
+                self.by_y[a + 1][out] = u64::from(column) << 1;
             }
         }
         // Edge neighbours give a line of 32 blocks, corner neighbours one block.
@@ -128,48 +133,9 @@ impl Pad {
             let Some(chunk) = neighbours.get(*d) else {
                 continue;
             };
-            // The touching cells: coordinate 0 of the neighbour on a +1 axis, 31 on a -1
-            // axis; `free` runs along the axis where d is 0 (none for a corner).
-            let near = |v: i32| if v > 0 { 0 } else { CHUNK_SIZE - 1 };
-            let padded = |v: i32| if v > 0 { P - 1 } else { 0 };
-            let free = d.iter().position(|&v| v == 0);
-            if let Some(id) = chunk.as_uniform() {
-                if is_opaque(id) {
-                    for k in 0..if free.is_some() { CHUNK_SIZE } else { 1 } {
-                        let mut p = d.map(padded);
-                        if let Some(f) = free {
-                            p[f] = k + 1;
-                        }
-                        self.set(p);
-                    }
-                }
-                continue;
-            }
-            // The neighbour's layer on the side facing us across the first non-zero axis.
-            let axis = d.iter().position(|&v| v != 0).unwrap_or(0);
-            let side = match (axis, d[axis] > 0) {
-                (0, true) => Face::NegX,
-                (0, false) => Face::PosX,
-                (1, true) => Face::NegY,
-                (1, false) => Face::PosY,
-                (_, true) => Face::NegZ,
-                (_, false) => Face::PosZ,
-            };
-            chunk.side_layers(side, layers, is_opaque);
-            let mut plane = [0u32; CHUNK_SIZE];
-            for (_, rows) in layers.iter() {
-                plane.iter_mut().zip(rows).for_each(|(p, r)| *p |= r);
-            }
-            for k in 0..if free.is_some() { CHUNK_SIZE } else { 1 } {
-                let mut local = d.map(near);
-                let mut p = d.map(padded);
-                if let Some(f) = free {
-                    local[f] = k;
-                    p[f] = k + 1;
-                }
-                if layer_bit(&plane, axis, local) {
-                    self.set(p);
-                }
+            let line = touching_line(chunk, *d, is_opaque, layers);
+            if line != 0 {
+                self.or_line(*d, line);
             }
         }
         for z in 0..P {
@@ -188,9 +154,39 @@ impl Pad {
         }
     }
 
-    fn set(&mut self, p: [usize; 3]) {
-        self.by_y[p[0]][p[2]] |= 1 << p[1];
-        self.by_x[p[1]][p[2]] |= 1 << p[0];
+    /// Sets the opaque cells `line` of the edge or corner neighbour at offset `d` (see
+    /// [`touching_line`]) in both layouts.
+    fn or_line(&mut self, d: [i32; 3], line: u32) {
+        let [x, y, z] = d.map(|v| if v > 0 { P - 1 } else { 0 });
+        let bits = |k: usize| u64::from(line >> k & 1);
+        match d {
+            // Along x: a row of `by_x`, one bit of each column of `by_y` at (y, z).
+            [0, _, _] => {
+                self.by_x[y][z] |= u64::from(line) << 1;
+                for k in 0..CHUNK_SIZE {
+                    self.by_y[k + 1][z] |= bits(k) << y;
+                }
+            }
+            // Along y: a column of `by_y`, one bit of each row of `by_x` at (y, z).
+            [_, 0, _] => {
+                self.by_y[x][z] |= u64::from(line) << 1;
+                for k in 0..CHUNK_SIZE {
+                    self.by_x[k + 1][z] |= bits(k) << x;
+                }
+            }
+            // Along z: one bit of each column and of each row.
+            [_, _, 0] => {
+                for k in 0..CHUNK_SIZE {
+                    self.by_y[x][k + 1] |= bits(k) << y;
+                    self.by_x[y][k + 1] |= bits(k) << x;
+                }
+            }
+            // A corner: one block.
+            _ => {
+                self.by_y[x][z] |= bits(0) << y;
+                self.by_x[y][z] |= bits(0) << x;
+            }
+        }
     }
 
     /// The occluders in front of the faces of layer `layer` of `face` (the layer one step
@@ -219,24 +215,45 @@ fn copy_shifted(dst: &mut [u64], src: &LayerMask) {
     }
 }
 
-/// Sets bit `to` of `dst[z + 1]` where bit `from` of `plane[z]` is set, for every z (one
-/// column of a neighbour's layer into the shell's border bit; vectorises).
-#[inline]
-fn or_bit(dst: &mut [u64; P], plane: &LayerMask, from: usize, to: usize) {
-    for (d, &p) in dst[1..=CHUNK_SIZE].iter_mut().zip(plane.iter()) {
-        *d |= u64::from(p >> from & 1) << to;
+/// The opaque blocks of the edge or corner neighbour at offset `d` that touch the chunk:
+/// for an edge, the line of 32 blocks along the axis where `d` is 0 (bit k: coordinate k
+/// there); for a corner, its one block (bit 0). A touching cell is at coordinate 0 of the
+/// neighbour along a +1 axis, 31 along a -1 axis.
+fn touching_line(
+    chunk: &voxel_core::Chunk,
+    d: [i32; 3],
+    is_opaque: &dyn Fn(BlockId) -> bool,
+    layers: &mut Vec<(BlockId, LayerMask)>,
+) -> u32 {
+    let corner = !d.contains(&0);
+    if let Some(id) = chunk.as_uniform() {
+        return match (is_opaque(id), corner) {
+            (false, _) => 0,
+            (true, true) => 1,
+            (true, false) => u32::MAX,
+        };
     }
-}
-
-/// Whether the block at `local` (whose `axis` coordinate is ignored) is set in a layer in
-/// the layout of [`voxel_core::Chunk::side_layers`] for a side along `axis`.
-fn layer_bit(plane: &LayerMask, axis: usize, local: [usize; 3]) -> bool {
-    let (row, bit) = match axis {
-        0 => (local[2], local[1]),
-        1 => (local[2], local[0]),
-        _ => (local[1], local[0]),
+    // The neighbour's layer facing us across x (rows z, bits y), or across y for an edge
+    // along x (rows z, bits x); both layers are contiguous in the mask layouts.
+    let side = match d {
+        [0, dy, _] if dy > 0 => Face::NegY,
+        [0, _, _] => Face::PosY,
+        [dx, _, _] if dx > 0 => Face::NegX,
+        _ => Face::PosX,
     };
-    plane[row] >> bit & 1 != 0
+    chunk.side_layers(side, layers, is_opaque);
+    let mut plane = [0u32; CHUNK_SIZE];
+    for (_, rows) in layers.iter() {
+        plane.iter_mut().zip(rows).for_each(|(p, r)| *p |= r);
+    }
+    let [_, y, z] = d.map(|v| if v > 0 { 0 } else { CHUNK_SIZE - 1 });
+    match d {
+        // Along x (rows z, bits x) or along y (rows z, bits y): the row at z.
+        [0, _, _] | [_, 0, _] => plane[z],
+        // Along z: bit y of every row.
+        [_, _, 0] => (0..CHUNK_SIZE).fold(0, |acc, k| acc | (plane[k] >> y & 1) << k),
+        _ => plane[z] >> y & 1,
+    }
 }
 
 /// The corners of a face in the plane's (row, bit) directions.
@@ -278,9 +295,10 @@ const fn cell(pattern: i32, dr: i32, db: i32) -> bool {
 /// [`ao_table`] for x and z faces (U along the bits) and for y faces (U along the rows).
 static AO_TABLES: [[u8; 512]; 2] = [ao_table(false), ao_table(true)];
 
-/// Covers the faces of `rows` that an occluder touches with rectangles of faces of equal
-/// corner values, and takes them out of `rows`; the faces left there have [`AO_NONE`].
-/// Calls `emit(row, rows, bit, bits, ao)` per rectangle. `axis` is the face's normal axis
+/// Covers the faces of `rows` (`live`: its rows holding any) that an occluder touches with
+/// rectangles of faces of equal corner values, and takes them out of `rows`; the faces
+/// left there have [`AO_NONE`]. Calls `emit(row, rows, bit, bits, ao)` per rectangle and
+/// returns the rows still holding faces. `axis` is the face's normal axis
 /// (it decides which corner is which slot).
 ///
 /// The corner values of a face are read once from the 3×3 occluders in front of it (one
@@ -292,14 +310,16 @@ static AO_TABLES: [[u8; 512]; 2] = [ao_table(false), ao_table(true)];
 #[inline]
 pub(crate) fn cover_occluded(
     rows: &mut [u32; CHUNK_SIZE],
+    rows_live: u32,
     occ: &Occluders,
     axis: usize,
     mut emit: impl FnMut(usize, usize, usize, usize, u8),
-) {
+) -> u32 {
     // The faces an occluder touches (any of the nine cells in front).
     let mut shaded = [0u32; CHUNK_SIZE];
     let mut live = 0u32;
-    let mut left = crate::bits::live_rows(rows);
+    let mut remaining = rows_live;
+    let mut left = rows_live;
     while left != 0 {
         let r = left.trailing_zeros() as usize;
         left &= left - 1;
@@ -308,6 +328,7 @@ pub(crate) fn cover_occluded(
         shaded[r] = s;
         rows[r] &= !s;
         live |= u32::from(s != 0) << r;
+        remaining &= !(u32::from(rows[r] == 0) << r);
     }
     let table = &AO_TABLES[usize::from(axis == 1)];
     // The AO byte of the face at bit `b` of row `r`.
@@ -342,6 +363,7 @@ pub(crate) fn cover_occluded(
             emit(r, h, b0, end - b0, ao);
         }
     }
+    remaining
 }
 
 /// The AO value (0 to 3) of corner `(u, v)` (each 0 or 1) of an AO byte.
@@ -429,7 +451,8 @@ mod tests {
                 }
                 let mut rows = faces;
                 let mut got = [[None; CHUNK_SIZE]; CHUNK_SIZE];
-                cover_occluded(&mut rows, &occ, axis, |r, h, b, w, ao| {
+                let live = crate::bits::live_rows(&rows);
+                let left = cover_occluded(&mut rows, live, &occ, axis, |r, h, b, w, ao| {
                     for row in &mut got[r..r + h] {
                         for g in &mut row[b..b + w] {
                             assert!(g.is_none(), "face twice");
@@ -437,6 +460,7 @@ mod tests {
                         }
                     }
                 });
+                assert_eq!(left, crate::bits::live_rows(&rows), "rows left");
                 for r in 0..CHUNK_SIZE {
                     for b in 0..CHUNK_SIZE {
                         if faces[r] >> b & 1 == 0 {
@@ -467,7 +491,8 @@ mod tests {
                 let (occ, faces) = random_plane(&mut next, k);
                 let mut got = Vec::new();
                 let mut rows = faces;
-                cover_occluded(&mut rows, &occ, axis, |r, h, b, w, ao| {
+                let live = crate::bits::live_rows(&rows);
+                cover_occluded(&mut rows, live, &occ, axis, |r, h, b, w, ao| {
                     got.push((ao, r, h, b, w));
                 });
                 // The reference: each face's byte from the table, one plane per byte.

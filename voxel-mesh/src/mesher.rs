@@ -198,14 +198,14 @@ fn emit_plane(
     flags: u32,
     sink: &mut Sink<'_>,
 ) {
+    let mut live = live_rows(rows);
     if let Some(occ) = sink.ao.and_then(|pad| pad.occluders(face, layer)) {
         let out = &mut *sink.out;
-        cover_occluded(rows, occ, face.axis(), |r, h, b, w, ao| {
+        live = cover_occluded(rows, live, occ, face.axis(), |r, h, b, w, ao| {
             out.push(quad(face, layer, r, h, b, w, block, flags, ao));
         });
     }
-    if rows.iter().fold(0, |acc, &r| acc | r) != 0 {
-        let live = live_rows(rows);
+    if live != 0 {
         cover(rows, live, face, layer, block, flags, AO_NONE, sink.out);
     }
 }
