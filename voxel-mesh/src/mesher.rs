@@ -186,19 +186,19 @@ fn or_into(dst: &mut [u32], src: &[u32]) {
     dst.iter_mut().zip(src).for_each(|(d, s)| *d |= s);
 }
 
-/// Emits the rectangles covering the faces in `rows` (layer `layer` of `face`) as quads
-/// with `flags`; with ambient occlusion, faces an occluder touches are covered first, by
-/// rectangles of equal corner values ([`cover_occluded`]).
+/// Emits the rectangles covering the faces in `rows` (layer `layer` of `face`; `live` says
+/// which rows hold any) as quads with `flags`; with ambient occlusion, faces an occluder
+/// touches are covered first, by rectangles of equal corner values ([`cover_occluded`]).
 #[inline]
 fn emit_plane(
     rows: &mut Plane,
+    mut live: u32,
     face: Face,
     layer: usize,
     block: BlockId,
     flags: u32,
     sink: &mut Sink<'_>,
 ) {
-    let mut live = live_rows(rows);
     if let Some(occ) = sink.ao.and_then(|pad| pad.occluders(face, layer)) {
         let out = &mut *sink.out;
         live = cover_occluded(rows, live, occ, face.axis(), |r, h, b, w, ao| {
@@ -208,6 +208,17 @@ fn emit_plane(
     if live != 0 {
         cover(rows, live, face, layer, block, flags, AO_NONE, sink.out);
     }
+}
+
+/// `rows & !hidden`, and whether it holds any bit (vectorises).
+#[inline(always)]
+fn and_not(rows: &Plane, hidden: &Plane) -> (Plane, bool) {
+    let mut faces = [0; CHUNK_SIZE];
+    for (f, (&r, &h)) in faces.iter_mut().zip(rows.iter().zip(hidden)) {
+        *f = r & !h;
+    }
+    let any = faces.iter().fold(0, |acc, &f| acc | f) != 0;
+    (faces, any)
 }
 
 /// The quad of the rectangle of `h` rows from `r` and `w` bits from `b` in layer `layer`
@@ -252,8 +263,8 @@ fn cover(
     });
 }
 
-/// Emits the faces in `rows`: those whose neighbour is set in the plane `interface` gives
-/// (the same layout; asked only when there are faces) flagged, the others not.
+/// Emits the faces in `rows` (a plane holding some): those whose neighbour is set in the
+/// plane `interface` gives (the same layout) flagged, the others not.
 #[inline]
 fn emit_split(
     rows: &mut Plane,
@@ -263,16 +274,17 @@ fn emit_split(
     block: BlockId,
     sink: &mut Sink<'_>,
 ) {
-    if rows.iter().all(|&r| r == 0) {
-        return;
-    }
+    let mut live = live_rows(rows);
     if let Some(next) = interface {
         let next = next();
         let mut flagged: Plane = std::array::from_fn(|r| rows[r] & next[r]);
-        if flagged.iter().any(|&r| r != 0) {
+        let flagged_live = live_rows(&flagged);
+        if flagged_live != 0 {
             rows.iter_mut().zip(&flagged).for_each(|(r, f)| *r &= !f);
+            live = live_rows(rows);
             emit_plane(
                 &mut flagged,
+                flagged_live,
                 face,
                 layer,
                 block,
@@ -281,7 +293,9 @@ fn emit_split(
             );
         }
     }
-    emit_plane(rows, face, layer, block, 0, sink);
+    if live != 0 {
+        emit_plane(rows, live, face, layer, block, 0, sink);
+    }
 }
 
 const EMPTY_OCCUPANCY: Occupancy = Occupancy {
@@ -528,7 +542,8 @@ impl Mesher {
                             let shaded =
                                 sink.ao.is_some_and(|pad| pad.occluders(face, l).is_some());
                             if shaded {
-                                emit_plane(&mut [u32::MAX; CHUNK_SIZE], face, l, id, 0, &mut sink);
+                                let mut all = [u32::MAX; CHUNK_SIZE];
+                                emit_plane(&mut all, u32::MAX, face, l, id, 0, &mut sink);
                             } else {
                                 let mut pos = [0; 3];
                                 pos[face.axis()] = l;
@@ -537,9 +552,11 @@ impl Mesher {
                             }
                         }
                     }
-                    let mut rows = nb_hide[face as usize].map(|h| !h);
-                    let interface = split.map(|sp| || sp.neighbours[face as usize]);
-                    emit_split(&mut rows, interface, face, border, id, &mut sink);
+                    let (mut rows, any) = and_not(&[u32::MAX; CHUNK_SIZE], &nb_hide[face as usize]);
+                    if any {
+                        let interface = split.map(|sp| || sp.neighbours[face as usize]);
+                        emit_split(&mut rows, interface, face, border, id, &mut sink);
+                    }
                 }
             } else {
                 mesh_type(bits, hide, &nb_hide, split, id, &mut sink);
@@ -562,7 +579,7 @@ fn mesh_type(
     id: BlockId,
     sink: &mut Sink<'_>,
 ) {
-    let empty = |rows: &Plane| rows.iter().all(|&r| r == 0);
+    let empty = |rows: &Plane| rows.iter().fold(0, |acc, &r| acc | r) == 0;
     for (mine, theirs, inter, faces) in [
         (
             &m.by_y,
@@ -589,7 +606,10 @@ fn mesh_type(
                 } else {
                     &nb_hide[face as usize]
                 };
-                let mut faces: Plane = std::array::from_fn(|r| rows[r] & !hidden[r]);
+                let (mut faces, any) = and_not(rows, hidden);
+                if !any {
+                    continue;
+                }
                 let interface = split.map(|s| {
                     move || {
                         if inside {
@@ -619,6 +639,9 @@ fn mesh_type(
                 };
                 m.by_x[row_index(y, z)] & !h
             });
+            if faces.iter().fold(0, |acc, &f| acc | f) == 0 {
+                continue;
+            }
             let interface = split.map(|s| {
                 move || -> Plane {
                     std::array::from_fn(|y| {
