@@ -550,12 +550,15 @@ fn storage_and_terrain_section(reg: &BlockRegistry, generator: &TerrainGenerator
     // corner values (tests/common/exact_merge.rs says why no other merge is exact but a
     // few small squares, counted here).
     let t = Instant::now();
-    let (mut fewest, mut fewest_plain, mut squares) = (0, 0, 0);
-    let bound = |m: &ChunkMeshes, fewest: &mut usize, squares: &mut usize| {
+    let (mut fewest, mut fewest_plain, mut squares, mut alone) = (0, 0, 0, 0);
+    // Adds a mesh's fewest exact quads, exact non-affine squares and non-affine faces.
+    let bound = |m: &ChunkMeshes, counts: [&mut usize; 3]| {
+        let [fewest, squares, alone] = counts;
         for quads in [&m.opaque, &m.cutout, &m.translucent] {
             for plane in exact_merge::planes(quads).values() {
                 *fewest += exact_merge::fewest_exact_quads(plane);
                 *squares += exact_merge::exact_non_affine_squares(plane);
+                *alone += exact_merge::non_affine_faces(plane);
             }
         }
     };
@@ -564,10 +567,10 @@ fn storage_and_terrain_section(reg: &BlockRegistry, generator: &TerrainGenerator
             .mesh(chunk, world.neighbourhood(p))
             .expect("known blocks");
         plain_quads += m.len();
-        bound(&m, &mut fewest_plain, &mut 0);
+        bound(&m, [&mut fewest_plain, &mut 0, &mut 0]);
     }
     for (_, m) in &meshes {
-        bound(m, &mut fewest, &mut squares);
+        bound(m, [&mut fewest, &mut squares, &mut alone]);
     }
     let bound_s = secs(t.elapsed());
     println!(
@@ -575,7 +578,7 @@ fn storage_and_terrain_section(reg: &BlockRegistry, generator: &TerrainGenerator
         quads as f64 / plain_quads as f64
     );
     println!(
-        "fewest exact quads (minimum partitions; {bound_s:.0} s): with AO {fewest} ({:.2}% below ours), without {fewest_plain}; with AO / ours without = {:.3}, / fewest without = {:.3}; exact merges that are not affine: {squares}",
+        "fewest exact quads (minimum partitions; {bound_s:.0} s): with AO {fewest} ({:.2}% below ours), without {fewest_plain}; with AO / ours without = {:.3}, / fewest without = {:.3}; faces with values not affine {alone}, exact merges that are not affine {squares}",
         100.0 * (quads - fewest) as f64 / quads as f64,
         fewest as f64 / plain_quads as f64,
         fewest as f64 / fewest_plain as f64

@@ -178,7 +178,7 @@ fn exact_merges_are_affine_or_small_squares() {
 
 #[test]
 fn the_square_exception_is_counted_on_a_plane() {
-    use exact_merge::{Plane, exact_non_affine_squares, fewest_exact_quads};
+    use exact_merge::{Plane, exact_non_affine_squares, fewest_exact_quads, non_affine_faces};
     let square = [[1i8, 2, 3], [2, 3, 3], [3, 3, 3]];
     let mut plane: Plane = [[None; 32]; 32];
     for (i, j) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
@@ -186,6 +186,7 @@ fn the_square_exception_is_counted_on_a_plane() {
         plane[j + 5][i + 7] = Some([v(0, 0), v(1, 0), v(0, 1), v(1, 1)]);
     }
     assert_eq!(exact_non_affine_squares(&plane), 1);
+    assert_eq!(non_affine_faces(&plane), 2);
     // Without it: two faces that are not affine, alone, and two affine ones of different
     // functions.
     assert_eq!(fewest_exact_quads(&plane), 4);

@@ -221,6 +221,17 @@ pub fn min_rects(rows: &[u32; 32]) -> usize {
     (reflex - independent + euler) as usize
 }
 
+/// How many of a plane's faces have corner values that are not affine (each a quad of its
+/// own in any exact merging, but for the squares of [`exact_non_affine_squares`]).
+pub fn non_affine_faces(plane: &Plane) -> usize {
+    plane
+        .iter()
+        .flatten()
+        .flatten()
+        .filter(|&&a| !affine(a))
+        .count()
+}
+
 /// The fewest exact quads for one plane's faces: a face whose values are not affine is a
 /// quad of its own (squares that merge it exactly are counted apart, by
 /// [`exact_non_affine_squares`]); the others group by the affine function of their values,
