@@ -35,6 +35,9 @@ use voxel_core::{
 };
 use voxel_mesh::{ChunkMeshes, MeshOptions, Mesher, mesh_chunks};
 
+#[path = "../tests/common/exact_merge.rs"]
+mod exact_merge;
+
 /// The mesher without ambient occlusion (the peer of "ours" with it).
 fn without_ao(reg: &BlockRegistry) -> Mesher {
     Mesher::with_options(
@@ -542,15 +545,43 @@ fn storage_and_terrain_section(reg: &BlockRegistry, generator: &TerrainGenerator
     // only with faces of equal corner values).
     let mut plain = without_ao(reg);
     let mut plain_quads = 0;
+    // The fewest quads any exact merging allows, with and without occlusion: per plane,
+    // the minimum rectangle partition of its faces grouped by the affine function of their
+    // corner values (tests/common/exact_merge.rs says why no other merge is exact but a
+    // few small squares, counted here).
+    let t = Instant::now();
+    let (mut fewest, mut fewest_plain, mut squares, mut alone) = (0, 0, 0, 0);
+    // Adds a mesh's fewest exact quads, exact non-affine squares and non-affine faces.
+    let bound = |m: &ChunkMeshes, counts: [&mut usize; 3]| {
+        let [fewest, squares, alone] = counts;
+        for quads in [&m.opaque, &m.cutout, &m.translucent] {
+            for plane in exact_merge::planes(quads).values() {
+                *fewest += exact_merge::fewest_exact_quads(plane);
+                *squares += exact_merge::exact_non_affine_squares(plane);
+                *alone += exact_merge::non_affine_faces(plane);
+            }
+        }
+    };
     for (p, chunk) in world.iter() {
-        plain_quads += plain
+        let m = plain
             .mesh(chunk, world.neighbourhood(p))
-            .expect("known blocks")
-            .len();
+            .expect("known blocks");
+        plain_quads += m.len();
+        bound(&m, [&mut fewest_plain, &mut 0, &mut 0]);
     }
+    for (_, m) in &meshes {
+        bound(m, [&mut fewest, &mut squares, &mut alone]);
+    }
+    let bound_s = secs(t.elapsed());
     println!(
         "quads with AO / without on the 2048-chunk world: {quads} / {plain_quads} = {:.3} (target <= 1.5)",
         quads as f64 / plain_quads as f64
+    );
+    println!(
+        "fewest exact quads (minimum partitions; {bound_s:.0} s): with AO {fewest} ({:.2}% below ours), without {fewest_plain}; with AO / ours without = {:.3}, / fewest without = {:.3}; faces with values not affine {alone}, exact merges that are not affine {squares}",
+        100.0 * (quads - fewest) as f64 / quads as f64,
+        fewest as f64 / plain_quads as f64,
+        fewest as f64 / fewest_plain as f64
     );
 
     storage_section(&world);

@@ -15,6 +15,10 @@
 //! the linear interpolation over the merged quad is exactly the per-face one, whatever
 //! diagonal its triangles use.
 //!
+//! The mesher reads the four values of a face once, with one lookup of the 3×3 opaque
+//! cells in front of it in a 512-entry table, and covers the occluded faces of a plane with
+//! the AO byte as a per-face merge key (`cover_occluded`).
+//!
 //! The values go into the quad's word 1, bits 24..32 (see [`crate::quad`]), two bits per
 //! corner in the order `(u0, v0)`, `(u1, v0)`, `(u0, v1)`, `(u1, v1)` of the face's (U, V)
 //! axes. The renderer splits a quad along the diagonal whose two corners are brighter in
@@ -81,42 +85,47 @@ impl Pad {
         is_opaque: &dyn Fn(BlockId) -> bool,
         layers: &mut Vec<(BlockId, LayerMask)>,
     ) {
-        for row in self.by_y.iter_mut().chain(self.by_x.iter_mut()) {
-            row.fill(0);
-        }
-        for a in 0..CHUNK_SIZE {
-            for z in 0..CHUNK_SIZE {
-                self.by_y[a + 1][z + 1] = u64::from(opaque.by_y[column_index(a, z)]) << 1;
-                self.by_x[a + 1][z + 1] = u64::from(opaque.by_x[row_index(a, z)]) << 1;
+        let [px, nx, py, ny, pz, nz] = faces;
+        // Every entry is written below but the four corner columns of each layout (x or y
+        // outside and z outside), which only edge and corner neighbours fill.
+        for plane in [&mut self.by_y, &mut self.by_x] {
+            for out in [0, P - 1] {
+                plane[out][0] = 0;
+                plane[out][P - 1] = 0;
             }
         }
-        // Face neighbours: one layout is a copy of the layer, the other a transpose.
-        for face in Face::ALL {
-            let plane = &faces[face as usize];
-            let out = if face.is_positive() { P - 1 } else { 0 };
-            match face.axis() {
-                // Rows z, bits y.
-                0 => {
-                    copy_shifted(&mut self.by_y[out][1..], plane);
-                    for y in 0..CHUNK_SIZE {
-                        or_bit(&mut self.by_x[y + 1], plane, y, out);
-                    }
-                }
-                // Rows z, bits x.
-                1 => {
-                    copy_shifted(&mut self.by_x[out][1..], plane);
-                    for x in 0..CHUNK_SIZE {
-                        or_bit(&mut self.by_y[x + 1], plane, x, out);
-                    }
-                }
-                // Rows y, bits x: its transpose has rows x, bits y.
-                _ => {
-                    let columns = crate::bits::transpose32(plane);
-                    for (a, (&row, &column)) in plane.iter().zip(&columns).enumerate() {
-                        self.by_x[a + 1][out] = u64::from(row) << 1;
-                        self.by_y[a + 1][out] = u64::from(column) << 1;
-                    }
-                }
+        // The chunk's columns, with the ±y neighbours' cells at y = -1 and 32 (their layers:
+        // rows z, bits x), and its rows along x, with the ±x neighbours' cells at x = -1 and
+        // 32 (rows z, bits y).
+        for a in 0..CHUNK_SIZE {
+            let columns = &opaque.by_y[column_index(a, 0)..][..CHUNK_SIZE];
+            let out = &mut self.by_y[a + 1][1..=CHUNK_SIZE];
+            for (z, (o, &c)) in out.iter_mut().zip(columns).enumerate() {
+                *o = u64::from(c) << 1
+                    | u64::from(ny[z] >> a & 1)
+                    | u64::from(py[z] >> a & 1) << (CHUNK_SIZE + 1);
+            }
+            let rows = &opaque.by_x[row_index(a, 0)..][..CHUNK_SIZE];
+            let out = &mut self.by_x[a + 1][1..=CHUNK_SIZE];
+            for (z, (o, &r)) in out.iter_mut().zip(rows).enumerate() {
+                *o = u64::from(r) << 1
+                    | u64::from(nx[z] >> a & 1)
+                    | u64::from(px[z] >> a & 1) << (CHUNK_SIZE + 1);
+            }
+        }
+        // The ±x neighbours' layers are the columns at x = -1 and 32, the ±y ones the rows
+        // at y = -1 and 32.
+        copy_shifted(&mut self.by_y[0][1..], nx);
+        copy_shifted(&mut self.by_y[P - 1][1..], px);
+        copy_shifted(&mut self.by_x[0][1..], ny);
+        copy_shifted(&mut self.by_x[P - 1][1..], py);
+        // The ±z neighbours' layers (rows y, bits x) are the rows at z = -1 and 32, and
+        // their transposes (rows x, bits y) the columns there.
+        for (plane, out) in [(nz, 0), (pz, P - 1)] {
+            let columns = crate::bits::transpose32(plane);
+            for (a, (&row, &column)) in plane.iter().zip(&columns).enumerate() {
+                self.by_x[a + 1][out] = u64::from(row) << 1;
+                self.by_y[a + 1][out] = u64::from(column) << 1;
             }
         }
         // Edge neighbours give a line of 32 blocks, corner neighbours one block.
@@ -124,48 +133,9 @@ impl Pad {
             let Some(chunk) = neighbours.get(*d) else {
                 continue;
             };
-            // The touching cells: coordinate 0 of the neighbour on a +1 axis, 31 on a -1
-            // axis; `free` runs along the axis where d is 0 (none for a corner).
-            let near = |v: i32| if v > 0 { 0 } else { CHUNK_SIZE - 1 };
-            let padded = |v: i32| if v > 0 { P - 1 } else { 0 };
-            let free = d.iter().position(|&v| v == 0);
-            if let Some(id) = chunk.as_uniform() {
-                if is_opaque(id) {
-                    for k in 0..if free.is_some() { CHUNK_SIZE } else { 1 } {
-                        let mut p = d.map(padded);
-                        if let Some(f) = free {
-                            p[f] = k + 1;
-                        }
-                        self.set(p);
-                    }
-                }
-                continue;
-            }
-            // The neighbour's layer on the side facing us across the first non-zero axis.
-            let axis = d.iter().position(|&v| v != 0).unwrap_or(0);
-            let side = match (axis, d[axis] > 0) {
-                (0, true) => Face::NegX,
-                (0, false) => Face::PosX,
-                (1, true) => Face::NegY,
-                (1, false) => Face::PosY,
-                (_, true) => Face::NegZ,
-                (_, false) => Face::PosZ,
-            };
-            chunk.side_layers(side, layers, is_opaque);
-            let mut plane = [0u32; CHUNK_SIZE];
-            for (_, rows) in layers.iter() {
-                plane.iter_mut().zip(rows).for_each(|(p, r)| *p |= r);
-            }
-            for k in 0..if free.is_some() { CHUNK_SIZE } else { 1 } {
-                let mut local = d.map(near);
-                let mut p = d.map(padded);
-                if let Some(f) = free {
-                    local[f] = k;
-                    p[f] = k + 1;
-                }
-                if layer_bit(&plane, axis, local) {
-                    self.set(p);
-                }
+            let line = touching_line(chunk, *d, is_opaque, layers);
+            if line != 0 {
+                self.or_line(*d, line);
             }
         }
         for z in 0..P {
@@ -184,9 +154,39 @@ impl Pad {
         }
     }
 
-    fn set(&mut self, p: [usize; 3]) {
-        self.by_y[p[0]][p[2]] |= 1 << p[1];
-        self.by_x[p[1]][p[2]] |= 1 << p[0];
+    /// Sets the opaque cells `line` of the edge or corner neighbour at offset `d` (see
+    /// [`touching_line`]) in both layouts.
+    fn or_line(&mut self, d: [i32; 3], line: u32) {
+        let [x, y, z] = d.map(|v| if v > 0 { P - 1 } else { 0 });
+        let bits = |k: usize| u64::from(line >> k & 1);
+        match d {
+            // Along x: a row of `by_x`, one bit of each column of `by_y` at (y, z).
+            [0, _, _] => {
+                self.by_x[y][z] |= u64::from(line) << 1;
+                for k in 0..CHUNK_SIZE {
+                    self.by_y[k + 1][z] |= bits(k) << y;
+                }
+            }
+            // Along y: a column of `by_y`, one bit of each row of `by_x` at (y, z).
+            [_, 0, _] => {
+                self.by_y[x][z] |= u64::from(line) << 1;
+                for k in 0..CHUNK_SIZE {
+                    self.by_x[k + 1][z] |= bits(k) << x;
+                }
+            }
+            // Along z: one bit of each column and of each row.
+            [_, _, 0] => {
+                for k in 0..CHUNK_SIZE {
+                    self.by_y[x][k + 1] |= bits(k) << y;
+                    self.by_x[y][k + 1] |= bits(k) << x;
+                }
+            }
+            // A corner: one block.
+            _ => {
+                self.by_y[x][z] |= bits(0) << y;
+                self.by_x[y][z] |= bits(0) << x;
+            }
+        }
     }
 
     /// The occluders in front of the faces of layer `layer` of `face` (the layer one step
@@ -215,162 +215,155 @@ fn copy_shifted(dst: &mut [u64], src: &LayerMask) {
     }
 }
 
-/// Sets bit `to` of `dst[z + 1]` where bit `from` of `plane[z]` is set, for every z (one
-/// column of a neighbour's layer into the shell's border bit; vectorises).
-#[inline]
-fn or_bit(dst: &mut [u64; P], plane: &LayerMask, from: usize, to: usize) {
-    for (d, &p) in dst[1..=CHUNK_SIZE].iter_mut().zip(plane.iter()) {
-        *d |= u64::from(p >> from & 1) << to;
+/// The opaque blocks of the edge or corner neighbour at offset `d` that touch the chunk:
+/// for an edge, the line of 32 blocks along the axis where `d` is 0 (bit k: coordinate k
+/// there); for a corner, its one block (bit 0). A touching cell is at coordinate 0 of the
+/// neighbour along a +1 axis, 31 along a -1 axis.
+fn touching_line(
+    chunk: &voxel_core::Chunk,
+    d: [i32; 3],
+    is_opaque: &dyn Fn(BlockId) -> bool,
+    layers: &mut Vec<(BlockId, LayerMask)>,
+) -> u32 {
+    let corner = !d.contains(&0);
+    if let Some(id) = chunk.as_uniform() {
+        return match (is_opaque(id), corner) {
+            (false, _) => 0,
+            (true, true) => 1,
+            (true, false) => u32::MAX,
+        };
+    }
+    // The neighbour's layer facing us across x (rows z, bits y), or across y for an edge
+    // along x (rows z, bits x); both layers are contiguous in the mask layouts.
+    let side = match d {
+        [0, dy, _] if dy > 0 => Face::NegY,
+        [0, _, _] => Face::PosY,
+        [dx, _, _] if dx > 0 => Face::NegX,
+        _ => Face::PosX,
+    };
+    chunk.side_layers(side, layers, is_opaque);
+    let mut plane = [0u32; CHUNK_SIZE];
+    for (_, rows) in layers.iter() {
+        plane.iter_mut().zip(rows).for_each(|(p, r)| *p |= r);
+    }
+    let [_, y, z] = d.map(|v| if v > 0 { 0 } else { CHUNK_SIZE - 1 });
+    match d {
+        // Along x (rows z, bits x) or along y (rows z, bits y): the row at z.
+        [0, _, _] | [_, 0, _] => plane[z],
+        // Along z: bit y of every row.
+        [_, _, 0] => (0..CHUNK_SIZE).fold(0, |acc, k| acc | (plane[k] >> y & 1) << k),
+        _ => plane[z] >> y & 1,
     }
 }
 
-/// Whether the block at `local` (whose `axis` coordinate is ignored) is set in a layer in
-/// the layout of [`voxel_core::Chunk::side_layers`] for a side along `axis`.
-fn layer_bit(plane: &LayerMask, axis: usize, local: [usize; 3]) -> bool {
-    let (row, bit) = match axis {
-        0 => (local[2], local[1]),
-        1 => (local[2], local[0]),
-        _ => (local[1], local[0]),
-    };
-    plane[row] >> bit & 1 != 0
-}
-
 /// The corners of a face in the plane's (row, bit) directions.
-#[cfg(test)]
 const CORNERS: [(i32, i32); 4] = [(-1, -1), (-1, 1), (1, -1), (1, 1)];
 
 /// Which of the quad's corner slots (`u + 2v`) the corner `(dr, db)` of a face is, for
 /// faces whose U axis runs along the bits (x and z faces) or along the rows (y faces).
-#[cfg(test)]
-fn slot(axis: usize, (dr, db): (i32, i32)) -> usize {
-    let (du, dv) = if axis == 1 { (dr, db) } else { (db, dr) };
-    usize::from(du > 0) + 2 * usize::from(dv > 0)
+const fn slot(u_along_rows: bool, (dr, db): (i32, i32)) -> usize {
+    let (du, dv) = if u_along_rows { (dr, db) } else { (db, dr) };
+    (du > 0) as usize + 2 * (dv > 0) as usize
 }
 
-/// Faces of one plane that share an AO byte, and which rows hold any.
-#[derive(Clone)]
-struct Bucket {
-    ao: u8,
-    live: u32,
-    rows: [u32; CHUNK_SIZE],
-}
-
-/// Working memory of [`split_by_ao`]: the faces of one plane grouped by AO byte. Buckets
-/// are reused; covering a bucket leaves its rows zero.
-#[derive(Clone)]
-pub(crate) struct Buckets {
-    /// Index + 1 in `buckets` of each AO byte's group (0: none yet).
-    index: [u8; 256],
-    buckets: Vec<Bucket>,
-    used: usize,
-}
-
-impl Buckets {
-    pub(crate) fn new() -> Self {
-        Self {
-            index: [0; 256],
-            buckets: Vec::new(),
-            used: 0,
+/// The AO byte of a face for each of the 512 patterns of opaque cells in the 3×3 block in
+/// front of it: bit `3 (dr + 1) + (db + 1)` is the cell `dr` rows and `db` bits away (the
+/// face's own front cell, bit 4, is never opaque where a face is).
+const fn ao_table(u_along_rows: bool) -> [u8; 512] {
+    let mut table = [0u8; 512];
+    let mut n = 0;
+    while n < 512 {
+        let mut ao = 0u8;
+        let mut c = 0;
+        while c < 4 {
+            let (dr, db) = CORNERS[c];
+            let v = vertex_ao(cell(n, dr, 0), cell(n, 0, db), cell(n, dr, db));
+            ao |= v << (2 * slot(u_along_rows, (dr, db)));
+            c += 1;
         }
+        table[n as usize] = ao;
+        n += 1;
     }
-
-    #[inline]
-    fn add(&mut self, ao: u8, row: usize, bits: u32) {
-        let i = match self.index[usize::from(ao)] {
-            0 => {
-                if self.used == self.buckets.len() {
-                    self.buckets.push(Bucket {
-                        ao,
-                        live: 0,
-                        rows: [0; CHUNK_SIZE],
-                    });
-                }
-                self.buckets[self.used].ao = ao;
-                self.used += 1;
-                self.index[usize::from(ao)] = self.used as u8;
-                self.used - 1
-            }
-            i => usize::from(i) - 1,
-        };
-        let b = &mut self.buckets[i];
-        b.rows[row] |= bits;
-        b.live |= 1 << row;
-    }
+    table
 }
 
-/// The value lanes of one corner over a row of 32 faces: `(low, high)` bits of
-/// `3 − count` (count = sides + corner, taken as 3 when both sides are there).
-#[inline(always)]
-fn corner_lanes(s1: u32, s2: u32, c: u32) -> (u32, u32) {
-    let both = s1 & s2;
-    let low = (s1 ^ s2 ^ c) | both;
-    let high = both | (s1 & c) | (s2 & c);
-    (!low, !high)
+/// Whether the cell `dr` rows and `db` bits away is set in a 3×3 pattern of [`ao_table`].
+const fn cell(pattern: i32, dr: i32, db: i32) -> bool {
+    pattern >> (3 * (dr + 1) + db + 1) & 1 != 0
 }
 
-/// Moves the faces of `rows` that an occluder touches out of `rows`, grouped by AO byte,
-/// and calls `emit(ao, live rows, plane)` for each group, which must leave the plane zero
-/// (as [`crate::greedy_rects`] does); the faces left in `rows` have [`AO_NONE`].
-/// `axis` is the face's normal axis (it decides which corner is which slot).
-pub(crate) fn split_by_ao(
+/// [`ao_table`] for x and z faces (U along the bits) and for y faces (U along the rows).
+static AO_TABLES: [[u8; 512]; 2] = [ao_table(false), ao_table(true)];
+
+/// Covers the faces of `rows` (`live`: its rows holding any) that an occluder touches with
+/// rectangles of faces of equal corner values, and takes them out of `rows`; the faces
+/// left there have [`AO_NONE`]. Calls `emit(row, rows, bit, bits, ao)` per rectangle and
+/// returns the rows still holding faces. `axis` is the face's normal axis
+/// (it decides which corner is which slot).
+///
+/// The corner values of a face are read once from the 3×3 occluders in front of it (one
+/// table lookup). The cover is [`crate::greedy_rects`]'s, with the AO byte as a per-face
+/// key: in each row from the lowest, the lowest face not yet covered starts a run as long
+/// as the next faces have its byte, and the run grows down while the row below has the
+/// same faces with the same byte. Rectangles of different bytes never meet, so this gives
+/// exactly the rectangles of grouping the faces by byte and covering each group alone.
+#[inline]
+pub(crate) fn cover_occluded(
     rows: &mut [u32; CHUNK_SIZE],
+    rows_live: u32,
     occ: &Occluders,
     axis: usize,
-    buckets: &mut Buckets,
-    mut emit: impl FnMut(u8, u32, &mut [u32; CHUNK_SIZE]),
-) {
-    let mut live = crate::bits::live_rows(rows);
+    mut emit: impl FnMut(usize, usize, usize, usize, u8),
+) -> u32 {
+    // The faces an occluder touches (any of the nine cells in front).
+    let mut shaded = [0u32; CHUNK_SIZE];
+    let mut live = 0u32;
+    let mut remaining = rows_live;
+    let mut left = rows_live;
+    while left != 0 {
+        let r = left.trailing_zeros() as usize;
+        left &= left - 1;
+        let v = occ[r] | occ[r + 1] | occ[r + 2];
+        let s = rows[r] & (v | v >> 1 | v >> 2) as u32;
+        shaded[r] = s;
+        rows[r] &= !s;
+        live |= u32::from(s != 0) << r;
+        remaining &= !(u32::from(rows[r] == 0) << r);
+    }
+    let table = &AO_TABLES[usize::from(axis == 1)];
+    // The AO byte of the face at bit `b` of row `r`.
+    let ao_at = |r: usize, b: usize| {
+        let (up, mid, down) = (occ[r] >> b & 7, occ[r + 1] >> b & 7, occ[r + 2] >> b & 7);
+        table[(up | mid << 3 | down << 6) as usize]
+    };
     while live != 0 {
         let r = live.trailing_zeros() as usize;
         live &= live - 1;
-        let (up, mid, down) = (occ[r], occ[r + 1], occ[r + 2]);
-        // Faces with any occluder among their eight neighbours in front.
-        let v = up | mid | down;
-        let shaded = rows[r] & ((v | v >> 1 | v >> 2) as u32);
-        if shaded == 0 {
-            continue;
-        }
-        rows[r] &= !shaded;
-        // Sides: the row before or after (dr = ∓1) at the face's bit, and the face's row
-        // at the bit before or after (db = ∓1); corners: both steps.
-        let (side_before, side_after) = ((up >> 1) as u32, (down >> 1) as u32);
-        let (bit_before, bit_after) = (mid as u32, (mid >> 2) as u32);
-        let corner = |row: u64, db_after: bool| (row >> if db_after { 2 } else { 0 }) as u32;
-        let a = corner_lanes(side_before, bit_before, corner(up, false)); // (-, -)
-        let b = corner_lanes(side_before, bit_after, corner(up, true)); // (-, +)
-        let c = corner_lanes(side_after, bit_before, corner(down, false)); // (+, -)
-        let d = corner_lanes(side_after, bit_after, corner(down, true)); // (+, +)
-        // Quad slots u + 2v: U along the bits for x and z faces, along the rows for y.
-        let [s0, s1, s2, s3] = if axis == 1 {
-            [a, c, b, d]
-        } else {
-            [a, b, c, d]
-        };
-        // Lane k is bit k of the AO byte.
-        let lanes = [s0.0, s0.1, s1.0, s1.1, s2.0, s2.1, s3.0, s3.1];
-        let mut left = shaded;
-        while left != 0 {
-            let bit = left.trailing_zeros();
-            // The AO byte of this face (lane k is bit k), and the faces of the row with the
-            // same byte: those where no lane differs from this face's bit.
-            let mut ao = 0u32;
-            let mut differs = 0u32;
-            for (k, lane) in lanes.iter().enumerate() {
-                let b = lane >> bit & 1;
-                ao |= b << k;
-                differs |= lane ^ 0u32.wrapping_sub(b);
+        let mut bits = shaded[r];
+        while bits != 0 {
+            let b0 = bits.trailing_zeros() as usize;
+            let ao = ao_at(r, b0);
+            let mut end = b0 + 1;
+            while end < CHUNK_SIZE && bits >> end & 1 != 0 && ao_at(r, end) == ao {
+                end += 1;
             }
-            let same = left & !differs;
-            buckets.add(ao as u8, r, same);
-            left &= !same;
+            let run = (u32::MAX >> (CHUNK_SIZE - (end - b0))) << b0;
+            bits &= !run;
+            let mut h = 1;
+            while r + h < CHUNK_SIZE
+                && shaded[r + h] & run == run
+                && (b0..end).all(|b| ao_at(r + h, b) == ao)
+            {
+                shaded[r + h] &= !run;
+                if shaded[r + h] == 0 {
+                    live &= !(1 << (r + h));
+                }
+                h += 1;
+            }
+            emit(r, h, b0, end - b0, ao);
         }
     }
-    for b in &mut buckets.buckets[..buckets.used] {
-        buckets.index[usize::from(b.ao)] = 0;
-        emit(b.ao, b.live, &mut b.rows);
-        b.live = 0;
-    }
-    buckets.used = 0;
+    remaining
 }
 
 /// The AO value (0 to 3) of corner `(u, v)` (each 0 or 1) of an AO byte.
@@ -380,11 +373,11 @@ pub fn corner_ao(ao: u8, u: usize, v: usize) -> u8 {
 
 /// The value, 0 (darkest) to 3 (open), of a vertex with these neighbours in front of its
 /// face: the rule in the module docs, one vertex at a time (tests and tools use it).
-pub fn vertex_ao(side1: bool, side2: bool, corner: bool) -> u8 {
+pub const fn vertex_ao(side1: bool, side2: bool, corner: bool) -> u8 {
     if side1 && side2 {
         0
     } else {
-        3 - u8::from(side1) - u8::from(side2) - u8::from(corner)
+        3 - side1 as u8 - side2 as u8 - corner as u8
     }
 }
 
@@ -402,25 +395,44 @@ mod tests {
         assert_eq!(vertex_ao(true, true, true), 0);
     }
 
-    /// The bit-parallel split against `vertex_ao` per face, on random occluders.
-    #[test]
-    #[allow(clippy::needless_range_loop)] // (row, bit) indices read as the matrix they are
-    fn split_matches_the_per_vertex_rule() {
-        let mut s = 0x1234_5678_9abc_def0u64;
-        let mut next = || {
+    fn xorshift(mut s: u64) -> impl FnMut() -> u64 {
+        move || {
             s ^= s << 13;
             s ^= s >> 7;
             s ^= s << 17;
             s
-        };
-        let mut buckets = Buckets::new();
+        }
+    }
+
+    /// Random occluders and faces where the cell in front is empty (as the mesher emits),
+    /// from sparse to dense occluders and faces.
+    fn random_plane(next: &mut impl FnMut() -> u64, k: usize) -> (Occluders, [u32; CHUNK_SIZE]) {
+        let occ: Occluders = std::array::from_fn(|_| {
+            let mut o = next();
+            for _ in 0..k % 3 {
+                o &= next();
+            }
+            o & ((1 << P) - 1)
+        });
+        let faces = std::array::from_fn(|r| {
+            let f = if k.is_multiple_of(2) {
+                next() as u32
+            } else {
+                !0
+            };
+            f & !((occ[r + 1] >> 1) as u32)
+        });
+        (occ, faces)
+    }
+
+    /// The covering against `vertex_ao` per face, on random occluders.
+    #[test]
+    #[allow(clippy::needless_range_loop)] // (row, bit) indices read as the matrix they are
+    fn cover_matches_the_per_vertex_rule() {
+        let mut next = xorshift(0x1234_5678_9abc_def0);
         for axis in 0..3 {
-            for _ in 0..20 {
-                let occ: Occluders = std::array::from_fn(|_| next() & next() & ((1 << P) - 1));
-                let faces: [u32; CHUNK_SIZE] = std::array::from_fn(|r| {
-                    // Faces only where the cell in front is empty, as the mesher emits.
-                    (next() as u32) & !((occ[r + 1] >> 1) as u32)
-                });
+            for k in 0..30 {
+                let (occ, faces) = random_plane(&mut next, k);
                 let cell = |r: i32, b: i32| occ[(r + 1) as usize] >> (b + 1) & 1 != 0;
                 let mut want = [[AO_NONE; CHUNK_SIZE]; CHUNK_SIZE];
                 let mut shaded_any = [[false; CHUNK_SIZE]; CHUNK_SIZE];
@@ -430,7 +442,7 @@ mod tests {
                         for c @ (dr, db) in CORNERS {
                             let v =
                                 vertex_ao(cell(r + dr, b), cell(r, b + db), cell(r + dr, b + db));
-                            ao |= v << (2 * slot(axis, c));
+                            ao |= v << (2 * slot(axis == 1, c));
                         }
                         want[r as usize][b as usize] = ao;
                         shaded_any[r as usize][b as usize] =
@@ -439,16 +451,16 @@ mod tests {
                 }
                 let mut rows = faces;
                 let mut got = [[None; CHUNK_SIZE]; CHUNK_SIZE];
-                split_by_ao(&mut rows, &occ, axis, &mut buckets, |ao, _, plane| {
-                    for (r, row) in std::mem::take(plane).iter().enumerate() {
-                        for b in 0..CHUNK_SIZE {
-                            if row >> b & 1 != 0 {
-                                assert!(got[r][b].is_none(), "face twice");
-                                got[r][b] = Some(ao);
-                            }
+                let live = crate::bits::live_rows(&rows);
+                let left = cover_occluded(&mut rows, live, &occ, axis, |r, h, b, w, ao| {
+                    for row in &mut got[r..r + h] {
+                        for g in &mut row[b..b + w] {
+                            assert!(g.is_none(), "face twice");
+                            *g = Some(ao);
                         }
                     }
                 });
+                assert_eq!(left, crate::bits::live_rows(&rows), "rows left");
                 for r in 0..CHUNK_SIZE {
                     for b in 0..CHUNK_SIZE {
                         if faces[r] >> b & 1 == 0 {
@@ -461,9 +473,65 @@ mod tests {
                         });
                         assert_eq!(ao, want[r][b], "axis {axis} face ({r}, {b})");
                         assert_eq!(got[r][b].is_some(), shaded_any[r][b]);
+                        assert!(got[r][b].is_none() || rows[r] >> b & 1 == 0, "left in rows");
                     }
                 }
             }
+        }
+    }
+
+    /// The covering gives exactly the rectangles of grouping the occluded faces by AO byte
+    /// and covering each group with `greedy_rects` (the mesher's cover before the per-face
+    /// key), so the quads do not change.
+    #[test]
+    fn cover_equals_greedy_rects_per_ao_group() {
+        let mut next = xorshift(0x0bad_cafe_f00d_1234);
+        for axis in 0..3 {
+            for k in 0..30 {
+                let (occ, faces) = random_plane(&mut next, k);
+                let mut got = Vec::new();
+                let mut rows = faces;
+                let live = crate::bits::live_rows(&rows);
+                cover_occluded(&mut rows, live, &occ, axis, |r, h, b, w, ao| {
+                    got.push((ao, r, h, b, w));
+                });
+                // The reference: each face's byte from the table, one plane per byte.
+                let mut groups = std::collections::BTreeMap::<u8, [u32; CHUNK_SIZE]>::new();
+                for r in 0..CHUNK_SIZE {
+                    for b in 0..CHUNK_SIZE {
+                        let front = occ[r] | occ[r + 1] | occ[r + 2];
+                        if faces[r] >> b & 1 == 0 || front >> b & 7 == 0 {
+                            continue;
+                        }
+                        let n = |o: u64| (o >> b & 7) as usize;
+                        let ao = AO_TABLES[usize::from(axis == 1)]
+                            [n(occ[r]) | n(occ[r + 1]) << 3 | n(occ[r + 2]) << 6];
+                        groups.entry(ao).or_insert([0; CHUNK_SIZE])[r] |= 1 << b;
+                    }
+                }
+                let mut want = Vec::new();
+                for (ao, mut plane) in groups {
+                    crate::greedy_rects(&mut plane, |r, h, b, w| want.push((ao, r, h, b, w)));
+                }
+                got.sort_unstable();
+                want.sort_unstable();
+                assert_eq!(got, want, "axis {axis} case {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn table_matches_vertex_ao_on_single_occluders() {
+        // One side occluder in the face's row, one bit before it (dr = 0, db = -1: pattern
+        // bit 3): the two corners at db = -1 drop to 2.
+        let side = 1 << 3;
+        for (u_along_rows, table) in [(false, &AO_TABLES[0]), (true, &AO_TABLES[1])] {
+            let ao = table[side];
+            for c @ (_, db) in CORNERS {
+                let v = ao >> (2 * slot(u_along_rows, c)) & 3;
+                assert_eq!(v, if db < 0 { 2 } else { 3 });
+            }
+            assert_eq!(table[0], AO_NONE);
         }
     }
 }

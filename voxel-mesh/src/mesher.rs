@@ -51,7 +51,7 @@ use voxel_core::{
     Neighbourhood, Occupancy, RenderClass, row_index,
 };
 
-use crate::ao::{AO_NONE, Buckets, Pad, split_by_ao};
+use crate::ao::{AO_NONE, Pad, cover_occluded};
 use crate::bits::{greedy_rects_live, live_rows};
 use crate::{Error, PackedQuad, Result};
 
@@ -156,8 +156,6 @@ pub struct Mesher {
     built: MaskBuffer,
     /// Opaque blocks of the chunk and the shell around it, for ambient occlusion.
     pad: Box<Pad>,
-    /// Faces of one plane grouped by their occlusion.
-    buckets: Buckets,
     /// An edge neighbour's touching layer, per type.
     edge_layers: Vec<(BlockId, LayerMask)>,
 }
@@ -166,7 +164,7 @@ pub struct Mesher {
 /// chunk with the scratch to group faces by them.
 struct Sink<'a> {
     out: &'a mut Vec<PackedQuad>,
-    ao: Option<(&'a Pad, &'a mut Buckets)>,
+    ao: Option<&'a Pad>,
 }
 
 impl std::fmt::Debug for Mesher {
@@ -188,32 +186,62 @@ fn or_into(dst: &mut [u32], src: &[u32]) {
     dst.iter_mut().zip(src).for_each(|(d, s)| *d |= s);
 }
 
-/// Emits the rectangles covering the faces in `rows` (layer `layer` of `face`) as quads
-/// with `flags`; with ambient occlusion, faces an occluder touches are grouped by their
-/// corner values first and each group covered on its own.
+/// Emits the rectangles covering the faces in `rows` (layer `layer` of `face`; `live` says
+/// which rows hold any) as quads with `flags`; with ambient occlusion, faces an occluder
+/// touches are covered first, by rectangles of equal corner values ([`cover_occluded`]).
 #[inline]
 fn emit_plane(
     rows: &mut Plane,
+    mut live: u32,
     face: Face,
     layer: usize,
     block: BlockId,
     flags: u32,
     sink: &mut Sink<'_>,
 ) {
-    let occluders = sink
-        .ao
-        .as_ref()
-        .and_then(|(pad, _)| pad.occluders(face, layer));
-    if let (Some(occ), Some((_, buckets))) = (occluders, sink.ao.as_mut()) {
+    if let Some(occ) = sink.ao.and_then(|pad| pad.occluders(face, layer)) {
         let out = &mut *sink.out;
-        split_by_ao(rows, occ, face.axis(), buckets, |ao, live, plane| {
-            cover(plane, live, face, layer, block, flags, ao, out);
+        live = cover_occluded(rows, live, occ, face.axis(), |r, h, b, w, ao| {
+            out.push(quad(face, layer, r, h, b, w, block, flags, ao));
         });
     }
-    if rows.iter().fold(0, |acc, &r| acc | r) != 0 {
-        let live = live_rows(rows);
+    if live != 0 {
         cover(rows, live, face, layer, block, flags, AO_NONE, sink.out);
     }
+}
+
+/// `rows & !hidden`, and whether it holds any bit (vectorises).
+#[inline(always)]
+fn and_not(rows: &Plane, hidden: &Plane) -> (Plane, bool) {
+    let mut faces = [0; CHUNK_SIZE];
+    for (f, (&r, &h)) in faces.iter_mut().zip(rows.iter().zip(hidden)) {
+        *f = r & !h;
+    }
+    let any = faces.iter().fold(0, |acc, &f| acc | f) != 0;
+    (faces, any)
+}
+
+/// The quad of the rectangle of `h` rows from `r` and `w` bits from `b` in layer `layer`
+/// of `face`'s plane.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn quad(
+    face: Face,
+    layer: usize,
+    r: usize,
+    h: usize,
+    b: usize,
+    w: usize,
+    block: BlockId,
+    flags: u32,
+    ao: u8,
+) -> PackedQuad {
+    let q = match face.axis() {
+        0 => PackedQuad::new([layer, b, r], w, h, face, block),
+        1 => PackedQuad::new([b, layer, r], h, w, face, block),
+        _ => PackedQuad::new([b, r, layer], w, h, face, block),
+    };
+    q.with_flags(flags).with_ao(ao)
 }
 
 /// Covers the faces in `rows` (whose rows holding any are `live`) with rectangles, emitted
@@ -231,17 +259,12 @@ fn cover(
     out: &mut Vec<PackedQuad>,
 ) {
     greedy_rects_live(rows, live, |r, h, b, w| {
-        let q = match face.axis() {
-            0 => PackedQuad::new([layer, b, r], w, h, face, block),
-            1 => PackedQuad::new([b, layer, r], h, w, face, block),
-            _ => PackedQuad::new([b, r, layer], w, h, face, block),
-        };
-        out.push(q.with_flags(flags).with_ao(ao));
+        out.push(quad(face, layer, r, h, b, w, block, flags, ao));
     });
 }
 
-/// Emits the faces in `rows`: those whose neighbour is set in the plane `interface` gives
-/// (the same layout; asked only when there are faces) flagged, the others not.
+/// Emits the faces in `rows` (a plane holding some): those whose neighbour is set in the
+/// plane `interface` gives (the same layout) flagged, the others not.
 #[inline]
 fn emit_split(
     rows: &mut Plane,
@@ -251,16 +274,17 @@ fn emit_split(
     block: BlockId,
     sink: &mut Sink<'_>,
 ) {
-    if rows.iter().all(|&r| r == 0) {
-        return;
-    }
+    let mut live = live_rows(rows);
     if let Some(next) = interface {
         let next = next();
         let mut flagged: Plane = std::array::from_fn(|r| rows[r] & next[r]);
-        if flagged.iter().any(|&r| r != 0) {
+        let flagged_live = live_rows(&flagged);
+        if flagged_live != 0 {
             rows.iter_mut().zip(&flagged).for_each(|(r, f)| *r &= !f);
+            live = live_rows(rows);
             emit_plane(
                 &mut flagged,
+                flagged_live,
                 face,
                 layer,
                 block,
@@ -269,7 +293,9 @@ fn emit_split(
             );
         }
     }
-    emit_plane(rows, face, layer, block, 0, sink);
+    if live != 0 {
+        emit_plane(rows, live, face, layer, block, 0, sink);
+    }
 }
 
 const EMPTY_OCCUPANCY: Occupancy = Occupancy {
@@ -290,7 +316,6 @@ impl Mesher {
             classes: registry.iter().map(|(_, d)| d.class).collect(),
             options,
             pad: Pad::new(),
-            buckets: Buckets::new(),
             edge_layers: Vec::new(),
             s: Box::new(Scratch {
                 opaque: EMPTY_OCCUPANCY,
@@ -360,7 +385,6 @@ impl Mesher {
             s,
             built,
             pad,
-            buckets,
             edge_layers,
         } = self;
         let classes = &*classes;
@@ -500,7 +524,7 @@ impl Mesher {
                 && (class != RenderClass::Translucent || options.translucent_occlusion);
             let mut sink = Sink {
                 out: out.for_class(class),
-                ao: occludes.then_some((&**pad, &mut *buckets)),
+                ao: occludes.then_some(&**pad),
             };
             if chunk.as_uniform().is_some() {
                 // One block type everywhere. An opaque or translucent type hides itself, so
@@ -515,12 +539,11 @@ impl Mesher {
                     };
                     if class == RenderClass::Cutout {
                         for l in (0..CHUNK_SIZE).filter(|&l| l != border) {
-                            let shaded = sink
-                                .ao
-                                .as_ref()
-                                .is_some_and(|(pad, _)| pad.occluders(face, l).is_some());
+                            let shaded =
+                                sink.ao.is_some_and(|pad| pad.occluders(face, l).is_some());
                             if shaded {
-                                emit_plane(&mut [u32::MAX; CHUNK_SIZE], face, l, id, 0, &mut sink);
+                                let mut all = [u32::MAX; CHUNK_SIZE];
+                                emit_plane(&mut all, u32::MAX, face, l, id, 0, &mut sink);
                             } else {
                                 let mut pos = [0; 3];
                                 pos[face.axis()] = l;
@@ -529,9 +552,11 @@ impl Mesher {
                             }
                         }
                     }
-                    let mut rows = nb_hide[face as usize].map(|h| !h);
-                    let interface = split.map(|sp| || sp.neighbours[face as usize]);
-                    emit_split(&mut rows, interface, face, border, id, &mut sink);
+                    let (mut rows, any) = and_not(&[u32::MAX; CHUNK_SIZE], &nb_hide[face as usize]);
+                    if any {
+                        let interface = split.map(|sp| || sp.neighbours[face as usize]);
+                        emit_split(&mut rows, interface, face, border, id, &mut sink);
+                    }
                 }
             } else {
                 mesh_type(bits, hide, &nb_hide, split, id, &mut sink);
@@ -554,7 +579,7 @@ fn mesh_type(
     id: BlockId,
     sink: &mut Sink<'_>,
 ) {
-    let empty = |rows: &Plane| rows.iter().all(|&r| r == 0);
+    let empty = |rows: &Plane| rows.iter().fold(0, |acc, &r| acc | r) == 0;
     for (mine, theirs, inter, faces) in [
         (
             &m.by_y,
@@ -581,7 +606,10 @@ fn mesh_type(
                 } else {
                     &nb_hide[face as usize]
                 };
-                let mut faces: Plane = std::array::from_fn(|r| rows[r] & !hidden[r]);
+                let (mut faces, any) = and_not(rows, hidden);
+                if !any {
+                    continue;
+                }
                 let interface = split.map(|s| {
                     move || {
                         if inside {
@@ -611,6 +639,9 @@ fn mesh_type(
                 };
                 m.by_x[row_index(y, z)] & !h
             });
+            if faces.iter().fold(0, |acc, &f| acc | f) == 0 {
+                continue;
+            }
             let interface = split.map(|s| {
                 move || -> Plane {
                     std::array::from_fn(|y| {
