@@ -147,7 +147,7 @@ fn draw_svg(
 ) -> Result<(), String> {
     let mut text = String::new();
     f(SVGBackend::with_string(&mut text, size).into_drawing_area())?;
-    crate::write_file(path, text.as_bytes())
+    crate::files::write_file(path, text.as_bytes())
 }
 
 fn scatter<DB: DrawingBackend>(

@@ -510,7 +510,7 @@ pub fn write_worst(
             opts.warmup,
             set.scene(index, size).text
         );
-        crate::write_file(&path, text.as_bytes())
+        crate::files::write_file(&path, text.as_bytes())
     };
     for t in &d.techniques {
         if t.technique == "reference" {

@@ -3,7 +3,8 @@
 //! It has no window: the demo's window and the integration tests both build on it.
 //!
 //! Modules depend on each other one way:
-//! - the model: [`limits`] (the documented caps on a run), [`progress`], [`random`]
+//! - the model: [`files`] (result files written in one checked call), [`limits`] (the
+//!   documented caps on a run), [`progress`], [`random`]
 //!   (random scenes as scene-file text), [`edges`] (which pixels lie on quad edges),
 //!   [`content`] (a game's particles and entities),
 //!   [`raymarch`] (the CPU ray-march reference),
@@ -21,6 +22,7 @@ pub mod content;
 pub mod distribution;
 pub mod edges;
 pub mod eval;
+pub mod files;
 pub mod gallery;
 pub mod headless;
 pub mod limits;
@@ -45,12 +47,6 @@ pub fn chain(e: &dyn std::error::Error) -> String {
         source = inner.source();
     }
     s
-}
-
-/// Writes a result file in one checked call, removing what a failed write left
-/// ([`voxel_render::readback::write_file`]); the error names the file.
-pub(crate) fn write_file(path: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
-    voxel_render::readback::write_file(path, bytes).map_err(|e| e.to_string())
 }
 
 /// Runs the evaluation `opts` asks for and writes every file into `opts.out`:

@@ -211,7 +211,7 @@ pub fn write(
 /// Writes `out/report.md`; an error names that file.
 fn write_report(out: &Path, text: String) -> Result<(), String> {
     let path = out.join("report.md");
-    crate::write_file(&path, text.as_bytes())
+    crate::files::write_file(&path, text.as_bytes())
 }
 
 fn header(s: &mut String, summary: &Summary, opts: &EvalOptions) {

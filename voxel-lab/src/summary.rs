@@ -252,5 +252,5 @@ pub fn is_real_time(run: &str) -> bool {
 /// Writes `value` as pretty JSON.
 pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), String> {
     let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
-    crate::write_file(path, (text + "\n").as_bytes())
+    crate::files::write_file(path, (text + "\n").as_bytes())
 }

@@ -4,7 +4,7 @@
 //! dropped, unrun, when the encoder is dropped unsubmitted. The next frame looks.
 //!
 //! The renderer uses it for two things: GPU timings end a profiler frame only once its
-//! encoder is submitted ([`crate::timing`]), and a frame whose encoder was dropped has
+//! encoder is submitted (the timing module), and a frame whose encoder was dropped has
 //! its queue writes (uniforms, draw commands) flushed by an empty submit. wgpu keeps
 //! queue writes, and their staging memory, until the next submit: a game that drops
 //! every encoder would otherwise grow by each frame's writes (about 20 KiB at view
