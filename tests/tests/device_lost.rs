@@ -205,10 +205,10 @@ fn a_device_lost_at_any_point_of_a_frame_gives_errors_not_panics() {
                 contract: Some(contract),
                 translucent_calls: std::cell::Cell::new(0),
                 killed: std::cell::Cell::new(false),
-                objects: [voxel_render::TranslucentObject {
-                    center: glam::DVec3::new(0.5, 0.5, 1.0),
-                    radius: 0.5,
-                }],
+                objects: [voxel_render::TranslucentObject::ball(
+                    glam::DVec3::new(0.5, 0.5, 1.0),
+                    0.5,
+                )],
             };
             if between {
                 ctx.device.destroy();

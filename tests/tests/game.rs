@@ -415,3 +415,53 @@ fn stale_game_pipelines_are_refused_before_recording() {
         "{e:?}"
     );
 }
+
+/// A flat translucent slab wholly above the water surface seen from under water, and its
+/// mirror (wholly below, seen from above): its bounding ball reaches through the surface,
+/// its box does not, and the sorted techniques order it by the box (exact, within 1/255
+/// of the A-buffer reference), as depth peeling is.
+#[test]
+fn a_slab_beyond_the_water_surface_is_exact_from_either_side() {
+    let Some(_ctx) = gpu() else { return };
+    let world = box_world(&[
+        ([-12, -8, -12], [12, -8, 12], SAND),
+        ([-12, -7, -12], [12, 0, 12], WATER),
+    ]);
+    let slab = |y: f64| Entity {
+        center: DVec3::new(0.5, y, -2.0),
+        half_extents: [3.0, 0.25, 3.0],
+        rotation: DQuat::IDENTITY,
+        color: [230, 60, 40],
+        opacity: 0.5,
+    };
+    let dir = out_dir("game_slab");
+    for (name, eye, y) in [
+        ("under_water_slab_above", [0.5, -4.0, 6.0], 3.0),
+        ("above_water_slab_below", [0.5, 6.0, 6.0], -3.0),
+    ] {
+        let scene = with(
+            &tests::scene(name, world.clone(), eye, [0.5, y, -2.0]),
+            entities(vec![slab(y)]),
+        );
+        let reference = render(&scene, technique_config(Technique::Reference, W, H));
+        let without = render(
+            &with(&scene, entities(vec![])),
+            technique_config(Technique::Reference, W, H),
+        );
+        assert!(
+            diff(&reference, &without).over_one > 500,
+            "{name}: the slab is seen"
+        );
+        for t in [
+            Technique::SortedQuads,
+            Technique::Sorted,
+            Technique::DepthPeeling,
+        ] {
+            let img = render(&scene, technique_config(t, W, H));
+            img.save_png(&dir.join(format!("{name}_{}.png", t.name())))
+                .unwrap();
+            let d = diff(&img, &reference);
+            assert!(d.max <= 1, "{name} {}: {d:?}", t.name());
+        }
+    }
+}

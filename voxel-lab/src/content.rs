@@ -52,6 +52,11 @@ impl Entity {
         self.opacity >= 1.0
     }
 
+    /// Half the sides of the axis-aligned box around it, world blocks.
+    pub fn world_half_extents(&self) -> DVec3 {
+        self.axes().iter().map(|a| a.abs()).sum()
+    }
+
     /// Its axes scaled by the half extents (columns), world directions.
     pub fn axes(&self) -> [DVec3; 3] {
         let h = self.half_extents.map(f64::from);
@@ -316,20 +321,16 @@ impl ContentStages {
         content
             .particles
             .iter()
-            .map(|p| TranslucentObject {
-                center: p.center,
-                // The square's corners.
-                radius: f64::from(p.half_size) * std::f64::consts::SQRT_2,
+            // A square facing the camera: its corners, whichever way it turns.
+            .map(|p| {
+                TranslucentObject::ball(p.center, f64::from(p.half_size) * std::f64::consts::SQRT_2)
             })
             .chain(
                 content
                     .entities
                     .iter()
                     .filter(|e| !e.is_opaque())
-                    .map(|e| TranslucentObject {
-                        center: e.center,
-                        radius: DVec3::from(e.half_extents.map(f64::from)).length(),
-                    }),
+                    .map(|e| TranslucentObject::aabb(e.center, e.world_half_extents())),
             )
             .collect()
     }

@@ -48,6 +48,17 @@ struct Thing {
     color: [f32; 4],
 }
 
+impl Thing {
+    /// Half the sides of the axis-aligned box around the turned box.
+    fn world_half(&self) -> DVec3 {
+        [DVec3::X, DVec3::Y, DVec3::Z]
+            .into_iter()
+            .zip(self.half.to_array())
+            .map(|(axis, h)| (self.rotation * axis * h).abs())
+            .sum()
+    }
+}
+
 /// The game's stages: its pipelines, buffers and this frame's things.
 struct Game {
     view: wgpu::Buffer,
@@ -171,17 +182,17 @@ impl Game {
         });
         self.opaque_things = vec![crate_box];
         self.things = std::iter::once(cube).chain(bubbles).collect();
-        // What the sorted techniques order: a ball around each.
+        // What the sorted techniques order: a ball around each bubble (a square facing
+        // the camera), the box around the turning cube.
         self.objects = self
             .things
             .iter()
-            .map(|th| TranslucentObject {
-                center: th.center,
-                radius: if th.particle {
-                    th.half.x * std::f64::consts::SQRT_2
+            .map(|th| {
+                if th.particle {
+                    TranslucentObject::ball(th.center, th.half.x * std::f64::consts::SQRT_2)
                 } else {
-                    th.half.length()
-                },
+                    TranslucentObject::aabb(th.center, th.world_half())
+                }
             })
             .collect();
     }

@@ -852,14 +852,7 @@ impl Renderer {
             let balls: Vec<Ball> = game
                 .translucent_objects()
                 .iter()
-                .map(|o| Ball {
-                    center: o.center,
-                    radius: if o.radius.is_finite() {
-                        o.radius.max(0.0)
-                    } else {
-                        0.0
-                    },
-                })
+                .map(|o| Ball::new(o.center, o.radius, o.half_extents))
                 .collect();
             // Each visible translucent chunk's surfaces, in draw order.
             let chunks: Vec<_> = self

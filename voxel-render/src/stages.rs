@@ -45,15 +45,43 @@ pub struct Stages {
 }
 
 /// A translucent thing a game draws, as the sorted techniques order it: a ball around it,
-/// placed among the chunks by where it lies against their translucent quads and back to
-/// front by its centre among the other objects (the sorted techniques' module docs say
-/// where that is exact). Order-independent techniques ignore it.
+/// and where known the axis-aligned box around it, placed among the chunks by where it
+/// lies against their translucent quads and back to front by its centre among the other
+/// objects (the sorted techniques' module docs say where that is exact). Order-independent
+/// techniques ignore it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TranslucentObject {
     /// Centre, in world blocks.
     pub center: DVec3,
-    /// Radius of a ball holding all of it, blocks (0: order it as a point).
+    /// Radius of a ball around the centre holding all of it, blocks (0: order it as a
+    /// point).
     pub radius: f64,
+    /// Half the sides of an axis-aligned box around the centre holding all of it, blocks,
+    /// when known (`None`: only the ball). The object lies in both: a flat slab over water
+    /// whose ball reaches through the surface is still wholly on one side of it.
+    pub half_extents: Option<DVec3>,
+}
+
+impl TranslucentObject {
+    /// An object known by a ball around it.
+    pub fn ball(center: DVec3, radius: f64) -> Self {
+        Self {
+            center,
+            radius,
+            half_extents: None,
+        }
+    }
+
+    /// An object known by an axis-aligned box around it (`center` ± `half_extents`), and
+    /// the ball around that box.
+    pub fn aabb(center: DVec3, half_extents: DVec3) -> Self {
+        let half = half_extents.abs();
+        Self {
+            center,
+            radius: half.length(),
+            half_extents: Some(half),
+        }
+    }
 }
 
 /// Where a run of objects is drawn: after quads `..quad` of chunk `chunk` (its position

@@ -741,10 +741,7 @@ mod tests {
         assert_eq!(depth_range(&cam, [around], None), [0.1, 30.0]);
         // A game's particle nearer than every mesh widens the range; undeclared geometry
         // takes the camera's.
-        let ball = TranslucentObject {
-            center: DVec3::new(0.0, 0.0, 7.0),
-            radius: 1.0,
-        };
+        let ball = TranslucentObject::ball(DVec3::new(0.0, 0.0, 7.0), 1.0);
         assert_eq!(depth_range(&cam, [sheet], Some(&[ball])), [2.0, 10.0]);
         assert_eq!(depth_range(&cam, [sheet], Some(&[])), [0.1, 1000.0]);
         // Nothing seen: the camera's range.

@@ -35,17 +35,47 @@ use voxel_mesh::PackedQuad;
 
 use crate::chunks::Surfaces;
 
-/// A ball: an object as the order sees it.
+/// An object as the order sees it: a ball, and along each axis how far the object
+/// reaches from the centre (the ball's radius, or less where its box is known).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ball {
     /// Centre, world blocks.
     pub center: DVec3,
     /// Radius, blocks (0: a point).
     pub radius: f64,
+    /// Reach along each axis from the centre, blocks: at most the radius.
+    pub half: DVec3,
+}
+
+impl Ball {
+    /// A ball of `radius` around `center` that also lies within `half` of it along each
+    /// axis, where given. A radius or extent that is not a finite non-negative number
+    /// counts as 0.
+    pub fn new(center: DVec3, radius: f64, half: Option<DVec3>) -> Self {
+        let clean = |v: f64| if v.is_finite() { v.max(0.0) } else { 0.0 };
+        let radius = clean(radius);
+        let half = half.map_or(DVec3::splat(radius), |h| {
+            DVec3::new(clean(h.x), clean(h.y), clean(h.z)).min(DVec3::splat(radius))
+        });
+        Self {
+            center,
+            radius,
+            half,
+        }
+    }
+
+    /// A ball of `radius` around `center`.
+    #[cfg(test)]
+    pub fn sphere(center: DVec3, radius: f64) -> Self {
+        Self::new(center, radius, None)
+    }
 }
 
 /// Which orders of ball `b` and chunk surfaces `s` the sound tests prove right: `[after
 /// the chunk, before it]` (the ball in front, behind). Both: they do not overlap on screen.
+/// Where one order is proven already, whether the other is right too (apart on screen) is
+/// looked at only with `look_apart`: it matters only where other chunks constrain the
+/// ball too.
 fn safe(
     b: Ball,
     o: f64,
@@ -53,14 +83,18 @@ fn safe(
     s: &Surfaces<'_>,
     [near, _, far]: [f64; 3],
     two_sided: bool,
+    look_apart: bool,
 ) -> [bool; 2] {
-    let (p, r) = (b.center, b.radius);
+    let (p, r, h) = (b.center, b.radius, b.half);
     let (mut front, mut behind) = (o + r < near, o - r > far);
     for a in 0..3 {
         let (lo, hi, ea) = (s.lo[a], s.hi[a], eye[a]);
-        let (below, above) = (p[a] + r < lo, p[a] - r > hi);
+        let (below, above) = (p[a] + h[a] < lo, p[a] - h[a] > hi);
         front |= (below && ea <= lo) || (above && ea >= hi);
         behind |= (below && ea >= lo) || (above && ea <= hi);
+    }
+    if !look_apart && (front || behind) {
+        return [front, behind];
     }
     // The quads' planes: every seen plane with the ball on the eye's side, or every one
     // with it beyond.
@@ -75,7 +109,7 @@ fn safe(
             // Culled or seen edge-on: no constraint.
             continue;
         }
-        if q.abs() <= r {
+        if q.abs() <= h[a] {
             // Through the plane: neither.
             eye_side = true;
             beyond = true;
@@ -88,7 +122,7 @@ fn safe(
     front |= !beyond;
     behind |= !eye_side && beyond;
     // Apart on screen: both orders are right.
-    let apart = (front && behind) || separate(b, eye, s);
+    let apart = (front && behind) || ((look_apart || front == behind) && separate(b, eye, s));
     [front || apart, behind || apart]
 }
 
@@ -130,7 +164,7 @@ fn quad_side(
     let plane = origin[a] + q.bounds().0[a];
     let e = (eye[a] - plane) * n;
     let d = (b.center[a] - plane) * n;
-    if (!two_sided && e <= 0.0) || e == 0.0 || d.abs() <= b.radius {
+    if (!two_sided && e <= 0.0) || e == 0.0 || d.abs() <= b.half[a] {
         return None;
     }
     Some((e > 0.0) == (d > 0.0))
@@ -152,16 +186,28 @@ pub struct ChunkSequence<'a> {
 /// touches both cells), and their keys' range for an eye in cell `eye`: the least and
 /// the greatest [`voxel_mesh::order::chunk_order_key`] among them.
 fn cells_and_keys(b: Ball, eye: [i64; 3]) -> ([[i64; 2]; 3], [u128; 2]) {
-    let s = voxel_core::CHUNK_SIZE as f64;
+    let s = 1.0 / voxel_core::CHUNK_SIZE as f64;
+    // Most balls lie inside the cell of their centre, off its borders.
+    let cell = [0, 1, 2].map(|a| floor_i64(b.center[a] * s));
+    let inside = (0..3).all(|a| {
+        let lo = cell[a] as f64 * voxel_core::CHUNK_SIZE as f64;
+        b.center[a] - b.half[a] > lo && b.center[a] + b.half[a] < lo + voxel_core::CHUNK_SIZE as f64
+    });
+    if inside {
+        let k = (0..3)
+            .map(|a| {
+                let d = (cell[a] - eye[a]).unsigned_abs();
+                u128::from(d) * u128::from(d)
+            })
+            .sum();
+        return (cell.map(|c| [c, c]), [k, k]);
+    }
     let mut cells = [[0i64; 2]; 3];
     let (mut kmin, mut kmax) = (0u128, 0u128);
     for a in 0..3 {
         // `ceil(x) - 1` is `floor(x)` except on a border, where it is the cell below.
-        let lo = (((b.center[a] - b.radius) / s).ceil() - 1.0)
-            .clamp(f64::from(i32::MIN) - 1.0, f64::from(i32::MAX) + 1.0) as i64;
-        let hi = ((b.center[a] + b.radius) / s)
-            .floor()
-            .clamp(f64::from(i32::MIN) - 1.0, f64::from(i32::MAX) + 1.0) as i64;
+        let lo = ceil_i64((b.center[a] - b.half[a]) * s) - 1;
+        let hi = floor_i64((b.center[a] + b.half[a]) * s);
         cells[a] = [lo, hi];
         let (dl, dh) = (lo - eye[a], hi - eye[a]);
         let sq = |d: i64| u128::from(d.unsigned_abs()) * u128::from(d.unsigned_abs());
@@ -173,6 +219,21 @@ fn cells_and_keys(b: Ball, eye: [i64; 3]) -> ([[i64; 2]; 3], [u128; 2]) {
         kmax += sq(dl).max(sq(dh));
     }
     (cells, [kmin, kmax])
+}
+
+/// The cell bound of a coordinate, clamped just past the `i32` world (as
+/// [`voxel_mesh::order::chunk_order_key`] clamps): by truncation, since `floor` and `ceil`
+/// are library calls on baseline x86-64.
+fn floor_i64(x: f64) -> i64 {
+    let x = x.clamp(f64::from(i32::MIN) - 1.0, f64::from(i32::MAX) + 1.0);
+    let t = x as i64;
+    t - i64::from((t as f64) > x)
+}
+
+fn ceil_i64(x: f64) -> i64 {
+    let x = x.clamp(f64::from(i32::MIN) - 1.0, f64::from(i32::MAX) + 1.0);
+    let t = x as i64;
+    t + i64::from((t as f64) < x)
 }
 
 /// The eye's chunk cell, as [`voxel_mesh::order::chunk_order_key`] takes it.
@@ -218,10 +279,52 @@ fn plane_weight(
     let plane = origin[a] + f64::from(c);
     let e = (eye[a] - plane) * n;
     let d = (b.center[a] - plane) * n;
-    if (!two_sided && e <= 0.0) || e == 0.0 || d.abs() <= b.radius {
+    if (!two_sided && e <= 0.0) || e == 0.0 || d.abs() <= b.half[a] {
         return 0;
     }
     if (e > 0.0) == (d > 0.0) { 1 } else { -1 }
+}
+
+/// How many chunks of the sequence have a key above a given one: a table by key when the
+/// keys are small (they are squared distances in chunks from the eye's chunk, below
+/// 3 · 64² for everything within the largest view distance), else a binary search.
+struct KeyIndex<'a> {
+    keys: &'a [u128],
+    /// `above[k]`: chunks with a key above `k`, for `k` up to the largest key.
+    above: Vec<u32>,
+}
+
+impl<'a> KeyIndex<'a> {
+    /// Largest key a table is made for.
+    const TABLE: u128 = 1 << 20;
+
+    fn new(keys: &'a [u128]) -> Self {
+        let largest = keys.first().copied().unwrap_or(0);
+        let mut above = Vec::new();
+        if largest < Self::TABLE {
+            // Keys are largest first: walk them from the end.
+            above.resize(largest as usize + 1, 0);
+            let mut i = keys.len();
+            for k in 0..=largest {
+                while i > 0 && keys[i - 1] <= k {
+                    i -= 1;
+                }
+                above[k as usize] = i as u32;
+            }
+        }
+        Self { keys, above }
+    }
+
+    /// How many chunks have a key above `k` (the index of the first with `k` or less).
+    fn above(&self, k: u128) -> usize {
+        if self.above.is_empty() {
+            return self.keys.partition_point(|&x| x > k);
+        }
+        if k >= self.above.len() as u128 {
+            return 0;
+        }
+        self.above[k as usize] as usize
+    }
 }
 
 /// Per frame, what [`interleave`] learns of a chunk the first time an object needs it.
@@ -268,23 +371,31 @@ pub fn interleave(
 ) -> (Vec<u32>, Vec<Split>) {
     let last = chunks.surfaces.len() as u32;
     let e = eye_cell(eye);
+    let keys = KeyIndex::new(chunks.keys);
     let mut facts: Vec<ChunkFacts> = Vec::new();
     facts.resize_with(chunks.surfaces.len(), ChunkFacts::default);
-    // The place of each object: chunk, quad, farthest first (bits of a non-negative
-    // distance order like the number), packed into one key; then the object.
-    let mut places: Vec<(u128, u32)> = Vec::with_capacity(balls.len());
+    // The place of each object (chunk, quad), and its distance as a key that orders
+    // farthest first (bits of a non-negative distance order like the number).
+    let mut places: Vec<(u32, u32)> = Vec::with_capacity(balls.len());
+    let mut farthest: Vec<(u64, u32)> = Vec::with_capacity(balls.len());
     let mut items: Vec<(u32, u32, i64)> = Vec::new();
     let mut weights: Vec<i64> = Vec::new();
     for (i, &b) in balls.iter().enumerate() {
-        let o = b.center.distance(eye);
-        if !o.is_finite() || !b.radius.is_finite() {
-            places.push((place_key(last, 0, 0.0), i as u32));
+        // Squared distances order like distances: the root only where a test needs it.
+        let o2 = b.center.distance_squared(eye);
+        if !o2.is_finite() || !b.radius.is_finite() {
+            places.push((last, 0));
+            farthest.push((u64::MAX, i as u32));
             continue;
         }
+        farthest.push((!o2.to_bits(), i as u32));
         let (cells, [kmin, kmax]) = cells_and_keys(b, e);
         // The part of the sequence whose keys lie in [kmin, kmax] (largest first).
-        let first = chunks.keys.partition_point(|&k| k > kmax);
-        let end = first + chunks.keys[first..].partition_point(|&k| k >= kmin);
+        let first = keys.above(kmax);
+        let end = match kmin.checked_sub(1) {
+            Some(k) => keys.above(k),
+            None => chunks.keys.len(),
+        };
         let single = (0..3).all(|a| cells[a][0] == cells[a][1]);
         let range = if single {
             // One cell: its chunk, if it is in the sequence; else no chunk constrains.
@@ -298,6 +409,16 @@ pub fn interleave(
         } else {
             first..end
         };
+        if range.is_empty() {
+            // Nothing constrains it: after the chunks of larger keys.
+            let mut at = range.start as u32;
+            while at < last && chunks.surfaces[at as usize].is_none() {
+                at += 1;
+            }
+            places.push((at, 0));
+            continue;
+        }
+        let o = o2.sqrt();
         // The constraints in draw order: (chunk, quad after which it applies, weight:
         // positive when the item must come before the object, negative after it).
         items.clear();
@@ -308,7 +429,7 @@ pub fn interleave(
             let f = &mut facts[c];
             let d = *f.distances.get_or_insert_with(|| s.distances(eye));
             let c32 = c as u32;
-            match safe(b, o, eye, s, d, two_sided) {
+            match safe(b, o, eye, s, d, two_sided, range.len() > 1) {
                 // Apart on screen: any place is right.
                 [true, true] => {}
                 [true, false] => items.push((c32, 0, SOUND)),
@@ -361,29 +482,57 @@ pub fn interleave(
         while at.0 < last && chunks.surfaces[at.0 as usize].is_none() {
             at = (at.0 + 1, 0);
         }
-        places.push((place_key(at.0, at.1, o), i as u32));
+        places.push(at);
     }
-    places.sort_unstable();
-    let mut order = Vec::with_capacity(balls.len());
+    let order = order_by_place(&places, &mut farthest, last);
     let mut splits = Vec::new();
-    for (n, &(key, i)) in places.iter().enumerate() {
-        order.push(i);
-        let (c, k) = ((key >> 96) as u32, (key >> 64) as u32);
-        let next = places.get(n + 1).map(|p| p.0 >> 64);
-        if c < last && next != Some(key >> 64) {
+    for (n, &i) in order.iter().enumerate() {
+        let (c, k) = places[i as usize];
+        let next = order.get(n + 1).map(|&j| places[j as usize]);
+        if c < last && next != Some((c, k)) {
             splits.push(Split {
                 chunk: c,
                 quad: k,
-                end: order.len() as u32,
+                end: n as u32 + 1,
             });
         }
     }
     (order, splits)
 }
 
-/// The sort key of an object's place: chunk, quad, then farther first.
-fn place_key(chunk: u32, quad: u32, distance: f64) -> u128 {
-    (u128::from(chunk) << 96) | (u128::from(quad) << 64) | u128::from(!distance.max(0.0).to_bits())
+/// The objects by place (`places[i]`: chunk, then quad), farthest first at each place:
+/// one sort by distance (`farthest`: a key that orders farthest first, and the object),
+/// then a stable counting sort by chunk (places are chunk indices up to `last`), and
+/// within a chunk whose objects go among its quads a stable sort by quad.
+fn order_by_place(places: &[(u32, u32)], farthest: &mut [(u64, u32)], last: u32) -> Vec<u32> {
+    farthest.sort_unstable();
+    let mut start = vec![0u32; last as usize + 2];
+    for &(c, _) in places {
+        start[c as usize + 1] += 1;
+    }
+    for c in 1..start.len() {
+        start[c] += start[c - 1];
+    }
+    let mut order = vec![0u32; places.len()];
+    let mut quads = false;
+    for &(_, i) in farthest.iter() {
+        let (c, k) = places[i as usize];
+        let at = &mut start[c as usize];
+        order[*at as usize] = i;
+        *at += 1;
+        quads |= k > 0;
+    }
+    if quads {
+        // Each chunk's run of objects, by quad (stable: farthest first stays).
+        let mut from = 0;
+        while from < order.len() {
+            let c = places[order[from] as usize].0;
+            let to = from + order[from..].partition_point(|&i| places[i as usize].0 == c);
+            order[from..to].sort_by_key(|&i| places[i as usize].1);
+            from = to;
+        }
+    }
+    order
 }
 
 #[cfg(test)]
@@ -408,7 +557,7 @@ mod tests {
         d: [f64; 3],
         two_sided: bool,
     ) -> Option<Side> {
-        match safe(b, o, eye, s, d, two_sided) {
+        match safe(b, o, eye, s, d, two_sided, true) {
             [true, _] => Some(Side::Front),
             [false, true] => Some(Side::Behind),
             [false, false] => None,
@@ -465,10 +614,7 @@ mod tests {
     }
 
     fn point(center: DVec3) -> Ball {
-        Ball {
-            center,
-            radius: 0.0,
-        }
+        Ball::sphere(center, 0.0)
     }
 
     #[test]
@@ -498,10 +644,7 @@ mod tests {
             Side::Behind
         );
         // A ball through the surface is decided by the box's centre.
-        let b = Ball {
-            center: DVec3::new(16.0, 8.2, 20.0),
-            radius: 1.0,
-        };
+        let b = Ball::sphere(DVec3::new(16.0, 8.2, 20.0), 1.0);
         assert_eq!(decide(b, b.center.distance(eye), eye, &s, d, true), None);
     }
 
@@ -586,7 +729,7 @@ mod tests {
             for k in 0..200 {
                 let center = around(&mut next);
                 let radius = if k % 2 == 0 { 0.0 } else { next() * 4.0 };
-                let ball = Ball { center, radius };
+                let ball = Ball::sphere(center, radius);
                 let o = center.distance(eye);
                 let Some(got) = decide(ball, o, eye, &s, d, two_sided) else {
                     continue;
@@ -681,10 +824,7 @@ mod tests {
             DVec3::new(16.0, 9.0, -10.0), // over the near water
             DVec3::new(16.0, 11.0, 2.0),  // by the eye
         ]
-        .map(|center| Ball {
-            center,
-            radius: 1.5,
-        });
+        .map(|center| Ball::sphere(center, 1.5));
         let (order, splits) = interleave(&balls, eye, &chunks, false, false);
         // Before the far water: what is under it. Before the near water: what lies over
         // the far water and what lies under the near water (each ball lies in one chunk
@@ -729,10 +869,7 @@ mod tests {
         };
         let eye = DVec3::new(16.0, 12.0, 40.0);
         let d = s.distances(eye);
-        let ball = |y, z| Ball {
-            center: DVec3::new(16.0, y, z),
-            radius: 1.0,
-        };
+        let ball = |y, z| Ball::sphere(DVec3::new(16.0, y, z), 1.0);
         // Above the water, behind the pane: the planes disagree, the quads split.
         let b = ball(7.0, 12.0);
         assert_eq!(decide(b, b.center.distance(eye), eye, &s, d, false), None);
@@ -815,7 +952,7 @@ mod against_all_pairs {
                 let Some(s) = s else { continue };
                 let c = c as u32;
                 let d = s.distances(eye);
-                match safe(b, o, eye, s, d, two_sided) {
+                match safe(b, o, eye, s, d, two_sided, true) {
                     [true, true] => {}
                     [true, false] => items.push((c, 0, SOUND)),
                     [false, true] => items.push((c, 0, -SOUND)),
@@ -867,7 +1004,9 @@ mod against_all_pairs {
                 }
                 let r = |n: u64| (n % 2001) as f64 / 1000.0 - 1.0;
                 let v = DVec3::new(r(next()), r(next()), r(next()));
-                b.center + v.normalize_or(DVec3::X) * b.radius * 0.999
+                // On the ball, moved into the box (nearer the centre: still in the ball).
+                let on = v.normalize_or(DVec3::X) * b.radius * 0.999;
+                b.center + on.clamp(-b.half * 0.999, b.half * 0.999)
             })
             .collect();
         let mut out = Vec::new();
@@ -1015,13 +1154,20 @@ mod against_all_pairs {
                 positions: &positions,
             };
             let balls: Vec<Ball> = (0..200)
-                .map(|k| Ball {
-                    center: DVec3::new(
+                .map(|k| {
+                    let center = DVec3::new(
                         (next() % 128) as f64 - 64.0 + (next() % 1000) as f64 / 1000.0,
                         (next() % 96) as f64 - 32.0 + (next() % 1000) as f64 / 1000.0,
                         (next() % 128) as f64 - 64.0 + (next() % 1000) as f64 / 1000.0,
-                    ),
-                    radius: [0.0, 0.3, 2.5, 9.0][k % 4],
+                    );
+                    let radius = [0.0, 0.3, 2.5, 9.0][k % 4];
+                    // Some objects flat along an axis: slabs whose ball is far larger.
+                    let half = (k % 3 == 0).then(|| {
+                        let mut h = DVec3::splat(radius);
+                        h[k / 3 % 3] = radius * 0.05;
+                        h
+                    });
+                    Ball::new(center, radius, half)
                 })
                 .collect();
             let old = all_pairs(&balls, eye, &surfaces, two_sided, split_quads);
@@ -1037,8 +1183,8 @@ mod against_all_pairs {
             }
             for (i, &b) in balls.iter().enumerate() {
                 if !(0..3).all(|a| {
-                    (b.center[a] - b.radius).div_euclid(32.0)
-                        == (b.center[a] + b.radius).div_euclid(32.0)
+                    (b.center[a] - b.half[a]).div_euclid(32.0)
+                        == (b.center[a] + b.half[a]).div_euclid(32.0)
                 }) {
                     straddling += 1;
                 }
