@@ -465,3 +465,58 @@ fn a_slab_beyond_the_water_surface_is_exact_from_either_side() {
         }
     }
 }
+
+/// Equal depths: a flat object lying exactly in the water surface's plane, and one lying
+/// exactly in a glass pane's face. One rule (at equal depth the block's face is in front
+/// of the object's: an object's depth counts `OBJECT_DEPTH_BIAS` farther) that both exact
+/// GPU references and the ray march follow: they agree within 2/255, and the ray march
+/// finds no edge there to excuse a difference.
+#[test]
+fn objects_in_a_block_face_plane_follow_one_rule_in_every_reference() {
+    let Some(ctx) = gpu() else { return };
+    let plate = |center: [f64; 3], half: [f32; 3], color| Entity {
+        center: DVec3::from(center),
+        half_extents: half,
+        rotation: DQuat::IDENTITY,
+        color,
+        opacity: 0.55,
+    };
+    // The water's surface is the plane y = 1; the pane's +z face the plane z = 7: the
+    // plates' faces seen from the camera lie in them (their other halves in the blocks).
+    let scene = with(
+        &pool(),
+        entities(vec![
+            plate([-3.5, 0.75, 3.0], [3.0, 0.25, 3.0], [230, 40, 40]),
+            plate([5.5, 3.5, 6.75], [2.0, 1.0, 0.25], [40, 220, 60]),
+        ]),
+    );
+    let cam = scene.cameras[0];
+    let (w, h) = (192, 108);
+    let abuffer = render(&scene, technique_config(Technique::Reference, w, h));
+    let peeled = render(&scene, technique_config(Technique::PeelReference, w, h));
+    let d = diff(&peeled, &abuffer);
+    abuffer
+        .save_png(&out_dir("game_coplanar").join("reference.png"))
+        .unwrap();
+    assert!(d.max <= 2, "the two exact references disagree: {d:?}");
+    let check = voxel_lab::eval::raymarch_check(&ctx, &scene, &cam, (w, h)).unwrap();
+    let c = &check.comparison;
+    assert_eq!(
+        (c.differing, c.cracks),
+        (0, 0),
+        "the ray march differs from the A-buffer: {:?}",
+        c.worst
+    );
+    // The plates are seen (and not excused as edges).
+    let without = render(&pool(), technique_config(Technique::Reference, w, h));
+    assert!(diff(&abuffer, &without).over_one > 800);
+    eprintln!(
+        "differing on edges {}, seams {}",
+        c.differing_on_edges, c.translucent_seams
+    );
+    assert!(
+        c.differing_on_edges < 100,
+        "{} pixels differ where the ray march sees edges",
+        c.differing_on_edges
+    );
+}

@@ -319,8 +319,11 @@ impl RayMarcher {
     /// Adds the content hits before `t` (from `next` on) to the walk: translucent ones as
     /// layers; an opaque one ends the ray (returns true).
     fn content_until(hits: &[ContentHit], next: &mut usize, t: f64, w: &mut Walker<'_>) -> bool {
+        // At equal depth a block's face is in front of an object's: the object's hit
+        // counts OBJECT_DEPTH_BIAS farther, as the GPU's exact methods count it.
+        let bias = 1.0 + f64::from(voxel_render::stages::OBJECT_DEPTH_BIAS);
         while let Some(h) = hits.get(*next) {
-            if h.t >= t {
+            if h.t * bias >= t {
                 break;
             }
             *next += 1;

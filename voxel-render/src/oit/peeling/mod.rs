@@ -553,11 +553,14 @@ impl TranslucentTechnique for Peeling {
     }
 
     fn variants(&self) -> Vec<TranslucentVariant> {
-        let output = "struct OitOutput {\n    @location(0) color: vec4<f32>,\n};\n\n\
-            // The fragment is a layer candidate strictly between the limits, or dropped.\n\
+        let output = "struct OitOutput {\n    @location(0) color: vec4<f32>,\n    \
+            @builtin(frag_depth) depth: f32,\n};\n\n\
+            // The fragment, at the depth the exact methods give an object, is a layer\n\
+            // candidate strictly between the limits, or dropped.\n\
             fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
-            if !peel_candidate(position) || color.a <= 0.0 {\n        discard;\n    }\n    \
-            return OitOutput(color);\n}\n";
+            let p = oit_object_position(position);\n    \
+            if !peel_candidate(p) || color.a <= 0.0 {\n        discard;\n    }\n    \
+            return OitOutput(color, p.z);\n}\n";
         let variant = |name, depth| TranslucentVariant {
             name,
             wgsl: game_prelude(include_str!("limits.wgsl"), output),

@@ -485,10 +485,12 @@ impl TranslucentTechnique for Reference {
                 &own,
                 "// The pass has no colour target: the output goes nowhere.\n\
                  struct OitOutput {\n    @location(0) unused: vec4<f32>,\n};\n\n\
-                 // Appends the fragment to its pixel's list. Call it in uniform control\n\
-                 // flow (it takes the depth's derivatives).\n\
+                 // Appends the fragment to its pixel's list, at the depth the exact methods\n\
+                 // give an object. Call it in uniform control flow (it takes the depth's\n\
+                 // derivatives).\n\
                  fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
-                 abuffer_append(position, vec2<f32>(dpdx(position.z), dpdy(position.z)), color);\n    \
+                 let p = oit_object_position(position);\n    \
+                 abuffer_append(p, vec2<f32>(dpdx(p.z), dpdy(p.z)), color);\n    \
                  return OitOutput(vec4<f32>(0.0));\n}\n",
             ),
             targets: Vec::new(),
