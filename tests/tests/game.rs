@@ -520,3 +520,72 @@ fn objects_in_a_block_face_plane_follow_one_rule_in_every_reference() {
         c.differing_on_edges
     );
 }
+
+/// The eye inside a game's translucent entity (a slime block around the camera, a diving
+/// bell): its far faces are drawn and tint everything beyond, in every technique, as the
+/// A-buffer reference and the ray march show it; the exact and sorted techniques within
+/// 1/255 of the reference (no block face lies inside the box).
+#[test]
+fn the_eye_inside_a_translucent_entity_is_tinted_by_it() {
+    let Some(ctx) = gpu() else { return };
+    let base = pool();
+    let eye = base.cameras[0].eye;
+    let slime = Entity {
+        center: eye + DVec3::new(0.3, -0.2, 0.1),
+        half_extents: [2.0, 1.5, 2.5],
+        rotation: DQuat::from_rotation_y(0.4),
+        color: [90, 220, 80],
+        opacity: 0.4,
+    };
+    let scene = with(&base, entities(vec![slime]));
+    let cam = scene.cameras[0];
+    let reference = render(&scene, technique_config(Technique::Reference, W, H));
+    let without = render(&base, technique_config(Technique::Reference, W, H));
+    let tinted = diff(&reference, &without);
+    assert!(
+        tinted.over_one as u32 > W * H * 9 / 10,
+        "the slime tints the picture: {tinted:?}"
+    );
+    // Greener everywhere.
+    let green = |img: &Image| {
+        img.rgba
+            .chunks_exact(4)
+            .map(|p| f64::from(p[1]) - f64::from(p[0]))
+            .sum::<f64>()
+    };
+    assert!(green(&reference) > green(&without) + f64::from(W * H) * 10.0);
+    let dir = out_dir("game_inside");
+    reference.save_png(&dir.join("reference.png")).unwrap();
+    for t in Technique::ALL {
+        if matches!(t, Technique::OpaqueOnly | Technique::Reference) {
+            continue;
+        }
+        let img = render(&scene, technique_config(t, W, H));
+        img.save_png(&dir.join(format!("{}.png", t.name())))
+            .unwrap();
+        let d = diff(&img, &reference);
+        match t {
+            Technique::PeelReference
+            | Technique::DepthPeeling
+            | Technique::Sorted
+            | Technique::SortedQuads => assert!(d.max <= 1, "{}: {d:?}", t.name()),
+            // Tinted too, nearer the reference than the picture without the slime.
+            _ => {
+                let e = diff(&img, &without);
+                assert!(
+                    e.over_one as u32 > W * H / 2,
+                    "{}: not tinted {e:?}",
+                    t.name()
+                );
+            }
+        }
+    }
+    let check = voxel_lab::eval::raymarch_check(&ctx, &scene, &cam, (W, H)).unwrap();
+    let c = &check.comparison;
+    assert_eq!(
+        (c.differing, c.cracks),
+        (0, 0),
+        "the ray march differs from the A-buffer: {:?}",
+        c.worst
+    );
+}

@@ -52,6 +52,15 @@ impl Entity {
         self.opacity >= 1.0
     }
 
+    /// Whether point `p` lies inside it (strictly).
+    pub fn contains(&self, p: DVec3) -> bool {
+        let o = p - self.center;
+        self.axes().iter().all(|a| {
+            let len2 = a.length_squared();
+            len2 > 0.0 && o.dot(*a).abs() < len2
+        })
+    }
+
     /// Half the sides of the axis-aligned box around it, world blocks.
     pub fn world_half_extents(&self) -> DVec3 {
         self.axes().iter().map(|a| a.abs()).sum()
@@ -459,7 +468,13 @@ impl ContentStages {
     }
 
     fn prim_of_entity(&self, e: &Entity, frame: &GameFrame<'_>) -> Prim {
-        let axes = e.axes();
+        let mut axes = e.axes();
+        // Seen from inside, a translucent box is a volume the eye is in: its far faces
+        // are drawn (one axis mirrored turns every face's winding inward), and tint
+        // what lies beyond as its near faces do from outside.
+        if !e.is_opaque() && e.contains(frame.camera.eye) {
+            axes[0] = -axes[0];
+        }
         let a = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
         Prim {
             center: frame.relative(e.center).to_array(),

@@ -298,8 +298,42 @@ impl RayMarcher {
                 }
                 t_out = t_out.min(hi);
             }
-            // The face the ray enters through (back faces are culled), in view.
-            if t_in > t_out || !(t_in >= near && t_in <= far) {
+            // The face the ray enters through (back faces are culled), in view; from
+            // inside a translucent box, the face it leaves through (the GPU draws the
+            // far faces of a box the eye is in).
+            if t_in > t_out {
+                continue;
+            }
+            if t_in < 0.0 && t_out > 0.0 && !e.is_opaque() {
+                let exit = axes
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(a, axis)| {
+                        let len2 = axis.length_squared();
+                        let (oa, da) = (o.dot(*axis) / len2, dir.dot(*axis) / len2);
+                        (da != 0.0).then(|| {
+                            let t = (da.signum() - oa) / da;
+                            (t, a, da.signum())
+                        })
+                    })
+                    .min_by(|x, y| x.0.total_cmp(&y.0));
+                if let Some((t, a, sign)) = exit
+                    && t >= near
+                    && t <= far
+                {
+                    let normal = box_normal(e.rotation, a, sign);
+                    let l = face_light(normal, light.sun, light.ambient);
+                    hits.push(ContentHit {
+                        t,
+                        color: e.color.map(|c| srgb_to_linear(c) * l),
+                        alpha: f64::from(e.opacity.clamp(0.0, 1.0)),
+                        opaque: false,
+                        id: (2, i as u32, a as u8 * 2 + u8::from(sign > 0.0)),
+                    });
+                }
+                continue;
+            }
+            if !(t_in >= near && t_in <= far) {
                 continue;
             }
             let normal = box_normal(e.rotation, face.0, face.1);

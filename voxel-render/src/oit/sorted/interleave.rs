@@ -361,7 +361,9 @@ struct ChunkFacts {
 /// decides with weight 1. Objects at one place go farthest centre first, so those that
 /// share a place are one run: one draw of the game's instances.
 ///
-/// An object whose centre or radius is not finite goes after every chunk.
+/// An object whose centre or radius is not finite, and one the eye is inside of (a game's
+/// translucent volume seen from within: its far faces are nearer than any chunk outside
+/// it), go after every chunk.
 pub fn interleave(
     balls: &[Ball],
     eye: DVec3,
@@ -389,6 +391,12 @@ pub fn interleave(
             continue;
         }
         farthest.push((!o2.to_bits(), i as u32));
+        if o2 < b.radius * b.radius && (0..3).all(|a| (b.center[a] - eye[a]).abs() < b.half[a]) {
+            // The eye is inside it (a volume seen from within, whose far faces are drawn):
+            // after every chunk, as what lies nearest.
+            places.push((last, 0));
+            continue;
+        }
         let (cells, [kmin, kmax]) = cells_and_keys(b, e);
         // The part of the sequence whose keys lie in [kmin, kmax] (largest first).
         let first = keys.above(kmax);
