@@ -232,7 +232,7 @@ fn plain_sort(objects: &[TranslucentObject], camera: &Camera) -> f64 {
 fn main() -> Result<(), String> {
     let ctx = headless::context()?;
     let vds = list("ORDER_VD", &[8, 16, 32]);
-    let counts = list("ORDER_OBJECTS", &[1_000, 10_000, 100_000]);
+    let counts = list("ORDER_OBJECTS", &[1_000, 2_000, 10_000, 100_000]);
     let mut out = String::new();
     let _ = writeln!(
         out,

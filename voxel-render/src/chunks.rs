@@ -671,6 +671,12 @@ impl Culled {
         &self.keys
     }
 
+    /// The store's slot of each visible translucent mesh, in the order of
+    /// [`Culled::translucent_positions`] ([`ChunkStore::by_slot`]).
+    pub fn translucent_slots(&self) -> impl Iterator<Item = u32> + '_ {
+        self.far.iter().map(|e| e.slot)
+    }
+
     /// The planes of the visible translucent meshes ([`crate::layers`]; in no particular
     /// order), when [`ChunkStore::cull`] was asked for them (else empty).
     pub fn translucent_layers(&self) -> VisibleLayers<'_> {
@@ -976,6 +982,12 @@ impl ChunkStore {
     /// The chunk at `pos`, if uploaded.
     pub fn get(&self, pos: ChunkPos) -> Option<&GpuChunk> {
         let slot = *self.by_pos.get(&pos)?;
+        self.by_slot(slot)
+    }
+
+    /// The chunk in `slot` (what [`Culled::translucent_slots`] names), without a lookup
+    /// by position.
+    pub fn by_slot(&self, slot: u32) -> Option<&GpuChunk> {
         self.slots.get(slot as usize)?.as_ref()
     }
 

@@ -19,12 +19,12 @@ use crate::chunks::{
 use crate::error::scoped;
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
 use crate::medium::{self, MediumLook, MediumPass};
-use crate::oit::sorted::interleave::{Ball, ChunkSequence, interleave};
+use crate::oit::sorted::interleave::{ChunkSequence, Interleaver};
 use crate::oit::{
     FrameView, OitConfig, OitManager, Setup, Technique, TechniqueReport, TranslucentFrame,
     WeightFunction,
 };
-use crate::stages::{GameDraw, GameFrame, GameStages, NoGame, TranslucentContract};
+use crate::stages::{GameDraw, GameFrame, GameStages, NoGame, Split, TranslucentContract};
 use crate::submission::{Outcome, Submissions};
 use crate::textures::BlockTextures;
 use crate::timing::{GpuPass, GpuTimes, Timer};
@@ -301,6 +301,9 @@ pub struct Renderer {
     /// What became of each frame's encoder (timings, and flushing a dropped frame's
     /// queue writes).
     submissions: Submissions,
+    /// Orders a game's translucent objects among the chunks (sorted techniques), its
+    /// buffers kept between frames.
+    interleaver: Interleaver,
     frame_index: u32,
     /// Chunks fading in, with the frame they appeared.
     fading: PosMap<ChunkPos, u32>,
@@ -397,6 +400,7 @@ impl Renderer {
             oit,
             timer: Timer::new(ctx),
             submissions: Submissions::default(),
+            interleaver: Interleaver::default(),
             frame_index: 0,
             fading: PosMap::default(),
             culled: Culled::default(),
@@ -848,18 +852,16 @@ impl Renderer {
         // sorted-quads splits a chunk's quads in their new order).
         let sort_start = Instant::now();
         let sorts = stages.translucent && self.oit.technique().sorts();
-        let (order, splits) = if sorts {
-            let balls: Vec<Ball> = game
-                .translucent_objects()
-                .iter()
-                .map(|o| Ball::new(o.center, o.radius, o.half_extents))
-                .collect();
+        if sorts {
             // Each visible translucent chunk's surfaces, in draw order.
             let chunks: Vec<_> = self
                 .culled
-                .translucent_positions()
-                .iter()
-                .map(|&p| self.chunks.get(p).and_then(|c| c.translucent_surfaces()))
+                .translucent_slots()
+                .map(|slot| {
+                    self.chunks
+                        .by_slot(slot)
+                        .and_then(|c| c.translucent_surfaces())
+                })
                 .collect();
             let split_quads = self.oit.technique() == Technique::SortedQuads;
             let sequence = ChunkSequence {
@@ -867,9 +869,18 @@ impl Renderer {
                 keys: self.culled.translucent_keys(),
                 positions: self.culled.translucent_positions(),
             };
-            interleave(&balls, camera.eye, &sequence, medium.is_some(), split_quads)
+            self.interleaver.order(
+                game.translucent_objects(),
+                camera.eye,
+                &sequence,
+                medium.is_some(),
+                split_quads,
+            );
+        }
+        let (order, splits): (&[u32], &[Split]) = if sorts {
+            self.interleaver.result()
         } else {
-            (Vec::new(), Vec::new())
+            (&[], &[])
         };
         let game_sort_ms = sort_start.elapsed().as_secs_f64() * 1e3;
         let objects = if sorts {
@@ -887,7 +898,7 @@ impl Renderer {
             size: (w, h),
             opaque_samples: if self.config.msaa { MSAA_SAMPLES } else { 1 },
             output_format: self.config.output_format,
-            order: sorts.then_some(order.as_slice()),
+            order: sorts.then_some(order),
         };
         if stages != crate::stages::Stages::default() {
             game.prepare(&self.ctx, &game_frame);
@@ -935,7 +946,7 @@ impl Renderer {
             stages: game,
             frame: &game_frame,
             objects,
-            splits: &splits,
+            splits,
             frame_buffer: &self.scene.frame_buffer,
             boundary: &t.boundary.view,
         });

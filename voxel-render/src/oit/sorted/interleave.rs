@@ -29,7 +29,9 @@
 
 use glam::DVec3;
 
-use voxel_core::{ChunkPos, Face};
+use voxel_core::ChunkPos;
+#[cfg(test)]
+use voxel_core::Face;
 #[cfg(test)]
 use voxel_mesh::PackedQuad;
 
@@ -71,18 +73,50 @@ impl Ball {
     }
 }
 
+/// A plane of a chunk's quads as the eye sees it, worked out once per frame: its axis,
+/// where it lies (world blocks), its facing (1 or -1 along the axis), and how far the eye
+/// is in front of it (along the facing). Planes the eye sees from behind (culled, unless
+/// both sides are drawn) or edge-on are left out: they order nothing.
+#[derive(Clone, Copy, Debug)]
+struct SeenPlane {
+    axis: usize,
+    at: f64,
+    facing: f64,
+    eye: f64,
+    /// Its index in [`Surfaces::planes`].
+    index: u32,
+}
+
+/// The planes of `s` the eye at `eye` sees (see [`SeenPlane`]).
+fn seen_planes(s: &Surfaces<'_>, eye: DVec3, two_sided: bool, out: &mut Vec<SeenPlane>) {
+    out.extend(s.planes.iter().enumerate().filter_map(|(i, &(face, c))| {
+        let axis = face.axis();
+        let facing = if face.is_positive() { 1.0 } else { -1.0 };
+        let at = s.origin[axis] + f64::from(c);
+        let e = (eye[axis] - at) * facing;
+        ((two_sided || e > 0.0) && e != 0.0).then_some(SeenPlane {
+            axis,
+            at,
+            facing,
+            eye: e,
+            index: i as u32,
+        })
+    }));
+}
+
 /// Which orders of ball `b` and chunk surfaces `s` the sound tests prove right: `[after
 /// the chunk, before it]` (the ball in front, behind). Both: they do not overlap on screen.
-/// Where one order is proven already, whether the other is right too (apart on screen) is
-/// looked at only with `look_apart`: it matters only where other chunks constrain the
-/// ball too.
+/// Whether both are right because they are apart on screen is looked at only with
+/// `look_apart`: it matters only where other chunks constrain the ball too (where one
+/// chunk alone does, any place it proves, or its planes choose, is right), and without it
+/// one order proven by the box or distance ends the tests.
 fn safe(
     b: Ball,
     o: f64,
     eye: DVec3,
     s: &Surfaces<'_>,
+    planes: &[SeenPlane],
     [near, _, far]: [f64; 3],
-    two_sided: bool,
     look_apart: bool,
 ) -> [bool; 2] {
     let (p, r, h) = (b.center, b.radius, b.half);
@@ -99,21 +133,13 @@ fn safe(
     // The quads' planes: every seen plane with the ball on the eye's side, or every one
     // with it beyond.
     let (mut eye_side, mut beyond) = (false, false);
-    for &(face, c) in s.planes {
-        let a = face.axis();
-        let n = if face.is_positive() { 1.0 } else { -1.0 };
-        let plane = s.origin[a] + f64::from(c);
-        let e = (eye[a] - plane) * n;
-        let q = (p[a] - plane) * n;
-        if (!two_sided && e <= 0.0) || e == 0.0 {
-            // Culled or seen edge-on: no constraint.
-            continue;
-        }
-        if q.abs() <= h[a] {
+    for pl in planes {
+        let q = (p[pl.axis] - pl.at) * pl.facing;
+        if q.abs() <= h[pl.axis] {
             // Through the plane: neither.
             eye_side = true;
             beyond = true;
-        } else if (e > 0.0) == (q > 0.0) {
+        } else if (pl.eye > 0.0) == (q > 0.0) {
             eye_side = true;
         } else {
             beyond = true;
@@ -122,7 +148,7 @@ fn safe(
     front |= !beyond;
     behind |= !eye_side && beyond;
     // Apart on screen: both orders are right.
-    let apart = (front && behind) || ((look_apart || front == behind) && separate(b, eye, s));
+    let apart = (front && behind) || (look_apart && separate(b, eye, s));
     [front || apart, behind || apart]
 }
 
@@ -135,8 +161,11 @@ fn separate(b: Ball, eye: DVec3, s: &Surfaces<'_>) -> bool {
     if du <= big || dv <= b.radius {
         return false;
     }
-    let apart = (u.dot(v) / (du * dv)).clamp(-1.0, 1.0).acos();
-    apart > (big / du).asin() + (b.radius / dv).asin()
+    // The angle between them beyond the sum of the cones' half angles A + B (each below
+    // a right angle): its cosine below cos(A + B), without trigonometry.
+    let (sa, sb) = (big / du, b.radius / dv);
+    let (ca, cb) = ((1.0 - sa * sa).sqrt(), (1.0 - sb * sb).sqrt());
+    u.dot(v) / (du * dv) < ca * cb - sa * sb
 }
 
 // `Split` lives with the stages that carry it to the techniques (`GameDraw::splits`), so
@@ -170,7 +199,7 @@ fn quad_side(
     Some((e > 0.0) == (d > 0.0))
 }
 
-/// The visible translucent chunks of a frame in draw order, as [`interleave`] reads them.
+/// The visible translucent chunks of a frame in draw order, as [`Interleaver::order`] reads them.
 #[derive(Clone, Copy, Debug)]
 pub struct ChunkSequence<'a> {
     /// Each chunk's surfaces (`None`: it draws nothing translucent).
@@ -188,7 +217,11 @@ pub struct ChunkSequence<'a> {
 fn cells_and_keys(b: Ball, eye: [i64; 3]) -> ([[i64; 2]; 3], [u128; 2]) {
     let s = 1.0 / voxel_core::CHUNK_SIZE as f64;
     // Most balls lie inside the cell of their centre, off its borders.
-    let cell = [0, 1, 2].map(|a| floor_i64(b.center[a] * s));
+    let cell = [
+        floor_i64(b.center.x * s),
+        floor_i64(b.center.y * s),
+        floor_i64(b.center.z * s),
+    ];
     let inside = (0..3).all(|a| {
         let lo = cell[a] as f64 * voxel_core::CHUNK_SIZE as f64;
         b.center[a] - b.half[a] > lo && b.center[a] + b.half[a] < lo + voxel_core::CHUNK_SIZE as f64
@@ -238,17 +271,19 @@ fn ceil_i64(x: f64) -> i64 {
 
 /// The eye's chunk cell, as [`voxel_mesh::order::chunk_order_key`] takes it.
 fn eye_cell(eye: DVec3) -> [i64; 3] {
-    let s = voxel_core::CHUNK_SIZE as f64;
-    [0, 1, 2].map(|k| {
-        ((eye[k] / s).floor() as i64).clamp(i64::from(i32::MIN) - 1, i64::from(i32::MAX) + 1)
-    })
+    let s = 1.0 / voxel_core::CHUNK_SIZE as f64;
+    [
+        floor_i64(eye.x * s),
+        floor_i64(eye.y * s),
+        floor_i64(eye.z * s),
+    ]
 }
 
 /// A chunk's quads as runs of one plane in their drawn order (index into
-/// [`Surfaces::planes`], count): every quad of a plane stands alike against a ball
+/// [`Surfaces::planes`], count), appended to `out`: every quad of a plane stands alike against a ball
 /// ([`quad_side`] depends only on the plane), so a split is chosen per run boundary.
 fn plane_runs(s: &Surfaces<'_>, out: &mut Vec<(u32, u32)>) {
-    out.clear();
+    let start = out.len();
     for q in s.quads {
         let Some(q) = q.unpack() else { continue };
         let plane = (q.face, q.bounds().0[q.face.axis()] as u8);
@@ -258,31 +293,21 @@ fn plane_runs(s: &Surfaces<'_>, out: &mut Vec<(u32, u32)>) {
         else {
             continue;
         };
-        match out.last_mut() {
+        match out[start..].last_mut() {
             Some((p, n)) if *p == i as u32 => *n += 1,
             _ => out.push((i as u32, 1)),
         }
     }
 }
 
-/// How a plane orders ball `b` (see [`quad_side`]), as a weight: 1 when the plane's quads
-/// come before the ball, -1 after it, 0 when it does not say.
-fn plane_weight(
-    b: Ball,
-    eye: DVec3,
-    origin: [f64; 3],
-    (face, c): (Face, u8),
-    two_sided: bool,
-) -> i64 {
-    let a = face.axis();
-    let n = if face.is_positive() { 1.0 } else { -1.0 };
-    let plane = origin[a] + f64::from(c);
-    let e = (eye[a] - plane) * n;
-    let d = (b.center[a] - plane) * n;
-    if (!two_sided && e <= 0.0) || e == 0.0 || d.abs() <= b.half[a] {
+/// How a seen plane orders ball `b` (see [`quad_side`]), as a weight: 1 when the plane's
+/// quads come before the ball, -1 after it, 0 when the ball reaches through it.
+fn plane_weight(b: Ball, pl: &SeenPlane) -> i64 {
+    let d = (b.center[pl.axis] - pl.at) * pl.facing;
+    if d.abs() <= b.half[pl.axis] {
         return 0;
     }
-    if (e > 0.0) == (d > 0.0) { 1 } else { -1 }
+    if (pl.eye > 0.0) == (d > 0.0) { 1 } else { -1 }
 }
 
 /// How many chunks of the sequence have a key above a given one: a table by key when the
@@ -327,43 +352,84 @@ impl<'a> KeyIndex<'a> {
     }
 }
 
-/// Per frame, what [`interleave`] learns of a chunk the first time an object needs it.
-#[derive(Default)]
-struct ChunkFacts {
-    /// `[near, mid, far]` distances of its box ([`Surfaces::distances`]).
-    distances: Option<[f64; 3]>,
-    /// Its quads as plane runs ([`plane_runs`]), for `split_quads`.
-    runs: Option<Vec<(u32, u32)>>,
+/// Where each chunk cell stands in the sequence: a grid over the box the sequence's chunks
+/// span (a few thousand cells within a view distance), else a map.
+struct CellIndex {
+    lo: [i64; 3],
+    size: [i64; 3],
+    grid: Vec<u32>,
+    map: std::collections::HashMap<[i64; 3], usize>,
 }
 
-/// The draw order of objects `balls` among the visible translucent `chunks` seen from
-/// `eye`. Returns the objects in draw order and where runs of them are drawn (in draw
-/// order; the objects after the last run come after every chunk).
-///
-/// **Which chunks an object is tested against.** The chunks are drawn by
-/// [`voxel_mesh::order::chunk_order_key`], which is exact for a grid of equal cubes:
-/// a chunk that hides part of another has the smaller key (Theorem 3 of
-/// [`voxel_mesh::order`]). A chunk that hides part of the ball hides part of a cell the
-/// ball touches, so its key is below the greatest key of those cells; a chunk the ball
-/// hides part of has a key above their least. So every chunk whose key lies above that
-/// range is rightly drawn before the object, every one below it after, and only the
-/// chunks with keys in the range can constrain it: for a ball inside one cell, that cell's
-/// chunk alone (others of the same key neither hide it nor are hidden); for a ball across
-/// cell borders, the thin shell of chunks at about its distance. Their places in the
-/// sequence are found by binary search. The cost grows with objects (plus the chunks of
-/// each shell, mostly proven apart on screen at once), not with objects times chunks.
-///
-/// **Where, among those.** Each object goes to the place in that part of the sequence
-/// (and, with `split_quads`, among the quads of its chunks, which are then in exact
-/// back-to-front order) that the fewest constraints rule out: a chunk a sound test puts
-/// wholly behind or in front of the object weighs [`SOUND`]; in a chunk no test decides,
-/// each quad's plane ([`quad_side`]) weighs 1, or without `split_quads` the box's centre
-/// decides with weight 1. Objects at one place go farthest centre first, so those that
-/// share a place are one run: one draw of the game's instances.
-///
-/// An object whose centre or radius is not finite, and one the eye is inside of (a game's
-/// translucent volume seen from within: its far faces are nearer than any chunk outside
-/// it), go after every chunk.
+impl CellIndex {
+    /// Most cells a grid is made for.
+    const GRID: i64 = 1 << 22;
+
+    fn new(positions: &[ChunkPos]) -> Self {
+        let cell = |p: &ChunkPos| [i64::from(p.x), i64::from(p.y), i64::from(p.z)];
+        let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
+        for p in positions {
+            let c = cell(p);
+            for a in 0..3 {
+                lo[a] = lo[a].min(c[a]);
+                hi[a] = hi[a].max(c[a]);
+            }
+        }
+        let size = [0, 1, 2].map(|a| (hi[a] - lo[a] + 1).max(0));
+        let mut index = Self {
+            lo,
+            size,
+            grid: Vec::new(),
+            map: std::collections::HashMap::new(),
+        };
+        let cells = size[0].saturating_mul(size[1]).saturating_mul(size[2]);
+        if cells <= Self::GRID {
+            index.grid = vec![u32::MAX; cells as usize];
+            for (i, p) in positions.iter().enumerate() {
+                let at = index.slot(cell(p)).unwrap_or(0);
+                index.grid[at] = i as u32;
+            }
+        } else {
+            index.map = positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (cell(p), i))
+                .collect();
+        }
+        index
+    }
+
+    fn slot(&self, c: [i64; 3]) -> Option<usize> {
+        let d = [0, 1, 2].map(|a| c[a] - self.lo[a]);
+        if (0..3).any(|a| d[a] < 0 || d[a] >= self.size[a]) {
+            return None;
+        }
+        Some((d[0] + self.size[0] * (d[1] + self.size[1] * d[2])) as usize)
+    }
+
+    /// The place in the sequence of the chunk in cell `c`, if it is there.
+    fn get(&self, c: [i64; 3]) -> Option<usize> {
+        if self.grid.is_empty() {
+            return self.map.get(&c).copied();
+        }
+        let i = self.grid[self.slot(c)?];
+        (i != u32::MAX).then_some(i as usize)
+    }
+}
+
+/// Per frame, what [`Interleaver::order`] learns of a chunk the first time an object
+/// needs it: the `[near, mid, far]` distances of its box ([`Surfaces::distances`]), the
+/// planes the eye sees and its quads as plane runs ([`plane_runs`], for `split_quads`),
+/// those two as ranges of the interleaver's buffers.
+#[derive(Clone, Copy, Debug, Default)]
+struct ChunkFacts {
+    distances: [f64; 3],
+    planes: Option<(u32, u32)>,
+    runs: Option<(u32, u32)>,
+}
+
+/// [`Interleaver::order`] of `balls` in fresh buffers (for the tests).
+#[cfg(test)]
 pub fn interleave(
     balls: &[Ball],
     eye: DVec3,
@@ -371,149 +437,295 @@ pub fn interleave(
     two_sided: bool,
     split_quads: bool,
 ) -> (Vec<u32>, Vec<Split>) {
-    let last = chunks.surfaces.len() as u32;
-    let e = eye_cell(eye);
-    let keys = KeyIndex::new(chunks.keys);
-    let mut facts: Vec<ChunkFacts> = Vec::new();
-    facts.resize_with(chunks.surfaces.len(), ChunkFacts::default);
-    // The place of each object (chunk, quad), and its distance as a key that orders
-    // farthest first (bits of a non-negative distance order like the number).
-    let mut places: Vec<(u32, u32)> = Vec::with_capacity(balls.len());
-    let mut farthest: Vec<(u64, u32)> = Vec::with_capacity(balls.len());
-    let mut items: Vec<(u32, u32, i64)> = Vec::new();
-    let mut weights: Vec<i64> = Vec::new();
-    for (i, &b) in balls.iter().enumerate() {
-        // Squared distances order like distances: the root only where a test needs it.
-        let o2 = b.center.distance_squared(eye);
-        if !o2.is_finite() || !b.radius.is_finite() {
-            places.push((last, 0));
-            farthest.push((u64::MAX, i as u32));
-            continue;
-        }
-        farthest.push((!o2.to_bits(), i as u32));
-        if o2 < b.radius * b.radius && (0..3).all(|a| (b.center[a] - eye[a]).abs() < b.half[a]) {
-            // The eye is inside it (a volume seen from within, whose far faces are drawn):
-            // after every chunk, as what lies nearest.
-            places.push((last, 0));
-            continue;
-        }
-        let (cells, [kmin, kmax]) = cells_and_keys(b, e);
-        // The part of the sequence whose keys lie in [kmin, kmax] (largest first).
-        let first = keys.above(kmax);
-        let end = match kmin.checked_sub(1) {
-            Some(k) => keys.above(k),
-            None => chunks.keys.len(),
+    let mut orderer = Interleaver::default();
+    orderer.run(
+        balls.len(),
+        |i| balls[i],
+        eye,
+        chunks,
+        two_sided,
+        split_quads,
+    );
+    (orderer.order, orderer.splits)
+}
+
+/// Orders a game's objects among the chunks ([`Interleaver::order`]), its buffers kept
+/// between frames (thousands of objects a frame would otherwise allocate and fault in
+/// megabytes each time): the renderer holds one.
+#[derive(Debug, Default)]
+pub struct Interleaver {
+    /// Each object's place (chunk, quad).
+    places: Vec<(u32, u32)>,
+    /// Each object's distance as a key that orders farthest first, and the object.
+    farthest: Vec<(u32, u32)>,
+    /// Room for the radix sort.
+    spare: Vec<(u32, u32)>,
+    items: Vec<(u32, u32, i64)>,
+    weights: Vec<i64>,
+    /// Per chunk, and the seen planes and runs they name.
+    facts: Vec<ChunkFacts>,
+    seen: Vec<SeenPlane>,
+    runs: Vec<(u32, u32)>,
+    /// The objects in draw order, and where runs of them are drawn.
+    order: Vec<u32>,
+    splits: Vec<Split>,
+}
+
+impl Interleaver {
+    /// Orders `objects` among the visible translucent `chunks` seen from `eye`:
+    /// [`Interleaver::result`] gives the objects in draw order and where runs of them are
+    /// drawn (in draw order; the objects after the last run come after every chunk).
+    ///
+    /// **Which chunks an object is tested against.** The chunks are drawn by
+    /// [`voxel_mesh::order::chunk_order_key`], which is exact for a grid of equal cubes:
+    /// a chunk that hides part of another has the smaller key (Theorem 3 of
+    /// [`voxel_mesh::order`]). A chunk that hides part of the ball hides part of a cell the
+    /// ball touches, so its key is below the greatest key of those cells; a chunk the ball
+    /// hides part of has a key above their least. So every chunk whose key lies above that
+    /// range is rightly drawn before the object, every one below it after, and only the
+    /// chunks with keys in the range can constrain it: for a ball inside one cell, that cell's
+    /// chunk alone (others of the same key neither hide it nor are hidden); for a ball across
+    /// cell borders, the thin shell of chunks at about its distance. Their places in the
+    /// sequence are found by binary search. The cost grows with objects (plus the chunks of
+    /// each shell, mostly proven apart on screen at once), not with objects times chunks.
+    ///
+    /// **Where, among those.** Each object goes to the place in that part of the sequence
+    /// (and, with `split_quads`, among the quads of its chunks, which are then in exact
+    /// back-to-front order) that the fewest constraints rule out: a chunk a sound test puts
+    /// wholly behind or in front of the object weighs [`SOUND`]; in a chunk no test decides,
+    /// each quad's plane ([`quad_side`]) weighs 1, or without `split_quads` the box's centre
+    /// decides with weight 1. Objects at one place go farthest centre first, so those that
+    /// share a place are one run: one draw of the game's instances.
+    ///
+    /// An object whose centre or radius is not finite, and one the eye is inside of (a game's
+    /// translucent volume seen from within: its far faces are nearer than any chunk outside
+    /// it), go after every chunk.
+    pub fn order(
+        &mut self,
+        objects: &[crate::stages::TranslucentObject],
+        eye: DVec3,
+        chunks: &ChunkSequence<'_>,
+        two_sided: bool,
+        split_quads: bool,
+    ) {
+        let ball = |i: usize| {
+            let o = &objects[i];
+            Ball::new(o.center, o.radius, o.half_extents)
         };
-        let single = (0..3).all(|a| cells[a][0] == cells[a][1]);
-        let range = if single {
-            // One cell: its chunk, if it is in the sequence; else no chunk constrains.
-            let cell = ChunkPos::new(cells[0][0] as i32, cells[1][0] as i32, cells[2][0] as i32);
-            let at = first + chunks.positions[first..end].partition_point(|&p| p < cell);
-            if chunks.positions.get(at) == Some(&cell) && at < end {
-                at..at + 1
-            } else {
-                at..at
-            }
-        } else {
-            first..end
-        };
-        if range.is_empty() {
-            // Nothing constrains it: after the chunks of larger keys.
-            let mut at = range.start as u32;
-            while at < last && chunks.surfaces[at as usize].is_none() {
-                at += 1;
-            }
-            places.push((at, 0));
-            continue;
-        }
-        let o = o2.sqrt();
-        // The constraints in draw order: (chunk, quad after which it applies, weight:
-        // positive when the item must come before the object, negative after it).
-        items.clear();
-        for c in range.clone() {
-            let Some(s) = &chunks.surfaces[c] else {
+        self.run(objects.len(), ball, eye, chunks, two_sided, split_quads);
+    }
+
+    /// The last order: the objects in draw order, and where runs of them are drawn.
+    pub fn result(&self) -> (&[u32], &[Split]) {
+        (&self.order, &self.splits)
+    }
+
+    fn run(
+        &mut self,
+        count: usize,
+        ball: impl Fn(usize) -> Ball,
+        eye: DVec3,
+        chunks: &ChunkSequence<'_>,
+        two_sided: bool,
+        split_quads: bool,
+    ) {
+        let Self {
+            places,
+            farthest,
+            spare,
+            items,
+            weights,
+            facts,
+            seen,
+            runs,
+            order,
+            splits,
+        } = self;
+        let last = chunks.surfaces.len() as u32;
+        let e = eye_cell(eye);
+        let keys = KeyIndex::new(chunks.keys);
+        let cells_index = CellIndex::new(chunks.positions);
+        facts.clear();
+        facts.resize(chunks.surfaces.len(), ChunkFacts::default());
+        seen.clear();
+        runs.clear();
+        places.clear();
+        farthest.clear();
+        for i in 0..count {
+            let b = ball(i);
+            // Squared distances order like distances: the root only where a test needs it.
+            let o2 = b.center.distance_squared(eye);
+            if !o2.is_finite() || !b.radius.is_finite() {
+                places.push((last, 0));
+                farthest.push((u32::MAX, i as u32));
                 continue;
+            }
+            // The squared distance's bits as a 32-bit float order like the number (enough to
+            // tell objects apart at one place: 24 bits of mantissa).
+            farthest.push((!(o2 as f32).to_bits(), i as u32));
+            if o2 < b.radius * b.radius && (0..3).all(|a| (b.center[a] - eye[a]).abs() < b.half[a])
+            {
+                // The eye is inside it (a volume seen from within, whose far faces are drawn):
+                // after every chunk, as what lies nearest.
+                places.push((last, 0));
+                continue;
+            }
+            let (cells, [kmin, kmax]) = cells_and_keys(b, e);
+            // The part of the sequence whose keys lie in [kmin, kmax] (largest first).
+            let first = keys.above(kmax);
+            let end = match kmin.checked_sub(1) {
+                Some(k) => keys.above(k),
+                None => chunks.keys.len(),
             };
-            let f = &mut facts[c];
-            let d = *f.distances.get_or_insert_with(|| s.distances(eye));
-            let c32 = c as u32;
-            match safe(b, o, eye, s, d, two_sided, range.len() > 1) {
-                // Apart on screen: any place is right.
-                [true, true] => {}
-                [true, false] => items.push((c32, 0, SOUND)),
-                [false, true] => items.push((c32, 0, -SOUND)),
-                [false, false] if split_quads => {
-                    let runs = f.runs.get_or_insert_with(|| {
-                        let mut r = Vec::new();
-                        plane_runs(s, &mut r);
-                        r
-                    });
-                    weights.clear();
-                    weights.extend(
-                        s.planes
-                            .iter()
-                            .map(|&p| plane_weight(b, eye, s.origin, p, two_sided)),
-                    );
-                    let mut k = 0u32;
-                    for &(p, n) in runs.iter() {
-                        let w = weights[p as usize];
-                        if w != 0 {
-                            // A run weighs its count; the place after it is after its
-                            // last quad.
-                            items.push((c32, k + n - 1, w * i64::from(n)));
-                        }
-                        k += n;
-                    }
+            let single = (0..3).all(|a| cells[a][0] == cells[a][1]);
+            let range = if single {
+                // One cell: its chunk, if it is in the sequence; else no chunk constrains.
+                match cells_index.get([cells[0][0], cells[1][0], cells[2][0]]) {
+                    Some(at) if (first..end).contains(&at) => at..at + 1,
+                    _ => first..first,
                 }
-                [false, false] => items.push((c32, 0, if o > d[1] { -1 } else { 1 })),
+            } else {
+                first..end
+            };
+            if range.is_empty() {
+                // Nothing constrains it: after the chunks of larger keys.
+                let mut at = range.start as u32;
+                while at < last && chunks.surfaces[at as usize].is_none() {
+                    at += 1;
+                }
+                places.push((at, 0));
+                continue;
+            }
+            let o = o2.sqrt();
+            // The constraints in draw order: (chunk, quad after which it applies, weight:
+            // positive when the item must come before the object, negative after it).
+            items.clear();
+            for c in range.clone() {
+                let Some(s) = &chunks.surfaces[c] else {
+                    continue;
+                };
+                let f = &mut facts[c];
+                let (from, to) = *f.planes.get_or_insert_with(|| {
+                    f.distances = s.distances(eye);
+                    let from = seen.len() as u32;
+                    seen_planes(s, eye, two_sided, seen);
+                    (from, seen.len() as u32)
+                });
+                let (d, planes) = (f.distances, &seen[from as usize..to as usize]);
+                let c32 = c as u32;
+                match safe(b, o, eye, s, planes, d, range.len() > 1) {
+                    // Apart on screen: any place is right.
+                    [true, true] => {}
+                    [true, false] => items.push((c32, 0, SOUND)),
+                    [false, true] => items.push((c32, 0, -SOUND)),
+                    [false, false] if split_quads => {
+                        let (from, to) = *f.runs.get_or_insert_with(|| {
+                            let from = runs.len() as u32;
+                            plane_runs(s, runs);
+                            (from, runs.len() as u32)
+                        });
+                        let runs = &runs[from as usize..to as usize];
+                        weights.clear();
+                        weights.resize(s.planes.len(), 0);
+                        for pl in planes.iter() {
+                            weights[pl.index as usize] = plane_weight(b, pl);
+                        }
+                        let mut k = 0u32;
+                        for &(p, n) in runs.iter() {
+                            let w = weights[p as usize];
+                            if w != 0 {
+                                // A run weighs its count; the place after it is after its
+                                // last quad.
+                                items.push((c32, k + n - 1, w * i64::from(n)));
+                            }
+                            k += n;
+                        }
+                    }
+                    [false, false] => items.push((c32, 0, if o > d[1] { -1 } else { 1 })),
+                }
+            }
+            // Before everything in range, every item that must come before the object is
+            // violated; passing an item changes the cost by its weight.
+            let mut cost: i64 = items.iter().map(|it| it.2.max(0)).sum();
+            let (mut min, mut at) = (cost, (range.start as u32, 0));
+            for &(c, k, w) in items.iter() {
+                cost -= w;
+                if cost < min {
+                    // Just after the item: after the whole chunk where it stood for it.
+                    let whole = w.abs() == SOUND || !split_quads;
+                    (min, at) = (cost, if whole { (c + 1, 0) } else { (c, k + 1) });
+                }
+            }
+            let (c, k) = at;
+            // After quads `..k` of chunk `c`; past the end of a chunk is before the next one.
+            let mut at = match chunks.surfaces.get(c as usize).and_then(Option::as_ref) {
+                Some(s) if k as usize >= s.quads.len() && k > 0 => (c + 1, 0),
+                _ => (c, k),
+            };
+            // Chunks with nothing translucent draw nothing: the next one that does.
+            while at.0 < last && chunks.surfaces[at.0 as usize].is_none() {
+                at = (at.0 + 1, 0);
+            }
+            places.push(at);
+        }
+        order_by_place(places, farthest, spare, last, order);
+        splits.clear();
+        for (n, &i) in order.iter().enumerate() {
+            let (c, k) = places[i as usize];
+            let next = order.get(n + 1).map(|&j| places[j as usize]);
+            if c < last && next != Some((c, k)) {
+                splits.push(Split {
+                    chunk: c,
+                    quad: k,
+                    end: n as u32 + 1,
+                });
             }
         }
-        // Before everything in range, every item that must come before the object is
-        // violated; passing an item changes the cost by its weight.
-        let mut cost: i64 = items.iter().map(|it| it.2.max(0)).sum();
-        let (mut min, mut at) = (cost, (range.start as u32, 0));
-        for &(c, k, w) in &items {
-            cost -= w;
-            if cost < min {
-                // Just after the item: after the whole chunk where it stood for it.
-                let whole = w.abs() == SOUND || !split_quads;
-                (min, at) = (cost, if whole { (c + 1, 0) } else { (c, k + 1) });
-            }
-        }
-        let (c, k) = at;
-        // After quads `..k` of chunk `c`; past the end of a chunk is before the next one.
-        let mut at = match chunks.surfaces.get(c as usize).and_then(Option::as_ref) {
-            Some(s) if k as usize >= s.quads.len() && k > 0 => (c + 1, 0),
-            _ => (c, k),
-        };
-        // Chunks with nothing translucent draw nothing: the next one that does.
-        while at.0 < last && chunks.surfaces[at.0 as usize].is_none() {
-            at = (at.0 + 1, 0);
-        }
-        places.push(at);
     }
-    let order = order_by_place(&places, &mut farthest, last);
-    let mut splits = Vec::new();
-    for (n, &i) in order.iter().enumerate() {
-        let (c, k) = places[i as usize];
-        let next = order.get(n + 1).map(|&j| places[j as usize]);
-        if c < last && next != Some((c, k)) {
-            splits.push(Split {
-                chunk: c,
-                quad: k,
-                end: n as u32 + 1,
-            });
+}
+
+/// Sorts `(key, value)` pairs by key, stably, in three passes of eleven bits (Bevy sorts
+/// its transparent phase by a radix sort too): linear in the count, a few times faster
+/// than a comparison sort for thousands of objects.
+fn radix_sort(v: &mut Vec<(u32, u32)>, other: &mut Vec<(u32, u32)>) {
+    other.clear();
+    other.resize(v.len(), (0, 0));
+    const BITS: u32 = 11;
+    const BUCKETS: usize = 1 << BITS;
+    let mut counts = vec![0usize; BUCKETS + 1];
+    for shift in [0u32, BITS, 2 * BITS] {
+        counts.fill(0);
+        for &(k, _) in v.iter() {
+            counts[((k >> shift) as usize & (BUCKETS - 1)) + 1] += 1;
         }
+        if counts[1..].iter().any(|&c| c == v.len()) {
+            // Every key has the same digit here: nothing moves.
+            continue;
+        }
+        for b in 1..=BUCKETS {
+            counts[b] += counts[b - 1];
+        }
+        for &e in v.iter() {
+            let b = (e.0 >> shift) as usize & (BUCKETS - 1);
+            other[counts[b]] = e;
+            counts[b] += 1;
+        }
+        std::mem::swap(v, other);
     }
-    (order, splits)
 }
 
 /// The objects by place (`places[i]`: chunk, then quad), farthest first at each place:
-/// one sort by distance (`farthest`: a key that orders farthest first, and the object),
-/// then a stable counting sort by chunk (places are chunk indices up to `last`), and
-/// within a chunk whose objects go among its quads a stable sort by quad.
-fn order_by_place(places: &[(u32, u32)], farthest: &mut [(u64, u32)], last: u32) -> Vec<u32> {
-    farthest.sort_unstable();
+/// one radix sort by distance (`farthest`: a key that orders farthest first, and the
+/// object), then a stable counting sort by chunk (places are chunk indices up to `last`),
+/// and within a chunk whose objects go among its quads a stable sort by quad.
+fn order_by_place(
+    places: &[(u32, u32)],
+    farthest: &mut Vec<(u32, u32)>,
+    spare: &mut Vec<(u32, u32)>,
+    last: u32,
+    order: &mut Vec<u32>,
+) {
+    radix_sort(farthest, spare);
     let mut start = vec![0u32; last as usize + 2];
     for &(c, _) in places {
         start[c as usize + 1] += 1;
@@ -521,7 +733,8 @@ fn order_by_place(places: &[(u32, u32)], farthest: &mut [(u64, u32)], last: u32)
     for c in 1..start.len() {
         start[c] += start[c - 1];
     }
-    let mut order = vec![0u32; places.len()];
+    order.clear();
+    order.resize(places.len(), 0);
     let mut quads = false;
     for &(_, i) in farthest.iter() {
         let (c, k) = places[i as usize];
@@ -540,7 +753,6 @@ fn order_by_place(places: &[(u32, u32)], farthest: &mut [(u64, u32)], last: u32)
             from = to;
         }
     }
-    order
 }
 
 #[cfg(test)]
@@ -565,7 +777,19 @@ mod tests {
         d: [f64; 3],
         two_sided: bool,
     ) -> Option<Side> {
-        match safe(b, o, eye, s, d, two_sided, true) {
+        match safe(
+            b,
+            o,
+            eye,
+            s,
+            &{
+                let mut v = Vec::new();
+                seen_planes(s, eye, two_sided, &mut v);
+                v
+            },
+            d,
+            true,
+        ) {
             [true, _] => Some(Side::Front),
             [false, true] => Some(Side::Behind),
             [false, false] => None,
@@ -960,7 +1184,19 @@ mod against_all_pairs {
                 let Some(s) = s else { continue };
                 let c = c as u32;
                 let d = s.distances(eye);
-                match safe(b, o, eye, s, d, two_sided, true) {
+                match safe(
+                    b,
+                    o,
+                    eye,
+                    s,
+                    &{
+                        let mut v = Vec::new();
+                        seen_planes(s, eye, two_sided, &mut v);
+                        v
+                    },
+                    d,
+                    true,
+                ) {
                     [true, true] => {}
                     [true, false] => items.push((c, 0, SOUND)),
                     [false, true] => items.push((c, 0, -SOUND)),
@@ -978,7 +1214,7 @@ mod against_all_pairs {
             }
             let mut cost: i64 = items.iter().map(|it| it.2.max(0)).sum();
             let (mut min, mut at) = (cost, (0, 0));
-            for &(c, k, w) in &items {
+            for &(c, k, w) in items.iter() {
                 cost -= w;
                 if cost < min {
                     let whole = w.abs() == SOUND || !split_quads;
