@@ -177,7 +177,7 @@ struct WindowArgs {
     #[arg(long, value_parser = size, default_value = "1280x720")]
     size: (u32, u32),
     /// Technique to start with.
-    #[arg(long, value_parser = technique, default_value = "wboit-mrt")]
+    #[arg(long, value_parser = technique, default_value = "sorted-quads")]
     technique: Technique,
     /// Chunks of terrain loaded around the eye, each way (1 to 32); they stream in as
     /// the camera flies.
@@ -234,7 +234,7 @@ struct StatsArgs {
 #[derive(Args, Debug)]
 struct RenderArgs {
     /// Technique.
-    #[arg(long, value_parser = technique, default_value = "wboit-mrt")]
+    #[arg(long, value_parser = technique, default_value = "sorted-quads")]
     technique: Technique,
     /// WBOIT weight (default: the renderer's).
     #[arg(long, value_parser = weight)]

@@ -134,6 +134,7 @@ fn overflow_renderer(ctx: &voxel_render::GpuContext, scene: &Scene, headroom: bo
         height: 48,
         ..RendererConfig::default()
     };
+    config.oit.technique = Technique::WboitMrt;
     config.oit.wboit.weight = WeightFunction::Flat;
     config.oit.wboit.headroom = headroom;
     renderer_for(ctx, scene, config).unwrap().renderer
@@ -180,11 +181,7 @@ fn resize_to_zero_and_back_and_switch_techniques_without_validation_errors() {
     let Some(ctx) = gpu() else { return };
     let scene = default_scene();
     let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let config = RendererConfig {
-        width: 96,
-        height: 64,
-        ..RendererConfig::default()
-    };
+    let config = technique_config(Technique::WboitMrt, 96, 64);
     let mut r = renderer_for(&ctx, &scene, config).unwrap();
     let cam = scene.cameras[0];
     let first = frame(&ctx, &mut r, &cam);

@@ -71,7 +71,7 @@ impl Default for DemoOptions {
         Self {
             seed: 1,
             size: (1280, 720),
-            technique: Technique::WboitMrt,
+            technique: voxel_render::OitConfig::default().technique,
             view_distance: 8,
             frames: None,
             screenshot: None,
