@@ -769,7 +769,10 @@ fn showcase(a: ShowcaseArgs) -> Result<(), String> {
     let mut renderer = headless::renderer_for(&ctx, &scene, config)?;
     let target = headless::Offscreen::new(&ctx, w, h);
     for t in Technique::ALL {
-        renderer.set_technique(t);
+        if let Err(e) = renderer.set_technique(t) {
+            println!("skipped {t}: {}", chain(&e));
+            continue;
+        }
         // One frame to settle (adaptive peeling), one to keep.
         renderer
             .render_and_submit(&target.view, &scene.cameras[0])

@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 
 /// voxel-render, bottom up (its lib.rs docs give the same order).
 const RENDER: &[&str] = &[
-    "error", "context", "camera", "readback", "timing", "gpu", "bindings", "textures", "arena",
-    "layers", "chunks", "medium", "stages", "oit", "renderer", "stream",
+    "error", "context", "ladder", "camera", "readback", "timing", "fetch", "gpu", "bindings",
+    "textures", "arena", "layers", "chunks", "medium", "stages", "oit", "renderer", "stream",
 ];
 
 /// voxel-lab, bottom up: the model, then the runs, then the report (its lib.rs docs).

@@ -327,7 +327,7 @@ fn game_draws_survive_switches_resizes_and_msaa() {
         Technique::Reference,
         Technique::WboitTwoPass,
     ] {
-        r.set_technique(t);
+        r.set_technique(t).unwrap();
         let got = shot(&mut r);
         let fresh = render(&scene, technique_config(t, W, H));
         let d = diff(&got, &fresh);
