@@ -37,6 +37,11 @@ use post::{FRAME_FORMAT, Frames, Post};
 /// How the demo starts, and what a scripted run does.
 #[derive(Clone, Debug)]
 pub struct DemoOptions {
+    /// The backends to find the window's adapter among (`None`: `WGPU_BACKEND`, else the
+    /// primary ones).
+    pub backends: Option<wgpu::Backends>,
+    /// The limits and optional features of the device.
+    pub limits: voxel_render::LimitsPreset,
     /// World seed.
     pub seed: u32,
     /// Initial window size.
@@ -69,6 +74,8 @@ pub struct DemoOptions {
 impl Default for DemoOptions {
     fn default() -> Self {
         Self {
+            backends: None,
+            limits: voxel_render::LimitsPreset::Adapter,
             seed: 1,
             size: (1280, 720),
             technique: Technique::WboitMrt,
@@ -373,7 +380,7 @@ struct Gfx {
 
 impl Gfx {
     fn new(window: Arc<Window>, opts: DemoOptions) -> Result<Self, String> {
-        let (display, ctx) = Display::new(window)?;
+        let (display, ctx) = Display::new(window, opts.backends, opts.limits)?;
         // The scene's first camera, or the default view of the seed (its world is only the
         // few chunks around it).
         let (cam, open) = match &opts.scene {
