@@ -62,8 +62,9 @@ impl QuadFetch {
             QuadFetch::Storage => vec![
                 Need::Downlevel(wgpu::DownlevelFlags::VERTEX_STORAGE),
                 Need::Limit(Limit::StorageBuffersPerStage, VERTEX_STORAGE_BUFFERS),
-                // A page holds any chunk's mesh: at most six faces a block.
-                Need::Limit(Limit::StorageBufferBindingSize, MAX_MESH_QUADS * QUAD_BYTES),
+                // A page holds a quad; a mesh larger than a page is refused at its upload
+                // (`Error::TooLarge`), not the whole world.
+                Need::Limit(Limit::StorageBufferBindingSize, QUAD_BYTES),
             ],
             QuadFetch::Instanced => vec![
                 Need::Limit(Limit::VertexBuffers, 1),
@@ -174,9 +175,6 @@ impl QuadFetch {
 
 /// Bytes of one quad.
 const QUAD_BYTES: u64 = std::mem::size_of::<voxel_mesh::PackedQuad>() as u64;
-
-/// The most quads a chunk's mesh of one kind can have: six faces a block.
-const MAX_MESH_QUADS: u64 = 6 * (voxel_core::CHUNK_SIZE as u64).pow(3);
 
 /// One `vec2<u32>` per instance at location 0: a page read as instanced quads.
 const QUAD_INSTANCES: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {

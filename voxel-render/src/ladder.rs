@@ -6,7 +6,7 @@
 //! `required_limits` the same way.
 //!
 //! The rungs, from the top: every technique on a Vulkan, Metal or DX12 class device; the
-//! world without storage buffers in the vertex stage ([`crate::QuadFetch::Instanced`]),
+//! world without storage buffers in the vertex stage (`QuadFetch::Instanced`),
 //! as on WebGL2 and many GLES 3.1 devices; WBOIT in two passes without independent blend;
 //! the blended techniques without float blending gone; stipple, which needs nothing but
 //! the world's own passes, last.
@@ -159,7 +159,7 @@ pub fn check(what: &str, needs: &[Need], caps: &Capabilities) -> Result<()> {
 }
 
 /// What the world's own passes need on every device, whichever way quads reach the
-/// vertex shader ([`crate::QuadFetch::needs`] adds that way's needs): the HDR scene colour
+/// vertex shader (`QuadFetch::needs` adds that way's needs): the HDR scene colour
 /// rendered to and blended into (the medium's fog, the composites, a game's overlays),
 /// and the chunk shaders' eight values passed from vertex to fragment (`VsOut` in
 /// `shaders/common.wgsl`).
