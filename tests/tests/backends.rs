@@ -392,3 +392,67 @@ fn a_device_below_the_last_rung_is_refused_naming_the_capability() {
     .unwrap_err();
     assert_names_capability(&e, "Renderer::new");
 }
+
+/// The arena's pages as vertex buffers: small ones (a 128 KiB buffer limit: 16 384 quads a
+/// page) so that terrain spans several; unloading most of it and drawing compacts pages
+/// away, and the picture equals a fresh renderer's given only the chunks kept, as with
+/// storage pages (`tests/tests/stream.rs`).
+#[test]
+fn instanced_pages_compact_and_keep_the_picture() {
+    let Some(ctx) = gpu_with_limits(|l| l.max_buffer_size = 128 << 10) else {
+        return;
+    };
+    let world = voxel_core::TerrainGenerator::new(voxel_core::TerrainConfig::default())
+        .generate_world(
+            std::sync::Arc::new(voxel_core::BlockRegistry::default()),
+            voxel_core::ChunkPos::new(-3, 0, -3),
+            voxel_core::ChunkPos::new(3, 1, 3),
+        )
+        .unwrap();
+    let all: Vec<_> = world.iter().map(|(p, _)| p).collect();
+    let meshes = voxel_mesh::mesh_chunks(&world, &all).unwrap();
+    let kept = |p: &voxel_core::ChunkPos| p.x >= 1 && p.z >= 1;
+    let camera = voxel_render::Camera::look_at(
+        glam::DVec3::new(40.0, 60.0, 40.0),
+        glam::DVec3::new(90.0, 20.0, 90.0),
+        70.0,
+        0.1,
+        400.0,
+    )
+    .unwrap();
+    let new = || {
+        let config = RendererConfig {
+            quad_fetch: Some(QuadFetch::Instanced),
+            // Small enough that its readback fits the buffer limit.
+            ..technique_config(Technique::SortedQuads, 160, 90)
+        };
+        Renderer::new(&ctx, world.registry(), config).unwrap()
+    };
+    let mut compacted = new();
+    for (pos, m) in &meshes {
+        compacted.upload_chunk(*pos, m).unwrap();
+    }
+    let before = compacted.chunk_memory();
+    assert!(before.pages >= 3, "terrain spans several pages: {before:?}");
+    for (pos, _) in meshes.iter().filter(|(p, _)| !kept(p)) {
+        compacted.remove_chunk(*pos);
+    }
+    for _ in 0..before.pages {
+        tests::frame(&ctx, &mut compacted, &camera);
+    }
+    let after = compacted.chunk_memory();
+    assert!(
+        after.pages < before.pages,
+        "no page compacted away: {before:?} -> {after:?}"
+    );
+    let mut fresh = new();
+    for (pos, m) in meshes.iter().filter(|(p, _)| kept(p)) {
+        fresh.upload_chunk(*pos, m).unwrap();
+    }
+    let a = tests::frame(&ctx, &mut compacted, &camera);
+    let b = tests::frame(&ctx, &mut fresh, &camera);
+    assert!(distinct_colours(&a) > 50, "a real picture");
+    // As with storage pages: where coplanar grown opaque quads meet, the draw order (which
+    // compaction changes) picks the pixel, within 1/255.
+    tests::assert_close("backends_instanced_compacted", &a, &b, 1);
+}
