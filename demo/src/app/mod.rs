@@ -693,7 +693,7 @@ impl Gfx {
 
     /// Applies what the panel changed.
     fn apply_settings(&mut self) -> Result<(), String> {
-        let s = self.settings.clone();
+        let mut s = self.settings.clone();
         let a = self.applied.clone();
         if s.seed != a.seed && self.scene.is_none() {
             // Another world: start it over at its default view.
@@ -715,9 +715,15 @@ impl Gfx {
         }
         self.far = far_plane(s.view_distance).max(self.scene.as_ref().map_or(0.0, |s| s.far));
         if s.oit != a.oit {
-            self.renderer
-                .set_oit_config(s.oit.clone())
-                .map_err(|e| chain(&e))?;
+            match self.renderer.set_oit_config(s.oit.clone()) {
+                // A technique this device cannot run: said, and the one in force kept.
+                Err(e @ voxel_render::Error::Unsupported(_)) => {
+                    log::warn!("{e}");
+                    s.oit = a.oit.clone();
+                    self.settings.oit = a.oit.clone();
+                }
+                other => other.map_err(|e| chain(&e))?,
+            }
         }
         if s.msaa != a.msaa {
             self.renderer.set_msaa(s.msaa).map_err(|e| chain(&e))?;
