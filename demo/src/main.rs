@@ -78,6 +78,23 @@ enum Command {
     /// One scene (a scene file or a .vox model) under every technique: each picture, its
     /// FLIP error map against the reference, and gallery.png with all of them.
     Gallery(GalleryArgs),
+    /// Every technique of the default scene on Vulkan, on wgpu's GL backend and on Vulkan
+    /// with WebGL2's limits: runs or which capability it lacks, error against the Vulkan
+    /// picture, GPU ms; report.md and the pictures (ignores --backend and --limits).
+    Backends(BackendsArgs),
+}
+
+#[derive(Args, Debug)]
+struct BackendsArgs {
+    /// Picture size.
+    #[arg(long, value_parser = size, default_value = "640x360")]
+    size: (u32, u32),
+    /// Timed frames per picture (after one untimed), 1 to 1000; the median is reported.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(voxel_lab::limits::MAX_FRAMES)), default_value_t = 5)]
+    frames: u32,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -382,6 +399,7 @@ fn main() {
         Some(Command::Eval(a)) => eval(a, &device),
         Some(Command::Stream(a)) => stream(a, &device),
         Some(Command::Gallery(a)) => gallery(a, &device),
+        Some(Command::Backends(a)) => backends(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e}");
@@ -784,6 +802,19 @@ fn gallery(a: GalleryArgs, device: &headless::Device) -> Result<(), String> {
         );
     }
     println!("wrote {}", a.out.join("gallery.png").display());
+    Ok(())
+}
+
+/// The backend × technique table.
+fn backends(a: BackendsArgs) -> Result<(), String> {
+    writable_dir(&a.out)?;
+    let opts = voxel_lab::backends::Options {
+        size: a.size,
+        frames: a.frames,
+        out: a.out,
+    };
+    voxel_lab::backends::run(&opts)?;
+    println!("wrote {}", opts.out.join("report.md").display());
     Ok(())
 }
 

@@ -32,6 +32,7 @@ const LAB: &[&str] = &[
     "report",
     "stream",
     "gallery",
+    "backends",
 ];
 
 /// The module each item re-exported by lib.rs (`pub use module::{A, B};`) comes from.
