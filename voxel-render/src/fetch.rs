@@ -279,9 +279,9 @@ impl TableTexture {
 /// The chunk records by slot: an array in a storage buffer ([`QuadFetch::Storage`]), or
 /// one record every `stride` bytes of a uniform buffer, bound at the drawn chunk's record
 /// with a dynamic offset ([`QuadFetch::Instanced`]; `stride` the device's uniform offset
-/// alignment). A uniform is what a vertex shader reads fastest on every device: on
-/// lavapipe, reading the record from a texture instead made the instanced world cost up
-/// to 1.17 times the storage one (`benches/quad_fetch.rs`).
+/// alignment): a uniform is a constant for the whole draw on every device, where a table
+/// texture (as the block layers need: a game's registry can outgrow a uniform buffer)
+/// would be fetched by every vertex.
 #[derive(Debug)]
 pub struct Records {
     buffer: wgpu::Buffer,
