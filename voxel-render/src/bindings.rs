@@ -140,7 +140,8 @@ impl SharedLayouts {
             gpu::texture_entry(3, gpu::DEPTH_READ),
             gpu::depth_sampler_entry(6),
         ];
-        // The block layers (`common.wgsl`), read where the quad is expanded.
+        // Group 0's block layers (read where the quad is expanded) and group 1, as
+        // `common.wgsl` declares them for each way of fetching quads.
         let chunk_entries = match fetch {
             QuadFetch::Storage => {
                 scene_entries.push(buffer_entry(4, S::VERTEX, B::Storage { read_only: true }));

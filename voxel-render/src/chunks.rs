@@ -324,7 +324,7 @@ impl FrameDraws<'_> {
                 _ => {
                     let cmds = &self.commands[run.first as usize..(run.first + run.count) as usize];
                     for c in cmds {
-                        self.store.draw(c, 0..c.vertex_count / 6, pass);
+                        self.store.draw(run.page, c, 0..c.vertex_count / 6, pass);
                     }
                 }
             }
@@ -362,7 +362,7 @@ impl FrameDraws<'_> {
         if a >= b || !self.store.bind_page(run.page, pass) {
             return;
         }
-        self.store.draw(c, a..b, pass);
+        self.store.draw(run.page, c, a..b, pass);
     }
 }
 
@@ -792,14 +792,20 @@ impl ChunkStore {
         true
     }
 
-    /// Draws quads `quads` (positions in the mesh) of the mesh of command `c`, whose page
-    /// is bound ([`ChunkStore::bind_page`]).
-    fn draw(&self, c: &DrawCommand, quads: std::ops::Range<u32>, pass: &mut wgpu::RenderPass<'_>) {
+    /// Draws quads `quads` (positions in the mesh) of the mesh of command `c`, in page
+    /// `page`, which is bound ([`ChunkStore::bind_page`]).
+    fn draw(
+        &self,
+        page: u32,
+        c: &DrawCommand,
+        quads: std::ops::Range<u32>,
+        pass: &mut wgpu::RenderPass<'_>,
+    ) {
         let slot = c.first_instance;
         let first = c.first_vertex / 6 + quads.start;
         let (vertices, instances) = self.fetch.draw_ranges(slot, first, quads.len() as u32);
         if self.fetch == QuadFetch::Instanced
-            && let Some(Some(group)) = self.groups.first()
+            && let Some(Some(group)) = self.groups.get(page as usize)
         {
             pass.set_bind_group(1, group, &[self.infos.offset(slot)]);
         }

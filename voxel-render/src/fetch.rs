@@ -1,9 +1,10 @@
 //! How the chunk pipelines' vertex shader gets the quads and their lookup tables (each
 //! chunk's record, each block's texture layers): pulled from storage buffers by vertex
 //! index, or, on devices whose vertex stage has no storage buffers (WebGL2, many GLES 3.1
-//! phones), each quad an instance's vertex attribute (the same 8 bytes) and the tables in
-//! integer textures read with `textureLoad`, which every device allows in vertex shaders.
-//! `shaders/common.wgsl` has both kinds of entry point; [`QuadFetch`] picks one.
+//! phones), each quad an instance's vertex attribute (the same 8 bytes), the chunk's record
+//! a uniform bound for its draw and the block layers an integer texture read with
+//! `textureLoad`, which every device allows in vertex shaders. `shaders/common.wgsl` has
+//! both kinds of entry point; [`QuadFetch`] picks one.
 
 use crate::context::Capabilities;
 use crate::ladder::{self, Limit, Need};

@@ -5,11 +5,12 @@
 //! wgpu's examples declare `required_features`, `required_downlevel_capabilities` and
 //! `required_limits` the same way.
 //!
-//! The rungs, from the top: every technique on a Vulkan, Metal or DX12 class device; the
-//! world without storage buffers in the vertex stage (`QuadFetch::Instanced`),
-//! as on WebGL2 and many GLES 3.1 devices; WBOIT in two passes without independent blend;
-//! the blended techniques without float blending gone; stipple, which needs nothing but
-//! the world's own passes, last.
+//! Where a device lacks something, the renderer steps down: the world's quads as instances
+//! where the vertex stage has no storage buffers (`QuadFetch::Instanced`: WebGL2, many
+//! GLES 3.1 devices), two-pass WBOIT without independent blend or a second colour
+//! attachment, peel-to-convergence for the A-buffer without fragment storage; what has no
+//! step down is refused. `Technique::LADDER` is the order a game goes down for the best
+//! technique a device runs, stipple (which needs nothing but the world's own passes) last.
 
 use std::fmt;
 
