@@ -23,7 +23,8 @@ impl Display {
         backends: Option<wgpu::Backends>,
         limits: voxel_render::LimitsPreset,
     ) -> Result<(Self, GpuContext), String> {
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        // The window's display: wgpu's GL backend makes its EGL display from it.
+        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(window.clone()));
         desc.backends = backends
             .or_else(wgpu::Backends::from_env)
             .unwrap_or(wgpu::Backends::PRIMARY);
