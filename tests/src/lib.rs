@@ -58,6 +58,17 @@ pub fn webgl2() -> Option<GpuContext> {
     )
 }
 
+/// wgpu's GL backend with WebGL2's limits and no optional feature: the closest to a
+/// browser's WebGL2 this machine has (GLSL ES from naga, no storage buffers). `None` as
+/// [`gpu`].
+pub fn gl_webgl2() -> Option<GpuContext> {
+    context_or_skip(
+        wgpu::Backends::GL,
+        LimitsPreset::WebGl2,
+        "a GL adapter (install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri)",
+    )
+}
+
 fn context_or_skip(
     backends: wgpu::Backends,
     limits: LimitsPreset,

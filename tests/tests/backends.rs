@@ -187,6 +187,34 @@ fn every_real_time_technique_on_gl_draws_like_vulkan_or_names_what_it_lacks() {
     }
 }
 
+/// GL with WebGL2's limits: instanced quads through naga's GLSL ES (integer vertex
+/// attributes, a uniform at a dynamic offset, the GL backend's emulated first instance).
+#[test]
+fn every_real_time_technique_on_gl_with_webgl2_limits_draws_like_vulkan_or_names_what_it_lacks() {
+    let (Some(vk), Some(gl)) = (gpu(), tests::gl_webgl2()) else {
+        return;
+    };
+    assert_eq!(
+        gl.caps.backend,
+        wgpu::Backend::Gl,
+        "{}",
+        gl.caps.adapter_name
+    );
+    assert_eq!(
+        QuadFetch::choose(&gl.caps, None).unwrap(),
+        QuadFetch::Instanced
+    );
+    for scene in scenes(false) {
+        for t in Technique::REAL_TIME {
+            let Some((drew, picture)) = draw_or_refuse(&gl, &scene, t) else {
+                continue;
+            };
+            let expected = render(&vk, &scene, vulkan_config(&gl, drew));
+            assert_like_vulkan("gl_webgl2", &scene, t, &picture, &expected, GL_TOLERANCE);
+        }
+    }
+}
+
 #[test]
 fn the_low_end_techniques_on_gl_are_within_the_targets() {
     // The targets: stipple and sorted-quads within 3/255 mean of Vulkan's picture of the
@@ -269,11 +297,11 @@ fn instanced_quads_draw_what_storage_buffers_draw() {
 /// missing, or draws as a replacement it lists.
 #[test]
 fn supported_agrees_with_what_draws() {
-    let devices: Vec<GpuContext> = [gpu(), tests::gl(), tests::webgl2()]
+    let devices: Vec<GpuContext> = [gpu(), tests::gl(), tests::webgl2(), tests::gl_webgl2()]
         .into_iter()
         .flatten()
         .collect();
-    if devices.len() < 3 {
+    if devices.len() < 4 {
         return;
     }
     let scene = tests::dense_sheets(3, 0.5);
