@@ -78,7 +78,7 @@ enum Command {
     /// One scene (a scene file or a .vox model) under every technique: each picture, its
     /// FLIP error map against the reference, and gallery.png with all of them.
     Gallery(GalleryArgs),
-    /// Every technique of the default scene on Vulkan, on wgpu's GL backend and on Vulkan
+    /// Every technique of the default scene on Vulkan, on wgpu's GL backend, and on both
     /// with WebGL2's limits: runs or which capability it lacks, error against the Vulkan
     /// picture, GPU ms; report.md and the pictures (ignores --backend and --limits).
     Backends(BackendsArgs),

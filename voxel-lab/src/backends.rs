@@ -1,5 +1,5 @@
 //! The backend × technique table (`demo backends`): every technique of the default scene
-//! on Vulkan, on wgpu's GL backend and on Vulkan with WebGL2's limits; whether it runs (as
+//! on Vulkan, on wgpu's GL backend, and on both with WebGL2's limits; whether it runs (as
 //! itself or as its replacement) or which capability it lacks, its error against the
 //! Vulkan picture, its GPU time.
 
@@ -31,8 +31,8 @@ pub struct Device {
     pub ctx: GpuContext,
 }
 
-/// The three devices: Vulkan, GL, and Vulkan with WebGL2's limits and no optional feature
-/// but timestamp queries (which WebGL2 lacks; asked for here only to time the passes).
+/// The four devices: Vulkan, GL, and both with WebGL2's limits and no optional feature but
+/// timestamp queries (which WebGL2 lacks; asked for here only to time the passes).
 pub fn devices() -> Result<Vec<Device>, String> {
     let vulkan = headless::Device {
         backends: wgpu::Backends::VULKAN,
@@ -53,21 +53,26 @@ pub fn devices() -> Result<Vec<Device>, String> {
         },
         Device {
             name: "Vulkan, WebGL2 limits".into(),
-            ctx: webgl2_timed()?,
+            ctx: webgl2_timed(wgpu::Backends::VULKAN)?,
+        },
+        Device {
+            name: "GL, WebGL2 limits".into(),
+            ctx: webgl2_timed(wgpu::Backends::GL)?,
         },
     ])
 }
 
-/// A Vulkan device with WebGL2's limits and timestamp queries (when the adapter has them).
-fn webgl2_timed() -> Result<GpuContext, String> {
+/// A device of `backends` with WebGL2's limits and timestamp queries (when the adapter has
+/// them).
+fn webgl2_timed(backends: wgpu::Backends) -> Result<GpuContext, String> {
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-    desc.backends = wgpu::Backends::VULKAN;
+    desc.backends = backends;
     let instance = wgpu::Instance::new(desc);
     pollster::block_on(async {
         let adapter = instance
             .request_adapter(&Default::default())
             .await
-            .map_err(|e| format!("no Vulkan adapter: {e}"))?;
+            .map_err(|e| format!("no {backends:?} adapter: {e}"))?;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("webgl2_limits_timed"),
