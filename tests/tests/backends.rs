@@ -484,3 +484,17 @@ fn instanced_pages_compact_and_keep_the_picture() {
     // compaction changes) picks the pixel, within 1/255.
     tests::assert_close("backends_instanced_compacted", &a, &b, 1);
 }
+
+/// The lab's game content pulls its instances from a storage buffer: under WebGL2's limits
+/// a scene with it is refused naming what is missing, not a wgpu panic.
+#[test]
+fn game_content_under_webgl2_limits_is_refused_naming_the_capability() {
+    let Some(w2) = tests::webgl2() else { return };
+    let scene = scenes(true).pop().unwrap();
+    assert!(!scene.content.is_empty(), "{}", scene.name);
+    let e = renderer_for(&w2, &scene, technique_config(Technique::Stipple, W, H)).unwrap_err();
+    assert!(
+        e.contains("max_storage_buffers_per_shader_stage of at least 1 (this device: 0)"),
+        "{e}"
+    );
+}

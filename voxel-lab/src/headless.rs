@@ -2,7 +2,8 @@
 
 use voxel_mesh::mesh_chunks;
 use voxel_render::{
-    Camera, FrameStats, GpuContext, Image, LimitsPreset, Renderer, RendererConfig, readback,
+    Camera, FrameStats, GpuContext, Image, Limit, LimitsPreset, Need, Renderer, RendererConfig,
+    readback,
 };
 
 use crate::content::ContentStages;
@@ -150,12 +151,28 @@ impl SceneRenderer {
     }
 }
 
-/// A renderer with every chunk of `scene` meshed and uploaded, and its content ready.
+/// What the scene's game content needs of a device: its shaders pull their instances from
+/// a storage buffer in the vertex stage (`content.wgsl`), as a desktop game's might.
+fn content_needs() -> [Need; 2] {
+    [
+        Need::Downlevel(wgpu::DownlevelFlags::VERTEX_STORAGE),
+        Need::Limit(Limit::StorageBuffersPerStage, 1),
+    ]
+}
+
+/// A renderer with every chunk of `scene` meshed and uploaded, and its content ready. A
+/// scene with game content on a device without storage buffers in the vertex stage (WebGL2's
+/// limits) is an error naming what is missing.
 pub fn renderer_for(
     ctx: &GpuContext,
     scene: &Scene,
     config: RendererConfig,
 ) -> Result<SceneRenderer, String> {
+    if !scene.content.is_empty() {
+        let what = format!("{}: the lab's game content", scene.name);
+        voxel_render::ladder::check(&what, &content_needs(), &ctx.caps)
+            .map_err(|e| crate::chain(&e))?;
+    }
     let mut renderer =
         Renderer::new(ctx, scene.world.registry(), config).map_err(|e| crate::chain(&e))?;
     let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
