@@ -498,3 +498,21 @@ fn game_content_under_webgl2_limits_is_refused_naming_the_capability() {
         "{e}"
     );
 }
+
+/// 4× MSAA on GL falls back to none (its resolve draws black there, see
+/// `Capabilities::msaa4`): the picture is GL's without MSAA, not a black one.
+#[test]
+fn msaa_on_gl_falls_back_to_none() {
+    let Some(gl) = tests::gl() else { return };
+    let scene = scenes(false).remove(0);
+    let config = technique_config(Technique::SortedQuads, W, H);
+    let msaa = RendererConfig {
+        msaa: true,
+        ..config.clone()
+    };
+    let r = Renderer::new(&gl, scene.world.registry(), msaa.clone()).unwrap();
+    assert!(!r.config().msaa);
+    let with = render(&gl, &scene, msaa);
+    let without = render(&gl, &scene, config);
+    tests::assert_close("backends_gl_msaa", &with, &without, 0);
+}

@@ -42,7 +42,11 @@ impl Capabilities {
                 .contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_X4)
             && f16
                 .flags
-                .contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE);
+                .contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE)
+            // On wgpu's GL backend (Mesa's llvmpipe) the 4× opaque pass resolves to black and
+            // its depth resolve reads zeros, with no error reported: the cause is not found,
+            // so GL draws without MSAA (the fallback every device without 4× support takes).
+            && info.backend != wgpu::Backend::Gl;
         Self {
             adapter_name: format!("{} ({:?})", info.name, info.backend),
             backend: info.backend,
