@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Makes sure a Vulkan driver is present (Mesa's software one, lavapipe, on machines without
-# a GPU), plus Xvfb and the X11 keyboard library winit loads at run time. Installs what is
-# missing with apt-get when running as root on Debian/Ubuntu; otherwise says what to
-# install and fails. Sourced by run.sh and test.sh.
+# a GPU), Mesa's EGL and GLES with its DRI drivers (wgpu's GL backend: llvmpipe without a
+# GPU, what the GL tests draw on), plus Xvfb and the X11 keyboard library winit loads at
+# run time. Installs what is missing with apt-get when running as root on Debian/Ubuntu;
+# otherwise says what to install and fails. Sourced by run.sh and test.sh.
 
 have_vulkan_driver() {
     compgen -G "/usr/share/vulkan/icd.d/*.json" >/dev/null ||
@@ -13,9 +14,21 @@ have_lib() {
     ldconfig -p 2>/dev/null | grep -q "$1"
 }
 
+# Mesa's software GL driver: swrast_dri.so (or, in newer Mesa, libgallium) in a dri folder.
+have_mesa_dri() {
+    compgen -G "/usr/lib/*/dri/swrast_dri.so" >/dev/null ||
+        compgen -G "/usr/lib/dri/swrast_dri.so" >/dev/null ||
+        have_lib libgallium
+}
+
 ensure_vulkan() {
     local missing=()
     have_vulkan_driver || missing+=(mesa-vulkan-drivers)
+    # wgpu's GL backend: the EGL loader, Mesa's EGL, GLES 2/3, the DRI drivers.
+    have_lib libEGL.so.1 || missing+=(libegl1)
+    have_lib libEGL_mesa.so.0 || missing+=(libegl-mesa0)
+    have_lib libGLESv2.so.2 || missing+=(libgles2)
+    have_mesa_dri || missing+=(libgl1-mesa-dri)
     command -v Xvfb >/dev/null || missing+=(xvfb)
     have_lib libxkbcommon-x11.so.0 || missing+=(libxkbcommon-x11-0)
     if ((${#missing[@]})); then

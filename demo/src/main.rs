@@ -20,6 +20,41 @@ struct Cli {
     /// Options of the window, when no command is given.
     #[command(flatten)]
     window: WindowArgs,
+    /// The device every command draws with.
+    #[command(flatten)]
+    device: DeviceArgs,
+}
+
+/// Which device to draw with.
+#[derive(Args, Debug, Clone, Copy)]
+struct DeviceArgs {
+    /// Graphics backend: vulkan, gl, metal or dx12 (default: WGPU_BACKEND; unset, Vulkan
+    /// for the headless commands and the primary backends for the window).
+    #[arg(long, global = true, value_parser = headless::backend)]
+    backend: Option<wgpu::Backends>,
+    /// Device limits: adapter (all the adapter has) or webgl2 (WebGL2's limits and no
+    /// optional feature, on any adapter).
+    #[arg(long, global = true, value_parser = limits_preset, default_value = "adapter")]
+    limits: voxel_render::LimitsPreset,
+}
+
+impl DeviceArgs {
+    /// The headless device: `--backend`, else `WGPU_BACKEND`, else Vulkan.
+    fn headless(&self) -> headless::Device {
+        let env = headless::Device::from_env();
+        headless::Device {
+            backends: self.backend.unwrap_or(env.backends),
+            limits: self.limits,
+        }
+    }
+}
+
+fn quad_fetch(s: &str) -> Result<voxel_render::QuadFetch, String> {
+    voxel_render::QuadFetch::from_name(s).map_err(|e| e.to_string())
+}
+
+fn limits_preset(s: &str) -> Result<voxel_render::LimitsPreset, String> {
+    voxel_render::LimitsPreset::from_name(s).map_err(|e| e.to_string())
 }
 
 #[derive(Subcommand, Debug)]
@@ -43,6 +78,23 @@ enum Command {
     /// One scene (a scene file or a .vox model) under every technique: each picture, its
     /// FLIP error map against the reference, and gallery.png with all of them.
     Gallery(GalleryArgs),
+    /// Every technique of the default scene on Vulkan, on wgpu's GL backend, and on both
+    /// with WebGL2's limits: runs or which capability it lacks, error against the Vulkan
+    /// picture, GPU ms; report.md and the pictures (ignores --backend and --limits).
+    Backends(BackendsArgs),
+}
+
+#[derive(Args, Debug)]
+struct BackendsArgs {
+    /// Picture size.
+    #[arg(long, value_parser = size, default_value = "640x360")]
+    size: (u32, u32),
+    /// Timed frames per picture (after one untimed), 1 to 1000; the median is reported.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(voxel_lab::limits::MAX_FRAMES)), default_value_t = 5)]
+    frames: u32,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -263,6 +315,10 @@ struct RenderArgs {
     /// Every block one flat colour (what the lab compares with its CPU ray march).
     #[arg(long)]
     flat_textures: bool,
+    /// How quads reach the vertex shader: storage or instanced (default: the first the
+    /// device can).
+    #[arg(long, value_parser = quad_fetch)]
+    quad_fetch: Option<voxel_render::QuadFetch>,
     /// Timed frames (after one untimed), 1 to 1000; the medians are printed.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(voxel_lab::limits::MAX_FRAMES)), default_value_t = 1)]
     frames: u32,
@@ -321,24 +377,29 @@ struct EvalArgs {
 fn main() {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
+    let (device, d) = (cli.device.headless(), cli.device);
     let result = match cli.command {
-        None if demo::app::have_display() => window(cli.window),
+        None if demo::app::have_display() => window(cli.window, d),
         None => {
             eprintln!(
                 "no display (neither DISPLAY nor WAYLAND_DISPLAY is set): running the headless showcase instead"
             );
-            showcase(ShowcaseArgs {
-                out: "out".into(),
-                size: (1280, 720),
-            })
+            showcase(
+                ShowcaseArgs {
+                    out: "out".into(),
+                    size: (1280, 720),
+                },
+                &device,
+            )
         }
-        Some(Command::Window(a)) => window(a),
-        Some(Command::Showcase(a)) => showcase(a),
+        Some(Command::Window(a)) => window(a, d),
+        Some(Command::Showcase(a)) => showcase(a, &device),
         Some(Command::Stats(a)) => stats(a),
-        Some(Command::Render(a)) => render(a),
-        Some(Command::Eval(a)) => eval(a),
-        Some(Command::Stream(a)) => stream(a),
-        Some(Command::Gallery(a)) => gallery(a),
+        Some(Command::Render(a)) => render(a, &device),
+        Some(Command::Eval(a)) => eval(a, &device),
+        Some(Command::Stream(a)) => stream(a, &device),
+        Some(Command::Gallery(a)) => gallery(a, &device),
+        Some(Command::Backends(a)) => backends(a),
     };
     if let Err(e) = result {
         eprintln!("error: {e}");
@@ -438,7 +499,7 @@ fn stats(a: StatsArgs) -> Result<(), String> {
 
 /// Renders the default scene (or a scene file) headlessly to a PNG and prints GPU times
 /// per pass.
-fn render(a: RenderArgs) -> Result<(), String> {
+fn render(a: RenderArgs, device: &headless::Device) -> Result<(), String> {
     writable_file(&a.out)?;
     let (width, height) = a.size;
     let mut config = RendererConfig {
@@ -447,6 +508,7 @@ fn render(a: RenderArgs) -> Result<(), String> {
         msaa: a.msaa,
         ao_strength: a.ao_strength,
         flat_textures: a.flat_textures,
+        quad_fetch: a.quad_fetch,
         ..RendererConfig::default()
     };
     config.oit.technique = a.technique;
@@ -475,9 +537,18 @@ fn render(a: RenderArgs) -> Result<(), String> {
         scene.world.len(),
         t.elapsed().as_secs_f64() * 1e3
     );
-    let ctx = headless::context()?;
-    println!("adapter: {}", ctx.caps.adapter_name);
+    let ctx = device.context()?;
+    println!("adapter: {} ({})", ctx.caps.adapter_name, device.name());
     let mut renderer = headless::renderer_for(&ctx, &scene, config)?;
+    println!(
+        "quads fetched by {}; techniques this device runs: {}",
+        renderer.config().quad_fetch.map_or("?", |f| f.name()),
+        Technique::supported(&ctx.caps)
+            .into_iter()
+            .map(Technique::name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
     let target = headless::Offscreen::new(&ctx, width, height);
     let camera = scene.cameras[0];
     let frames = a.frames as usize;
@@ -599,7 +670,7 @@ fn names<T: Copy>(
 
 /// Renders every scene with every technique and the exact reference; writes the summary,
 /// charts, heat maps, stability sweeps and report.
-fn eval(a: EvalArgs) -> Result<(), String> {
+fn eval(a: EvalArgs, device: &headless::Device) -> Result<(), String> {
     writable_dir(&a.out)?;
     let random = a
         .random
@@ -631,7 +702,7 @@ fn eval(a: EvalArgs) -> Result<(), String> {
     };
     // Before the GPU: a broken scene or an option past its cap is the first thing said.
     opts.validate()?;
-    let ctx = headless::context()?;
+    let ctx = device.context()?;
     eprintln!(
         "adapter: {}; {} scenes x {} techniques + {} weights",
         ctx.caps.adapter_name,
@@ -652,7 +723,7 @@ fn eval(a: EvalArgs) -> Result<(), String> {
 }
 
 /// Flies over streamed terrain and writes what it measured.
-fn stream(a: StreamArgs) -> Result<(), String> {
+fn stream(a: StreamArgs, device: &headless::Device) -> Result<(), String> {
     let opts = voxel_lab::stream::StreamOptions {
         view_distance: a.view_distance,
         vertical_distance: a.vertical_distance,
@@ -666,7 +737,7 @@ fn stream(a: StreamArgs) -> Result<(), String> {
     };
     opts.validate()?;
     writable_dir(&a.out)?;
-    let ctx = headless::context()?;
+    let ctx = device.context()?;
     eprintln!(
         "adapter: {}; view distance {}, {} frames at {} blocks per frame, {} draws",
         ctx.caps.adapter_name,
@@ -715,10 +786,10 @@ fn stream(a: StreamArgs) -> Result<(), String> {
 }
 
 /// Renders one scene with every technique and writes the pictures, error maps and sheet.
-fn gallery(a: GalleryArgs) -> Result<(), String> {
+fn gallery(a: GalleryArgs, device: &headless::Device) -> Result<(), String> {
     writable_dir(&a.out)?;
     let scene = scene::Scene::load(&a.scene)?;
-    let ctx = headless::context()?;
+    let ctx = device.context()?;
     println!("adapter: {}; scene: {}", ctx.caps.adapter_name, scene.name);
     let entries = voxel_lab::gallery::render(&ctx, &scene, a.size)?;
     voxel_lab::gallery::write(&a.out, &entries, a.columns)?;
@@ -734,9 +805,24 @@ fn gallery(a: GalleryArgs) -> Result<(), String> {
     Ok(())
 }
 
+/// The backend × technique table.
+fn backends(a: BackendsArgs) -> Result<(), String> {
+    writable_dir(&a.out)?;
+    let opts = voxel_lab::backends::Options {
+        size: a.size,
+        frames: a.frames,
+        out: a.out,
+    };
+    voxel_lab::backends::run(&opts)?;
+    println!("wrote {}", opts.out.join("report.md").display());
+    Ok(())
+}
+
 /// Opens the interactive demo.
-fn window(a: WindowArgs) -> Result<(), String> {
+fn window(a: WindowArgs, device: DeviceArgs) -> Result<(), String> {
     demo::app::run(demo::app::DemoOptions {
+        backends: device.backend,
+        limits: device.limits,
         seed: a.seed,
         size: a.size,
         technique: a.technique,
@@ -755,10 +841,10 @@ fn window(a: WindowArgs) -> Result<(), String> {
 
 /// Without a display: every technique's picture of the default scene, and a quick
 /// evaluation of the suite with its speed/accuracy chart.
-fn showcase(a: ShowcaseArgs) -> Result<(), String> {
+fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<(), String> {
     writable_dir(&a.out)?;
     let (w, h) = a.size;
-    let ctx = headless::context()?;
+    let ctx = device.context()?;
     println!("adapter: {}", ctx.caps.adapter_name);
     let scene = scene::default_scene(1)?;
     let config = RendererConfig {
@@ -769,7 +855,10 @@ fn showcase(a: ShowcaseArgs) -> Result<(), String> {
     let mut renderer = headless::renderer_for(&ctx, &scene, config)?;
     let target = headless::Offscreen::new(&ctx, w, h);
     for t in Technique::ALL {
-        renderer.set_technique(t);
+        if let Err(e) = renderer.set_technique(t) {
+            println!("skipped {t}: {}", chain(&e));
+            continue;
+        }
         // One frame to settle (adaptive peeling), one to keep.
         renderer
             .render_and_submit(&target.view, &scene.cameras[0])

@@ -12,7 +12,9 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use voxel_core::{BlockId, BlockRegistry, World};
-use voxel_render::{Camera, GpuContext, Image, Renderer, RendererConfig, Technique, readback};
+use voxel_render::{
+    Camera, GpuContext, Image, LimitsPreset, Renderer, RendererConfig, Technique, readback,
+};
 
 pub use voxel_lab::headless::{Offscreen, renderer_for};
 pub use voxel_lab::scene::Scene;
@@ -29,6 +31,56 @@ pub fn gpu() -> Option<GpuContext> {
             eprintln!(
                 "\n!!!! SKIPPING GPU TEST: no Vulkan adapter ({e}). Install mesa-vulkan-drivers. !!!!\n"
             );
+            None
+        }
+    }
+}
+
+/// A headless context on wgpu's GL backend (Mesa's llvmpipe through EGL, a GLES 3.2
+/// device, on machines without a GPU), or `None` as [`gpu`]: without an adapter a test
+/// skips loudly, unless `CI` is set, when it fails.
+pub fn gl() -> Option<GpuContext> {
+    context_or_skip(
+        wgpu::Backends::GL,
+        LimitsPreset::Adapter,
+        "a GL adapter (install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri)",
+    )
+}
+
+/// A Vulkan device with WebGL2's limits and no optional feature
+/// ([`LimitsPreset::WebGl2`]): what a browser's WebGL2 or a GLES 3.0 phone gives, as far
+/// as limits and features go. `None` as [`gpu`].
+pub fn webgl2() -> Option<GpuContext> {
+    context_or_skip(
+        wgpu::Backends::VULKAN,
+        LimitsPreset::WebGl2,
+        "a Vulkan adapter (install mesa-vulkan-drivers)",
+    )
+}
+
+/// wgpu's GL backend with WebGL2's limits and no optional feature: the closest to a
+/// browser's WebGL2 this machine has (GLSL ES from naga, no storage buffers). `None` as
+/// [`gpu`].
+pub fn gl_webgl2() -> Option<GpuContext> {
+    context_or_skip(
+        wgpu::Backends::GL,
+        LimitsPreset::WebGl2,
+        "a GL adapter (install libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri)",
+    )
+}
+
+fn context_or_skip(
+    backends: wgpu::Backends,
+    limits: LimitsPreset,
+    what: &str,
+) -> Option<GpuContext> {
+    match GpuContext::headless_with(backends, limits) {
+        Ok(ctx) => Some(ctx),
+        Err(e) if std::env::var_os("CI").is_some() => {
+            panic!("CI is set but no device was made on {what}: {e}")
+        }
+        Err(e) => {
+            eprintln!("\n!!!! SKIPPING GPU TEST: no device on {what}: {e} !!!!\n");
             None
         }
     }

@@ -11,10 +11,12 @@ use std::path::{Path, PathBuf};
 const RENDER: &[&str] = &[
     "error",
     "context",
+    "ladder",
     "camera",
     "readback",
     "submission",
     "timing",
+    "fetch",
     "gpu",
     "bindings",
     "textures",
@@ -48,6 +50,7 @@ const LAB: &[&str] = &[
     "report",
     "stream",
     "gallery",
+    "backends",
 ];
 
 /// The module each item re-exported by lib.rs (`pub use module::{A, B};`) comes from.

@@ -133,7 +133,10 @@ fn config_tells_the_truth_after_every_setter() {
     let Some(ctx) = gpu() else { return };
     let scene = dense_sheets(2, 0.5);
     let mut r = renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, 64, 48)).unwrap();
-    r.set_technique(Technique::Stipple);
+    assert_eq!(
+        r.set_technique(Technique::Stipple).unwrap(),
+        Technique::Stipple
+    );
     assert_eq!(r.config().oit.technique, Technique::Stipple);
     r.set_weight(voxel_render::WeightFunction::McGuire8);
     assert_eq!(

@@ -50,13 +50,16 @@ fn a_lost_device_gives_errors_and_a_new_device_works() {
     let oit = r.config().oit.clone();
     lost(r.set_oit_config(oit).unwrap_err(), "set_oit_config");
     lost(
+        r.set_technique(Technique::WboitMrt).unwrap_err(),
+        "set_technique",
+    );
+    lost(
         r.translucent_contract().unwrap_err(),
         "translucent_contract",
     );
     // The calls without a result do nothing harmful.
     r.remove_chunk(pos);
     r.clear_chunks();
-    r.set_technique(Technique::WboitMrt);
     r.set_weight(voxel_render::WeightFunction::McGuire8);
     r.set_fade_in_frames(4);
     assert!(r.gpu_times_blocking().is_empty());
@@ -239,9 +242,13 @@ fn a_device_lost_at_any_point_of_a_frame_gives_errors_not_panics() {
             drop(encoder);
             lost(r.prebuild_technique(Technique::Mboit).unwrap_err(), &what);
             lost(r.translucent_contract().unwrap_err(), &what);
-            r.set_technique(Technique::Reference);
+            if let Err(e) = r.set_technique(Technique::Reference) {
+                lost(e, &what);
+            }
             lost(r.render_and_submit(&target.view, &cam).unwrap_err(), &what);
-            r.set_technique(Technique::PeelReference);
+            if let Err(e) = r.set_technique(Technique::PeelReference) {
+                lost(e, &what);
+            }
             lost(r.render_and_submit(&target.view, &cam).unwrap_err(), &what);
             assert!(r.gpu_times().is_empty() || r.gpu_times_blocking().is_empty());
             lost(

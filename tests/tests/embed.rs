@@ -421,14 +421,14 @@ fn a_technique_built_ahead_switches_without_building() {
     assert_eq!(builds(&r), 2);
     // Resized while waiting: it follows.
     r.resize(80, 60).unwrap();
-    r.set_technique(Technique::SortedQuads);
+    r.set_technique(Technique::SortedQuads).unwrap();
     let sorted = frame(&ctx, &mut r, &cam);
     assert_eq!(builds(&r), 2, "the switch built nothing");
     // Back and forth: WBOIT was not built ahead, the sorted technique stays built.
-    r.set_technique(Technique::WboitMrt);
+    r.set_technique(Technique::WboitMrt).unwrap();
     frame(&ctx, &mut r, &cam);
     assert_eq!(builds(&r), 3);
-    r.set_technique(Technique::SortedQuads);
+    r.set_technique(Technique::SortedQuads).unwrap();
     let again = frame(&ctx, &mut r, &cam);
     assert_eq!(builds(&r), 3);
     let mut fresh =
@@ -443,13 +443,13 @@ fn a_technique_built_ahead_switches_without_building() {
     oit.peeling.layers = 6;
     r.set_oit_config(oit).unwrap();
     assert_eq!(builds(&r), n + 1);
-    r.set_technique(Technique::DepthPeeling);
+    r.set_technique(Technique::DepthPeeling).unwrap();
     frame(&ctx, &mut r, &cam);
     assert_eq!(builds(&r), n + 1);
     // Released: switching to it builds again.
-    r.set_technique(Technique::Stipple);
+    r.set_technique(Technique::Stipple).unwrap();
     r.release_technique(Technique::SortedQuads);
-    r.set_technique(Technique::SortedQuads);
+    r.set_technique(Technique::SortedQuads).unwrap();
     frame(&ctx, &mut r, &cam);
     assert!(builds(&r) > n + 1);
 }

@@ -327,7 +327,7 @@ fn game_draws_survive_switches_resizes_and_msaa() {
         Technique::Reference,
         Technique::WboitTwoPass,
     ] {
-        r.set_technique(t);
+        r.set_technique(t).unwrap();
         let got = shot(&mut r);
         let fresh = render(&scene, technique_config(t, W, H));
         let d = diff(&got, &fresh);
@@ -376,7 +376,7 @@ fn stale_game_pipelines_are_refused_before_recording() {
         .render_and_submit_with(&target.view, &camera, &mut content)
         .unwrap();
 
-    r.set_technique(Technique::SortedQuads);
+    r.set_technique(Technique::SortedQuads).unwrap();
     let quads = r.translucent_contract().unwrap().id;
     assert_ne!(quads, wboit);
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -404,7 +404,7 @@ fn stale_game_pipelines_are_refused_before_recording() {
     assert!(d.max <= 1, "rebuilt: {d:?}");
 
     // Back to WBOIT: the same id again, so pipelines a game kept for it are valid.
-    r.set_technique(Technique::WboitMrt);
+    r.set_technique(Technique::WboitMrt).unwrap();
     assert_eq!(r.translucent_contract().unwrap().id, wboit);
     let e = r
         .renderer

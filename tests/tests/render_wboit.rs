@@ -199,7 +199,7 @@ fn resize_to_zero_and_back_and_switch_techniques_without_validation_errors() {
         Technique::OpaqueOnly,
         Technique::WboitMrt,
     ] {
-        r.set_technique(t);
+        r.set_technique(t).unwrap();
         frame(&ctx, &mut r, &cam);
     }
     r.set_msaa(true).unwrap();

@@ -154,14 +154,14 @@ fn main() -> Result<(), String> {
         // Cold: the technique is built in the first frame after the switch.
         let mut r = renderer(&ctx, &world, &positions, config(Technique::OpaqueOnly))?;
         steady(&ctx, &mut r, &target.view, &cam);
-        r.set_technique(t);
+        r.set_technique(t).map_err(|e| e.to_string())?;
         let cold = frame(&ctx, &mut r, &target.view, &cam);
         let settled = steady(&ctx, &mut r, &target.view, &cam);
         // Built ahead at load time.
         let mut r = renderer(&ctx, &world, &positions, config(Technique::OpaqueOnly))?;
         r.prebuild_technique(t).map_err(|e| e.to_string())?;
         steady(&ctx, &mut r, &target.view, &cam);
-        r.set_technique(t);
+        r.set_technique(t).map_err(|e| e.to_string())?;
         let ahead = frame(&ctx, &mut r, &target.view, &cam);
         println!("| `{t}` | {cold:.2} | {ahead:.2} | {settled:.2} |");
     }

@@ -1,17 +1,75 @@
 //! Rendering without a window: a headless GPU, an offscreen target, PNG output.
 
 use voxel_mesh::mesh_chunks;
-use voxel_render::{Camera, FrameStats, GpuContext, Image, Renderer, RendererConfig, readback};
+use voxel_render::{
+    Camera, FrameStats, GpuContext, Image, Limit, LimitsPreset, Need, Renderer, RendererConfig,
+    readback,
+};
 
 use crate::content::ContentStages;
 
 use crate::scene::Scene;
 
 /// A headless context on Vulkan (lavapipe on a machine without a GPU), or the backends
-/// named by `WGPU_BACKEND`.
+/// named by `WGPU_BACKEND`, with the adapter's limits.
 pub fn context() -> Result<GpuContext, String> {
-    let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
-    GpuContext::headless(backends).map_err(|e| crate::chain(&e))
+    Device::from_env().context()
+}
+
+/// Which device the headless tools draw with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Device {
+    /// The backends to find the adapter among.
+    pub backends: wgpu::Backends,
+    /// The limits and optional features it is requested with.
+    pub limits: LimitsPreset,
+}
+
+impl Device {
+    /// The backends of `WGPU_BACKEND` (Vulkan when unset), the adapter's limits.
+    pub fn from_env() -> Self {
+        Self {
+            backends: wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN),
+            limits: LimitsPreset::Adapter,
+        }
+    }
+
+    /// A headless context on it.
+    pub fn context(&self) -> Result<GpuContext, String> {
+        GpuContext::headless_with(self.backends, self.limits).map_err(|e| crate::chain(&e))
+    }
+
+    /// Its name in reports: the backends and, unless the adapter's, the limits.
+    pub fn name(&self) -> String {
+        let backend = BACKENDS
+            .iter()
+            .find(|(_, b)| *b == self.backends)
+            .map_or_else(|| format!("{:?}", self.backends), |(n, _)| (*n).to_owned());
+        match self.limits {
+            LimitsPreset::Adapter => backend,
+            other => format!("{backend}, {} limits", other.name()),
+        }
+    }
+}
+
+/// The backends a command line names, by name.
+pub const BACKENDS: [(&str, wgpu::Backends); 4] = [
+    ("vulkan", wgpu::Backends::VULKAN),
+    ("gl", wgpu::Backends::GL),
+    ("metal", wgpu::Backends::METAL),
+    ("dx12", wgpu::Backends::DX12),
+];
+
+/// Parses a backend's name ([`BACKENDS`]); the error lists the names.
+pub fn backend(name: &str) -> Result<wgpu::Backends, String> {
+    BACKENDS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, b)| *b)
+        .ok_or_else(|| {
+            let names: Vec<&str> = BACKENDS.iter().map(|(n, _)| *n).collect();
+            format!("{name:?}: expected one of {}", names.join(", "))
+        })
 }
 
 /// An RGBA8 sRGB texture to render into and read back.
@@ -93,12 +151,28 @@ impl SceneRenderer {
     }
 }
 
-/// A renderer with every chunk of `scene` meshed and uploaded, and its content ready.
+/// What the scene's game content needs of a device: its shaders pull their instances from
+/// a storage buffer in the vertex stage (`content.wgsl`), as a desktop game's might.
+fn content_needs() -> [Need; 2] {
+    [
+        Need::Downlevel(wgpu::DownlevelFlags::VERTEX_STORAGE),
+        Need::Limit(Limit::StorageBuffersPerStage, 1),
+    ]
+}
+
+/// A renderer with every chunk of `scene` meshed and uploaded, and its content ready. A
+/// scene with game content on a device without storage buffers in the vertex stage (WebGL2's
+/// limits) is an error naming what is missing.
 pub fn renderer_for(
     ctx: &GpuContext,
     scene: &Scene,
     config: RendererConfig,
 ) -> Result<SceneRenderer, String> {
+    if !scene.content.is_empty() {
+        let what = format!("{}: the lab's game content", scene.name);
+        voxel_render::ladder::check(&what, &content_needs(), &ctx.caps)
+            .map_err(|e| crate::chain(&e))?;
+    }
     let mut renderer =
         Renderer::new(ctx, scene.world.registry(), config).map_err(|e| crate::chain(&e))?;
     let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();

@@ -15,8 +15,10 @@
 //!   scenes, where each technique fails), [`charts`], [`report`];
 //! - [`evaluate`] here, which runs everything and writes every file;
 //! - [`stream`]: the streaming flight (`demo stream`), which draws its own chart;
-//! - [`gallery`]: one scene under every technique with its error maps (`demo gallery`).
+//! - [`gallery`]: one scene under every technique with its error maps (`demo gallery`);
+//! - [`backends`]: every technique on Vulkan, GL and WebGL2's limits (`demo backends`).
 
+pub mod backends;
 pub mod charts;
 pub mod content;
 pub mod distribution;

@@ -168,8 +168,10 @@ impl winit::application::ApplicationHandler for Game {
                 if let Some(&technique) =
                     digit.and_then(|n: usize| Technique::REAL_TIME.get(n.wrapping_sub(1)))
                 {
-                    g.renderer.set_technique(technique);
-                    g.window.set_title(&format!("window example: {technique}"));
+                    match g.renderer.set_technique(technique) {
+                        Ok(t) => g.window.set_title(&format!("window example: {t}")),
+                        Err(e) => eprintln!("{technique}: {e}"),
+                    }
                 }
             }
             WindowEvent::RedrawRequested => self.redraw(event_loop).unwrap_or_else(|e| {

@@ -169,17 +169,21 @@ pub struct QuadArena {
     pages: Vec<Option<Page>>,
     /// Largest page, in quads (the adapter's storage binding limit).
     max_page_quads: u32,
+    /// The pages' usages (storage or vertex buffers, `crate::QuadFetch`).
+    usage: wgpu::BufferUsages,
 }
 
 impl QuadArena {
-    /// An empty arena whose pages may hold up to `max_binding` bytes.
-    pub fn new(max_binding: u64) -> Self {
+    /// An empty arena whose pages may hold up to `max_binding` bytes, made with `usage`
+    /// (copies are added).
+    pub fn new(max_binding: u64, usage: wgpu::BufferUsages) -> Self {
         // A draw counts 6 vertices per quad in a `u32` (first vertex and count): a page
         // holds no more quads than that can address.
         let addressable = u64::from(u32::MAX / 6);
         Self {
             pages: Vec::new(),
             max_page_quads: (max_binding / QUAD_BYTES).min(addressable) as u32,
+            usage: usage | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
         }
     }
 
@@ -232,9 +236,7 @@ impl QuadArena {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("quad_arena_page"),
                 size: u64::from(size) * QUAD_BYTES,
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_DST
-                    | wgpu::BufferUsages::COPY_SRC,
+                usage: self.usage,
                 mapped_at_creation: false,
             })
         })?;

@@ -5,7 +5,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::gpu::{self, buffer_entry};
+use crate::fetch::{self, QuadFetch};
+use crate::gpu::{self, ChunkGroups, buffer_entry};
 
 /// WGSL shared by every chunk pipeline: the structs below, vertex pulling and shading,
 /// after the constants it shares with this module.
@@ -16,8 +17,10 @@ pub fn common_wgsl() -> String {
         .f32("AO_DEPTH", AO_DEPTH)
         .f32("OPAQUE_EXPANSION_PX", OPAQUE_EXPANSION_PX)
         .f32("MAX_GROWTH", MAX_GROWTH)
+        .u32("TABLE_WIDTH", crate::fetch::TABLE_WIDTH)
         .finish()
         + FRAME_WGSL
+        + gpu::DEPTH_UV_WGSL
         + include_str!("shaders/common.wgsl")
 }
 
@@ -78,6 +81,9 @@ pub struct FrameUniforms {
     pub ao_strength: f32,
 }
 
+// A record is one texel of the records' table texture (`fetch.rs`).
+const _: () = assert!(std::mem::size_of::<ChunkUniforms>() == crate::fetch::RECORD_BYTES);
+
 /// [`FrameUniforms::medium`] when the eye is in no translucent volume.
 pub const NO_MEDIUM: u32 = u32::MAX;
 
@@ -101,63 +107,72 @@ pub struct SharedLayouts {
     /// Group 0: frame uniforms, block textures, sampler, the medium's boundary depth, and
     /// the layer of each block's face groups in the block textures.
     pub scene: wgpu::BindGroupLayout,
-    /// Group 1: a page of the quad arena and the chunk records.
+    /// Group 1: a page of the quad arena and the chunk records (with
+    /// [`QuadFetch::Instanced`], the records only: the page is a vertex buffer).
     pub chunk: wgpu::BindGroupLayout,
+    /// How the chunk pipelines fetch quads.
+    pub fetch: QuadFetch,
 }
 
 impl SharedLayouts {
-    /// Creates both layouts.
-    pub fn new(device: &wgpu::Device) -> Self {
+    /// Creates both layouts for `fetch`.
+    pub fn new(device: &wgpu::Device, fetch: QuadFetch) -> Self {
         use wgpu::BufferBindingType as B;
         use wgpu::ShaderStages as S;
-        let scene = gpu::layout(
-            device,
-            "scene_layout",
-            &[
-                buffer_entry(0, S::VERTEX_FRAGMENT, B::Uniform),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: S::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                    count: None,
+        let mut scene_entries = vec![
+            buffer_entry(0, S::VERTEX_FRAGMENT, B::Uniform),
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: S::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
                 },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: S::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-                gpu::texture_entry(3, wgpu::TextureSampleType::Depth),
-                // Read where the quad is expanded: vertex storage, which every chunk
-                // pipeline needs for its quads anyway (fragment storage is optional).
-                buffer_entry(4, S::VERTEX, B::Storage { read_only: true }),
-            ],
-        );
-        let chunk = gpu::layout(
-            device,
-            "chunk_layout",
-            &[
-                buffer_entry(0, S::VERTEX, B::Storage { read_only: true }),
-                buffer_entry(1, S::VERTEX, B::Storage { read_only: true }),
-            ],
-        );
-        Self { scene, chunk }
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: S::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+            gpu::texture_entry(3, gpu::DEPTH_READ),
+            gpu::depth_sampler_entry(6),
+        ];
+        // Group 0's block layers (read where the quad is expanded) and group 1, as
+        // `common.wgsl` declares them for each way of fetching quads.
+        let chunk_entries = match fetch {
+            QuadFetch::Storage => {
+                scene_entries.push(buffer_entry(4, S::VERTEX, B::Storage { read_only: true }));
+                vec![
+                    buffer_entry(0, S::VERTEX, B::Storage { read_only: true }),
+                    buffer_entry(1, S::VERTEX, B::Storage { read_only: true }),
+                ]
+            }
+            QuadFetch::Instanced => {
+                scene_entries.push(fetch::table_entry(5));
+                vec![fetch::record_entry(2)]
+            }
+        };
+        Self {
+            scene: gpu::layout(device, "scene_layout", &scene_entries),
+            chunk: gpu::layout(device, "chunk_layout", &chunk_entries),
+            fetch,
+        }
     }
 
-    /// Groups 0 and 1, then `extra` (a technique's own groups from 2 on).
-    pub fn with<'a>(
-        &'a self,
-        extra: &[&'a wgpu::BindGroupLayout],
-    ) -> Vec<Option<&'a wgpu::BindGroupLayout>> {
-        [&self.scene, &self.chunk]
-            .into_iter()
-            .chain(extra.iter().copied())
-            .map(Some)
-            .collect()
+    /// Groups 0 and 1, then `extra` (a technique's own groups from 2 on), with the way
+    /// quads are fetched: what a [`gpu::ChunkPipeline`] is built against.
+    pub fn with<'a>(&'a self, extra: &[&'a wgpu::BindGroupLayout]) -> ChunkGroups<'a> {
+        ChunkGroups {
+            layouts: [&self.scene, &self.chunk]
+                .into_iter()
+                .chain(extra.iter().copied())
+                .map(Some)
+                .collect(),
+            fetch: self.fetch,
+        }
     }
 }
 

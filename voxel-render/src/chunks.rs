@@ -29,6 +29,7 @@ use voxel_mesh::{ChunkMeshes, PackedQuad};
 
 use crate::arena::{Alloc, ArenaStats, QuadArena};
 use crate::bindings::ChunkUniforms;
+use crate::fetch::{QuadFetch, Records};
 use crate::gpu;
 use crate::layers::{self, LayerBuffer, Plane, VisibleLayers};
 use crate::{Error, GpuContext, Result};
@@ -215,7 +216,8 @@ fn layers_bounds(layers: &[Plane]) -> Option<([f64; 3], [f64; 3])> {
     Some((lo.as_dvec3().to_array(), hi.as_dvec3().to_array()))
 }
 
-/// One draw command, as `multi_draw_indirect` reads it.
+/// One draw command, as `multi_draw_indirect` reads it with [`QuadFetch::Storage`] (with
+/// [`QuadFetch::Instanced`] each is a direct draw of its own).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct DrawCommand {
@@ -310,23 +312,19 @@ impl FrameDraws<'_> {
                 first: a as u32,
                 count: (b - a) as u32,
             };
-            let Some(Some(group)) = self.store.groups.get(run.page as usize) else {
+            if !self.store.bind_page(run.page, pass) {
                 continue;
-            };
-            pass.set_bind_group(1, group, &[]);
+            }
             match self.mode {
-                DrawMode::Indirect => pass.multi_draw_indirect(
+                DrawMode::Indirect if self.store.fetch.indirect() => pass.multi_draw_indirect(
                     &self.store.indirect,
                     u64::from(run.first) * std::mem::size_of::<DrawCommand>() as u64,
                     run.count,
                 ),
-                DrawMode::PerChunk => {
+                _ => {
                     let cmds = &self.commands[run.first as usize..(run.first + run.count) as usize];
                     for c in cmds {
-                        pass.draw(
-                            c.first_vertex..c.first_vertex + c.vertex_count,
-                            c.first_instance..c.first_instance + 1,
-                        );
+                        self.store.draw(run.page, c, 0..c.vertex_count / 6, pass);
                     }
                 }
             }
@@ -356,22 +354,15 @@ impl FrameDraws<'_> {
         else {
             return;
         };
-        let (Some(Some(group)), Some(c)) = (
-            self.store.groups.get(run.page as usize),
-            self.commands.get(at as usize),
-        ) else {
+        let Some(c) = self.commands.get(at as usize) else {
             return;
         };
         let n = c.vertex_count / 6;
         let (a, b) = (quads.start.min(n), quads.end.min(n));
-        if a >= b {
+        if a >= b || !self.store.bind_page(run.page, pass) {
             return;
         }
-        pass.set_bind_group(1, group, &[]);
-        pass.draw(
-            c.first_vertex + 6 * a..c.first_vertex + 6 * b,
-            c.first_instance..c.first_instance + 1,
-        );
+        self.store.draw(run.page, c, a..b, pass);
     }
 }
 
@@ -694,9 +685,11 @@ fn near_key(page: u32, distance: f64, slot: u32) -> u128 {
 #[derive(Debug)]
 pub struct ChunkStore {
     layout: wgpu::BindGroupLayout,
+    /// How the chunk pipelines fetch quads: what the pages and records are.
+    fetch: QuadFetch,
     arena: QuadArena,
     /// One [`ChunkUniforms`] per slot, and its CPU copy.
-    infos: wgpu::Buffer,
+    infos: Records,
     info_data: Vec<ChunkUniforms>,
     /// Group 1 per page index: the page's quads and the chunk records (`None` for a page
     /// given back).
@@ -723,16 +716,22 @@ const FIRST_SLOTS: usize = 1024;
 
 impl ChunkStore {
     /// An empty store whose bind groups use `layout` (group 1 of
-    /// [`crate::SharedLayouts`]).
+    /// [`crate::SharedLayouts`], for `fetch`).
     /// `block_opacity` (by block id) weighs the planes of translucent meshes
     /// ([`crate::layers`]).
-    pub fn new(ctx: &GpuContext, layout: wgpu::BindGroupLayout, block_opacity: Arc<[f32]>) -> Self {
+    pub fn new(
+        ctx: &GpuContext,
+        layout: wgpu::BindGroupLayout,
+        fetch: QuadFetch,
+        block_opacity: Arc<[f32]>,
+    ) -> Self {
         let l = &ctx.caps.limits;
-        let infos = Self::infos_buffer(&ctx.device, FIRST_SLOTS);
+        let infos = Records::new(&ctx.device, fetch, l, FIRST_SLOTS);
         let indirect = Self::indirect_buffer(&ctx.device, FIRST_SLOTS);
         Self {
             layout,
-            arena: QuadArena::new(l.max_storage_buffer_binding_size.min(l.max_buffer_size)),
+            fetch,
+            arena: QuadArena::new(fetch.max_page_bytes(l), fetch.page_usage()),
             infos,
             info_data: Vec::new(),
             groups: Vec::new(),
@@ -749,15 +748,6 @@ impl ChunkStore {
         }
     }
 
-    fn infos_buffer(device: &wgpu::Device, slots: usize) -> wgpu::Buffer {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("chunk_infos"),
-            size: (slots * std::mem::size_of::<ChunkUniforms>()) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
-    }
-
     fn indirect_buffer(device: &wgpu::Device, commands: usize) -> wgpu::Buffer {
         device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("chunk_draws"),
@@ -767,19 +757,72 @@ impl ChunkStore {
         })
     }
 
-    /// Group 1 of every page, remade after the pages or the record buffer changed.
+    /// Group 1 of every page, remade after the pages or the record buffer changed. With
+    /// [`QuadFetch::Instanced`] the group holds a record only (the page is a vertex
+    /// buffer; each draw picks its chunk's record), the same for every page.
     fn remake_groups(&mut self, device: &wgpu::Device) {
+        let records = match self.fetch {
+            QuadFetch::Storage => None,
+            QuadFetch::Instanced => Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("chunk_record"),
+                layout: &self.layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.infos.binding(),
+                }],
+            })),
+        };
         self.groups = (0..self.arena.pages())
             .map(|i| {
                 let page = self.arena.page(i)?;
-                Some(gpu::bind_group(
-                    device,
-                    "chunk_page",
-                    &self.layout,
-                    &[page.as_entire_binding(), self.infos.as_entire_binding()],
-                ))
+                Some(match &records {
+                    Some(group) => group.clone(),
+                    None => gpu::bind_group(
+                        device,
+                        "chunk_page",
+                        &self.layout,
+                        &[page.as_entire_binding(), self.infos.binding()],
+                    ),
+                })
             })
             .collect();
+    }
+
+    /// Sets what draws from page `page` read: its group 1, or with
+    /// [`QuadFetch::Instanced`] the page as vertex buffer 0 (the group goes with each
+    /// draw). `false` for a page given back.
+    fn bind_page(&self, page: u32, pass: &mut wgpu::RenderPass<'_>) -> bool {
+        let (Some(Some(group)), Some(buffer)) = (
+            self.groups.get(page as usize),
+            self.arena.page(page as usize),
+        ) else {
+            return false;
+        };
+        match self.fetch {
+            QuadFetch::Storage => pass.set_bind_group(1, group, &[]),
+            QuadFetch::Instanced => pass.set_vertex_buffer(0, buffer.slice(..)),
+        }
+        true
+    }
+
+    /// Draws quads `quads` (positions in the mesh) of the mesh of command `c`, in page
+    /// `page`, which is bound ([`ChunkStore::bind_page`]).
+    fn draw(
+        &self,
+        page: u32,
+        c: &DrawCommand,
+        quads: std::ops::Range<u32>,
+        pass: &mut wgpu::RenderPass<'_>,
+    ) {
+        let slot = c.first_instance;
+        let first = c.first_vertex / 6 + quads.start;
+        let (vertices, instances) = self.fetch.draw_ranges(slot, first, quads.len() as u32);
+        if self.fetch == QuadFetch::Instanced
+            && let Some(Some(group)) = self.groups.get(page as usize)
+        {
+            pass.set_bind_group(1, group, &[self.infos.offset(slot)]);
+        }
+        pass.draw(vertices, instances);
     }
 
     /// Call once a frame's draw lists hold the meshes' places: from now until
@@ -827,16 +870,14 @@ impl ChunkStore {
             self.info_data.resize(i + 1, ChunkUniforms::default());
         }
         self.info_data[i] = info;
-        let size = std::mem::size_of::<ChunkUniforms>();
-        if (i + 1) * size > self.infos.size() as usize {
-            let slots = (self.infos.size() as usize / size * 2).max(i + 1);
-            self.infos = Self::infos_buffer(&ctx.device, slots);
-            ctx.queue
-                .write_buffer(&self.infos, 0, bytemuck::cast_slice(&self.info_data));
+        if i >= self.infos.capacity() {
+            let slots = (self.infos.capacity() * 2).max(i + 1);
+            self.infos = Records::new(&ctx.device, self.fetch, &ctx.caps.limits, slots);
+            self.infos
+                .write(&ctx.queue, 0, bytemuck::cast_slice(&self.info_data));
             self.remake_groups(&ctx.device);
         } else {
-            ctx.queue
-                .write_buffer(&self.infos, (i * size) as u64, bytemuck::bytes_of(&info));
+            self.infos.write(&ctx.queue, i, bytemuck::bytes_of(&info));
         }
     }
 
@@ -875,7 +916,10 @@ impl ChunkStore {
                 return Err(Error::TooLarge {
                     what: format!("the {kind} mesh of chunk {pos:?}, in quads,"),
                     value: quads.len() as u64,
-                    limit_name: "max_storage_buffer_binding_size (in 8-byte quads)",
+                    limit_name: match self.fetch {
+                        QuadFetch::Storage => "max_storage_buffer_binding_size (in 8-byte quads)",
+                        QuadFetch::Instanced => "max_buffer_size (in 8-byte quads)",
+                    },
                     limit: u64::from(limit),
                 });
             }
@@ -1008,7 +1052,7 @@ impl ChunkStore {
 
     /// What the arena holds, and the bytes of the chunk records.
     pub fn memory(&self) -> (ArenaStats, u64) {
-        (self.arena.stats(), self.infos.size())
+        (self.arena.stats(), self.infos.bytes())
     }
 
     /// Bytes of the indirect command buffer.

@@ -24,6 +24,8 @@ pub struct Capabilities {
     pub msaa4: bool,
     /// Device limits.
     pub limits: wgpu::Limits,
+    /// The adapter, for the features of texture formats ([`Capabilities::renders_to`]).
+    adapter: wgpu::Adapter,
 }
 
 impl Capabilities {
@@ -40,7 +42,11 @@ impl Capabilities {
                 .contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_X4)
             && f16
                 .flags
-                .contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE);
+                .contains(wgpu::TextureFormatFeatureFlags::MULTISAMPLE_RESOLVE)
+            // On wgpu's GL backend (Mesa's llvmpipe) the 4× opaque pass resolves to black and
+            // its depth resolve reads zeros, with no error reported: the cause is not found,
+            // so GL draws without MSAA (the fallback every device without 4× support takes).
+            && info.backend != wgpu::Backend::Gl;
         Self {
             adapter_name: format!("{} ({:?})", info.name, info.backend),
             backend: info.backend,
@@ -55,7 +61,22 @@ impl Capabilities {
                     .contains(wgpu::TextureFormatFeatureFlags::BLENDABLE),
             msaa4,
             limits,
+            adapter: adapter.clone(),
         }
+    }
+
+    /// Whether `format` can be a render target (`blend`: with blending) on the device:
+    /// what the adapter does, within what wgpu validates without
+    /// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES` (the format's guaranteed features, with
+    /// the device's features: `FLOAT32_BLENDABLE` for 32-bit floats).
+    pub fn renders_to(&self, format: wgpu::TextureFormat, blend: bool) -> bool {
+        let ok = |f: wgpu::TextureFormatFeatures| {
+            f.allowed_usages
+                .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+                && (!blend || f.flags.contains(wgpu::TextureFormatFeatureFlags::BLENDABLE))
+        };
+        ok(format.guaranteed_format_features(self.features))
+            && ok(self.adapter.get_texture_format_features(format))
     }
 
     /// Whether timestamp queries at pass boundaries are available.
@@ -85,10 +106,14 @@ impl Capabilities {
         self.features.contains(wgpu::Features::FLOAT32_BLENDABLE)
     }
 
-    /// Whether fragment shaders may write storage buffers (the A-buffer reference).
+    /// Whether fragment shaders may write storage buffers (the A-buffer reference): the
+    /// adapter can, and the device's limits leave room for them (a device made with
+    /// WebGL2's limits has none).
     pub fn fragment_storage(&self) -> bool {
         self.downlevel
             .contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE)
+            && self.limits.max_storage_buffers_per_shader_stage > 0
+            && self.limits.max_storage_buffer_binding_size > 0
     }
 }
 
@@ -188,7 +213,13 @@ impl GpuContext {
     /// `Backends::VULKAN`, which finds lavapipe on a machine without a GPU). Asks for
     /// [`WANTED_FEATURES`] where the adapter has them.
     pub fn headless(backends: wgpu::Backends) -> Result<Self> {
-        pollster::block_on(Self::headless_async(backends))
+        Self::headless_with(backends, LimitsPreset::Adapter)
+    }
+
+    /// [`GpuContext::headless`] with the device's limits and features from `preset`
+    /// ([`LimitsPreset::WebGl2`]: a device as small as WebGL2's on any adapter).
+    pub fn headless_with(backends: wgpu::Backends, preset: LimitsPreset) -> Result<Self> {
+        pollster::block_on(Self::headless_async(backends, preset))
     }
 
     /// A context on an adapter that can draw to `surface` (a game's window), asking for
@@ -214,7 +245,7 @@ impl GpuContext {
         })
     }
 
-    async fn headless_async(backends: wgpu::Backends) -> Result<Self> {
+    async fn headless_async(backends: wgpu::Backends, preset: LimitsPreset) -> Result<Self> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
         desc.backends = backends;
         let instance = wgpu::Instance::new(desc);
@@ -225,20 +256,72 @@ impl GpuContext {
             })
             .await
             .map_err(|error| Error::NoAdapter { backends, error })?;
-        let (device, queue) = request_device(&adapter).await?;
+        let (device, queue) = request_device_with(&adapter, preset).await?;
         Ok(Self::from_device(&adapter, device, queue))
+    }
+}
+
+/// The limits and optional features a device is requested with.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum LimitsPreset {
+    /// All of the adapter's limits (the A-buffer reference wants large storage buffers),
+    /// and the [`WANTED_FEATURES`] it has.
+    #[default]
+    Adapter,
+    /// WebGL2's limits (`wgpu::Limits::downlevel_webgl2_defaults`: no storage buffers or
+    /// textures, no compute, 2048-texel textures) and no optional feature: what a
+    /// browser's WebGL2 or a GLES 3.0 phone gives, on any adapter.
+    WebGl2,
+}
+
+impl LimitsPreset {
+    /// Both, in order.
+    pub const ALL: [LimitsPreset; 2] = [LimitsPreset::Adapter, LimitsPreset::WebGl2];
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            LimitsPreset::Adapter => "adapter",
+            LimitsPreset::WebGl2 => "webgl2",
+        }
+    }
+
+    /// Parses a command-line name; the error lists the known names.
+    pub fn from_name(name: &str) -> Result<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|p| p.name() == name)
+            .ok_or_else(|| Error::unknown_name("limits preset", name, Self::ALL.map(Self::name)))
+    }
+
+    /// The limits and features to request of `adapter`.
+    pub fn request(self, adapter: &wgpu::Adapter) -> (wgpu::Limits, wgpu::Features) {
+        match self {
+            LimitsPreset::Adapter => (adapter.limits(), adapter.features() & WANTED_FEATURES),
+            LimitsPreset::WebGl2 => (
+                wgpu::Limits::downlevel_webgl2_defaults(),
+                wgpu::Features::empty(),
+            ),
+        }
     }
 }
 
 /// Requests a device with the optional features the adapter has and all of its limits.
 pub async fn request_device(adapter: &wgpu::Adapter) -> Result<(wgpu::Device, wgpu::Queue)> {
-    let features = adapter.features() & WANTED_FEATURES;
+    request_device_with(adapter, LimitsPreset::Adapter).await
+}
+
+/// Requests a device with the limits and features of `preset`.
+pub async fn request_device_with(
+    adapter: &wgpu::Adapter,
+    preset: LimitsPreset,
+) -> Result<(wgpu::Device, wgpu::Queue)> {
+    let (limits, features) = preset.request(adapter);
     adapter
         .request_device(&wgpu::DeviceDescriptor {
             label: Some("voxel_render_device"),
             required_features: features,
-            // The adapter's own limits: the A-buffer reference wants large storage buffers.
-            required_limits: adapter.limits(),
+            required_limits: limits,
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,

@@ -2,8 +2,51 @@
 //! pipeline builders for chunk quads and fullscreen triangles, render targets, and one
 //! helper that records a render pass with its attachments and timing.
 
+use crate::fetch::QuadFetch;
 use crate::timing::{GpuPass, Timer};
 use crate::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
+
+/// How shaders read a depth texture: as an unfilterable float texture (`texture_2d<f32>`,
+/// the depth in `.x`, which WebGPU allows for depth formats), sampled at a texel's centre
+/// with a nearest, non-filtering sampler ([`depth_sampler`], [`DEPTH_UV_WGSL`]). GLSL has
+/// no load from depth textures (naga refuses `textureLoad` of a `texture_depth_2d` for GL
+/// and GLES). A `texelFetch` of it as a float texture would read through no sampler
+/// object on wgpu's GL backend, so with the texture's own filter, linear by default; GLES
+/// 3.0 counts a depth texture filtered linearly and not compared as incomplete (and a read
+/// of an incomplete texture as 0), which ANGLE, WebGL2 in Chrome, enforces. Mesa's
+/// llvmpipe returns the texel either way, so the tests here cannot tell: the nearest
+/// sampler keeps the read valid under the rule.
+pub const DEPTH_READ: wgpu::TextureSampleType =
+    wgpu::TextureSampleType::Float { filterable: false };
+
+/// WGSL: `depth_uv(xy, size)`, the coordinates of the centre of the texel under pixel `xy`
+/// of a texture of `size`, where a nearest sampler returns exactly that texel.
+pub const DEPTH_UV_WGSL: &str = "
+// The centre of the texel under pixel `xy` of a depth texture of `size` (`gpu.rs`,
+// DEPTH_READ): sampled there with a nearest sampler, the texel's exact depth.
+fn depth_uv(xy: vec2<f32>, size: vec2<u32>) -> vec2<f32> {
+    return (floor(xy) + 0.5) / vec2<f32>(size);
+}
+";
+
+/// The sampler depth textures are read with ([`DEPTH_READ`]): nearest, no mipmaps,
+/// clamped.
+pub fn depth_sampler(device: &wgpu::Device) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("depth_sampler"),
+        ..Default::default()
+    })
+}
+
+/// A layout entry for [`depth_sampler`] in the fragment stage.
+pub fn depth_sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
+        count: None,
+    }
+}
 
 /// WGSL shared by every fullscreen pipeline.
 pub const FULLSCREEN_WGSL: &str = include_str!("shaders/fullscreen.wgsl");
@@ -78,8 +121,8 @@ pub fn depth_state(mode: DepthMode) -> wgpu::DepthStencilState {
     }
 }
 
-/// A pipeline that draws chunk quads with `common.wgsl`'s vertex pulling (`vs_main`, or
-/// `vs_solid` for opaque quads).
+/// A pipeline that draws chunk quads with `common.wgsl`'s vertex entry points (`vs_main`,
+/// or `vs_solid` for opaque quads, of the groups' [`crate::QuadFetch`]).
 #[derive(Debug)]
 pub struct ChunkPipeline<'a> {
     /// Debug label.
@@ -88,14 +131,25 @@ pub struct ChunkPipeline<'a> {
     pub module: &'a wgpu::ShaderModule,
     /// The fragment entry point.
     pub fragment_entry: &'a str,
-    /// Bind group layouts: group 0 the scene, group 1 the chunk, then the technique's.
-    pub groups: &'a [Option<&'a wgpu::BindGroupLayout>],
+    /// Bind group layouts: group 0 the scene, group 1 the chunk, then the technique's
+    /// (`SharedLayouts::with`), and how quads are fetched.
+    pub groups: &'a ChunkGroups<'a>,
     /// Colour targets.
     pub targets: &'a [Option<wgpu::ColorTargetState>],
     /// Depth test and write.
     pub depth: DepthMode,
     /// Samples per pixel (1 or 4).
     pub samples: u32,
+}
+
+/// The bind group layouts of a chunk pipeline, and how it fetches quads
+/// (`SharedLayouts::with`).
+#[derive(Debug, Clone)]
+pub struct ChunkGroups<'a> {
+    /// Groups 0, 1, then the technique's.
+    pub layouts: Vec<Option<&'a wgpu::BindGroupLayout>>,
+    /// How the pipeline fetches quads: its vertex entry point and buffers.
+    pub fetch: QuadFetch,
 }
 
 /// A translucent chunk pipeline in its two variants: culling back faces (the eye in air),
@@ -121,37 +175,38 @@ impl SidedPipeline {
 impl ChunkPipeline<'_> {
     /// Creates the pipeline (back faces culled).
     pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        self.build_with(device, "vs_main", Some(wgpu::Face::Back))
+        self.build_with(device, false, Some(wgpu::Face::Back))
     }
 
     /// Creates an opaque pipeline: back faces culled, quads grown against T-junction
     /// cracks (`vs_solid`; see `OPAQUE_EXPANSION_PX` in `bindings.rs`).
     pub fn build_solid(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        self.build_with(device, "vs_solid", Some(wgpu::Face::Back))
+        self.build_with(device, true, Some(wgpu::Face::Back))
     }
 
     /// Creates the pipeline drawing both sides of every face.
     pub fn build_two_sided(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        self.build_with(device, "vs_main", None)
+        self.build_with(device, false, None)
     }
 
     /// Creates both variants of a translucent pipeline (see [`SidedPipeline`]).
     pub fn build_sided(&self, device: &wgpu::Device) -> SidedPipeline {
         SidedPipeline {
-            culled: self.build_with(device, "vs_main", Some(wgpu::Face::Back)),
-            two_sided: self.build_with(device, "vs_main", None),
+            culled: self.build_with(device, false, Some(wgpu::Face::Back)),
+            two_sided: self.build_with(device, false, None),
         }
     }
 
     fn build_with(
         &self,
         device: &wgpu::Device,
-        vertex_entry: &str,
+        solid: bool,
         cull_mode: Option<wgpu::Face>,
     ) -> wgpu::RenderPipeline {
+        let fetch = self.groups.fetch;
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(self.label),
-            bind_group_layouts: self.groups,
+            bind_group_layouts: &self.groups.layouts,
             immediate_size: 0,
         });
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -159,9 +214,9 @@ impl ChunkPipeline<'_> {
             layout: Some(&layout),
             vertex: wgpu::VertexState {
                 module: self.module,
-                entry_point: Some(vertex_entry),
+                entry_point: Some(fetch.vertex_entry(solid)),
                 compilation_options: Default::default(),
-                buffers: &[],
+                buffers: fetch.vertex_buffers(),
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
@@ -259,7 +314,8 @@ pub fn scene_target(blend: Option<wgpu::BlendState>) -> Option<wgpu::ColorTarget
     })
 }
 
-/// A layout entry for a non-filterable 2D texture read with `textureLoad` in fragments.
+/// A layout entry for a non-filterable 2D texture read with `textureLoad` in fragments
+/// (a depth texture: [`DEPTH_READ`]).
 pub fn texture_entry(
     binding: u32,
     sample_type: wgpu::TextureSampleType,
@@ -643,4 +699,102 @@ pub fn flush(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) -> crate::Res
     let done = std::mem::replace(encoder, fresh);
     ctx.queue.submit([done.finish()]);
     Ok(())
+}
+
+/// Copies one depth target into another of the same size: a texture copy where the device
+/// copies depth textures, else a full-screen pass that writes each texel's depth. wgpu's GL
+/// backend copies textures through a colour framebuffer, so a depth texture copy does
+/// nothing there (no error either); those are the backends without
+/// `DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES` ("GLES/WebGL don't support this"), and
+/// the flag decides.
+#[derive(Debug)]
+pub struct DepthCopy {
+    /// The pass, where texture copies cannot.
+    pass: Option<CopyPass>,
+}
+
+/// What [`DepthCopy`]'s pass is made of.
+#[derive(Debug)]
+struct CopyPass {
+    device: wgpu::Device,
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+}
+
+impl DepthCopy {
+    /// The copy for the device of `ctx`.
+    pub fn new(ctx: &GpuContext) -> Self {
+        let copies = ctx
+            .caps
+            .downlevel
+            .contains(wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES);
+        let pass = (!copies).then(|| {
+            let device = &ctx.device;
+            let layout = layout(
+                device,
+                "depth_copy_layout",
+                &[texture_entry(0, DEPTH_READ), depth_sampler_entry(1)],
+            );
+            let source = DEPTH_UV_WGSL.to_owned() + include_str!("shaders/depth_copy.wgsl");
+            let pipeline = FullscreenPipeline {
+                label: "depth_copy",
+                source: &source,
+                fragment_entry: "fs_copy_depth",
+                groups: &[Some(&layout)],
+                targets: &[],
+                writes_depth: true,
+                constants: &[],
+            }
+            .build(device);
+            CopyPass {
+                device: device.clone(),
+                pipeline,
+                layout,
+                sampler: depth_sampler(device),
+            }
+        });
+        Self { pass }
+    }
+
+    /// Records the copy of `src` into `dst` (timed as `timing`, when a pass).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        src: &Target,
+        dst: &Target,
+        timing: GpuPass,
+        timer: Option<&Timer>,
+    ) {
+        let Some(CopyPass {
+            device,
+            pipeline,
+            layout,
+            sampler,
+        }) = &self.pass
+        else {
+            encoder.copy_texture_to_texture(
+                src.texture.as_image_copy(),
+                dst.texture.as_image_copy(),
+                src.texture.size(),
+            );
+            return;
+        };
+        let group = bind_group(
+            device,
+            "depth_copy",
+            layout,
+            &[
+                wgpu::BindingResource::TextureView(&src.view),
+                wgpu::BindingResource::Sampler(sampler),
+            ],
+        );
+        Pass::new("depth_copy", timing, &[])
+            .depth(Depth::Clear(&dst.view, 0.0))
+            .record(encoder, timer, |pass| {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &group, &[]);
+                pass.draw(0..3, 0..1);
+            });
+    }
 }

@@ -7,8 +7,9 @@
 //! - [`ChunkStreamer`]: the chunks around a moving eye, generated, meshed and uploaded on
 //!   rayon's workers.
 //!
-//! Modules depend on each other one way, from the bottom: `error`, `context`, `camera`,
-//! `readback`, `submission`, `timing` → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
+//! Modules depend on each other one way, from the bottom: `error`, `context`, `ladder`
+//! (what each pass needs of a device), `camera`, `readback`, `submission`, `timing`, `fetch`
+//! (how quads reach the vertex shader) → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
 //! pipeline binds), `textures`, `arena` (the quad arena), `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
 //! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` → `stream` (chunks loaded around a moving eye). A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
@@ -19,7 +20,9 @@ mod camera;
 mod chunks;
 mod context;
 mod error;
+mod fetch;
 pub mod gpu;
+pub mod ladder;
 pub mod layers;
 pub mod medium;
 pub mod oit;
@@ -39,8 +42,12 @@ pub use chunks::{
     ChunkStore, Culled, DrawCommand, DrawList, DrawMode, FrameDraws, Frustum, GpuChunk, MeshKind,
     REGION_CHUNKS,
 };
-pub use context::{Capabilities, GpuContext, WANTED_FEATURES, request_device};
+pub use context::{
+    Capabilities, GpuContext, LimitsPreset, WANTED_FEATURES, request_device, request_device_with,
+};
 pub use error::{Error, Result};
+pub use fetch::QuadFetch;
+pub use ladder::{Limit, Need};
 pub use oit::{
     BayerSize, MboitReport, MboitSettings, OitConfig, OitManager, PeelReport, PeelingSettings,
     ReferenceReport, ShadingState, SortReport, StippleSettings, Technique, TechniqueReport,

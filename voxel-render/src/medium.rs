@@ -45,7 +45,7 @@ use crate::bindings::SharedLayouts;
 use crate::chunks::{ChunkStore, DrawList, FrameDraws, MeshKind};
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
 use crate::timing::{GpuPass, Timer};
-use crate::{Camera, MIN_NEAR};
+use crate::{Camera, GpuContext, MIN_NEAR};
 
 /// Blocks of a medium that dim what lies behind as much as one layer of it.
 pub const FOG_BLOCKS: f64 = 16.0;
@@ -104,7 +104,9 @@ pub fn boundary_wgsl() -> String {
 }
 
 /// The fog pass's shader (after `fullscreen.wgsl`).
-pub const FOG_WGSL: &str = include_str!("shaders/medium_fog.wgsl");
+pub fn fog_wgsl() -> String {
+    gpu::DEPTH_UV_WGSL.to_owned() + include_str!("shaders/medium_fog.wgsl")
+}
 
 /// The pipelines of the two passes a frame inside a medium adds.
 #[derive(Debug)]
@@ -115,11 +117,16 @@ pub struct MediumPass {
     pub fog_layout: wgpu::BindGroupLayout,
     /// The fog's parameters, written each frame inside a medium.
     pub fog_params: wgpu::Buffer,
+    /// The nearest sampler the fog reads the boundary depth with.
+    depth_sampler: wgpu::Sampler,
+    /// Copies the opaque depth into the boundary.
+    depth_copy: gpu::DepthCopy,
 }
 
 impl MediumPass {
     /// Creates the pipelines.
-    pub fn new(device: &wgpu::Device, layouts: &SharedLayouts) -> Self {
+    pub fn new(ctx: &GpuContext, layouts: &SharedLayouts) -> Self {
+        let device = &ctx.device;
         let module = gpu::shader(device, "medium_boundary", &[&boundary_wgsl()]);
         let groups = layouts.with(&[]);
         // Both sides, nearest kept and written: the depth of the first surface.
@@ -137,17 +144,18 @@ impl MediumPass {
             device,
             "medium_fog_layout",
             &[
-                gpu::texture_entry(0, wgpu::TextureSampleType::Depth),
+                gpu::texture_entry(0, gpu::DEPTH_READ),
                 gpu::buffer_entry(
                     1,
                     wgpu::ShaderStages::FRAGMENT,
                     wgpu::BufferBindingType::Uniform,
                 ),
+                gpu::depth_sampler_entry(2),
             ],
         );
         let fog = FullscreenPipeline {
             label: "medium_fog",
-            source: FOG_WGSL,
+            source: &fog_wgsl(),
             fragment_entry: "fs_fog",
             groups: &[Some(&fog_layout)],
             targets: &[gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
@@ -166,6 +174,8 @@ impl MediumPass {
             fog,
             fog_layout,
             fog_params,
+            depth_sampler: gpu::depth_sampler(device),
+            depth_copy: gpu::DepthCopy::new(ctx),
         }
     }
 
@@ -178,6 +188,7 @@ impl MediumPass {
             &[
                 wgpu::BindingResource::TextureView(&boundary.view),
                 self.fog_params.as_entire_binding(),
+                wgpu::BindingResource::Sampler(&self.depth_sampler),
             ],
         )
     }
@@ -196,12 +207,8 @@ impl MediumPass {
         chunks: &DrawList,
         timer: Option<&Timer>,
     ) {
-        let opaque = &opaque_depth.texture;
-        encoder.copy_texture_to_texture(
-            opaque.as_image_copy(),
-            boundary.texture.as_image_copy(),
-            opaque.size(),
-        );
+        self.depth_copy
+            .record(encoder, opaque_depth, boundary, GpuPass::Medium, timer);
         Pass::new("medium_boundary", GpuPass::Medium, &[])
             .depth(Depth::Load(&boundary.view))
             .record(encoder, timer, |pass| {

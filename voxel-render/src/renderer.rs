@@ -17,7 +17,9 @@ use crate::chunks::{
     ChunkStore, Culled, DrawBuilder, DrawList, DrawMode, FrameDraws, Frustum, MeshKind, PosMap,
 };
 use crate::error::scoped;
+use crate::fetch::{QuadFetch, TableTexture};
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
+use crate::ladder;
 use crate::medium::{self, MediumLook, MediumPass};
 use crate::oit::sorted::interleave::{ChunkSequence, Interleaver};
 use crate::oit::{
@@ -67,7 +69,7 @@ pub struct RendererConfig {
     pub sky: [f32; 3],
     /// How chunk meshes are drawn. Default: indirect (`multi_draw_indirect` per page and
     /// pass), which costs the CPU next to nothing per chunk; adapters without indirect
-    /// first-instance draws fall back to one draw per mesh (logged).
+    /// first-instance draws, and [`QuadFetch::Instanced`], draw one mesh per draw (logged).
     pub draw: DrawMode,
     /// Frames over which a newly uploaded chunk fades in (screen-door dissolve of its
     /// opaque and cutout faces, alpha ramp of its translucent ones). Default 0: off, so
@@ -81,6 +83,10 @@ pub struct RendererConfig {
     /// solid), no texture pattern. Default off. For comparisons with references that
     /// cannot filter textures as a GPU does (the lab's CPU ray march).
     pub flat_textures: bool,
+    /// How the chunk pipelines fetch quads. Default `None`: the first of
+    /// [`QuadFetch::ALL`] the device can (storage buffers where the vertex stage has them,
+    /// else instance attributes). A way the device cannot is an [`Error::Unsupported`].
+    pub quad_fetch: Option<QuadFetch>,
 }
 
 impl Default for RendererConfig {
@@ -99,6 +105,8 @@ impl Default for RendererConfig {
             fade_in_frames: 0,
             ao_strength: 1.0,
             flat_textures: false,
+            // The device decides: both draw the same picture.
+            quad_fetch: None,
         }
     }
 }
@@ -147,6 +155,10 @@ pub struct ChunkMemory {
 struct SceneResources {
     frame_buffer: wgpu::Buffer,
     textures: BlockTextures,
+    /// The block layers as a texture ([`QuadFetch::Instanced`]).
+    layer_table: Option<TableTexture>,
+    /// The nearest sampler every depth texture is read with (`gpu::DEPTH_READ`).
+    depth_sampler: wgpu::Sampler,
 }
 
 /// The HDR scene colour and depth, the medium boundary, and what reads them.
@@ -331,6 +343,7 @@ impl Renderer {
         check_lighting(&config)?;
         config.oit.validate()?;
         check_ao_strength(config.ao_strength)?;
+        ladder::check("drawing the world", &ladder::world_needs(), &ctx.caps)?;
         if !OUTPUT_FORMATS.contains(&config.output_format) {
             return Err(Error::InvalidSetting(format!(
                 "output format {:?}: the renderer draws into {}",
@@ -342,14 +355,23 @@ impl Renderer {
             log::warn!("4x MSAA is not supported for the scene formats: rendering without MSAA");
             config.msaa = false;
         }
+        let fetch = QuadFetch::choose(&ctx.caps, config.quad_fetch)?;
         if config.draw == DrawMode::Indirect && !ctx.caps.indirect_draws() {
             log::warn!(
                 "no indirect draws with a first instance on this adapter: one draw per chunk mesh"
             );
             config.draw = DrawMode::PerChunk;
         }
+        if config.draw == DrawMode::Indirect && !fetch.indirect() {
+            log::info!("{} quad fetch: one draw per chunk mesh", fetch.name());
+            config.draw = DrawMode::PerChunk;
+        }
+        if fetch != QuadFetch::ALL[0] {
+            log::info!("drawing the world with {} quad fetch", fetch.name());
+        }
+        config.quad_fetch = Some(fetch);
         scoped(&ctx.device, "creating the renderer", || {
-            Self::create(ctx, registry, config)
+            Self::create(ctx, registry, config, fetch)
         })?
     }
 
@@ -357,21 +379,35 @@ impl Renderer {
         ctx: &GpuContext,
         registry: &BlockRegistry,
         mut config: RendererConfig,
+        fetch: QuadFetch,
     ) -> Result<Self> {
         let device = &ctx.device;
-        let layouts = SharedLayouts::new(device);
+        let layouts = SharedLayouts::new(device, fetch);
+        let textures = BlockTextures::new(ctx, registry, config.flat_textures)?;
+        let layer_table = (fetch == QuadFetch::Instanced).then(|| {
+            let t = TableTexture::new(
+                device,
+                "block_layer_table",
+                wgpu::TextureFormat::R32Uint,
+                textures.table.len(),
+            );
+            t.write(&ctx.queue, 0, bytemuck::cast_slice(&textures.table));
+            t
+        });
         let scene = SceneResources {
             frame_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("frame_uniforms"),
                 contents: bytemuck::bytes_of(&FrameUniforms::default()),
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             }),
-            textures: BlockTextures::new(ctx, registry, config.flat_textures)?,
+            textures,
+            layer_table,
+            depth_sampler: gpu::depth_sampler(device),
         };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
         let mut post = Post::new(device);
         post.make_tonemap(ctx, config.output_format);
-        let medium = MediumPass::new(device, &layouts);
+        let medium = MediumPass::new(ctx, &layouts);
         let size = (config.width, config.height);
         let targets = SceneTargets::new(ctx, &post, &layouts, &scene, &medium, size, config.msaa);
         let block_opacity = registry
@@ -388,7 +424,7 @@ impl Renderer {
         config_with(&mut config.oit, oit.config());
         Ok(Self {
             ctx: ctx.clone(),
-            chunks: ChunkStore::new(ctx, layouts.chunk.clone(), block_opacity),
+            chunks: ChunkStore::new(ctx, layouts.chunk.clone(), fetch, block_opacity),
             layouts,
             scene,
             opaque,
@@ -516,10 +552,15 @@ impl Renderer {
         Ok(())
     }
 
-    /// Switches the transparency technique (or what replaces it on this adapter).
-    pub fn set_technique(&mut self, technique: Technique) {
-        self.oit.set_technique(technique);
+    /// Switches the transparency technique (or what replaces it on this adapter) and
+    /// returns the one in force. A technique the device cannot run (nor a replacement) is
+    /// an [`Error::Unsupported`] naming what it lacks, and changes nothing
+    /// ([`Technique::supported`] lists what a device runs).
+    pub fn set_technique(&mut self, technique: Technique) -> Result<Technique> {
+        self.ctx.check_device()?;
+        let t = self.oit.set_technique(technique)?;
         config_with(&mut self.config.oit, self.oit.config());
+        Ok(t)
     }
 
     /// Builds `technique`'s pipelines and targets now, so that a later
@@ -527,7 +568,7 @@ impl Renderer {
     /// frame costs (a game prepares the techniques its settings menu offers at loading
     /// time). It stays built until [`Renderer::release_technique`]; see
     /// [`OitManager::prebuild`]. Returns the technique built (after its fallback on this
-    /// adapter).
+    /// adapter); one the device cannot run is an [`Error::Unsupported`].
     pub fn prebuild_technique(&mut self, technique: Technique) -> Result<Technique> {
         self.ctx.check_device()?;
         let oit = &mut self.oit;
@@ -551,9 +592,10 @@ impl Renderer {
     }
 
     /// Changes how chunk meshes are drawn; indirect draws stay off on an adapter without
-    /// them (logged at creation).
+    /// them (logged at creation) and with [`QuadFetch::Instanced`].
     pub fn set_draw_mode(&mut self, mode: DrawMode) {
-        self.config.draw = if mode == DrawMode::Indirect && !self.ctx.caps.indirect_draws() {
+        let indirect = self.ctx.caps.indirect_draws() && self.layouts.fetch.indirect();
+        self.config.draw = if mode == DrawMode::Indirect && !indirect {
             DrawMode::PerChunk
         } else {
             mode
@@ -949,6 +991,7 @@ impl Renderer {
             splits,
             frame_buffer: &self.scene.frame_buffer,
             boundary: &t.boundary.view,
+            depth_sampler: &self.scene.depth_sampler,
         });
         self.oit.render(
             encoder,
@@ -1366,7 +1409,7 @@ impl Post {
                 binding: 0,
                 visibility: wgpu::ShaderStages::FRAGMENT,
                 ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Depth,
+                    sample_type: gpu::DEPTH_READ,
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled: true,
                 },
@@ -1474,19 +1517,28 @@ impl SceneTargets {
             1,
             U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST,
         );
+        // The block layers: binding 4 (a storage buffer) or 5 (a table texture),
+        // `shaders/common.wgsl`.
+        let layers = match &scene.layer_table {
+            Some(table) => (5, wgpu::BindingResource::TextureView(&table.view)),
+            None => (4, scene.textures.layers.as_entire_binding()),
+        };
         let group = |label, boundary: &Target| {
-            gpu::bind_group(
-                device,
-                label,
-                &layouts.scene,
-                &[
-                    scene.frame_buffer.as_entire_binding(),
-                    wgpu::BindingResource::TextureView(&scene.textures.view),
-                    wgpu::BindingResource::Sampler(&scene.textures.sampler),
-                    wgpu::BindingResource::TextureView(&boundary.view),
-                    scene.textures.layers.as_entire_binding(),
-                ],
-            )
+            let resources = [
+                (0, scene.frame_buffer.as_entire_binding()),
+                (1, wgpu::BindingResource::TextureView(&scene.textures.view)),
+                (2, wgpu::BindingResource::Sampler(&scene.textures.sampler)),
+                (3, wgpu::BindingResource::TextureView(&boundary.view)),
+                layers.clone(),
+                (6, wgpu::BindingResource::Sampler(&scene.depth_sampler)),
+            ];
+            let entries =
+                resources.map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout: &layouts.scene,
+                entries: &entries,
+            })
         };
         let scene_group = group("scene", &boundary);
         // The pass writing the boundary reads the opaque depth in its place (ties with

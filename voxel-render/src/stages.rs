@@ -259,6 +259,8 @@ pub struct GameDraw<'a> {
     pub frame_buffer: &'a wgpu::Buffer,
     /// The medium boundary depth (see `medium.rs`).
     pub boundary: &'a wgpu::TextureView,
+    /// The nearest sampler depth textures are read with (`gpu::DEPTH_READ`).
+    pub depth_sampler: &'a wgpu::Sampler,
 }
 
 impl std::fmt::Debug for GameDraw<'_> {
@@ -307,8 +309,9 @@ impl GameDraw<'_> {
 }
 
 /// The group a technique binds for games at [`OIT_GROUP`]: binding 0 the frame uniforms,
-/// 1 the medium boundary (what the techniques' WGSL reads of group 0), then the technique's
-/// own entries (its chunk pipelines' group 2) moved up by two.
+/// 1 the medium boundary, 2 the sampler depth textures are read with (what the techniques'
+/// WGSL reads of group 0), then the technique's own entries (its chunk pipelines' group 2)
+/// moved up by [`OWN_SHIFT`].
 pub(crate) fn game_layout(
     device: &wgpu::Device,
     label: &str,
@@ -317,10 +320,11 @@ pub(crate) fn game_layout(
     use wgpu::ShaderStages as S;
     let mut entries = vec![
         crate::gpu::buffer_entry(0, S::VERTEX_FRAGMENT, wgpu::BufferBindingType::Uniform),
-        crate::gpu::texture_entry(1, wgpu::TextureSampleType::Depth),
+        crate::gpu::texture_entry(1, crate::gpu::DEPTH_READ),
+        crate::gpu::depth_sampler_entry(2),
     ];
     entries.extend(own.iter().map(|e| wgpu::BindGroupLayoutEntry {
-        binding: e.binding + 2,
+        binding: e.binding + OWN_SHIFT,
         visibility: S::FRAGMENT,
         ..*e
     }));
@@ -339,23 +343,33 @@ pub(crate) fn game_group(
     let mut resources = vec![
         draw.frame_buffer.as_entire_binding(),
         wgpu::BindingResource::TextureView(draw.boundary),
+        wgpu::BindingResource::Sampler(draw.depth_sampler),
     ];
     resources.extend(own.iter().cloned());
     crate::gpu::bind_group(device, label, layout, &resources)
 }
 
-/// A game's prelude: the frame uniforms and the medium boundary at [`OIT_GROUP`], the
-/// technique's WGSL `own` (its group-2 bindings moved to [`OIT_GROUP`], two up), and
-/// `output` (which declares `OitOutput` and `oit_output`).
+/// How far a technique's own bindings (its group 2) move up in the game's group.
+const OWN_SHIFT: u32 = 3;
+
+/// A game's prelude: the frame uniforms, the medium boundary and the depth sampler at
+/// [`OIT_GROUP`], the technique's WGSL `own` (its group-2 bindings moved to [`OIT_GROUP`],
+/// [`OWN_SHIFT`] up), and `output` (which declares `OitOutput` and `oit_output`).
 pub(crate) fn game_prelude(own: &str, output: &str) -> String {
     let header = crate::gpu::WgslConsts::default()
         .u32("NO_MEDIUM", crate::bindings::NO_MEDIUM)
         .f32("OIT_OBJECT_DEPTH_BIAS", OBJECT_DEPTH_BIAS)
         .finish()
         + crate::bindings::FRAME_WGSL
+        + crate::gpu::DEPTH_UV_WGSL
         + &format!(
             "@group({OIT_GROUP}) @binding(0) var<uniform> frame: Frame;\n\
-             @group({OIT_GROUP}) @binding(1) var medium_boundary: texture_depth_2d;\n\n\
+             @group({OIT_GROUP}) @binding(1) var medium_boundary: texture_2d<f32>;\n\
+             @group({OIT_GROUP}) @binding(2) var depth_sampler: sampler;\n\n\
+             // The medium boundary's depth at pixel `xy`.\n\
+             fn boundary_depth(xy: vec2<f32>) -> f32 {{\n    \
+             let uv = depth_uv(xy, textureDimensions(medium_boundary));\n    \
+             return textureSampleLevel(medium_boundary, depth_sampler, uv, 0.0).x;\n}}\n\n\
              // View depth of a fragment from its reverse-Z depth.\n\
              fn oit_view_depth(position: vec4<f32>) -> f32 {{\n    \
              return frame.near * frame.far / (position.z * (frame.far - frame.near) + frame.near);\n}}\n\n\
@@ -364,7 +378,7 @@ pub(crate) fn game_prelude(own: &str, output: &str) -> String {
              fn oit_object_position(position: vec4<f32>) -> vec4<f32> {{\n    \
              return vec4<f32>(position.xy, position.z * (1.0 - OIT_OBJECT_DEPTH_BIAS), position.w);\n}}\n\n"
         );
-    header + &regroup(own, 2, OIT_GROUP, 2) + "\n" + output
+    header + &regroup(own, 2, OIT_GROUP, OWN_SHIFT) + "\n" + output
 }
 
 /// `src` with every `@group(from) @binding(k)` made `@group(to) @binding(k + shift)`.

@@ -348,6 +348,8 @@ pub struct BlockTextures {
     /// Per block id, the layers of its top, bottom and side faces (`array<u32>`, three a
     /// block).
     pub layers: wgpu::Buffer,
+    /// What `layers` holds, for devices that read it from a texture (`crate::QuadFetch`).
+    pub table: Vec<u32>,
 }
 
 impl BlockTextures {
@@ -434,6 +436,7 @@ impl BlockTextures {
             view,
             sampler,
             layers,
+            table,
         })
     }
 }

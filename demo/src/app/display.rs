@@ -16,10 +16,18 @@ pub struct Display {
 }
 
 impl Display {
-    /// A surface for `window` and a device (on the adapter that can draw to it).
-    pub fn new(window: Arc<Window>) -> Result<(Self, GpuContext), String> {
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
+    /// A surface for `window` and a device (on the adapter of `backends` that can draw to
+    /// it; `None`: `WGPU_BACKEND`, else the primary ones) with `limits`.
+    pub fn new(
+        window: Arc<Window>,
+        backends: Option<wgpu::Backends>,
+        limits: voxel_render::LimitsPreset,
+    ) -> Result<(Self, GpuContext), String> {
+        // The window's display: wgpu's GL backend makes its EGL display from it.
+        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(window.clone()));
+        desc.backends = backends
+            .or_else(wgpu::Backends::from_env)
+            .unwrap_or(wgpu::Backends::PRIMARY);
         let instance = wgpu::Instance::new(desc);
         let surface = instance
             .create_surface(window.clone())
@@ -33,7 +41,8 @@ impl Display {
             format!("no GPU adapter can draw to this window: {e} (install mesa-vulkan-drivers)")
         })?;
         let (device, queue) =
-            pollster::block_on(voxel_render::request_device(&adapter)).map_err(|e| chain(&e))?;
+            pollster::block_on(voxel_render::request_device_with(&adapter, limits))
+                .map_err(|e| chain(&e))?;
         let ctx = GpuContext::from_device(&adapter, device, queue);
         let caps = surface.get_capabilities(&adapter);
         let format = caps

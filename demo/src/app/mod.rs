@@ -37,6 +37,11 @@ use post::{FRAME_FORMAT, Frames, Post};
 /// How the demo starts, and what a scripted run does.
 #[derive(Clone, Debug)]
 pub struct DemoOptions {
+    /// The backends to find the window's adapter among (`None`: `WGPU_BACKEND`, else the
+    /// primary ones).
+    pub backends: Option<wgpu::Backends>,
+    /// The limits and optional features of the device.
+    pub limits: voxel_render::LimitsPreset,
     /// World seed.
     pub seed: u32,
     /// Initial window size.
@@ -69,6 +74,8 @@ pub struct DemoOptions {
 impl Default for DemoOptions {
     fn default() -> Self {
         Self {
+            backends: None,
+            limits: voxel_render::LimitsPreset::Adapter,
             seed: 1,
             size: (1280, 720),
             technique: voxel_render::OitConfig::default().technique,
@@ -373,7 +380,7 @@ struct Gfx {
 
 impl Gfx {
     fn new(window: Arc<Window>, opts: DemoOptions) -> Result<Self, String> {
-        let (display, ctx) = Display::new(window)?;
+        let (display, ctx) = Display::new(window, opts.backends, opts.limits)?;
         // The scene's first camera, or the default view of the seed (its world is only the
         // few chunks around it).
         let (cam, open) = match &opts.scene {
@@ -686,7 +693,7 @@ impl Gfx {
 
     /// Applies what the panel changed.
     fn apply_settings(&mut self) -> Result<(), String> {
-        let s = self.settings.clone();
+        let mut s = self.settings.clone();
         let a = self.applied.clone();
         if s.seed != a.seed && self.scene.is_none() {
             // Another world: start it over at its default view.
@@ -708,9 +715,15 @@ impl Gfx {
         }
         self.far = far_plane(s.view_distance).max(self.scene.as_ref().map_or(0.0, |s| s.far));
         if s.oit != a.oit {
-            self.renderer
-                .set_oit_config(s.oit.clone())
-                .map_err(|e| chain(&e))?;
+            match self.renderer.set_oit_config(s.oit.clone()) {
+                // A technique this device cannot run: said, and the one in force kept.
+                Err(e @ voxel_render::Error::Unsupported(_)) => {
+                    log::warn!("{e}");
+                    s.oit = a.oit.clone();
+                    self.settings.oit = a.oit.clone();
+                }
+                other => other.map_err(|e| chain(&e))?,
+            }
         }
         if s.msaa != a.msaa {
             self.renderer.set_msaa(s.msaa).map_err(|e| chain(&e))?;

@@ -25,7 +25,9 @@ use voxel_core::ChunkPos;
 use crate::bindings::SharedLayouts;
 use crate::chunks::{ChunkStore, DrawList, FrameDraws};
 use crate::context::Capabilities;
+use crate::fetch::QuadFetch;
 use crate::gpu::Target;
+use crate::ladder::{self, Need};
 use crate::layers::VisibleLayers;
 use crate::stages::{GameDraw, TranslucentContract, TranslucentObject, TranslucentVariant};
 use crate::timing::Timer;
@@ -105,6 +107,12 @@ macro_rules! techniques {
             /// What replaces the technique on an adapter that cannot run it.
             fn fallback(self, caps: &Capabilities) -> Option<Technique> {
                 match self { $( Technique::$variant => <$kind as TechniqueKind>::fallback(self, caps), )* }
+            }
+
+            /// What the technique with `config` needs of a device beyond the world's own
+            /// passes ([`crate::ladder::world_needs`], and the way quads are fetched).
+            pub fn needs(self, config: &OitConfig, caps: &Capabilities) -> Vec<Need> {
+                match self { $( Technique::$variant => <$kind as TechniqueKind>::needs(self, config, caps), )* }
             }
 
             fn key(self, config: &OitConfig, caps: &Capabilities) -> Key {
@@ -190,6 +198,71 @@ impl Technique {
 }
 
 impl Technique {
+    /// The ladder a game climbs down to the best technique a device runs
+    /// ([`Technique::best_available`]), best first by the lab's measurements: the sorted
+    /// techniques (the default, see [`OitConfig::technique`]; they blend into the scene
+    /// colour and need nothing more), WBOIT in one pass and in two (float accumulation
+    /// targets, independent blend for one pass), and stipple, the low-end mode, which
+    /// needs nothing but the world's own passes (no blending at all).
+    pub const LADDER: [Technique; 5] = [
+        Technique::SortedQuads,
+        Technique::Sorted,
+        Technique::WboitMrt,
+        Technique::WboitTwoPass,
+        Technique::Stipple,
+    ];
+
+    /// The low-end mode: stipple, the last rung of [`Technique::LADDER`].
+    pub const LOW_END: Technique = Technique::Stipple;
+
+    /// `Ok` when a device of `caps` draws the world and the technique with `config` as
+    /// itself; else [`Error::Unsupported`] naming each capability it lacks.
+    pub fn check(self, config: &OitConfig, caps: &Capabilities) -> Result<()> {
+        QuadFetch::choose(caps, None)?;
+        ladder::check("drawing the world", &ladder::world_needs(), caps)?;
+        ladder::check(self.name(), &self.needs(config, caps), caps)
+    }
+
+    /// What draws when the technique is asked for with `config` on a device of `caps`:
+    /// itself, or what replaces it where it cannot run (two-pass WBOIT without independent
+    /// blend, peel-to-convergence as the reference without fragment storage), or
+    /// [`Error::Unsupported`] naming what the device lacks.
+    pub fn resolve(self, config: &OitConfig, caps: &Capabilities) -> Result<Technique> {
+        match self.fallback(caps) {
+            None => self.check(config, caps).map(|()| self),
+            Some(other) => other.check(config, caps).map(|()| other).map_err(|e| {
+                let lacking = ladder::missing(&self.needs(config, caps), caps).unwrap_or_default();
+                Error::Unsupported(format!(
+                    "{self} needs {lacking}, and its replacement {other} cannot run either: {e}"
+                ))
+            }),
+        }
+    }
+
+    /// The techniques a device of `caps` runs as themselves with default settings, in
+    /// [`Technique::ALL`]'s order (one it lacks something for may still be asked for and
+    /// draw as its replacement, [`Technique::resolve`]).
+    pub fn supported(caps: &Capabilities) -> Vec<Technique> {
+        let config = OitConfig::default();
+        Self::ALL
+            .into_iter()
+            .filter(|t| t.fallback(caps).is_none() && t.check(&config, caps).is_ok())
+            .collect()
+    }
+
+    /// The highest rung of [`Technique::LADDER`] a device of `caps` runs as itself; an
+    /// [`Error::Unsupported`] naming what stipple, the last rung, lacks when it runs none.
+    pub fn best_available(caps: &Capabilities) -> Result<Technique> {
+        let config = OitConfig::default();
+        match Self::LADDER
+            .into_iter()
+            .find(|t| t.fallback(caps).is_none() && t.check(&config, caps).is_ok())
+        {
+            Some(t) => Ok(t),
+            None => Self::LOW_END.check(&config, caps).map(|()| Self::LOW_END),
+        }
+    }
+
     /// Parses a command-line name; the error lists the known names.
     pub fn from_name(name: &str) -> Result<Self> {
         Self::ALL
@@ -231,6 +304,13 @@ pub trait TechniqueKind: TranslucentTechnique + Sized + 'static {
     /// What replaces `technique` on an adapter that lacks something it needs.
     fn fallback(_technique: Technique, _caps: &Capabilities) -> Option<Technique> {
         None
+    }
+
+    /// What `technique` with `config` needs of the device beyond the world's own passes
+    /// (features, downlevel flags, limits, formats beyond what WebGPU guarantees), checked
+    /// before it is built. Default: nothing more.
+    fn needs(_technique: Technique, _config: &OitConfig, _caps: &Capabilities) -> Vec<Need> {
+        Vec::new()
     }
 
     /// The key of `technique` with `config` on this adapter.
@@ -444,9 +524,12 @@ pub struct OitManager {
 impl OitManager {
     /// A manager for `config`. No GPU resource is created until a frame needs one. A
     /// technique the adapter cannot run falls back (logged): two-pass WBOIT without
-    /// independent blend, peel-to-convergence as the reference without fragment storage.
+    /// independent blend, peel-to-convergence as the reference without fragment storage;
+    /// one without a replacement it can run is an [`Error::Unsupported`] naming what the
+    /// device lacks ([`Technique::resolve`]).
     pub fn new(setup: Setup, config: OitConfig) -> Result<Self> {
         config.validate()?;
+        let technique = Self::resolve_with(&setup, &config, config.technique)?;
         let mut m = Self {
             setup,
             config,
@@ -458,19 +541,23 @@ impl OitManager {
             contract: None,
             contract_keys: Vec::new(),
         };
-        m.config.technique = m.supported(m.config.technique);
+        m.config.technique = technique;
         Ok(m)
     }
 
-    /// `technique`, or what replaces it on this adapter.
-    fn supported(&self, technique: Technique) -> Technique {
-        match technique.fallback(&self.setup.ctx.caps) {
-            Some(other) => {
-                log::warn!("this adapter cannot run {technique}: using {other} instead");
-                other
-            }
-            None => technique,
+    /// `technique`, or what replaces it on this adapter (logged), with `config`'s
+    /// settings; [`Error::Unsupported`] when neither can run.
+    fn resolve_with(setup: &Setup, config: &OitConfig, technique: Technique) -> Result<Technique> {
+        let t = technique.resolve(config, &setup.ctx.caps)?;
+        if t != technique {
+            log::warn!("this adapter cannot run {technique}: using {t} instead");
         }
+        Ok(t)
+    }
+
+    /// [`OitManager::resolve_with`] with the settings in force.
+    fn resolve(&self, technique: Technique) -> Result<Technique> {
+        Self::resolve_with(&self.setup, &self.config, technique)
     }
 
     /// The configuration in force (after any fallback).
@@ -490,23 +577,27 @@ impl OitManager {
         self.config.technique.reads_layers(&self.config)
     }
 
-    /// Switches technique at run time; the old one's resources are freed at once.
-    pub fn set_technique(&mut self, technique: Technique) {
+    /// Switches technique at run time; the old one's resources are freed at once. Returns
+    /// the technique in force (`technique`, or what replaces it on this adapter); one the
+    /// adapter cannot run is an [`Error::Unsupported`] and changes nothing.
+    pub fn set_technique(&mut self, technique: Technique) -> Result<Technique> {
         let config = OitConfig {
             technique,
             ..self.config.clone()
         };
-        // Only the technique changed, and the rest was valid.
-        let _ = self.set_config(config);
+        self.set_config(config)?;
+        Ok(self.config.technique)
     }
 
     /// Changes the settings. Resources are rebuilt only when the technique's key (what
     /// its pipelines and targets are built from) changes; other settings apply from the
-    /// next frame. An invalid setting is an error and changes nothing.
+    /// next frame. An invalid setting, or a technique the adapter cannot run
+    /// ([`Error::Unsupported`]), is an error and changes nothing.
     pub fn set_config(&mut self, config: OitConfig) -> Result<()> {
         config.validate()?;
+        let technique = Self::resolve_with(&self.setup, &config, config.technique)?;
         self.config = config;
-        self.config.technique = self.supported(self.config.technique);
+        self.config.technique = technique;
         let key = self
             .config
             .technique
@@ -568,9 +659,10 @@ impl OitManager {
     /// its fallback on this adapter), so that switching to it later builds nothing and the
     /// first frame after the switch costs what any frame costs. It stays built while other
     /// techniques draw, is resized with the others and rebuilt when a setting it is built
-    /// from changes, until [`OitManager::release`]. Returns the technique built.
+    /// from changes, until [`OitManager::release`]. Returns the technique built; one the
+    /// adapter cannot run (nor its replacement) is an [`Error::Unsupported`].
     pub fn prebuild(&mut self, technique: Technique) -> Result<Technique> {
-        let technique = self.supported(technique);
+        let technique = self.resolve(technique)?;
         if !self.prebuilt.contains(&technique) {
             self.prebuilt.push(technique);
         }
@@ -589,7 +681,10 @@ impl OitManager {
 
     /// Forgets a [`OitManager::prebuild`]: its resources are freed unless it is active.
     pub fn release(&mut self, technique: Technique) {
-        let technique = self.supported(technique);
+        // A technique that cannot run was never built.
+        let Ok(technique) = technique.resolve(&self.config, &self.setup.ctx.caps) else {
+            return;
+        };
         self.prebuilt.retain(|t| *t != technique);
         self.kept.retain(|(k, _)| k.technique() != technique);
     }

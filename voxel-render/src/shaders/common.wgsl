@@ -21,14 +21,26 @@ struct ChunkInfo {
 @group(0) @binding(2) var block_sampler: sampler;
 // Inside a medium: per pixel, the depth of the first surface of the medium's volume the
 // eye's ray meets (or the opaque depth when nearer); see `medium.rs`.
-@group(0) @binding(3) var medium_boundary: texture_depth_2d;
-// Per block id, the texture layers of its top, bottom and side faces (`textures.rs`).
-@group(0) @binding(4) var<storage, read> block_layers: array<u32>;
+// A depth texture read as a float one with the nearest sampler below (`gpu.rs`,
+// DEPTH_READ): `boundary_depth`.
+@group(0) @binding(3) var medium_boundary: texture_2d<f32>;
+// The sampler depth textures are read with (every chunk pass's own too).
+@group(0) @binding(6) var depth_sampler: sampler;
 
-// Group 1: a page of the quad arena, and every chunk's record by slot (the instance
-// index of its draws).
+// How quads and their tables reach the vertex stage (`fetch.rs`); a pipeline uses one of
+// the two, and binds only that one's resources.
+//
+// Storage: per block id, the texture layers of its top, bottom and side faces
+// (`textures.rs`); group 1: a page of the quad arena, and every chunk's record by slot
+// (the instance index of its draws).
+@group(0) @binding(4) var<storage, read> block_layers: array<u32>;
 @group(1) @binding(0) var<storage, read> quads: array<vec2<u32>>;
 @group(1) @binding(1) var<storage, read> chunks: array<ChunkInfo>;
+// Instanced: the block layers in a texture TABLE_WIDTH entries wide (`table_texel`), the
+// drawn chunk's record a uniform (bound at its dynamic offset for each draw), the quads the
+// instances' attribute.
+@group(0) @binding(5) var block_layer_table: texture_2d<u32>;
+@group(1) @binding(2) var<uniform> chunk_record: ChunkInfo;
 
 struct VsOut {
     // Invariant: the same quad gets bit-identical depths in every pipeline, which depth
@@ -95,19 +107,16 @@ const NORMALS = array<vec3<f32>, 6>(
     vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, -1.0),
 );
 
-// Expands vertex `vi` of the page's quads (a draw starts at its mesh's first quad times
-// 6): quad vi / 6, corner vi % 6, of the chunk in slot `slot`. The quad is split along the
+// Expands vertex `k` (0..6) of quad `q` of `chunk` (the face's layer is the caller's:
+// `layer_index` says which entry of its table). The quad is split along the
 // diagonal whose corners are brighter in sum (Sodium's rule), so that interpolated
 // occlusion is symmetric; with `grow` it grows by OPAQUE_EXPANSION_PX pixels along its
 // plane (opaque quads: no crack at T-junctions, `bindings.rs`).
-fn quad_vertex(vi: u32, slot: u32, grow: bool) -> VsOut {
-    let q = quads[vi / 6u];
-    let chunk = chunks[slot];
+fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool) -> VsOut {
     let g = q.x;
     let face = min((g >> 25u) & 7u, 5u);
     let size = vec2<f32>(f32(((g >> 15u) & 31u) + 1u), f32(((g >> 20u) & 31u) + 1u));
     let flip = corner_ao(q, 1u) + corner_ao(q, 2u) > corner_ao(q, 0u) + corner_ao(q, 3u);
-    let k = vi % 6u;
     let positive = (face & 1u) == 0u;
     let corner = quad_corner(positive, flip, k);
     let axis = face / 2u;
@@ -160,9 +169,6 @@ fn quad_vertex(vi: u32, slot: u32, grow: bool) -> VsOut {
     }
     out.uv = uv;
     out.block = q.y & 0xffffu;
-    // Face groups: +y top (0), -y bottom (1), the rest sides (2).
-    let group = select(2u, face - 2u, face == 2u || face == 3u);
-    out.layer = block_layers[out.block * 3u + group];
     out.flags = q.y >> 16u;
     out.alpha = chunk.alpha;
     out.face = face;
@@ -178,16 +184,53 @@ fn screen_rate(clip: vec4<f32>, d: vec4<f32>) -> f32 {
     return length((d.xy * w - clip.xy * d.w) / (w * w) * frame.viewport * 0.5);
 }
 
-// Translucent quads (every technique, the medium boundary): exactly as meshed.
+// The entry of a block's layer table for `face`: three a block, the face groups +y top
+// (0), -y bottom (1), the rest sides (2).
+fn layer_index(block: u32, face: u32) -> u32 {
+    return block * 3u + select(2u, face - 2u, face == 2u || face == 3u);
+}
+
+// Storage: vertex `vi` of the page's quads (a draw starts at its mesh's first quad times
+// 6), quad vi / 6, corner vi % 6, of the chunk in slot `slot`.
+fn pulled_vertex(vi: u32, slot: u32, grow: bool) -> VsOut {
+    var out = quad_vertex(quads[vi / 6u], chunks[slot], vi % 6u, grow);
+    out.layer = block_layers[layer_index(out.block, out.face)];
+    return out;
+}
+
+// Where entry `i` of a table texture lies.
+fn table_texel(i: u32) -> vec2<i32> {
+    return vec2<i32>(i32(i % TABLE_WIDTH), i32(i / TABLE_WIDTH));
+}
+
+// Instanced: corner vi % 6 of the instance's quad `q`, of the drawn chunk.
+fn instanced_vertex(vi: u32, q: vec2<u32>, grow: bool) -> VsOut {
+    var out = quad_vertex(q, chunk_record, vi % 6u, grow);
+    out.layer = textureLoad(block_layer_table, table_texel(layer_index(out.block, out.face)), 0).x;
+    return out;
+}
+
+// Translucent and cutout quads (every technique, the medium boundary): exactly as meshed.
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -> VsOut {
-    return quad_vertex(vi, slot, false);
+    return pulled_vertex(vi, slot, false);
 }
 
 // Opaque quads, grown against T-junction cracks.
 @vertex
 fn vs_solid(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) -> VsOut {
-    return quad_vertex(vi, slot, true);
+    return pulled_vertex(vi, slot, true);
+}
+
+// The same two, the quads as instances.
+@vertex
+fn vs_main_instanced(@builtin(vertex_index) vi: u32, @location(0) q: vec2<u32>) -> VsOut {
+    return instanced_vertex(vi, q, false);
+}
+
+@vertex
+fn vs_solid_instanced(@builtin(vertex_index) vi: u32, @location(0) q: vec2<u32>) -> VsOut {
+    return instanced_vertex(vi, q, true);
 }
 
 // Image coordinates of face coordinates `uv` (along the face's U and V axes): side faces
@@ -224,7 +267,13 @@ fn counts(in: VsOut, front: bool) -> bool {
     }
     return in.block == frame.medium
         && (in.flags & FLAG_INTERFACE) == 0u
-        && in.clip.z == textureLoad(medium_boundary, vec2<i32>(in.clip.xy), 0);
+        && in.clip.z == boundary_depth(in.clip.xy);
+}
+
+// The medium boundary's depth at pixel `xy`.
+fn boundary_depth(xy: vec2<f32>) -> f32 {
+    let size = textureDimensions(medium_boundary);
+    return textureSampleLevel(medium_boundary, depth_sampler, depth_uv(xy, size), 0.0).x;
 }
 
 // The lit colour and opacity of a translucent fragment: what every technique composes.

@@ -13,7 +13,7 @@ const TIE: f32 = 1.0 / 16384.0;
 
 @fragment
 fn fs_boundary(in: VsOut) {
-    let opaque = textureLoad(medium_boundary, vec2<i32>(in.clip.xy), 0);
+    let opaque = boundary_depth(in.clip.xy);
     if in.block != frame.medium || in.clip.z <= opaque * (1.0 + TIE) {
         discard;
     }

@@ -10,12 +10,14 @@ struct FogParams {
     viewport: vec2<f32>,
 };
 
-@group(0) @binding(0) var boundary: texture_depth_2d;
+// A depth texture, read as a float one (`gpu::DEPTH_READ`).
+@group(0) @binding(0) var boundary: texture_2d<f32>;
 @group(0) @binding(1) var<uniform> fog: FogParams;
+@group(0) @binding(2) var depth_sampler: sampler;
 
 @fragment
 fn fs_fog(in: FullscreenOut) -> @location(0) vec4<f32> {
-    let z = textureLoad(boundary, vec2<i32>(in.clip.xy), 0);
+    let z = textureSampleLevel(boundary, depth_sampler, depth_uv(in.clip.xy, textureDimensions(boundary)), 0.0).x;
     let n = fog.near_far.x;
     let f = fog.near_far.y;
     // Reverse-Z window depth to view depth; the far plane where nothing was drawn.

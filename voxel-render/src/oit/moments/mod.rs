@@ -26,6 +26,7 @@ use wgpu::util::DeviceExt;
 use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
 use crate::gpu::{self, ChunkPipeline, Depth, Pass, SidedPipeline};
+use crate::ladder::Need;
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -328,6 +329,17 @@ impl TechniqueKind for Mboit {
 
     fn fallback(_: Technique, caps: &Capabilities) -> Option<Technique> {
         (!caps.rgba16f_blendable).then_some(Technique::WboitTwoPass)
+    }
+
+    /// Additive blending into the moments' targets (both in one pass) and the colour
+    /// accumulation.
+    fn needs(_: Technique, config: &OitConfig, caps: &Capabilities) -> Vec<Need> {
+        let (b0, moments) = moment_formats(single_precision(caps, &config.mboit));
+        let mut needs = [b0, moments, ACCUMULATION_FORMAT]
+            .map(Need::BlendableTarget)
+            .to_vec();
+        needs.push(Need::Limit(crate::ladder::Limit::ColorAttachments, 2));
+        needs
     }
 
     fn key(_: Technique, config: &OitConfig, caps: &Capabilities) -> bool {

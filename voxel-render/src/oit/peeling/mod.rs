@@ -131,7 +131,7 @@ struct Targets {
 
 /// The group-2 entries of the peel pipelines: the front and back limits.
 fn limit_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
-    [0, 1].map(|i| gpu::texture_entry(i, wgpu::TextureSampleType::Depth))
+    [0, 1].map(|i| gpu::texture_entry(i, gpu::DEPTH_READ))
 }
 
 /// Depth peeling resources.
@@ -153,6 +153,8 @@ pub struct Peeling {
     /// Dual mode: iterations to run this frame (adaptive).
     iterations: u32,
     report: PeelReport,
+    /// Copies the opaque depth into the limits.
+    depth_copy: gpu::DepthCopy,
 }
 
 const UNDER: wgpu::BlendState = wgpu::BlendState {
@@ -254,6 +256,7 @@ impl TechniqueKind for Peeling {
             ),
             iterations: max_iterations,
             report: PeelReport::default(),
+            depth_copy: gpu::DepthCopy::new(&setup.ctx),
         })
     }
 }
@@ -385,12 +388,9 @@ impl Peeling {
                 .depth(Depth::Clear(&t.front[1].view, 1.0))
         }
         .record(encoder, None, |_| {});
-        let opaque = &frame.depth.texture;
-        encoder.copy_texture_to_texture(
-            opaque.as_image_copy(),
-            t.back[1].texture.as_image_copy(),
-            opaque.size(),
-        );
+        let timing = GpuPass::Translucent;
+        self.depth_copy
+            .record(encoder, frame.depth, &t.back[1], timing, frame.timer);
     }
 
     /// Front peel of iteration `i` into slot `i % 2`, with `limits`, then under-blends it.
@@ -404,12 +404,9 @@ impl Peeling {
         let t = &self.targets;
         let cur = (i % 2) as usize;
         // The candidates must also lie in front of the opaque surfaces: start from them.
-        let opaque = &frame.depth.texture;
-        encoder.copy_texture_to_texture(
-            opaque.as_image_copy(),
-            t.front[cur].texture.as_image_copy(),
-            opaque.size(),
-        );
+        let timing = GpuPass::Translucent;
+        self.depth_copy
+            .record(encoder, frame.depth, &t.front[cur], timing, frame.timer);
         self.peel_pass(
             encoder,
             frame,

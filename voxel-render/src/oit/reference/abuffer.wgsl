@@ -6,7 +6,8 @@
 @group(2) @binding(1) var<storage, read_write> nodes: array<Node>;
 @group(2) @binding(2) var<storage, read_write> counters: Counters;
 @group(2) @binding(3) var<uniform> params: Params;
-@group(2) @binding(4) var opaque_depth: texture_depth_2d;
+// Read with group 0's nearest sampler (`gpu::DEPTH_READ`).
+@group(2) @binding(4) var opaque_depth: texture_2d<f32>;
 
 // Appends a fragment of colour `c` at `position` (its depth's screen-space `slope`) to its
 // pixel's list, if it lies in front of the opaque surface and counts.
@@ -14,7 +15,8 @@ fn abuffer_append(position: vec4<f32>, slope: vec2<f32>, c: vec4<f32>) {
     let p = vec2<u32>(position.xy);
     // The depth test, in the shader: a fragment with storage writes may run them before a
     // late depth test would have dropped it. The scissor keeps fragments in the tile.
-    if position.z <= textureLoad(opaque_depth, vec2<i32>(p), 0) || c.a <= 0.0 {
+    let uv = depth_uv(position.xy, textureDimensions(opaque_depth));
+    if position.z <= textureSampleLevel(opaque_depth, depth_sampler, uv, 0.0).x || c.a <= 0.0 {
         return;
     }
     let index = atomicAdd(&counters.nodes, 1u);

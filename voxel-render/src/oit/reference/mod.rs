@@ -28,6 +28,7 @@ use crate::context::Capabilities;
 use crate::gpu::{
     self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, SidedPipeline, WgslConsts,
 };
+use crate::ladder::{Limit, Need};
 use crate::oit::{
     OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -145,7 +146,17 @@ fn build_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
         storage(1),
         storage(2),
         params_entry(),
-        gpu::texture_entry(4, wgpu::TextureSampleType::Depth),
+        gpu::texture_entry(4, gpu::DEPTH_READ),
+    ]
+}
+
+/// The fragment stage writes the heads, nodes and counters (storage buffers, atomics), and
+/// reads the opaque depth while it is the pass's read-only depth attachment.
+fn reference_needs() -> Vec<Need> {
+    vec![
+        Need::Downlevel(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE),
+        Need::Limit(Limit::StorageBuffersPerStage, 3),
+        Need::Downlevel(wgpu::DownlevelFlags::READ_ONLY_DEPTH_STENCIL),
     ]
 }
 
@@ -204,7 +215,11 @@ impl TechniqueKind for Reference {
     }
 
     fn fallback(_: Technique, caps: &Capabilities) -> Option<Technique> {
-        (!caps.fragment_storage()).then_some(Technique::PeelReference)
+        crate::ladder::missing(&reference_needs(), caps).map(|_| Technique::PeelReference)
+    }
+
+    fn needs(_: Technique, _: &OitConfig, _: &Capabilities) -> Vec<Need> {
+        reference_needs()
     }
 
     fn key(_: Technique, _: &OitConfig, _: &Capabilities) {}

@@ -8,15 +8,18 @@ struct StippleParams {
 
 @group(2) @binding(0) var<uniform> params: StippleParams;
 // The 2×2, 4×4, 8×8 and 16×16 Bayer matrices one after the other, made in Rust
-// (`bayer::bayer_levels`, tested equal to the tables as commonly printed).
-@group(2) @binding(1) var<storage, read> bayer_levels: array<u32>;
+// (`bayer::bayer_levels`, tested equal to the tables as commonly printed), four levels to a
+// vec4: a uniform array's elements are 16 bytes apart, and a uniform (not a storage buffer)
+// is what every device has, WebGL2 included.
+@group(2) @binding(1) var<uniform> bayer_levels: array<vec4<u32>, BAYER_VEC4S>;
 
 // The threshold: the Bayer level at the pixel, over n² (Bayer 1973). Pattern codes: 0 = 2×2,
 // 1 = 4×4, 2 = 8×8, 3 = 16×16.
 fn bayer_threshold(pattern: u32, frag_xy: vec2<f32>) -> f32 {
     let n = 2u << (pattern & 3u);
     let p = vec2<u32>(frag_xy) % n;
-    return f32(bayer_levels[BAYER_OFFSETS[pattern & 3u] + p.y * n + p.x]) / f32(n * n);
+    let i = BAYER_OFFSETS[pattern & 3u] + p.y * n + p.x;
+    return f32(bayer_levels[i / 4u][i % 4u]) / f32(n * n);
 }
 
 // The state's bit layout: bits 0-7 alpha, 8-9 mode (always stipple here), 10-11 pattern.

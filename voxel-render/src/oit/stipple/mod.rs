@@ -89,23 +89,30 @@ fn bayer_consts() -> String {
     let offsets = BayerSize::ALL.map(|b| bayer::bayer_offset(b) as u32);
     WgslConsts::default()
         .u32_array("BAYER_OFFSETS", &offsets)
+        .u32("BAYER_VEC4S", bayer_vec4s().len() as u32)
         .finish()
 }
 
-/// The group-2 entries of the stipple pipeline: the shading state and the Bayer tables.
+/// The Bayer levels of [`bayer::bayer_levels`], four to a `vec4<u32>` (the last one padded
+/// with zeros), as the uniform array of `dither.wgsl` holds them.
+fn bayer_vec4s() -> Vec<[u32; 4]> {
+    bayer::bayer_levels()
+        .chunks(4)
+        .map(|c| std::array::from_fn(|i| c.get(i).copied().unwrap_or(0)))
+        .collect()
+}
+
+/// The group-2 entries of the stipple pipeline: the shading state and the Bayer tables,
+/// both uniforms.
 fn group_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
-    [
+    let uniform = |i| {
         gpu::buffer_entry(
-            0,
+            i,
             wgpu::ShaderStages::FRAGMENT,
             wgpu::BufferBindingType::Uniform,
-        ),
-        gpu::buffer_entry(
-            1,
-            wgpu::ShaderStages::FRAGMENT,
-            wgpu::BufferBindingType::Storage { read_only: true },
-        ),
-    ]
+        )
+    };
+    [uniform(0), uniform(1)]
 }
 
 /// The stipple pipeline and its uniform.
@@ -137,8 +144,8 @@ impl TechniqueKind for Stipple {
         });
         let levels = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("bayer_levels"),
-            contents: bytemuck::cast_slice(&bayer::bayer_levels()),
-            usage: wgpu::BufferUsages::STORAGE,
+            contents: bytemuck::cast_slice(&bayer_vec4s()),
+            usage: wgpu::BufferUsages::UNIFORM,
         });
         let group = gpu::bind_group(
             device,
@@ -254,6 +261,18 @@ impl TranslucentTechnique for Stipple {
 mod tests {
     use super::*;
     use crate::wgsl_layout::{assert_layout, field, parse};
+
+    #[test]
+    fn the_uniform_tables_hold_every_level_in_order() {
+        let levels = bayer::bayer_levels();
+        let packed: Vec<u32> = bayer_vec4s().into_iter().flatten().collect();
+        assert_eq!(&packed[..levels.len()], &levels[..]);
+        assert!(
+            packed[levels.len()..].iter().all(|&v| v == 0),
+            "zero padding"
+        );
+        assert!(packed.len() - levels.len() < 4);
+    }
 
     #[test]
     fn params_match_their_wgsl() {

@@ -40,7 +40,7 @@ fn cube(x: f32) -> f32 {
 // The eye's medium in front of a fragment: its surface (the way out) dims every fragment
 // behind the first medium surface at the pixel (`medium.rs`).
 fn medium_in_front(pixel: vec2<f32>, frag_z: f32) -> f32 {
-    if frame.medium == NO_MEDIUM || frag_z >= textureLoad(medium_boundary, vec2<i32>(pixel), 0) {
+    if frame.medium == NO_MEDIUM || frag_z >= boundary_depth(pixel) {
         return 0.0;
     }
     return params.medium_depth;

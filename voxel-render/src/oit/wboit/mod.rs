@@ -42,6 +42,7 @@ use wgpu::util::DeviceExt;
 use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
 use crate::gpu::{self, ChunkPipeline, Depth, Pass, SidedPipeline, Target};
+use crate::ladder::Need;
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -52,6 +53,13 @@ use crate::{GpuContext, Result};
 
 use fit::{PROFILE_LEN, TILES};
 use weights::{MAX_FITTED_DEPTH, WeightFit, WeightFunction};
+
+/// What the one-pass variant needs besides the two-pass one: both targets in one pass,
+/// each with its own blend state.
+const MRT_NEEDS: [Need; 2] = [
+    Need::Downlevel(wgpu::DownlevelFlags::INDEPENDENT_BLEND),
+    Need::Limit(crate::ladder::Limit::ColorAttachments, 2),
+];
 
 /// Revealage format: one byte of Π(1 − α).
 pub const REVEALAGE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
@@ -363,8 +371,21 @@ impl TechniqueKind for Wboit {
     }
 
     fn fallback(technique: Technique, caps: &Capabilities) -> Option<Technique> {
-        (technique == Technique::WboitMrt && !caps.independent_blend())
+        (technique == Technique::WboitMrt && crate::ladder::missing(&MRT_NEEDS, caps).is_some())
             .then_some(Technique::WboitTwoPass)
+    }
+
+    /// Additive and multiplicative blending into its two targets; MRT: both in one pass,
+    /// with a blend state each.
+    fn needs(technique: Technique, config: &OitConfig, caps: &Capabilities) -> Vec<Need> {
+        let mut needs = vec![
+            Need::BlendableTarget(accumulation_format(caps, &config.wboit)),
+            Need::BlendableTarget(REVEALAGE_FORMAT),
+        ];
+        if technique == Technique::WboitMrt {
+            needs.extend(MRT_NEEDS);
+        }
+        needs
     }
 
     fn key(technique: Technique, config: &OitConfig, caps: &Capabilities) -> Self::Key {
