@@ -633,3 +633,69 @@ fn a_game_registry_generates_the_default_terrain_through_a_mapping() {
         }
     }
 }
+
+/// Every real-time technique built ahead, with a game's translucent pipelines for its
+/// contract (`translucent_contract_for`, whose id is the one the contract has once in
+/// force): switching through them builds no render pipeline, neither the renderer's
+/// (counted by `gpu::pipelines_built`) nor the game's, and each first frame after a switch
+/// draws what a fresh renderer of that technique draws.
+#[test]
+fn switching_to_prebuilt_techniques_builds_no_pipeline() {
+    let Some(ctx) = gpu() else { return };
+    let s = tests::Scene {
+        content: voxel_lab::content::Content {
+            particles: (0..40)
+                .map(|i| voxel_lab::content::Particle {
+                    center: DVec3::new(
+                        -6.0 + f64::from(i) * 0.3,
+                        1.5 + f64::from(i % 5) * 0.4,
+                        1.0,
+                    ),
+                    half_size: 0.2,
+                    color: [240, 200, 120],
+                    opacity: 0.5,
+                })
+                .collect(),
+            entities: vec![],
+        },
+        ..lit_scene()
+    };
+    let cam = s.cameras[0];
+    let (w, h) = (96, 72);
+    let mut r = renderer_for(&ctx, &s, technique_config(Technique::OpaqueOnly, w, h)).unwrap();
+    let mut game = r.content.take().unwrap();
+    let mut ids = Vec::new();
+    for t in Technique::REAL_TIME {
+        r.prebuild_technique(t).unwrap();
+        game.prebuild(&mut r.renderer, t).unwrap();
+        ids.push(r.translucent_contract_for(t).unwrap().id);
+    }
+    let target = Offscreen::new(&ctx, w, h);
+    let game_built = game.pipelines_built();
+    for (t, id) in Technique::REAL_TIME.into_iter().zip(ids).rev() {
+        let built = voxel_render::gpu::pipelines_built();
+        r.set_technique(t).unwrap();
+        assert_eq!(
+            r.translucent_contract().unwrap().id,
+            id,
+            "{t}: the id said ahead"
+        );
+        game.update_pipelines(&mut r.renderer).unwrap();
+        r.renderer
+            .render_and_submit_with(&target.view, &cam, &mut game)
+            .unwrap();
+        let got = target.read(&ctx).unwrap();
+        assert_eq!(
+            voxel_render::gpu::pipelines_built(),
+            built,
+            "{t}: the switch built a pipeline"
+        );
+        assert_eq!(
+            game.pipelines_built(),
+            game_built,
+            "{t}: the game built one"
+        );
+        let expected = tests::render_with(&ctx, &s, technique_config(t, w, h));
+        tests::assert_close(&format!("embed_switch_{t}"), &got, &expected, 0);
+    }
+}

@@ -282,6 +282,7 @@ fn shader_weights_match_the_rust_formulas() {
             height: 33,
             ..Default::default()
         };
+        config.oit.technique = Technique::WboitMrt;
         config.oit.wboit.weight = weight;
         let mut r = renderer_for(&ctx, &scene, config).unwrap();
         let stats = r

@@ -9,6 +9,7 @@
 //! buffer is written in that order each frame. The CPU ray march (the `raymarch` module) draws
 //! the same things from the same description.
 
+use std::collections::HashMap;
 use std::ops::Range;
 
 use glam::{DQuat, DVec3, Mat3};
@@ -184,8 +185,12 @@ pub struct ContentStages {
     opaque: Buffer,
     translucent: Buffer,
     opaque_pipeline: Option<(u32, wgpu::RenderPipeline)>,
-    /// The contract the translucent pipelines were built for, and one pipeline per variant.
-    translucent_pipelines: Option<(u64, Vec<wgpu::RenderPipeline>)>,
+    /// One translucent pipeline per variant of each contract built for (by its id), and
+    /// the contract in force.
+    translucent_pipelines: HashMap<u64, Vec<wgpu::RenderPipeline>>,
+    contract: Option<u64>,
+    /// Render pipelines built so far.
+    built: usize,
     /// The translucent objects (particles, then translucent entities), for ordering.
     objects: Vec<TranslucentObject>,
 }
@@ -292,7 +297,9 @@ impl ContentStages {
             prims_layout,
             view_group,
             opaque_pipeline: None,
-            translucent_pipelines: None,
+            translucent_pipelines: HashMap::new(),
+            contract: None,
+            built: 0,
             objects,
             content,
         }
@@ -348,6 +355,20 @@ impl ContentStages {
     /// configuration and contract. Call before drawing a frame (cheap when nothing
     /// changed).
     pub fn update_pipelines(&mut self, renderer: &mut Renderer) -> voxel_render::Result<()> {
+        self.opaque_pipeline_for(renderer);
+        let contract = renderer.translucent_contract()?;
+        if !self.translucent_pipelines.contains_key(&contract.id) {
+            let device = renderer.context().device.clone();
+            let pipelines = self.translucent_for(&device, &contract);
+            self.built += pipelines.len();
+            self.translucent_pipelines.insert(contract.id, pipelines);
+        }
+        self.contract = Some(contract.id);
+        Ok(())
+    }
+
+    /// The opaque pipeline for `renderer`'s sample count, built if it has none.
+    fn opaque_pipeline_for(&mut self, renderer: &Renderer) {
         let samples = if renderer.config().msaa { 4 } else { 1 };
         let ctx = renderer.context().clone();
         let device = &ctx.device;
@@ -381,11 +402,32 @@ impl ContentStages {
                 samples,
             );
             self.opaque_pipeline = Some((samples, pipeline));
+            self.built += 1;
         }
-        let contract = renderer.translucent_contract()?;
-        if self.translucent_pipelines.as_ref().map(|(id, _)| *id) != Some(contract.id) {
-            let pipelines = self.translucent_for(device, &contract);
-            self.translucent_pipelines = Some((contract.id, pipelines));
+    }
+
+    /// How many render pipelines it has built (opaque and translucent).
+    pub fn pipelines_built(&self) -> usize {
+        self.built
+    }
+
+    /// Builds the translucent pipelines for `technique`'s contract ahead
+    /// (`Renderer::translucent_contract_for`, which builds the technique too), as a game
+    /// does at loading time for every technique its settings offer: a switch to it then
+    /// compiles nothing (its opaque pipeline is built too). Pipelines are kept by contract
+    /// id.
+    pub fn prebuild(
+        &mut self,
+        renderer: &mut Renderer,
+        technique: voxel_render::Technique,
+    ) -> voxel_render::Result<()> {
+        self.opaque_pipeline_for(renderer);
+        let contract = renderer.translucent_contract_for(technique)?;
+        if !self.translucent_pipelines.contains_key(&contract.id) {
+            let device = renderer.context().device.clone();
+            let pipelines = self.translucent_for(&device, &contract);
+            self.built += pipelines.len();
+            self.translucent_pipelines.insert(contract.id, pipelines);
         }
         Ok(())
     }
@@ -524,7 +566,7 @@ impl GameStages for ContentStages {
     }
 
     fn translucent_contract_id(&self) -> Option<u64> {
-        self.translucent_pipelines.as_ref().map(|(id, _)| *id)
+        self.contract
     }
 
     fn prepare(&mut self, ctx: &GpuContext, frame: &GameFrame<'_>) {
@@ -603,9 +645,9 @@ impl GameStages for ContentStages {
         objects: Range<usize>,
     ) {
         let Some(pipeline) = self
-            .translucent_pipelines
-            .as_ref()
-            .and_then(|(_, p)| p.get(variant))
+            .contract
+            .and_then(|id| self.translucent_pipelines.get(&id))
+            .and_then(|p| p.get(variant))
         else {
             return;
         };

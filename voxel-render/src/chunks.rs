@@ -137,6 +137,11 @@ impl GpuChunk {
         self.meshes[kind as usize]
     }
 
+    /// Where the chunk is.
+    pub fn pos(&self) -> ChunkPos {
+        self.pos
+    }
+
     /// The translucent quads in their current GPU order.
     pub fn translucent_quads(&self) -> &[PackedQuad] {
         &self.translucent

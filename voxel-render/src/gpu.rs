@@ -203,6 +203,7 @@ impl ChunkPipeline<'_> {
         solid: bool,
         cull_mode: Option<wgpu::Face>,
     ) -> wgpu::RenderPipeline {
+        count_pipeline();
         let fetch = self.groups.fetch;
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(self.label),
@@ -243,6 +244,23 @@ impl ChunkPipeline<'_> {
     }
 }
 
+thread_local! {
+    /// Render pipelines the renderer built on this thread (see [`pipelines_built`]).
+    static PIPELINES_BUILT: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+fn count_pipeline() {
+    PIPELINES_BUILT.with(|n| n.set(n.get() + 1));
+}
+
+/// How many render pipelines the renderer's own passes have built on the calling thread
+/// (a renderer builds them on the thread that calls it): what a frame or a call cost in
+/// pipeline compilation, the usual cause of a hitch. A game's own pipelines are not
+/// counted.
+pub fn pipelines_built() -> u64 {
+    PIPELINES_BUILT.with(std::cell::Cell::get)
+}
+
 /// A fullscreen-triangle pipeline: `source` (a fragment shader, after `fullscreen.wgsl`,
 /// whose `vs_fullscreen` it uses).
 #[derive(Debug)]
@@ -266,6 +284,7 @@ pub struct FullscreenPipeline<'a> {
 impl FullscreenPipeline<'_> {
     /// Creates the pipeline.
     pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        count_pipeline();
         let module = &shader(device, self.label, &[FULLSCREEN_WGSL, self.source]);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(self.label),

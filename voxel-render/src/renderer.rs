@@ -572,9 +572,11 @@ impl Renderer {
     pub fn prebuild_technique(&mut self, technique: Technique) -> Result<Technique> {
         self.ctx.check_device()?;
         let oit = &mut self.oit;
-        scoped(&self.ctx.device, "building a technique ahead", || {
+        let built = scoped(&self.ctx.device, "building a technique ahead", || {
             oit.prebuild(technique)
-        })?
+        })??;
+        self.oit.warm(built, &self.chunks);
+        Ok(built)
     }
 
     /// Frees what [`Renderer::prebuild_technique`] built for `technique`, unless it is
@@ -810,6 +812,22 @@ impl Renderer {
     pub fn translucent_contract(&mut self) -> Result<Arc<TranslucentContract>> {
         self.ctx.check_device()?;
         self.oit.contract()
+    }
+
+    /// [`Renderer::translucent_contract`] of `technique` (or what replaces it on this
+    /// device), before switching to it: a game builds its translucent pipelines for every
+    /// technique its settings offer at loading time, as [`Renderer::prebuild_technique`]
+    /// builds the renderer's (which this does too), so that a switch compiles nothing.
+    /// The id is the one the contract has once the technique is in force.
+    pub fn translucent_contract_for(
+        &mut self,
+        technique: Technique,
+    ) -> Result<Arc<TranslucentContract>> {
+        self.ctx.check_device()?;
+        let oit = &mut self.oit;
+        scoped(&self.ctx.device, "building a technique ahead", || {
+            oit.contract_for(technique)
+        })?
     }
 
     /// [`Renderer::render`] with a game's stages: its opaque geometry after the world's,

@@ -6,7 +6,7 @@
 use glam::{DQuat, DVec3};
 use voxel_core::TerrainConfig;
 use voxel_lab::content::{Content, ContentStages, Entity, Particle};
-use voxel_render::{Camera, GpuContext, Renderer};
+use voxel_render::{Camera, GpuContext, Renderer, Technique};
 
 /// Which content is shown (the panel's toggles).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -159,9 +159,9 @@ impl Game {
             return Ok(());
         }
         let content = self.content(toggles, time);
-        prepare(&mut self.stages, ctx, renderer, &content)?;
+        prepare(&mut self.stages, ctx, renderer, &content, true)?;
         match reference {
-            Some(r) => prepare(&mut self.reference, ctx, r, &content)?,
+            Some(r) => prepare(&mut self.reference, ctx, r, &content, false)?,
             None => self.reference = None,
         }
         Ok(())
@@ -180,19 +180,32 @@ impl Game {
 }
 
 /// Makes or refreshes `stages` for `renderer` with `content`, its pipelines matching the
-/// renderer's technique.
+/// renderer's technique; made new, with `ahead` its pipelines for every real-time
+/// technique the device runs are built at once, as the renderer built the techniques
+/// (switching then compiles nothing).
 fn prepare(
     stages: &mut Option<ContentStages>,
     ctx: &GpuContext,
     renderer: &mut Renderer,
     content: &Content,
+    ahead: bool,
 ) -> voxel_render::Result<()> {
     let s = match stages {
         Some(s) => {
             s.set_content(ctx, content.clone());
             s
         }
-        None => stages.insert(ContentStages::new(renderer, content.clone())),
+        None => {
+            let s = stages.insert(ContentStages::new(renderer, content.clone()));
+            if ahead {
+                for t in Technique::supported(&ctx.caps) {
+                    if !t.stalls() {
+                        s.prebuild(renderer, t)?;
+                    }
+                }
+            }
+            s
+        }
     };
     s.update_pipelines(renderer)
 }

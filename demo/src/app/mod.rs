@@ -424,7 +424,14 @@ impl Gfx {
         let registry = open
             .as_ref()
             .map_or_else(BlockRegistry::default, |s| (**s.world.registry()).clone());
-        let renderer = Renderer::new(&ctx, &registry, config).map_err(|e| chain(&e))?;
+        let mut renderer = Renderer::new(&ctx, &registry, config).map_err(|e| chain(&e))?;
+        // Every real-time technique the device runs, built now: the number keys and the
+        // panel switch without a hitch (the game's pipelines follow with its content).
+        for t in Technique::supported(&ctx.caps) {
+            if !t.stalls() {
+                renderer.prebuild_technique(t).map_err(|e| chain(&e))?;
+            }
+        }
         let post = Post::new(&ctx.device, display.config.format);
         let frames = Frames::new(&ctx.device, &post, w, h, 0);
         let ui = Ui::new(&display.window, &ctx);

@@ -479,6 +479,11 @@ pub trait TranslucentTechnique: fmt::Debug + Send {
     /// The passes a game's translucent pipelines must match (see [`crate::stages`]).
     fn variants(&self) -> Vec<TranslucentVariant>;
 
+    /// Built ahead of a switch ([`OitManager::prebuild`]): prepares what its first frame
+    /// would otherwise build for the chunks on the GPU now (sorted-quads: each chunk's
+    /// order structure), so that the switch's first frame costs what a frame costs.
+    fn warm(&mut self, _chunks: &ChunkStore) {}
+
     /// Technique-specific facts about the last frame.
     fn report(&self) -> TechniqueReport {
         TechniqueReport::default()
@@ -639,6 +644,18 @@ impl OitManager {
             None => Vec::new(),
         };
         let key = technique.key(&self.config, &self.setup.ctx.caps);
+        let c = Arc::new(TranslucentContract {
+            id: self.contract_id(key),
+            technique: technique.name(),
+            variants,
+        });
+        self.contract = Some(c.clone());
+        Ok(c)
+    }
+
+    /// The id of the contract of the technique of `key`: its key's place among the keys
+    /// seen so far, plus one.
+    fn contract_id(&mut self, key: Key) -> u64 {
         let place = match self.contract_keys.iter().position(|k| *k == key) {
             Some(i) => i,
             None => {
@@ -646,13 +663,33 @@ impl OitManager {
                 self.contract_keys.len() - 1
             }
         };
-        let c = Arc::new(TranslucentContract {
-            id: place as u64 + 1,
+        place as u64 + 1
+    }
+
+    /// What a game's translucent pipelines must match for `technique` (or what replaces
+    /// it on this device) with the current settings, before switching to it: the same
+    /// contract, id included, that [`OitManager::contract`] gives once it is in force, so
+    /// that a game builds its pipelines ahead as [`OitManager::prebuild`] builds the
+    /// technique's (which this does too: the technique stays built). An
+    /// [`Error::Unsupported`] for a technique the device cannot run.
+    pub fn contract_for(&mut self, technique: Technique) -> Result<Arc<TranslucentContract>> {
+        let technique = self.resolve(technique)?;
+        if technique == self.config.technique {
+            return self.contract();
+        }
+        self.prebuild(technique)?;
+        let key = technique.key(&self.config, &self.setup.ctx.caps);
+        let variants = self
+            .kept
+            .iter()
+            .find(|(k, _)| *k == key)
+            .map(|(_, t)| t.variants())
+            .unwrap_or_default();
+        Ok(Arc::new(TranslucentContract {
+            id: self.contract_id(key),
             technique: technique.name(),
             variants,
-        });
-        self.contract = Some(c.clone());
-        Ok(c)
+        }))
     }
 
     /// Builds `technique`'s pipelines and targets now (with the current settings; after
@@ -677,6 +714,20 @@ impl OitManager {
             self.kept.push((key, t));
         }
         Ok(technique)
+    }
+
+    /// What [`TranslucentTechnique::warm`] prepares for `technique` (built ahead), for the
+    /// chunks on the GPU now.
+    pub fn warm(&mut self, technique: Technique, chunks: &ChunkStore) {
+        let Ok(technique) = self.resolve(technique) else {
+            return;
+        };
+        let key = technique.key(&self.config, &self.setup.ctx.caps);
+        for (k, t) in self.active.iter_mut().chain(&mut self.kept) {
+            if *k == key {
+                t.warm(chunks);
+            }
+        }
     }
 
     /// Forgets a [`OitManager::prebuild`]: its resources are freed unless it is active.

@@ -174,6 +174,37 @@ impl TranslucentTechnique for Sorted {
         Ok(())
     }
 
+    /// Sorted-quads: builds the order structure of every chunk with translucent quads that
+    /// has none (or one of an older mesh), so that the first frame only sorts.
+    fn warm(&mut self, chunks: &ChunkStore) {
+        if !self.sort_quads {
+            return;
+        }
+        for chunk in chunks.iter() {
+            let quads = chunk.translucent_quads();
+            if quads.is_empty() {
+                continue;
+            }
+            let (pos, generation) = (chunk.pos(), chunk.generation());
+            if self
+                .orders
+                .get(&pos)
+                .is_some_and(|o| o.generation == generation)
+            {
+                continue;
+            }
+            self.orders.insert(
+                pos,
+                ChunkOrder {
+                    generation,
+                    order: QuadOrder::new(quads),
+                    sorted_for: None,
+                    cycles: (0, 0),
+                },
+            );
+        }
+    }
+
     /// Sorted-quads: sorts the visible chunks whose region key changed since their last
     /// sort, building the order structure of newly visible or remeshed chunks first.
     fn prepare(
