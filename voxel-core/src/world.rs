@@ -334,8 +334,9 @@ impl World {
     }
 
     /// The translucent block type at `point` (world block units; the block containing
-    /// it), or `None` when that block is not translucent, or the point is not finite or
-    /// lies outside the `i32` world: what an eye at `point` is immersed in.
+    /// it), or the medium a block there stands in ([`crate::BlockDef::medium`]), or `None`
+    /// when neither, or the point is not finite or lies outside the `i32` world: what an
+    /// eye at `point` is immersed in.
     pub fn medium_at(&self, point: [f64; 3]) -> Option<BlockId> {
         let inside =
             |v: f64| v.is_finite() && v >= f64::from(i32::MIN) && v < f64::from(i32::MAX) + 1.0;
@@ -344,7 +345,10 @@ impl World {
         }
         let p = point.map(|v| v.floor() as i32);
         let id = self.get_block(WorldPos::new(p[0], p[1], p[2]));
-        (self.registry.class(id).ok()? == crate::RenderClass::Translucent).then_some(id)
+        let def = self.registry.get(id).ok()?;
+        // A block standing in a medium (waterlogged kelp) is in that medium.
+        def.medium
+            .or((def.class == crate::RenderClass::Translucent).then_some(id))
     }
 
     /// The block at `pos`; air where no chunk is loaded.

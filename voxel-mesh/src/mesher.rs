@@ -9,6 +9,8 @@
 //!   translucent type carries [`crate::FLAG_INTERFACE`] (quads never merge across it), so
 //!   that the renderer can tell, seen from inside a volume, where it meets air from where it
 //!   meets another translucent type.
+//! - A block standing in a medium (waterlogged kelp, [`voxel_core::BlockDef::medium`])
+//!   hides that medium's faces, as the medium does: the volume goes on through it.
 //! - Air and cutout blocks hide nothing, so cutout faces stay against air, translucent and
 //!   other cutout blocks, leaves against leaves included (the holes of one leaf block show
 //!   the leaves behind it, as in Minecraft's fancy leaves).
@@ -150,6 +152,8 @@ struct Split<'a> {
 #[derive(Clone)]
 pub struct Mesher {
     classes: Vec<RenderClass>,
+    /// Per block id, the medium it stands in ([`voxel_core::BlockDef::medium`]).
+    media: Vec<Option<BlockId>>,
     options: MeshOptions,
     s: Box<Scratch>,
     /// A packed centre's masks.
@@ -314,6 +318,7 @@ impl Mesher {
     pub fn with_options(registry: &BlockRegistry, options: MeshOptions) -> Self {
         Self {
             classes: registry.iter().map(|(_, d)| d.class).collect(),
+            media: registry.iter().map(|(_, d)| d.medium).collect(),
             options,
             pad: Pad::new(),
             edge_layers: Vec::new(),
@@ -381,6 +386,7 @@ impl Mesher {
         let neighbours: Neighbours<'n> = Face::ALL.map(|f| neighbourhood.face(f));
         let Self {
             classes,
+            media,
             options,
             s,
             built,
@@ -390,6 +396,8 @@ impl Mesher {
         let classes = &*classes;
         let s = &mut **s;
         let class = |id: BlockId| classes[id.index()];
+        // A block standing in a medium hides that medium's faces, as the medium does.
+        let medium = |id: BlockId| media[id.index()];
         let is_opaque = |id: BlockId| class(id) == RenderClass::Opaque;
         let is_translucent = |id: BlockId| class(id) == RenderClass::Translucent;
 
@@ -413,9 +421,10 @@ impl Mesher {
             let layers = &mut s.nb_layers[face as usize];
             layers.clear();
             if let Some(n) = neighbours[face as usize] {
-                // Only opaque and translucent blocks hide anything.
+                // Only opaque and translucent blocks (and those standing in a medium)
+                // hide anything.
                 n.side_layers(face.opposite(), layers, |id| {
-                    is_opaque(id) || is_translucent(id)
+                    is_opaque(id) || is_translucent(id) || medium(id).is_some()
                 });
             }
         }
@@ -497,7 +506,8 @@ impl Mesher {
             }
             let mut nb_hide = s.nb_opaque;
             let hide = if class == RenderClass::Translucent {
-                // Blocks of the same type hide too, inside the chunk and across borders.
+                // Blocks of the same type hide too, inside the chunk and across borders,
+                // and blocks standing in it (waterlogged): the volume goes on through them.
                 for (h, (o, m)) in [
                     (&mut s.hide.by_y, (&s.opaque.by_y, &bits.by_y)),
                     (&mut s.hide.by_x, (&s.opaque.by_x, &bits.by_x)),
@@ -506,9 +516,16 @@ impl Mesher {
                         .zip(o.iter().zip(m))
                         .for_each(|(h, (o, m))| *h = o | m);
                 }
+                for (_, inside) in entries().filter(|(w, _)| medium(*w) == Some(id)) {
+                    or_into(&mut s.hide.by_y, &inside.by_y);
+                    or_into(&mut s.hide.by_x, &inside.by_x);
+                }
                 for face in Face::ALL {
                     let layers = &s.nb_layers[face as usize];
-                    if let Some((_, same)) = layers.iter().find(|(i, _)| *i == id) {
+                    for (_, same) in layers
+                        .iter()
+                        .filter(|(i, _)| *i == id || medium(*i) == Some(id))
+                    {
                         or_into(&mut nb_hide[face as usize], same);
                     }
                 }
@@ -876,8 +893,11 @@ mod tests {
                             y as i64 + i64::from(n[1]),
                             z as i64 + i64::from(n[2]),
                         ]);
+                        // A block standing in a medium hides the medium's faces.
+                        let medium_of_b = reg.get(b).expect("known").medium;
                         let hidden = class(b) == RenderClass::Opaque
-                            || (ca == RenderClass::Translucent && a == b);
+                            || (ca == RenderClass::Translucent
+                                && (a == b || medium_of_b == Some(a)));
                         if !hidden {
                             let k = match ca {
                                 RenderClass::Cutout => 1,
@@ -1328,9 +1348,15 @@ mod tests {
             BlockDef::new("tinted_glass", [60, 50, 70], 0.6),
             BlockDef::new("slime", [110, 200, 90], 0.85),
             BlockDef::new("basalt", [50, 50, 55], 1.0),
+            // Standing in water and in the tinted glass: they hide those faces.
+            BlockDef::cutout("kelp", [40, 120, 60]).in_medium(voxel_core::blocks::WATER),
         ] {
             extended.register(def).unwrap();
         }
+        let tinted = extended.id("tinted_glass").unwrap();
+        extended
+            .register(BlockDef::cutout("reeds", [150, 160, 70]).in_medium(tinted))
+            .unwrap();
         let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
         let mut covered = BTreeSet::new();
         let mut forms = BTreeSet::new();
@@ -1429,7 +1455,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(cases, (14 + 19) * 8);
+        assert_eq!(cases, (14 + 21) * 8);
         assert_eq!(covered.len(), 5 * 6, "{covered:?}");
         assert_eq!(forms.len(), 3 * 4, "{forms:?}");
     }
