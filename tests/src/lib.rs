@@ -104,6 +104,32 @@ pub fn box_world(boxes: &[([i32; 3], [i32; 3], BlockId)]) -> World {
     world
 }
 
+/// [`box_world`] with its water a thin surface: a block of the built-in water's colour,
+/// opacity and pattern with no absorption, for tests of the order of surfaces and
+/// objects, which the volume's absorption along the path would blur (volumes are tested
+/// in `tests/volumes.rs`).
+pub fn thin_water_world(boxes: &[([i32; 3], [i32; 3], BlockId)]) -> World {
+    let mut registry = BlockRegistry::default();
+    let water = registry.get(voxel_core::blocks::WATER).unwrap().clone();
+    let thin = registry
+        .register(voxel_core::BlockDef {
+            name: "thin_water".into(),
+            absorption: 0.0,
+            ..water
+        })
+        .unwrap();
+    let mut world = World::new(Arc::new(registry));
+    for &(min, max, id) in boxes {
+        let id = if id == voxel_core::blocks::WATER {
+            thin
+        } else {
+            id
+        };
+        voxel_lab::scene::fill_box(&mut world, min, max, id).unwrap();
+    }
+    world
+}
+
 /// A scene of `world` seen by one camera at `eye` looking at `target` (fov 60°).
 pub fn scene(name: &str, world: World, eye: [f64; 3], target: [f64; 3]) -> Scene {
     let camera = Camera::look_at(DVec3::from(eye), DVec3::from(target), 60.0, 0.1, 500.0).unwrap();

@@ -1,9 +1,11 @@
-//! A game's own geometry in the world (issue 22): translucent game quads composed by every
-//! technique with water and glass, opaque entities treated like terrain, and game draws
-//! that survive technique switches, resizes and MSAA.
+//! A game's own geometry in the world: translucent game quads composed by every technique
+//! with water and glass, opaque entities treated like terrain, and game draws that survive
+//! technique switches, resizes and MSAA. The water here is a thin surface
+//! ([`thin_water_world`]): these tests are about order, which the absorption of a volume
+//! along the path would blur (`volumes.rs` tests volumes, the lab measures objects in them).
 
 use glam::{DQuat, DVec3};
-use tests::{Scene, box_world, diff, gpu, out_dir, technique_config};
+use tests::{Scene, diff, gpu, out_dir, technique_config, thin_water_world};
 use voxel_core::blocks::{GLASS, SAND, WATER};
 use voxel_lab::content::{Content, Entity, Particle};
 use voxel_render::{Image, RendererConfig, Technique};
@@ -16,7 +18,7 @@ const H: u32 = 90;
 /// them: the case where the sorted techniques must place an object between the layers of
 /// one chunk.
 fn pool() -> Scene {
-    let world = box_world(&[
+    let world = thin_water_world(&[
         ([-12, -8, -12], [12, -8, 12], SAND),
         ([-12, -7, -12], [12, 0, 12], WATER),
         ([2, 2, 6], [9, 5, 6], GLASS),
@@ -423,7 +425,7 @@ fn stale_game_pipelines_are_refused_before_recording() {
 #[test]
 fn a_slab_beyond_the_water_surface_is_exact_from_either_side() {
     let Some(_ctx) = gpu() else { return };
-    let world = box_world(&[
+    let world = thin_water_world(&[
         ([-12, -8, -12], [12, -8, 12], SAND),
         ([-12, -7, -12], [12, 0, 12], WATER),
     ]);

@@ -144,8 +144,11 @@ pub struct RayMarcher {
     /// the flat colour and opacity for [`Texturing::Flat`].
     textures: voxel_render::textures::TextureSet,
     flat: Vec<[f64; 4]>,
-    /// Per translucent block: linear colour and opacity (the medium's fog).
-    looks: Vec<Option<voxel_render::medium::MediumLook>>,
+    /// Per block: the medium a ray inside it is in (a translucent block's own, a cutout
+    /// block's [`voxel_core::BlockDef::medium`]): linear colour and absorption per block.
+    media: Vec<Option<Medium>>,
+    /// Per block: the medium a cutout block stands in.
+    medium_of: Vec<Option<BlockId>>,
     /// A game's particles and entities ([`crate::content`]).
     content: Content,
 }
@@ -209,6 +212,7 @@ impl RayMarcher {
             chunks,
             bounds: (lo, hi),
             classes: defs.iter().map(|(_, d)| d.class).collect(),
+            medium_of: defs.iter().map(|(_, d)| d.medium).collect(),
             textures: voxel_render::textures::TextureSet::new(registry, false),
             flat: defs
                 .iter()
@@ -223,7 +227,24 @@ impl RayMarcher {
                     [r, g, b, a]
                 })
                 .collect(),
-            looks: voxel_render::medium::looks(registry),
+            media: defs
+                .iter()
+                .map(|(id, d)| {
+                    let own = |d: &voxel_core::BlockDef| Medium {
+                        color: d.color.map(srgb_to_linear),
+                        absorption: f64::from(d.absorption),
+                    };
+                    match d.class {
+                        RenderClass::Translucent => Some(own(d)),
+                        RenderClass::Cutout => d
+                            .medium
+                            .filter(|&m| m != *id)
+                            .and_then(|m| registry.get(m).ok())
+                            .map(own),
+                        _ => None,
+                    }
+                })
+                .collect(),
             content: Content::default(),
         }
     }
@@ -362,6 +383,7 @@ impl RayMarcher {
             }
             *next += 1;
             h.id.hash(w.hasher);
+            w.absorb_to(h.t);
             if h.opaque {
                 return true;
             }
@@ -507,6 +529,7 @@ impl RayMarcher {
             near,
             far,
             medium,
+            volume: None,
             shading,
             light,
             want_color,
@@ -674,6 +697,10 @@ impl RayMarcher {
             content_end = true;
             end_t = hits[next_hit - 1].t;
         }
+        if !content_end && walker.end.is_none() {
+            // Into the sky: a volume the ray is still in ends where the loaded blocks do.
+            walker.absorb_to(t1.min(far));
+        }
         let end_surface = end.map(|(s, _)| s);
         end_surface.map(|s| s.plane()).hash(&mut hasher);
         let content_color = content_end.then(|| hits[next_hit - 1].color);
@@ -720,10 +747,17 @@ impl RayMarcher {
         }
         let (ca, cb) = (self.class(x.from), self.class(x.to));
         let p = w.eye + w.dir * x.t;
+        // The volume the ray was in, up to here.
+        w.absorb_to(x.t);
+        // A cutout block standing in a medium hides the medium's faces toward it.
+        let stands_in = |cutout: BlockId, medium: BlockId| {
+            self.class(cutout) == RenderClass::Cutout && self.medium_block(cutout) == Some(medium)
+        };
         // The face of `to` facing the ray: its normal points back along the step.
         let front_face = face_of(x.axis, x.step < 0);
         let front = cb != RenderClass::Air
-            && !(ca == RenderClass::Opaque || (cb == RenderClass::Translucent && x.from == x.to));
+            && !(ca == RenderClass::Opaque || (cb == RenderClass::Translucent && x.from == x.to))
+            && !stands_in(x.from, x.to);
         let mut ended = false;
         if front {
             let surface = Surface {
@@ -757,7 +791,7 @@ impl RayMarcher {
         // From inside a medium the renderer draws translucent back faces too.
         if let Some(m) = w.medium
             && ca == RenderClass::Translucent
-            && !(cb == RenderClass::Opaque || x.from == x.to)
+            && !(cb == RenderClass::Opaque || x.from == x.to || stands_in(x.to, x.from))
         {
             let back = Surface {
                 block: [0, 1, 2].map(|a| x.to_cell[a] - if a == x.axis { x.step } else { 0 }),
@@ -776,7 +810,26 @@ impl RayMarcher {
                 w.layer(self, back, p, a);
             }
         }
+        // The volume of the block entered, unless the eye's own passage goes on (the
+        // medium's fog stands for it).
+        let own_passage = w.medium.is_some() && w.boundary.is_none();
+        w.volume = self
+            .media
+            .get(x.to.index())
+            .copied()
+            .flatten()
+            .filter(|m| m.absorption > 0.0 && !own_passage)
+            .map(|m| Volume {
+                start: x.t,
+                color: m.color.map(|c| c * w.light.medium_light),
+                absorption: m.absorption,
+            });
         ended
+    }
+
+    /// The block whose medium a cutout block `id` stands in.
+    fn medium_block(&self, id: BlockId) -> Option<BlockId> {
+        self.medium_of.get(id.index()).copied().flatten()
     }
 
     /// The lit colour of `surface` at point `p` with albedo `a`.
@@ -1025,6 +1078,8 @@ struct Walker<'a> {
     near: f64,
     far: f64,
     medium: Option<BlockId>,
+    /// The volume the ray is in since the last layer (none in the eye's own medium).
+    volume: Option<Volume>,
     shading: &'a Shading,
     light: &'a Light,
     want_color: bool,
@@ -1035,7 +1090,36 @@ struct Walker<'a> {
     faces: &'a mut std::collections::hash_map::DefaultHasher,
 }
 
+/// A medium: linear colour, absorption per block.
+#[derive(Clone, Copy, Debug)]
+struct Medium {
+    color: [f64; 3],
+    absorption: f64,
+}
+
+/// A volume the ray is in: since `start` (a ray parameter), lit colour and absorption.
+#[derive(Clone, Copy, Debug)]
+struct Volume {
+    start: f64,
+    color: [f64; 3],
+    absorption: f64,
+}
+
 impl Walker<'_> {
+    /// The way through the volume the ray is in, up to `t`: one layer that keeps
+    /// `exp(−σ d)` of what lies behind over its `d` blocks.
+    fn absorb_to(&mut self, t: f64) {
+        if let Some(v) = &mut self.volume {
+            let d = (t - v.start) * self.dir.length();
+            if d > 0.0 && self.want_color {
+                let keep = (-v.absorption * d).exp();
+                self.layers
+                    .push([v.color[0], v.color[1], v.color[2], 1.0 - keep]);
+            }
+            v.start = v.start.max(t);
+        }
+    }
+
     /// The medium's first surface (it ends the fog; the signature notes it, since the fog
     /// changes where it does).
     fn set_boundary(&mut self, t: f64, s: Surface) {
@@ -1063,6 +1147,8 @@ struct Light {
     ambient: f64,
     sky: [f64; 3],
     fog: Option<Fog>,
+    /// What a medium's colour is lit by: a face turned to the sky.
+    medium_light: f64,
     /// The camera's forward, right and up (unit): particles face the camera.
     basis: [DVec3; 3],
 }
@@ -1077,16 +1163,13 @@ impl Light {
         let s = shading.sun_dir.map(f64::from);
         let sun = DVec3::from(s).try_normalize().unwrap_or(DVec3::Y);
         let ambient = f64::from(shading.ambient);
+        let medium_light = ambient + (1.0 - ambient) * sun.y.max(0.0);
         let fog = camera
             .medium
-            .and_then(|id| m.looks.get(id.index()).copied().flatten())
-            .map(|look| {
-                let light = ambient + (1.0 - ambient) * sun.y.max(0.0);
-                let transmit = (1.0 - f64::from(look.opacity)).max(1e-6);
-                Fog {
-                    color: look.color.map(|c| f64::from(c) * light),
-                    density: -transmit.ln() / voxel_render::medium::FOG_BLOCKS,
-                }
+            .and_then(|id| m.media.get(id.index()).copied().flatten())
+            .map(|look| Fog {
+                color: look.color.map(|c| c * medium_light),
+                density: look.absorption,
             });
         let f = camera.unit_forward();
         let up = if f.y.abs() > 0.999 {
@@ -1100,6 +1183,7 @@ impl Light {
             ambient,
             sky: shading.sky.map(f64::from),
             fog,
+            medium_light,
             basis: [f, right, right.cross(f)],
         }
     }

@@ -20,6 +20,8 @@
 //! opacity = 0.5                     # below 1: translucent
 //! class = "translucent"             # opaque, cutout or translucent (default: from opacity)
 //! pattern = "framed"                # noise, leaves, framed, grass (with soil = [r, g, b])
+//! absorption = 0.2                  # translucent: a volume, light kept exp(-0.2 d) over d blocks
+//! medium = "water"                  # cutout: stands in this (earlier) block, as kelp in water
 //! texture = "smoky.png"             # a PNG for every face, relative to this file
 //! top = "smoky_top.png"             # top, bottom, side: one face group (over texture)
 //!
@@ -434,6 +436,11 @@ struct BlockDefFile {
     /// The soil colour of the `grass` pattern.
     #[serde(default, deserialize_with = "exact_opt")]
     soil: Option<[u8; 3]>,
+    /// A translucent block's absorption per block: a volume (0, the default: a thin
+    /// surface).
+    absorption: Option<Spanned<f32>>,
+    /// A cutout block standing in this medium (a translucent block named before it).
+    medium: Option<Spanned<String>>,
     /// A PNG file for every face, relative to the scene file.
     texture: Option<Spanned<String>>,
     /// PNG files for the top, bottom and side faces (over `texture`).
@@ -454,9 +461,30 @@ fn class_named(name: &str) -> Option<RenderClass> {
 
 /// The block a `[[blocks]]` entry declares: class, pattern and images checked, images read
 /// relative to `dir`. Errors read `LINE: blocks.key: message`.
-fn block_def(text: &str, dir: &Path, b: &Spanned<BlockDefFile>) -> Result<BlockDef, String> {
+fn block_def(
+    text: &str,
+    dir: &Path,
+    b: &Spanned<BlockDefFile>,
+    registry: &BlockRegistry,
+) -> Result<BlockDef, String> {
     let d = b.get_ref();
     let mut def = BlockDef::new(d.name.clone(), d.color, d.opacity);
+    if let Some(a) = &d.absorption {
+        def = def.with_absorption(*a.get_ref());
+    }
+    if let Some(m) = &d.medium {
+        let id = registry.id(m.get_ref()).map_err(|_| {
+            at_line(
+                text,
+                m.span().start,
+                format!(
+                    "blocks.medium: no block {:?} before this one (a medium is a translucent block)",
+                    m.get_ref()
+                ),
+            )
+        })?;
+        def = def.in_medium(id);
+    }
     if let Some(class) = &d.class {
         def.class = class_named(class.get_ref()).ok_or_else(|| {
             at_line(
@@ -668,7 +696,7 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
 
     let mut registry = BlockRegistry::default();
     for b in &file.blocks {
-        let def = block_def(text, dir, b)?;
+        let def = block_def(text, dir, b, &registry)?;
         registry
             .register(def)
             .map_err(|e| at_line(text, b.span().start, format!("blocks: {e}")))?;

@@ -1,5 +1,5 @@
-//! What every chunk pipeline binds: group 0 (the frame: camera, light, sky, viewport, and
-//! the block textures with their table of layers) and group 1 (a chunk mesh's quads and its uniform), with the
+//! What every chunk pipeline binds: group 0 (the frame: camera, light, sky, viewport, the
+//! block textures with their table of layers, and what volumes read) and group 1 (a chunk mesh's quads and its uniform), with the
 //! structs shared with WGSL (`shaders/common.wgsl`) byte for byte. Techniques add their own
 //! groups from 2 on; nothing here belongs to one technique.
 
@@ -22,6 +22,39 @@ pub fn common_wgsl() -> String {
         + FRAME_WGSL
         + gpu::DEPTH_UV_WGSL
         + include_str!("shaders/common.wgsl")
+        + VOLUME_WGSL
+}
+
+/// The volume functions (`shaders/volume.wgsl`): they read `frame`, `block_media` and
+/// `TABLE_WIDTH`, `FLAG_INTERFACE`, which the including shader declares.
+pub const VOLUME_WGSL: &str = include_str!("shaders/volume.wgsl");
+
+/// WGSL of a full-screen pass that binds the chunk passes' group 0 (the renderer's scene
+/// group, [`SharedLayouts::scene`]) as group `group`: the frame, the depth sampler, the
+/// volume depth and each block's look as a medium (`medium_look`), with the volume
+/// functions.
+pub fn scene_volume_wgsl(group: u32) -> String {
+    gpu::WgslConsts::default()
+        .u32("FLAG_INTERFACE", FLAG_INTERFACE)
+        .u32("TABLE_WIDTH", crate::fetch::TABLE_WIDTH)
+        .finish()
+        + FRAME_WGSL
+        + gpu::DEPTH_UV_WGSL
+        + &format!(
+            "@group({group}) @binding(0) var<uniform> frame: Frame;\n\
+             @group({group}) @binding(6) var depth_sampler: sampler;\n\
+             @group({group}) @binding(7) var volume_depth: texture_2d<f32>;\n\
+             @group({group}) @binding(8) var block_media: texture_2d<f32>;\n\n\
+             // A block's look as a medium (`medium_look` of `common.wgsl`).\n\
+             fn medium_look(block: u32) -> vec4<f32> {{\n    \
+             if block == OBJECT_BLOCK {{\n        return vec4<f32>(0.0);\n    }}\n    \
+             return textureLoad(block_media, vec2<i32>(i32(block % TABLE_WIDTH), i32(block / TABLE_WIDTH)), 0);\n}}\n\n\
+             // The opaque depth at pixel `xy` (valid when frame.volumes is 1).\n\
+             fn opaque_depth_at(xy: vec2<f32>) -> f32 {{\n    \
+             let uv = depth_uv(xy, textureDimensions(volume_depth));\n    \
+             return textureSampleLevel(volume_depth, depth_sampler, uv, 0.0).x;\n}}\n\n"
+        )
+        + VOLUME_WGSL
 }
 
 /// The `Frame` struct (what [`FrameUniforms`] is in WGSL).
@@ -79,6 +112,14 @@ pub struct FrameUniforms {
     pub medium: u32,
     /// Ambient-occlusion strength, 0 (off) to 1.
     pub ao_strength: f32,
+    /// `tan` of half the horizontal and vertical field of view: a pixel's ray length per
+    /// unit of view depth.
+    pub tan_half: [f32; 2],
+    /// 1 when a volume (a translucent block with absorption) is in view and group 0's
+    /// volume depth holds this frame's opaque depth; else 0.
+    pub volumes: u32,
+    /// Padding to 16 bytes.
+    pub _pad2: f32,
 }
 
 // A record is one texel of the records' table texture (`fetch.rs`).
@@ -139,6 +180,9 @@ impl SharedLayouts {
             },
             gpu::texture_entry(3, gpu::DEPTH_READ),
             gpu::depth_sampler_entry(6),
+            // The opaque depth as volumes read it, and each block's look as a medium.
+            gpu::texture_entry(7, gpu::DEPTH_READ),
+            gpu::texture_entry(8, wgpu::TextureSampleType::Float { filterable: false }),
         ];
         // Group 0's block layers (read where the quad is expanded) and group 1, as
         // `common.wgsl` declares them for each way of fetching quads.
@@ -200,6 +244,8 @@ mod tests {
                 field!(FrameUniforms, viewport),
                 field!(FrameUniforms, medium),
                 field!(FrameUniforms, ao_strength),
+                field!(FrameUniforms, tan_half),
+                field!(FrameUniforms, volumes),
             ],
         );
         let tonemap = include_str!("shaders/tonemap.wgsl");

@@ -127,6 +127,8 @@ pub struct GpuChunk {
     /// The distinct planes of the translucent quads: face and chunk-local coordinate along
     /// its axis.
     translucent_planes: Vec<(Face, u8)>,
+    /// Whether a translucent quad is of a volume (a block type with absorption).
+    volume: bool,
     /// Changes with every upload of the chunk.
     generation: u64,
 }
@@ -140,6 +142,12 @@ impl GpuChunk {
     /// Where the chunk is.
     pub fn pos(&self) -> ChunkPos {
         self.pos
+    }
+
+    /// Whether the translucent mesh has a face of a volume (a block type with absorption,
+    /// [`voxel_core::BlockDef::absorption`]).
+    pub fn has_volume(&self) -> bool {
+        self.volume
     }
 
     /// The translucent quads in their current GPU order.
@@ -715,6 +723,8 @@ pub struct ChunkStore {
     retired_slots: Vec<u32>,
     /// Opacity by block id, for the planes of translucent meshes.
     block_opacity: Arc<[f32]>,
+    /// Whether each block id is a volume (has absorption).
+    volume_blocks: Arc<[bool]>,
 }
 
 const FIRST_SLOTS: usize = 1024;
@@ -723,12 +733,14 @@ impl ChunkStore {
     /// An empty store whose bind groups use `layout` (group 1 of
     /// [`crate::SharedLayouts`], for `fetch`).
     /// `block_opacity` (by block id) weighs the planes of translucent meshes
-    /// ([`crate::layers`]).
+    /// ([`crate::layers`]); `volume_blocks` (by block id) says which block types are
+    /// volumes.
     pub fn new(
         ctx: &GpuContext,
         layout: wgpu::BindGroupLayout,
         fetch: QuadFetch,
         block_opacity: Arc<[f32]>,
+        volume_blocks: Arc<[bool]>,
     ) -> Self {
         let l = &ctx.caps.limits;
         let infos = Records::new(&ctx.device, fetch, l, FIRST_SLOTS);
@@ -750,6 +762,7 @@ impl ChunkStore {
             retired: Vec::new(),
             retired_slots: Vec::new(),
             block_opacity,
+            volume_blocks,
         }
     }
 
@@ -988,6 +1001,10 @@ impl ChunkStore {
             translucent: meshes.translucent.clone(),
             translucent_bounds: layers_bounds(&planes),
             translucent_planes: distinct_planes(&planes),
+            volume: meshes.translucent.iter().any(|q| {
+                let block = q.unpack().map_or(0, |u| u.block.index());
+                self.volume_blocks.get(block).copied().unwrap_or(false)
+            }),
             generation: self.next_generation,
         });
         self.next_generation += 1;

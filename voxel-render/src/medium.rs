@@ -13,12 +13,25 @@
 //! two faces lie at one depth, which depth peeling could not keep apart. With the eye in
 //! air nothing of this applies and every picture is what it was.
 //!
-//! **Fog.** Inside a medium, the way from the eye to the medium's first surface (or to the
-//! opaque surface behind it, whichever is nearer) is filled with fog of the block's colour,
-//! lit like a face turned to the sky: after `d` blocks the picture behind keeps
-//! `(1 − α)^(d / FOG_BLOCKS)` of its light, `α` the block's opacity. So 16 blocks of water
-//! (α 0.7) dim what lies behind as much as one water surface does. The fog goes over the
-//! composited picture, opaque and translucent alike, the same for every technique.
+//! **Volumes.** A translucent block type with absorption `σ`
+//! ([`voxel_core::BlockDef::absorption`]; the built-in water's 16 blocks dim as much as
+//! one water surface, [`voxel_core::WATER_ABSORPTION`]) is a volume: along a path of `d`
+//! blocks inside it, what lies beyond keeps `exp(−σ d)` of its light and takes the
+//! block's colour, lit like a face turned to the sky, for the rest. Seen from outside, every
+//! technique composes an entry face together with the volume behind it down to where it
+//! ends (`translucent_color` in `common.wgsl`): the first back face of a volume in front of
+//! the opaque surface, or that surface (`volume_depth`, a copy of the opaque depth and a
+//! depth pass of the volumes' back faces, `volume_exit.wgsl`, made only when a volume is in
+//! view). That is exact for one volume along the ray with nothing translucent inside it
+//! (a lake over its ground, a pool seen through its side), the common case; translucent
+//! things inside a volume get the whole path in front of them. The exact references (the
+//! A-buffer and peeling to convergence) split the path at every surface instead, with the
+//! opaque depth alone. A block type without absorption (glass) is a thin surface.
+//!
+//! **Fog.** Inside a volume, the way from the eye to the medium's first surface (or to the
+//! opaque surface behind it, whichever is nearer) is the same absorption: fog of the
+//! block's colour over the composited picture, opaque and translucent alike, the same for
+//! every technique. Inside a thin surface's block nothing is fogged.
 //!
 //! **How.** With the eye inside a medium, a frame adds two passes: a depth pass over the
 //! visible translucent meshes that keeps, per pixel, the nearest surface of the medium's
@@ -47,9 +60,6 @@ use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass
 use crate::timing::{GpuPass, Timer};
 use crate::{Camera, GpuContext, MIN_NEAR};
 
-/// Blocks of a medium that dim what lies behind as much as one layer of it.
-pub const FOG_BLOCKS: f64 = 16.0;
-
 /// What the renderer needs of a block type to treat it as a medium.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MediumLook {
@@ -57,6 +67,9 @@ pub struct MediumLook {
     pub color: [f32; 3],
     /// Opacity of one layer.
     pub opacity: f32,
+    /// Absorption per block of the volume ([`voxel_core::BlockDef::absorption`]; 0: a
+    /// thin surface).
+    pub absorption: f32,
 }
 
 /// The look of every translucent block type, by block id (`None`: not translucent).
@@ -75,6 +88,7 @@ pub fn looks(registry: &BlockRegistry) -> Vec<Option<MediumLook>> {
             (def.class == RenderClass::Translucent).then(|| MediumLook {
                 color: def.color.map(linear),
                 opacity: def.opacity,
+                absorption: def.absorption,
             })
         })
         .collect()
@@ -86,7 +100,7 @@ pub fn looks(registry: &BlockRegistry) -> Vec<Option<MediumLook>> {
 pub struct FogParams {
     /// Lit fog colour, linear.
     pub color: [f32; 3],
-    /// Optical depth per block: `−ln(1 − α) / FOG_BLOCKS`.
+    /// Optical depth per block: the medium's absorption.
     pub density: f32,
     /// `tan` of half the horizontal and vertical field of view.
     pub tan_half: [f32; 2],
@@ -103,6 +117,11 @@ pub fn boundary_wgsl() -> String {
     crate::bindings::common_wgsl() + include_str!("shaders/medium_boundary.wgsl")
 }
 
+/// The volume exit pass's shader.
+pub fn volume_exit_wgsl() -> String {
+    crate::bindings::common_wgsl() + include_str!("shaders/volume_exit.wgsl")
+}
+
 /// The fog pass's shader (after `fullscreen.wgsl`).
 pub fn fog_wgsl() -> String {
     gpu::DEPTH_UV_WGSL.to_owned() + include_str!("shaders/medium_fog.wgsl")
@@ -112,6 +131,8 @@ pub fn fog_wgsl() -> String {
 #[derive(Debug)]
 pub struct MediumPass {
     boundary: wgpu::RenderPipeline,
+    /// The nearest back face of a volume in front of the opaque surface (`volume_exit.wgsl`).
+    volume_exit: wgpu::RenderPipeline,
     fog: wgpu::RenderPipeline,
     /// Group 0 of the fog: the boundary depth and the parameters.
     pub fog_layout: wgpu::BindGroupLayout,
@@ -134,6 +155,17 @@ impl MediumPass {
             label: "medium_boundary",
             module: &module,
             fragment_entry: "fs_boundary",
+            groups: &groups,
+            targets: &[],
+            depth: DepthMode::Write,
+            samples: 1,
+        }
+        .build_two_sided(device);
+        let exit_module = gpu::shader(device, "volume_exit", &[&volume_exit_wgsl()]);
+        let volume_exit = ChunkPipeline {
+            label: "volume_exit",
+            module: &exit_module,
+            fragment_entry: "fs_volume_exit",
             groups: &groups,
             targets: &[],
             depth: DepthMode::Write,
@@ -171,6 +203,7 @@ impl MediumPass {
         });
         Self {
             boundary,
+            volume_exit,
             fog,
             fog_layout,
             fog_params,
@@ -218,6 +251,33 @@ impl MediumPass {
             });
     }
 
+    /// Writes `volume_depth`, what volumes read (`common.wgsl`): the opaque depth, and
+    /// with `exits` (the translucent chunks to draw, and group 0 with the opaque depth in
+    /// `volume_depth`'s place) the nearest back face of a volume in front of it, where the
+    /// techniques that compose a volume at its entry face end it. The exact references,
+    /// which see every face, take the opaque depth alone. After the boundary pass.
+    pub fn volume_depth_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        opaque_depth: &Target,
+        volume_depth: &Target,
+        exits: Option<(&wgpu::BindGroup, &FrameDraws<'_>, &DrawList)>,
+        timer: Option<&Timer>,
+    ) {
+        self.depth_copy
+            .record(encoder, opaque_depth, volume_depth, GpuPass::Medium, timer);
+        let Some((scene, draws, chunks)) = exits else {
+            return;
+        };
+        Pass::new("volume_exit", GpuPass::Medium, &[])
+            .depth(Depth::Load(&volume_depth.view))
+            .record(encoder, timer, |pass| {
+                pass.set_pipeline(&self.volume_exit);
+                pass.set_bind_group(0, scene, &[]);
+                draws.draw(chunks, pass);
+            });
+    }
+
     /// Blends the fog over `target` along the way to the boundary.
     pub fn fog_pass(
         &self,
@@ -245,10 +305,9 @@ pub fn fog_params(
     light: f32,
 ) -> FogParams {
     let tan_y = (camera.fov_y_deg.to_radians() / 2.0).tan();
-    let transmit = f64::from(1.0 - look.opacity).max(1e-6);
     FogParams {
         color: look.color.map(|c| c * light),
-        density: (-transmit.ln() / FOG_BLOCKS) as f32,
+        density: look.absorption,
         tan_half: [(tan_y * aspect) as f32, tan_y as f32],
         near_far: [camera.near as f32, camera.far as f32],
         viewport,

@@ -14,7 +14,8 @@ use wgpu::util::DeviceExt;
 
 use crate::bindings::{FrameUniforms, NO_MEDIUM, SharedLayouts, common_wgsl};
 use crate::chunks::{
-    ChunkStore, Culled, DrawBuilder, DrawList, DrawMode, FrameDraws, Frustum, MeshKind, PosMap,
+    ChunkStore, Culled, DrawBuilder, DrawList, DrawMode, FrameDraws, Frustum, GpuChunk, MeshKind,
+    PosMap,
 };
 use crate::error::scoped;
 use crate::fetch::{QuadFetch, TableTexture};
@@ -157,6 +158,9 @@ struct SceneResources {
     textures: BlockTextures,
     /// The block layers as a texture ([`QuadFetch::Instanced`]).
     layer_table: Option<TableTexture>,
+    /// Per block id, its look as a medium (`block_media` in `common.wgsl`): linear colour
+    /// and absorption.
+    media: TableTexture,
     /// The nearest sampler every depth texture is read with (`gpu::DEPTH_READ`).
     depth_sampler: wgpu::Sampler,
 }
@@ -169,10 +173,17 @@ struct SceneTargets {
     depth: Target,
     /// Inside a medium: the depth of its first surface per pixel ([`crate::medium`]).
     boundary: Target,
+    /// With a volume in view: a copy of the opaque depth, which the translucent passes
+    /// read (their depth attachment is that depth, read-only).
+    volume_depth: Target,
+    /// Whether `volume_depth` is at full size (1×1 until a volume is in view).
+    volumes: bool,
     /// Group 0 of the chunk passes (the boundary readable).
     scene_group: wgpu::BindGroup,
     /// Group 0 of the pass that writes the boundary.
     boundary_scene_group: wgpu::BindGroup,
+    /// The scene group of the pass writing `volume_depth` (the opaque depth in its place).
+    exit_scene_group: wgpu::BindGroup,
     fog_group: wgpu::BindGroup,
     /// MSAA colour and depth, resolved into `color` and `depth`.
     msaa: Option<(Target, Target)>,
@@ -394,6 +405,22 @@ impl Renderer {
             t.write(&ctx.queue, 0, bytemuck::cast_slice(&textures.table));
             t
         });
+        let looks = medium::looks(registry);
+        let media = TableTexture::new(
+            device,
+            "block_media",
+            wgpu::TextureFormat::Rgba32Float,
+            looks.len(),
+        );
+        let media_data: Vec<[f32; 4]> = looks
+            .iter()
+            .map(|l| {
+                l.map_or([0.0; 4], |l| {
+                    [l.color[0], l.color[1], l.color[2], l.absorption]
+                })
+            })
+            .collect();
+        media.write(&ctx.queue, 0, bytemuck::cast_slice(&media_data));
         let scene = SceneResources {
             frame_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("frame_uniforms"),
@@ -402,6 +429,7 @@ impl Renderer {
             }),
             textures,
             layer_table,
+            media,
             depth_sampler: gpu::depth_sampler(device),
         };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
@@ -409,7 +437,15 @@ impl Renderer {
         post.make_tonemap(ctx, config.output_format);
         let medium = MediumPass::new(ctx, &layouts);
         let size = (config.width, config.height);
-        let targets = SceneTargets::new(ctx, &post, &layouts, &scene, &medium, size, config.msaa);
+        let targets = SceneTargets::new(
+            ctx,
+            &post,
+            &layouts,
+            &scene,
+            &medium,
+            size,
+            (config.msaa, false),
+        );
         let block_opacity = registry
             .iter()
             .map(|(_, def)| def.opacity)
@@ -424,14 +460,23 @@ impl Renderer {
         config_with(&mut config.oit, oit.config());
         Ok(Self {
             ctx: ctx.clone(),
-            chunks: ChunkStore::new(ctx, layouts.chunk.clone(), fetch, block_opacity),
+            chunks: ChunkStore::new(
+                ctx,
+                layouts.chunk.clone(),
+                fetch,
+                block_opacity,
+                looks
+                    .iter()
+                    .map(|l| l.is_some_and(|l| l.absorption > 0.0))
+                    .collect(),
+            ),
             layouts,
             scene,
             opaque,
             cutout,
             post,
             medium,
-            looks: medium::looks(registry),
+            looks,
             targets,
             oit,
             timer: Timer::new(ctx),
@@ -482,7 +527,9 @@ impl Renderer {
         )
     }
 
-    fn targets_for(&self, size: (u32, u32), msaa: bool) -> SceneTargets {
+    /// The scene targets for `size`, with or without MSAA, and the volume depth at full
+    /// size once a volume has been in view.
+    fn targets_for(&self, size: (u32, u32), msaa: bool, volumes: bool) -> SceneTargets {
         SceneTargets::new(
             &self.ctx,
             &self.post,
@@ -490,7 +537,7 @@ impl Renderer {
             &self.scene,
             &self.medium,
             size,
-            msaa,
+            (msaa, volumes),
         )
     }
 
@@ -680,7 +727,7 @@ impl Renderer {
         let (pipelines, targets) = scoped(&ctx.device, "switching MSAA", || {
             (
                 Self::opaque_pipelines(ctx, &self.layouts, msaa),
-                self.targets_for(size, msaa),
+                self.targets_for(size, msaa, self.targets.volumes),
             )
         })?;
         (self.opaque, self.cutout) = pipelines;
@@ -700,7 +747,7 @@ impl Renderer {
         check_size(&self.ctx, width, height)?;
         let ctx = &self.ctx;
         let targets = scoped(&ctx.device, "resizing", || {
-            self.targets_for((width, height), self.config.msaa)
+            self.targets_for((width, height), self.config.msaa, self.targets.volumes)
         })?;
         self.targets = targets;
         self.checked_view = None;
@@ -898,6 +945,19 @@ impl Renderer {
         let layers = self.oit.wants_layers();
         self.chunks.cull(&frustum, layers, &mut self.culled);
         self.chunks.lists_built();
+        // A volume in view: its faces read the opaque depth (a copy, made below), whose
+        // target is made the first time.
+        let volumes = self
+            .culled
+            .translucent_slots()
+            .any(|slot| self.chunks.by_slot(slot).is_some_and(GpuChunk::has_volume));
+        if volumes && !self.targets.volumes {
+            let (size, msaa) = (self.size(), self.config.msaa);
+            let targets = scoped(&self.ctx.device, "making the volume depth", || {
+                self.targets_for(size, msaa, true)
+            })?;
+            self.targets = targets;
+        }
         // The technique's CPU work (it may reorder quads within their places).
         let view = FrameView {
             camera,
@@ -948,7 +1008,7 @@ impl Renderer {
         } else {
             game.translucent_objects().len()
         };
-        self.write_frame_uniforms(camera, view_proj, medium.map(|(b, _)| b));
+        self.write_frame_uniforms(camera, view_proj, medium.map(|(b, _)| b), volumes);
         let (eye_int, eye_frac) = camera.eye_split();
         let game_frame = GameFrame {
             camera,
@@ -1002,6 +1062,15 @@ impl Renderer {
                 timer,
             );
         }
+        if volumes {
+            let exits = (!self.oit.technique().is_exact()).then_some((
+                &t.exit_scene_group,
+                &draws,
+                translucent,
+            ));
+            self.medium
+                .volume_depth_pass(encoder, &t.depth, &t.volume_depth, exits, timer);
+        }
         let game_draw = stages.translucent.then(|| GameDraw {
             stages: game,
             frame: &game_frame,
@@ -1021,6 +1090,7 @@ impl Renderer {
                 chunks: translucent,
                 timer,
                 two_sided: medium.is_some(),
+                volumes,
                 game: game_draw.as_ref(),
             },
         )?;
@@ -1211,10 +1281,18 @@ impl Renderer {
         self.frame_index = self.frame_index.wrapping_add(1);
     }
 
-    fn write_frame_uniforms(&self, camera: &Camera, view_proj: Mat4, medium: Option<BlockId>) {
+    fn write_frame_uniforms(
+        &self,
+        camera: &Camera,
+        view_proj: Mat4,
+        medium: Option<BlockId>,
+        volumes: bool,
+    ) {
         let (eye_int, eye_frac) = camera.eye_split();
         let sun = sun_unit(self.config.sun_dir);
         let (w, h) = self.size();
+        let tan_y = (camera.fov_y_deg.to_radians() / 2.0).tan();
+        let tan_x = tan_y * f64::from(w) / f64::from(h);
         let uniforms = FrameUniforms {
             view_proj: view_proj.to_cols_array_2d(),
             eye_int: eye_int.map(|v| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32),
@@ -1227,6 +1305,8 @@ impl Renderer {
             viewport: [w as f32, h as f32],
             medium: medium.map_or(NO_MEDIUM, |b| u32::from(b.0)),
             ao_strength: self.config.ao_strength,
+            tan_half: [tan_x as f32, tan_y as f32],
+            volumes: u32::from(volumes),
             ..FrameUniforms::default()
         };
         self.ctx
@@ -1480,6 +1560,8 @@ impl Post {
 }
 
 impl SceneTargets {
+    /// The targets for `size`; `(msaa, volumes)`: with MSAA targets, and with the volume
+    /// depth at full size (else 1×1: no volume has been in view).
     fn new(
         ctx: &GpuContext,
         post: &Post,
@@ -1487,7 +1569,7 @@ impl SceneTargets {
         scene: &SceneResources,
         medium: &MediumPass,
         size: (u32, u32),
-        msaa: bool,
+        (msaa, volumes): (bool, bool),
     ) -> Self {
         use wgpu::TextureUsages as U;
         let device = &ctx.device;
@@ -1535,13 +1617,21 @@ impl SceneTargets {
             1,
             U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST,
         );
+        let volume_depth = gpu::TargetDesc {
+            label: "volume_depth",
+            format: DEPTH_FORMAT,
+            usage: U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST,
+            size: if volumes { size } else { (1, 1) },
+            samples: 1,
+        }
+        .create(device);
         // The block layers: binding 4 (a storage buffer) or 5 (a table texture),
         // `shaders/common.wgsl`.
         let layers = match &scene.layer_table {
             Some(table) => (5, wgpu::BindingResource::TextureView(&table.view)),
             None => (4, scene.textures.layers.as_entire_binding()),
         };
-        let group = |label, boundary: &Target| {
+        let group = |label, boundary: &Target, volume_depth: &Target| {
             let resources = [
                 (0, scene.frame_buffer.as_entire_binding()),
                 (1, wgpu::BindingResource::TextureView(&scene.textures.view)),
@@ -1549,6 +1639,8 @@ impl SceneTargets {
                 (3, wgpu::BindingResource::TextureView(&boundary.view)),
                 layers.clone(),
                 (6, wgpu::BindingResource::Sampler(&scene.depth_sampler)),
+                (7, wgpu::BindingResource::TextureView(&volume_depth.view)),
+                (8, wgpu::BindingResource::TextureView(&scene.media.view)),
             ];
             let entries =
                 resources.map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
@@ -1558,10 +1650,12 @@ impl SceneTargets {
                 entries: &entries,
             })
         };
-        let scene_group = group("scene", &boundary);
+        let scene_group = group("scene", &boundary, &volume_depth);
         // The pass writing the boundary reads the opaque depth in its place (ties with
-        // cutout faces, `shaders/medium_boundary.wgsl`).
-        let boundary_scene_group = group("scene_writing_boundary", &depth);
+        // cutout faces, `shaders/medium_boundary.wgsl`), and so does the pass writing the
+        // volume depth.
+        let boundary_scene_group = group("scene_writing_boundary", &depth, &volume_depth);
+        let exit_scene_group = group("scene_writing_volume_depth", &boundary, &depth);
         let fog_group = medium.fog_group(device, &boundary);
         let tonemap_group =
             gpu::texture_group(device, "tonemap", &post.tonemap_layout, &[&color.view]);
@@ -1578,8 +1672,11 @@ impl SceneTargets {
             color,
             depth,
             boundary,
+            volume_depth,
+            volumes,
             scene_group,
             boundary_scene_group,
+            exit_scene_group,
             fog_group,
             msaa,
             tonemap_group,

@@ -358,6 +358,7 @@ const OWN_SHIFT: u32 = 3;
 pub(crate) fn game_prelude(own: &str, output: &str) -> String {
     let header = crate::gpu::WgslConsts::default()
         .u32("NO_MEDIUM", crate::bindings::NO_MEDIUM)
+        .u32("FLAG_INTERFACE", voxel_mesh::FLAG_INTERFACE)
         .f32("OIT_OBJECT_DEPTH_BIAS", OBJECT_DEPTH_BIAS)
         .finish()
         + crate::bindings::FRAME_WGSL

@@ -437,6 +437,10 @@ pub struct TranslucentFrame<'a> {
     /// The eye is inside a translucent volume: draw both sides of translucent faces
     /// (the `two_sided` variant of each [`crate::gpu::SidedPipeline`]).
     pub two_sided: bool,
+    /// A volume (a translucent block with absorption) is in view: group 0's volume depth
+    /// holds the opaque depth, and the exact references draw both sides (where a ray
+    /// leaves a volume).
+    pub volumes: bool,
     /// The game's translucent geometry, drawn in every pass of the technique.
     pub game: Option<&'a GameDraw<'a>>,
 }

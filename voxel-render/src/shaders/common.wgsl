@@ -26,6 +26,11 @@ struct ChunkInfo {
 @group(0) @binding(3) var medium_boundary: texture_2d<f32>;
 // The sampler depth textures are read with (every chunk pass's own too).
 @group(0) @binding(6) var depth_sampler: sampler;
+// Volumes (`medium.rs`): the opaque depth behind the translucent passes (a copy, valid
+// when frame.volumes is 1), and per block id its look as a medium, TABLE_WIDTH entries a
+// row: linear colour and absorption per block (0: a thin surface).
+@group(0) @binding(7) var volume_depth: texture_2d<f32>;
+@group(0) @binding(8) var block_media: texture_2d<f32>;
 
 // How quads and their tables reach the vertex stage (`fetch.rs`); a pipeline uses one of
 // the two, and binds only that one's resources.
@@ -276,13 +281,48 @@ fn boundary_depth(xy: vec2<f32>) -> f32 {
     return textureSampleLevel(medium_boundary, depth_sampler, depth_uv(xy, size), 0.0).x;
 }
 
-// The lit colour and opacity of a translucent fragment: what every technique composes.
-// Opacity is the texture's (the block's opacity, or 1 on glass frames) times the chunk's;
-// 0 for a fragment that does not count.
-fn translucent_color(in: VsOut, front: bool) -> vec4<f32> {
+// The lit colour and opacity of a translucent face: opacity is the texture's (the
+// block's opacity, or 1 on glass frames) times the chunk's; 0 for a fragment that does
+// not count.
+fn surface_color(in: VsOut, front: bool) -> vec4<f32> {
     let a = albedo(in);
     let alpha = select(0.0, clamp(a.a * in.alpha, 0.0, 1.0), counts(in, front));
     return vec4<f32>(light(a.rgb, in), alpha);
+}
+
+// A block's look as a medium: linear colour and absorption per block (0: a thin surface);
+// nothing for a game's object (OBJECT_BLOCK, `volume.wgsl`).
+fn medium_look(block: u32) -> vec4<f32> {
+    if block == OBJECT_BLOCK {
+        return vec4<f32>(0.0);
+    }
+    return textureLoad(block_media, table_texel(block), 0);
+}
+
+// What every technique composes for a translucent fragment: its face, and where it is
+// the entry face of a volume (a front face of a block with absorption), the volume behind
+// it down to where it ends (`volume_depth`: the first back face of a volume, or the
+// opaque surface; `volume_exit.wgsl`): what lies behind keeps exp(−absorption · d) of its
+// light over the d blocks the ray travels inside, and takes the medium's lit colour for
+// the rest. Exact for one volume along the ray with nothing translucent inside it (water
+// over the ground, or left through its far side); translucent things inside it get the
+// whole path in front of them, and a second volume behind the first ends at the first's
+// exit (the exact references split the path at every face).
+fn translucent_color(in: VsOut, front: bool) -> vec4<f32> {
+    let c = surface_color(in, front);
+    if frame.volumes == 0u || !front || c.a <= 0.0 {
+        return c;
+    }
+    let m = medium_look(in.block);
+    if m.a <= 0.0 {
+        return c;
+    }
+    let size = textureDimensions(volume_depth);
+    let z = textureSampleLevel(volume_depth, depth_sampler, depth_uv(in.clip.xy, size), 0.0).x;
+    let p = in_front_of(vec4<f32>(0.0), c);
+    let v = medium_segment(m, ray_length(in.clip.xy, in.clip.z, z));
+    let all = p + (1.0 - p.a) * v;
+    return vec4<f32>(all.rgb / all.a, all.a);
 }
 
 // Level of the n×n Bayer matrix (n a power of two) at a pixel, over n²: the matrix

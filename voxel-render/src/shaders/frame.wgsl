@@ -16,4 +16,8 @@ struct Frame {
     medium: u32,
     // Ambient-occlusion strength, 0 (off) to 1.
     ao_strength: f32,
+    // tan of half the horizontal and vertical field of view.
+    tan_half: vec2<f32>,
+    // 1 when a volume is in view and `volume_depth` holds this frame's opaque depth.
+    volumes: u32,
 };

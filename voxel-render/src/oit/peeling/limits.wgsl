@@ -12,3 +12,8 @@ fn peel_candidate(position: vec4<f32>) -> bool {
     return d < textureSampleLevel(front_limit, depth_sampler, uv, 0.0).x
         && d > textureSampleLevel(back_limit, depth_sampler, uv, 0.0).x;
 }
+
+// Peeling to convergence: per pixel, the medium the ray is in after the layers peeled so
+// far (a look as halves: colour r, g in x; b and absorption in y) and the last layer's
+// depth (z, the bits of an f32). Unused (1×1) in dual peeling.
+@group(2) @binding(2) var peel_state: texture_2d<u32>;

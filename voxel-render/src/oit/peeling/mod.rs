@@ -103,12 +103,12 @@ impl PeelMode {
     }
 }
 
-/// The two depth limits of a peel pass: the group the chunk pipelines bind, and the views
-/// (a game's group holds them too).
+/// The two depth limits of a peel pass and the medium state: the group the chunk
+/// pipelines bind, and the views (a game's group holds them too).
 #[derive(Debug)]
 struct Limits {
     group: wgpu::BindGroup,
-    views: [wgpu::TextureView; 2],
+    views: [wgpu::TextureView; 3],
 }
 
 #[derive(Debug)]
@@ -118,6 +118,12 @@ struct Targets {
     front_layer: Target,
     back_layer: Target,
     front_acc: Target,
+    /// Converge mode: the medium state after the layers so far (`peel_state` in
+    /// `limits.wgsl`), read from [0] and written into [1] (copied back after each peel:
+    /// where a pass writes nothing the state stays). 1×1 in dual mode.
+    state: [Target; 2],
+    /// The group of the volume after the last layer: `state[1]`.
+    last_group: wgpu::BindGroup,
     /// Limits for the front peel of an iteration writing slot `i`: (front[1-i], back[1-i]).
     front_limits: [Limits; 2],
     /// Limits for the back peel writing slot `i`: (front[i], back[1-i]).
@@ -129,9 +135,22 @@ struct Targets {
     front_acc_group: wgpu::BindGroup,
 }
 
-/// The group-2 entries of the peel pipelines: the front and back limits.
-fn limit_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
-    [0, 1].map(|i| gpu::texture_entry(i, gpu::DEPTH_READ))
+/// The group-2 entries of the peel pipelines: the front and back limits, the medium state.
+fn limit_entries() -> [wgpu::BindGroupLayoutEntry; 3] {
+    [
+        gpu::texture_entry(0, gpu::DEPTH_READ),
+        gpu::texture_entry(1, gpu::DEPTH_READ),
+        gpu::texture_entry(2, wgpu::TextureSampleType::Uint),
+    ]
+}
+
+/// The medium state's format (`peel_state` in `limits.wgsl`).
+const STATE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
+
+/// The peel pass's own WGSL (after the shared chunk code, or a game's prelude with the
+/// volume functions).
+fn peel_own_wgsl() -> String {
+    [include_str!("limits.wgsl"), include_str!("state.wgsl")].concat()
 }
 
 /// Depth peeling resources.
@@ -144,6 +163,9 @@ pub struct Peeling {
     under: wgpu::RenderPipeline,
     over: wgpu::RenderPipeline,
     front_composite: wgpu::RenderPipeline,
+    /// Converge mode: the volume after each pixel's last layer.
+    last_volume: wgpu::RenderPipeline,
+    last_layout: wgpu::BindGroupLayout,
     limits_layout: wgpu::BindGroupLayout,
     layer_layout: wgpu::BindGroupLayout,
     game_layout: wgpu::BindGroupLayout,
@@ -201,18 +223,25 @@ impl TechniqueKind for Peeling {
             "peel",
             &[
                 &crate::bindings::common_wgsl(),
-                include_str!("limits.wgsl"),
+                &peel_own_wgsl(),
                 include_str!("peel.wgsl"),
             ],
         );
         let groups = setup.layouts.with(&[&limits_layout]);
+        // Peeling to convergence passes the medium on from layer to layer.
+        let converge = mode == PeelMode::Converge;
+        let (entry, targets) = if converge {
+            ("fs_peel_state", peel_targets(true))
+        } else {
+            ("fs_peel", peel_targets(false))
+        };
         let peel = |label, depth| {
             ChunkPipeline {
                 label,
                 module: &module,
-                fragment_entry: "fs_peel",
+                fragment_entry: entry,
                 groups: &groups,
-                targets: &[gpu::scene_target(None)],
+                targets: &targets,
                 depth,
                 samples: 1,
             }
@@ -230,7 +259,20 @@ impl TechniqueKind for Peeling {
             }
             .build(device)
         };
-        let targets = Self::targets(device, &limits_layout, &layer_layout, setup.size);
+        let last_layout =
+            gpu::textures_layout(device, "peel_last_layout", wgpu::TextureSampleType::Uint, 1);
+        let last_volume = FullscreenPipeline {
+            label: "peel_last_volume",
+            source: &(crate::bindings::scene_volume_wgsl(1) + include_str!("last.wgsl")),
+            fragment_entry: "fs_last_volume",
+            groups: &[Some(&last_layout), Some(&setup.layouts.scene)],
+            targets: &[gpu::scene_target(Some(UNDER))],
+            writes_depth: false,
+            constants: &[],
+        }
+        .build(device);
+        let layouts = (&limits_layout, &layer_layout, &last_layout);
+        let targets = Self::targets(device, layouts, setup.size, mode);
         let max_iterations = mode.max_iterations();
         Ok(Self {
             device: device.clone(),
@@ -245,6 +287,8 @@ impl TechniqueKind for Peeling {
                 wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
             ),
             game_layout: game_layout(device, "peel_game", &limit_entries()),
+            last_volume,
+            last_layout,
             limits_layout,
             layer_layout,
             targets,
@@ -262,12 +306,19 @@ impl TechniqueKind for Peeling {
 }
 
 impl Peeling {
+    /// The targets for `size`; `layouts` are the limits', the layers' and the last
+    /// volume's.
     fn targets(
         d: &wgpu::Device,
-        limits_layout: &wgpu::BindGroupLayout,
-        layer_layout: &wgpu::BindGroupLayout,
+        layouts: (
+            &wgpu::BindGroupLayout,
+            &wgpu::BindGroupLayout,
+            &wgpu::BindGroupLayout,
+        ),
         size: (u32, u32),
+        mode: PeelMode,
     ) -> Targets {
+        let (limits_layout, layer_layout, last_layout) = layouts;
         use wgpu::TextureUsages as U;
         let depth = |label| {
             let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST;
@@ -279,9 +330,18 @@ impl Peeling {
         };
         let front = [depth("peel_front_depth_0"), depth("peel_front_depth_1")];
         let back = [depth("peel_back_depth_0"), depth("peel_back_depth_1")];
+        let state_size = if mode == PeelMode::Converge {
+            size
+        } else {
+            (1, 1)
+        };
+        let state = ["peel_state_0", "peel_state_1"].map(|label| {
+            let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
+            gpu::target(d, label, STATE_FORMAT, usage, state_size)
+        });
         let limits = |label, a: &Target, b: &Target| Limits {
-            group: gpu::texture_group(d, label, limits_layout, &[&a.view, &b.view]),
-            views: [a.view.clone(), b.view.clone()],
+            group: gpu::texture_group(d, label, limits_layout, &[&a.view, &b.view, &state[0].view]),
+            views: [a.view.clone(), b.view.clone(), state[0].view.clone()],
         };
         let front_limits = [
             limits("peel_front_limits_0", &front[1], &back[1]),
@@ -299,7 +359,10 @@ impl Peeling {
         let back_layer = color("peel_back_layer");
         let front_acc = color("peel_front_accumulation");
         let layer = |label, t: &Target| gpu::texture_group(d, label, layer_layout, &[&t.view]);
+        let last_group = gpu::texture_group(d, "peel_last", last_layout, &[&state[1].view]);
         Targets {
+            state,
+            last_group,
             front_layer_group: layer("peel_front_layer", &front_layer),
             back_layer_group: layer("peel_back_layer", &back_layer),
             front_acc_group: layer("peel_front_accumulation", &front_acc),
@@ -340,13 +403,21 @@ impl Peeling {
         } else {
             ("peel_front", &self.peel_front, &self.targets.front_layer)
         };
-        let colors = [gpu::clear(&layer.view, wgpu::Color::TRANSPARENT)];
+        let converge = self.mode == PeelMode::Converge;
+        let state = &self.targets.state;
+        let mut colors = vec![gpu::clear(&layer.view, wgpu::Color::TRANSPARENT)];
+        if converge {
+            colors.push(gpu::load(&state[1].view));
+        }
         let pass = Pass {
             occlusion: query.map(|_| self.counts.set()),
             ..Pass::new(label, GpuPass::Translucent, &colors).depth(depth)
         };
+        // With volumes in view, peeling to convergence needs the faces where rays leave
+        // them (seen from behind) too.
+        let two_sided = frame.two_sided || (converge && frame.volumes);
         pass.record(encoder, frame.timer, |pass| {
-            pass.set_pipeline(pipeline.get(frame.two_sided));
+            pass.set_pipeline(pipeline.get(two_sided));
             pass.set_bind_group(2, &limits.group, &[]);
             if let Some(i) = query {
                 pass.begin_occlusion_query(i);
@@ -359,6 +430,14 @@ impl Peeling {
                 pass.end_occlusion_query();
             }
         });
+        if converge {
+            // Where the pass wrote nothing, the state stays what it was.
+            encoder.copy_texture_to_texture(
+                state[1].texture.as_image_copy(),
+                state[0].texture.as_image_copy(),
+                state[1].texture.size(),
+            );
+        }
     }
 
     /// Blends `group`'s layer into `target` with `pipeline`.
@@ -381,13 +460,25 @@ impl Peeling {
     /// back[1] a copy of the opaque depth.
     fn begin(&self, encoder: &mut wgpu::CommandEncoder, frame: &TranslucentFrame<'_>) {
         let t = &self.targets;
-        let colors = [gpu::clear(&t.front_acc.view, wgpu::Color::TRANSPARENT)];
+        let mut colors = vec![gpu::clear(&t.front_acc.view, wgpu::Color::TRANSPARENT)];
+        let converge = self.mode == PeelMode::Converge;
+        if converge {
+            // No medium before the first layer.
+            colors.push(gpu::clear(&t.state[1].view, wgpu::Color::TRANSPARENT));
+        }
         Pass {
             timing: None,
             ..Pass::new("peel_clear", GpuPass::Translucent, &colors)
                 .depth(Depth::Clear(&t.front[1].view, 1.0))
         }
         .record(encoder, None, |_| {});
+        if converge {
+            encoder.copy_texture_to_texture(
+                t.state[1].texture.as_image_copy(),
+                t.state[0].texture.as_image_copy(),
+                t.state[1].texture.size(),
+            );
+        }
         let timing = GpuPass::Translucent;
         self.depth_copy
             .record(encoder, frame.depth, &t.back[1], timing, frame.timer);
@@ -515,6 +606,19 @@ impl Peeling {
             iterations: layers + u32::from(!truncated),
             truncated,
         };
+        if frame.volumes {
+            let colors = [gpu::load(&self.targets.front_acc.view)];
+            Pass::new("peel_last_volume", GpuPass::Composite, &colors).record(
+                encoder,
+                frame.timer,
+                |pass| {
+                    pass.set_pipeline(&self.last_volume);
+                    pass.set_bind_group(0, &self.targets.last_group, &[]);
+                    pass.set_bind_group(1, frame.scene, &[]);
+                    pass.draw(0..3, 0..1);
+                },
+            );
+        }
         Self::blend_pass(
             encoder,
             frame,
@@ -528,12 +632,8 @@ impl Peeling {
 
 impl TranslucentTechnique for Peeling {
     fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
-        self.targets = Self::targets(
-            &ctx.device,
-            &self.limits_layout,
-            &self.layer_layout,
-            (width, height),
-        );
+        let layouts = (&self.limits_layout, &self.layer_layout, &self.last_layout);
+        self.targets = Self::targets(&ctx.device, layouts, (width, height), self.mode);
         Ok(())
     }
 
@@ -560,15 +660,27 @@ impl TranslucentTechnique for Peeling {
             return OitOutput(color, p.z);\n}\n";
         let variant = |name, depth| TranslucentVariant {
             name,
-            wgsl: game_prelude(include_str!("limits.wgsl"), output),
-            targets: vec![gpu::scene_target(None)],
+            wgsl: game_prelude(&(peel_own_wgsl() + crate::bindings::VOLUME_WGSL), output),
+            targets: peel_targets(false),
             depth_stencil: gpu::depth_state(depth),
             layout: self.game_layout.clone(),
         };
-        let front = variant("peel_front", DepthMode::Write);
         match self.mode {
-            PeelMode::Dual { .. } => vec![front, variant("peel_back", DepthMode::WriteFarthest)],
-            PeelMode::Converge => vec![front],
+            PeelMode::Dual { .. } => vec![
+                variant("peel_front", DepthMode::Write),
+                variant("peel_back", DepthMode::WriteFarthest),
+            ],
+            // The layer holds the volume in front of the object; the medium goes on.
+            PeelMode::Converge => vec![TranslucentVariant {
+                name: "peel_front",
+                wgsl: game_prelude(
+                    &(peel_own_wgsl() + crate::bindings::VOLUME_WGSL),
+                    CONVERGE_OUTPUT,
+                ),
+                targets: peel_targets(true),
+                depth_stencil: gpu::depth_state(DepthMode::Write),
+                layout: self.game_layout.clone(),
+            }],
         }
     }
 
@@ -579,3 +691,28 @@ impl TranslucentTechnique for Peeling {
         }
     }
 }
+
+/// The colour targets of a peel pass: the layer, and in peeling to convergence the medium
+/// state after it.
+fn peel_targets(converge: bool) -> Vec<Option<wgpu::ColorTargetState>> {
+    let mut targets = vec![gpu::scene_target(None)];
+    if converge {
+        targets.push(Some(wgpu::ColorTargetState {
+            format: STATE_FORMAT,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        }));
+    }
+    targets
+}
+
+/// A game's `oit_output` in peeling to convergence (after `state.wgsl`).
+const CONVERGE_OUTPUT: &str = "struct OitOutput {\n    @location(0) color: vec4<f32>,\n    \
+    @location(1) state: vec4<u32>,\n    @builtin(frag_depth) depth: f32,\n};\n\n\
+    // The fragment, at the depth the exact methods give an object, is a layer candidate\n\
+    // strictly between the limits, or dropped; its layer holds the volume in front of it.\n\
+    fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
+    let p = oit_object_position(position);\n    \
+    if !peel_candidate(p) || color.a <= 0.0 {\n        discard;\n    }\n    \
+    let layer = peel_layer(p, color, vec4<f32>(0.0), OBJECT_BLOCK);\n    \
+    return OitOutput(layer.color, layer.state, p.z);\n}\n";

@@ -19,3 +19,16 @@ fn fs_peel(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     }
     return c;
 }
+
+// Peeling to convergence (after state.wgsl): a fragment is also a layer where it changes
+// the medium, and the layer holds the volume in front of it.
+@fragment
+fn fs_peel_state(in: VsOut, @builtin(front_facing) front: bool) -> PeelLayer {
+    let c = surface_color(in, front);
+    let look = medium_look(in.block);
+    let info = fragment_info(in.block, front, in.flags);
+    if !peel_candidate(in.clip) || (c.a <= 0.0 && !changes_medium(look, info)) {
+        discard;
+    }
+    return peel_layer(in.clip, c, look, info);
+}

@@ -85,6 +85,10 @@ pub struct Node {
     pub next: u32,
     /// The depth's screen-space gradient, which orders fragments of equal depth.
     pub slope: [f32; 2],
+    /// Its part in the medium the ray is in (`fragment_info` in `shaders/volume.wgsl`).
+    pub info: u32,
+    /// Padding.
+    pub _pad: u32,
 }
 
 /// The counters read back per tile (`Counters` in `types.wgsl`).
@@ -173,9 +177,14 @@ fn params_entry() -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-/// The resolve pass's shader (after `fullscreen.wgsl`).
+/// The resolve pass's shader (after `fullscreen.wgsl`); the scene group is its group 1.
 pub fn resolve_wgsl() -> String {
-    [&types_wgsl(), include_str!("resolve.wgsl")].concat()
+    [
+        &crate::bindings::scene_volume_wgsl(1),
+        &types_wgsl(),
+        include_str!("resolve.wgsl"),
+    ]
+    .concat()
 }
 
 #[derive(Debug)]
@@ -255,7 +264,7 @@ impl TechniqueKind for Reference {
             label: "abuffer_resolve",
             source: &resolve_wgsl(),
             fragment_entry: "fs_resolve",
-            groups: &[Some(&resolve_layout)],
+            groups: &[Some(&resolve_layout), Some(&setup.layouts.scene)],
             targets: &[gpu::scene_target(Some(
                 wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
             ))],
@@ -435,7 +444,8 @@ impl Reference {
                 .depth(Depth::ReadOnly(&frame.depth.view))
                 .record(encoder, frame.timer, |pass| {
                     pass.set_scissor_rect(x, y, w, h);
-                    pass.set_pipeline(self.build.get(frame.two_sided));
+                    // Volumes: the faces where the ray leaves them (seen from behind) too.
+                    pass.set_pipeline(self.build.get(frame.two_sided || frame.volumes));
                     pass.set_bind_group(2, &b.build_group, &dynamic);
                     frame.draw_chunks(pass);
                     if let Some((g, group)) = &game {
@@ -450,6 +460,7 @@ impl Reference {
                         pass.set_scissor_rect(x, y, w, h);
                         pass.set_pipeline(&self.resolve);
                         pass.set_bind_group(0, &b.resolve_group, &dynamic);
+                        pass.set_bind_group(1, frame.scene, &[]);
                         pass.draw(0..3, 0..1);
                     },
                 );
@@ -505,7 +516,7 @@ impl TranslucentTechnique for Reference {
                  // derivatives).\n\
                  fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
                  let p = oit_object_position(position);\n    \
-                 abuffer_append(p, vec2<f32>(dpdx(p.z), dpdy(p.z)), color);\n    \
+                 abuffer_append(p, vec2<f32>(dpdx(p.z), dpdy(p.z)), color, ABUFFER_OBJECT, false);\n    \
                  return OitOutput(vec4<f32>(0.0));\n}\n",
             ),
             targets: Vec::new(),
@@ -625,6 +636,8 @@ mod tests {
                 field!(Node, depth),
                 field!(Node, next),
                 field!(Node, slope),
+                field!(Node, info),
+                field!(Node, _pad),
             ],
         );
         assert_layout::<Counters>(

@@ -1,6 +1,9 @@
-// Exact reference, pass 2 (appended to fullscreen.wgsl and types.wgsl): sort each pixel's
-// fragments by depth and blend them front to back; the result goes over the opaque image
-// with (One, OneMinusSrcAlpha): out = Σ layers (exact "over" order) + Π(1 − α) · opaque.
+// Exact reference, pass 2 (appended to fullscreen.wgsl, the scene group as group 1 with
+// the volume functions, and types.wgsl): sort each pixel's fragments by depth and blend
+// them front to back, with the volumes between them (the path inside each medium, from
+// the face where the ray enters it to the one where it leaves or to the opaque surface);
+// the result goes over the opaque image with (One, OneMinusSrcAlpha):
+// out = Σ layers (exact "over" order) + Π(1 − α) · opaque.
 
 @group(0) @binding(0) var<storage, read> heads: array<u32>;
 @group(0) @binding(1) var<storage, read> nodes: array<Node>;
@@ -61,9 +64,20 @@ fn fs_resolve(in: FullscreenOut) -> @location(0) vec4<f32> {
         n = min(n + 1u, MAX_LAYERS);
     }
     var acc = vec4<f32>(0.0);
+    // The medium the ray is in (a look; absorption 0: none) since depth `last`.
+    var medium = vec4<f32>(0.0);
+    var last = 0.0;
     for (var i = 0u; i < n; i += 1u) {
-        let c = vec4<f32>(unpack2x16float(kept[i].color.x), unpack2x16float(kept[i].color.y));
-        acc += (1.0 - acc.a) * vec4<f32>(c.rgb * c.a, c.a);
+        let node = kept[i];
+        let c = vec4<f32>(unpack2x16float(node.color.x), unpack2x16float(node.color.y));
+        let segment = medium_segment(medium, ray_length(in.clip.xy, last, node.depth));
+        acc += (1.0 - acc.a) * in_front_of(segment, c);
+        medium = medium_after(medium, medium_look(node.info & 0xffffu), node.info);
+        last = node.depth;
+    }
+    if medium.a > 0.0 {
+        let segment = medium_segment(medium, ray_length(in.clip.xy, last, opaque_depth_at(in.clip.xy)));
+        acc += (1.0 - acc.a) * segment;
     }
     if total > MAX_LAYERS {
         atomicAdd(&counters.capped, 1u);

@@ -9,6 +9,9 @@ struct Node {
     next: u32,
     // The depth's screen-space gradient (dpdx, dpdy): orders fragments of equal depth.
     slope: vec2<f32>,
+    // Its part in the medium the ray is in (`fragment_info` in volume.wgsl).
+    info: u32,
+    _pad: u32,
 };
 
 // Read back after every tile (`Counters` in mod.rs, checked equal by a test).

@@ -1,0 +1,15 @@
+// Peeling to convergence, after the last layer (appended to fullscreen.wgsl and the
+// scene group as group 1 with the volume functions): the volume between each pixel's last
+// layer and the opaque surface, under-blended into the front accumulation.
+
+@group(0) @binding(0) var final_state: texture_2d<u32>;
+
+@fragment
+fn fs_last_volume(in: FullscreenOut) -> @location(0) vec4<f32> {
+    let s = textureLoad(final_state, vec2<i32>(in.clip.xy), 0);
+    let medium = vec4<f32>(unpack2x16float(s.x), unpack2x16float(s.y));
+    if medium.a <= 0.0 {
+        discard;
+    }
+    return medium_segment(medium, ray_length(in.clip.xy, bitcast<f32>(s.z), opaque_depth_at(in.clip.xy)));
+}

@@ -1,0 +1,18 @@
+// Where the volumes end along each pixel's ray (appended to common.wgsl), for the
+// techniques that compose a volume at its entry face (`translucent_color`): the back faces
+// of every volume type in front of the opaque surface, nearest kept in the depth
+// attachment, which starts as a copy of the opaque depth. A volume entered at a front face
+// then ends at the first of them, or at the opaque surface. With the eye inside a medium
+// the faces up to that medium's boundary are its own way out, which the fog covers: they
+// are dropped.
+//
+// In this pass group 0's `volume_depth` binding holds the opaque depth itself.
+@fragment
+fn fs_volume_exit(in: VsOut, @builtin(front_facing) front: bool) {
+    if front || medium_look(in.block).a <= 0.0 {
+        discard;
+    }
+    if frame.medium != NO_MEDIUM && in.clip.z >= boundary_depth(in.clip.xy) {
+        discard;
+    }
+}
