@@ -2,7 +2,7 @@
 //! that tells the mesher what to rebuild.
 //!
 //! Coordinates and faces are in `coords`, the 26 neighbours of a chunk in `neighbours`, ray
-//! casts ([`World::raycast`]) in `raycast`.
+//! casts ([`World::raycast_by`], [`World::raycast`]) in `raycast`.
 
 mod coords;
 mod neighbours;

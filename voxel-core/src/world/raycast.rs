@@ -1,8 +1,8 @@
 //! Ray casts through a world: a voxel walk (Amanatides & Woo 1987) that stops at the first
-//! block of the classes asked, its input checks, and what it hits.
+//! block a caller's test accepts, its input checks, and what it hits.
 
 use super::{Face, World, WorldPos};
-use crate::{BlockId, Error, RenderClass, Result};
+use crate::{BlockDef, BlockId, Error, RenderClass, Result};
 
 /// `v` scaled to length 1, computed so that no finite non-zero vector overflows or
 /// underflows on the way (`[1e300; 3]`, `[f64::MAX, 0, 0]` and `[1e-320, 0, 0]` all have a
@@ -60,20 +60,56 @@ fn to_world_pos(c: [i64; 3]) -> Option<WorldPos> {
 
 impl World {
     /// The first block along the ray from `origin` in `direction` (any length but zero)
-    /// within `max_distance` blocks whose render class is one of `stops`, by a voxel walk
-    /// (Amanatides & Woo 1987), or `None`. The block holding the origin is not tested: a
-    /// ray cast from inside a block finds what lies beyond it. Chunks that are not loaded
-    /// are air.
+    /// within `max_distance` blocks whose render class is one of `stops`, or `None`:
+    /// [`World::raycast_by`] with a test of the class. `&RenderClass::VISIBLE` picks the
+    /// first block that draws anything.
     ///
-    /// Fails on an origin that is not finite or lies outside the `i32` world, a direction
-    /// that is zero or not finite, and a `max_distance` that is negative, NaN or beyond
-    /// [`MAX_RAY_DISTANCE`].
+    /// Fails as [`World::raycast_by`] does.
     pub fn raycast(
         &self,
         origin: [f64; 3],
         direction: [f64; 3],
         max_distance: f64,
         stops: &[RenderClass],
+    ) -> Result<Option<RayHit>> {
+        self.raycast_by(origin, direction, max_distance, |_, def| {
+            stops.contains(&def.class)
+        })
+    }
+
+    /// The first block along the ray from `origin` in `direction` (any length but zero)
+    /// within `max_distance` blocks for which `stop(id, definition)` is true, by a voxel
+    /// walk (Amanatides & Woo 1987), or `None`. `stop` is asked about every block the ray
+    /// enters, in order, air included, until it says yes; so a pick can pass water and
+    /// stop at glass, or stop at a block of one name. The block holding the origin is not
+    /// tested: a ray cast from inside a block finds what lies beyond it. Chunks that are
+    /// not loaded are air.
+    ///
+    /// Fails on an origin that is not finite or lies outside the `i32` world, a direction
+    /// that is zero or not finite, and a `max_distance` that is negative, NaN or beyond
+    /// [`MAX_RAY_DISTANCE`].
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use voxel_core::blocks::{GLASS, WATER};
+    /// use voxel_core::{BlockRegistry, RenderClass, World, WorldPos};
+    ///
+    /// let mut world = World::new(Arc::new(BlockRegistry::default()));
+    /// world.fill_box(WorldPos::new(0, 0, -4), WorldPos::new(0, 0, -1), WATER)?;
+    /// world.set_block(WorldPos::new(0, 0, -6), GLASS)?;
+    /// // Through water, up to the first other block that draws something.
+    /// let hit = world.raycast_by([0.5, 0.5, 0.5], [0.0, 0.0, -1.0], 20.0, |id, def| {
+    ///     id != WATER && def.class != RenderClass::Air
+    /// })?;
+    /// assert_eq!(hit.map(|h| (h.pos, h.block)), Some((WorldPos::new(0, 0, -6), GLASS)));
+    /// # Ok::<(), voxel_core::Error>(())
+    /// ```
+    pub fn raycast_by(
+        &self,
+        origin: [f64; 3],
+        direction: [f64; 3],
+        max_distance: f64,
+        mut stop: impl FnMut(BlockId, &BlockDef) -> bool,
     ) -> Result<Option<RayHit>> {
         let bad = |reason: String| Err(Error::InvalidRay(reason));
         let inside = |v: f64| v >= f64::from(i32::MIN) && v < f64::from(i32::MAX) + 1.0;
@@ -120,7 +156,7 @@ impl World {
                 return Ok(None);
             };
             let block = self.get_block(pos);
-            if self.registry.class(block).is_ok_and(|c| stops.contains(&c)) {
+            if self.registry.get(block).is_ok_and(|def| stop(block, def)) {
                 let face = Face::ALL[2 * axis + usize::from(step[axis] > 0)];
                 return Ok(Some(RayHit {
                     pos,
@@ -283,5 +319,81 @@ mod tests {
                 .unwrap(),
             None
         );
+    }
+
+    #[test]
+    fn raycast_by_passes_water_and_stops_at_glass() {
+        // Water from z = -1 to z = -4 (x and y from -1 to 1), glass at z = -5, air at z = -6,
+        // stone at z = -7.
+        let mut w = World::new(Arc::new(BlockRegistry::default()));
+        w.fill_box(WorldPos::new(-1, -1, -4), WorldPos::new(1, 1, -1), WATER)
+            .unwrap();
+        w.set_block(WorldPos::new(0, 0, -5), GLASS).unwrap();
+        w.set_block(WorldPos::new(0, 0, -7), STONE).unwrap();
+        let (o, d) = ([0.5, 0.5, 0.5], [0.0, 0.0, -1.0]);
+        let through_water =
+            |id: BlockId, def: &BlockDef| id != WATER && def.class != RenderClass::Air;
+        let hit = w.raycast_by(o, d, 20.0, through_water).unwrap().unwrap();
+        assert_eq!(
+            (hit.pos, hit.block, hit.face),
+            (WorldPos::new(0, 0, -5), GLASS, Face::PosZ)
+        );
+        assert!((hit.distance - 4.5).abs() < 1e-12, "{}", hit.distance);
+        // A filter by class stops at the water's surface.
+        let hit = w.raycast(o, d, 20.0, &SOLID).unwrap().unwrap();
+        assert_eq!((hit.pos, hit.block), (WorldPos::new(0, 0, -1), WATER));
+        // By name: through water and glass to the stone.
+        let hit = w
+            .raycast_by(o, d, 20.0, |_, def| def.name == "stone")
+            .unwrap()
+            .unwrap();
+        assert_eq!((hit.pos, hit.block), (WorldPos::new(0, 0, -7), STONE));
+        // From under water up to the surface: the first air block.
+        let hit = w
+            .raycast_by([0.5, 0.5, -2.5], [0.0, 1.0, 0.0], 20.0, |id, _| id == AIR)
+            .unwrap()
+            .unwrap();
+        assert_eq!((hit.pos, hit.face), (WorldPos::new(0, 2, -3), Face::NegY));
+        assert!((hit.distance - 1.5).abs() < 1e-12, "{}", hit.distance);
+        // The test is asked about every block the ray enters, in order, air included,
+        // the origin's block not.
+        let mut asked = Vec::new();
+        let none = w
+            .raycast_by(o, d, 7.0, |id, def| {
+                asked.push((id, def.class));
+                false
+            })
+            .unwrap();
+        assert_eq!(none, None);
+        let want = [WATER, WATER, WATER, WATER, GLASS, AIR, STONE];
+        assert_eq!(asked.iter().map(|a| a.0).collect::<Vec<_>>(), want);
+        assert_eq!(asked[5].1, RenderClass::Air);
+    }
+
+    #[test]
+    fn raycast_by_refuses_what_raycast_refuses() {
+        let w = wall();
+        for (origin, dir, max) in [
+            ([f64::NAN, 0.0, 0.0], [0.0, 0.0, -1.0], 5.0),
+            ([3e9, 0.0, 0.0], [0.0, 0.0, -1.0], 5.0),
+            ([0.0; 3], [0.0; 3], 5.0),
+            ([0.0; 3], [f64::INFINITY, 0.0, 0.0], 5.0),
+            ([0.0; 3], [0.0, f64::NAN, -1.0], 5.0),
+            ([0.0; 3], [0.0, 0.0, -1.0], -1.0),
+            ([0.0; 3], [0.0, 0.0, -1.0], f64::NAN),
+            ([0.0; 3], [0.0, 0.0, -1.0], MAX_RAY_DISTANCE * 2.0),
+        ] {
+            let mut asked = 0;
+            let by = w
+                .raycast_by(origin, dir, max, |_, _| {
+                    asked += 1;
+                    true
+                })
+                .unwrap_err();
+            let classes = w.raycast(origin, dir, max, &SOLID).unwrap_err();
+            assert!(matches!(by, Error::InvalidRay(_)), "{by}");
+            assert_eq!(by.to_string(), classes.to_string());
+            assert_eq!(asked, 0);
+        }
     }
 }
