@@ -96,7 +96,7 @@ pub(super) fn transpose32(a: &mut LayerMask) {
 }
 
 /// The layer of `bits` on `side` of the chunk, in that axis's plane layout (see
-/// [`Chunk::side_layers`]).
+/// [`Chunk::side_layers`](super::Chunk::side_layers)).
 pub(super) fn side_layer(bits: &Occupancy, side: Face) -> LayerMask {
     let i = side_index(side);
     let rows =

@@ -22,8 +22,9 @@ pub(super) const EMPTY: Occupancy = Occupancy {
 /// A block type's masks in a [`MaskBuffer`].
 type Built = (BlockId, Box<Occupancy>);
 
-/// Per-type masks built from a chunk by [`Chunk::build_masks`], with the scratch memory
-/// that building them takes; kept between calls so that a remesh allocates nothing.
+/// Per-type masks built from a chunk by [`Chunk::build_masks`](super::Chunk::build_masks),
+/// with the scratch memory that building them takes; kept between calls so that a remesh
+/// allocates nothing.
 #[derive(Clone, Debug, Default)]
 pub struct MaskBuffer {
     /// The first `len` entries are valid; the others keep their allocation.

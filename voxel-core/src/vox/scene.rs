@@ -148,8 +148,8 @@ impl VoxFile {
             .sum()
     }
 
-    /// Every placed voxel: this crate's block (y-up, before any [`VoxPlacement`]) and its
-    /// colour index.
+    /// Every placed voxel: this crate's block (y-up, before any
+    /// [`VoxPlacement`](super::VoxPlacement)) and its colour index.
     pub fn voxels(&self) -> impl Iterator<Item = ([i64; 3], u8)> + '_ {
         self.instances.iter().flat_map(move |inst| {
             let m = &self.models[inst.model];

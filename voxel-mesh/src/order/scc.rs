@@ -7,14 +7,14 @@ use std::cmp::Reverse;
 use super::SortStats;
 use super::relation::{QBox, Span, hides_at, may_hide_in_cell, tie_at};
 
-/// The group a placeholder of [`Leaf::components`]'s sequence stands for (`u32::MAX -
+/// The group a placeholder of the sequence of a leaf's components stands for (`u32::MAX -
 /// group number`), or `None` for a plain index.
 pub(super) fn group_of(v: u32, groups: &[Vec<u32>]) -> Option<&[u32]> {
     let g = (u32::MAX - v) as usize;
     groups.get(g).map(Vec::as_slice)
 }
 
-/// Tarjan's bookkeeping for [`Leaf::components`].
+/// Tarjan's bookkeeping for the search over a leaf's relation (`Leaf::components`).
 pub(super) struct Tarjan {
     pub(super) index: Vec<u32>,
     pub(super) low: Vec<u32>,
