@@ -5,6 +5,8 @@
 //! Nothing here knows about the GPU: `voxel-mesh` and `voxel-render` build on these types.
 //! Coordinates: `y` is up; a chunk is [`CHUNK_SIZE`]³ blocks; world block coordinates are `i32`.
 
+#![warn(missing_docs)]
+
 mod block;
 mod chunk;
 mod error;

@@ -19,14 +19,15 @@
 //! cells in front of it in a 512-entry table, and covers the occluded faces of a plane with
 //! the AO byte as a per-face merge key (`cover_occluded`).
 //!
-//! The values go into the quad's word 1, bits 24..32 (see [`crate::quad`]), two bits per
-//! corner in the order `(u0, v0)`, `(u1, v0)`, `(u0, v1)`, `(u1, v1)` of the face's (U, V)
-//! axes. The renderer splits a quad along the diagonal whose two corners are brighter in
-//! sum (Sodium's rule), so that a single dark corner shades one triangle's corner instead of
-//! a band across the quad, and the result does not depend on how the quad is rotated.
+//! The values go into the quad's word 1, bits 24..32 (see [`PackedQuad`](crate::PackedQuad)),
+//! two bits per corner in the order `(u0, v0)`, `(u1, v0)`, `(u0, v1)`, `(u1, v1)` of the
+//! face's (U, V) axes. The renderer splits a quad along the diagonal whose two corners are
+//! brighter in sum (Sodium's rule), so that a single dark corner shades one triangle's
+//! corner instead of a band across the quad, and the result does not depend on how the quad
+//! is rotated.
 //!
 //! Occluders come from the chunk, its six face neighbours and (at the chunk's edges and
-//! corners) its 12 edge and 8 corner neighbours: a 34³ shell of opaque bits, [`Pad`].
+//! corners) its 12 edge and 8 corner neighbours: a 34³ shell of opaque bits, `Pad`.
 
 use voxel_core::{
     BlockId, CHUNK_SIZE, Face, LayerMask, Neighbourhood, Occupancy, column_index, row_index,

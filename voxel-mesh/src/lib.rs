@@ -9,6 +9,8 @@
 //!   when the eye crosses a trigger plane; exact chunk order.
 //! - [`sort`]: back-to-front ordering of translucent quads and chunks for a camera.
 
+#![warn(missing_docs)]
+
 pub mod ao;
 mod bits;
 mod mesher;

@@ -253,7 +253,7 @@ fn oracles_agree() {
 }
 
 #[test]
-fn the_issue_example() {
+fn centre_sorting_fails_on_water_under_a_glass_pillar_the_exact_order_does_not() {
     // A chunk-wide water surface at y = 10 and a glass pillar at x = 20, z = 16 just above
     // it, the eye a little higher in the same chunk: centre sorting draws the pillar's faces
     // first and blends the water over them; the exact order does not.

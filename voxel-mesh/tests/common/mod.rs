@@ -82,7 +82,7 @@ pub fn checkerboard(o: [usize; 3], size: [usize; 3], a: BlockId, b: BlockId) -> 
     c
 }
 
-/// The example: a chunk-wide water surface at y = 10 and a glass pillar at
+/// Where centre sorting fails: a chunk-wide water surface at y = 10 and a glass pillar at
 /// x = 20, z = 16, y = 11..15 just above it. (A pillar standing on the water would cut the
 /// surface into several quads: the water's face under it meets glass, an interface, which
 /// the mesher keeps apart; floating, the surface stays one chunk-wide quad.)
