@@ -576,7 +576,7 @@ fn random_report(s: &mut String, summary: &Summary, d: &Distribution, opts: &Eva
     let _ = writeln!(s, "## The scenes\n");
     let _ = writeln!(
         s,
-        "What the {} scenes hold (the generator's design is in `voxel-lab/src/random.rs`; the last two rows are measured):\n",
+        "What the {} scenes hold (the generator's design is in `voxel-lab/src/random/mod.rs`; the last two rows are measured):\n",
         d.count
     );
     let _ = writeln!(s, "| feature | scenes | share |\n|---|---|---|");
