@@ -129,7 +129,9 @@ fn small_eval_of_the_suite() {
     let wboit = suite_mean("wboit-mrt");
     eprintln!("suite mean FLIP: mboit {mboit:.4}, wboit-mrt {wboit:.4}");
     assert!(mboit < wboit, "mboit {mboit}, wboit-mrt {wboit}");
-    assert!(mboit <= 0.026, "mboit {mboit}");
+    // 0.026 at most with water as a thin surface; 0.043 with water a volume, whose faces
+    // carry an opacity near 1 that the moments reconstruct worst (docs/techniques.md).
+    assert!(mboit <= 0.05, "mboit {mboit}");
 
     // summary.json: an array of records with the documented keys.
     let json: Vec<serde_json::Value> =

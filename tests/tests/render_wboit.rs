@@ -68,7 +68,7 @@ fn wboit_variants_agree_within_one_level() {
 /// every pixel ray enters at most one slab, through one face, so each pixel holds at most
 /// one translucent layer.
 fn one_layer_scene() -> Scene {
-    let world = box_world(&[
+    let world = thin_water_world(&[
         ([-40, -20, -2], [40, 20, -1], STONE),
         ([-30, -12, 6], [-2, 12, 6], WATER),
         ([2, -12, 6], [30, 12, 6], RED_GLASS),
@@ -98,7 +98,7 @@ fn one_layer_wboit_equals_alpha_blending() {
 #[test]
 fn without_translucent_blocks_every_technique_is_identical() {
     let Some(ctx) = gpu() else { return };
-    let world = box_world(&[
+    let world = thin_water_world(&[
         ([-20, -2, -20], [20, 0, 20], GRASS),
         ([-3, 1, -3], [3, 6, 3], STONE),
         ([5, 1, -2], [8, 4, 1], LEAVES),
@@ -122,7 +122,7 @@ fn overflow_scene() -> Scene {
     }
     scene(
         "overflow",
-        box_world(&boxes),
+        thin_water_world(&boxes),
         [0.5, 0.5, 1.0],
         [0.5, 0.5, -10.0],
     )
@@ -259,7 +259,7 @@ fn shader_weights_match_the_rust_formulas() {
     // A red glass sheet nearer, just right of the centre pixel: the fitted weight's depth
     // range runs from it to the water, and the centre pixel's screen tile (pixels 16.5 to
     // 20.6 of 33) has some of its optical depth in front of the water.
-    let world = box_world(&[
+    let world = thin_water_world(&[
         ([-20, -20, -20], [20, 20, -20], WATER),
         ([1, -3, -12], [6, 3, -12], RED_GLASS),
     ]);
@@ -327,7 +327,7 @@ fn shader_weights_match_the_rust_formulas() {
 /// A small pane of red glass in the middle of the view, in front of a stone wall: its
 /// chunk's translucent box covers a small part of the screen.
 fn pane_scene() -> Scene {
-    let world = box_world(&[
+    let world = thin_water_world(&[
         ([-40, -20, -2], [40, 20, -1], STONE),
         ([-3, -2, 6], [3, 2, 6], RED_GLASS),
     ]);

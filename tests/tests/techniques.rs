@@ -35,7 +35,7 @@ fn sheets_scene() -> Scene {
     boxes.push(([2, -3, -20], [6, 3, -16], STONE));
     scene(
         "sheets",
-        box_world(&boxes),
+        thin_water_world(&boxes),
         [0.5, 0.5, 30.0],
         [0.5, 0.5, 0.0],
     )
@@ -89,7 +89,7 @@ fn depth_peeling_with_enough_layers_equals_the_reference() {
 fn depth_peeling_adapts_its_layer_count() {
     let Some(ctx) = gpu() else { return };
     // Two sheets: one dual iteration holds both, the second finds nothing.
-    let world = box_world(&[
+    let world = thin_water_world(&[
         ([-60, -40, -60], [60, 40, -58], STONE),
         ([-20, -12, 0], [20, 12, 0], RED_GLASS),
         ([-20, -12, -6], [20, 12, -6], WATER),
@@ -147,7 +147,7 @@ fn the_reference_reports_zero_overflow_and_grows_when_short() {
     }
     let scene = scene(
         "deep",
-        box_world(&boxes),
+        thin_water_world(&boxes),
         [0.5, 0.5, 1.0],
         [0.5, 0.5, -10.0],
     );
@@ -170,7 +170,7 @@ fn the_reference_reports_zero_overflow_and_grows_when_short() {
 
 /// A full-screen water sheet (texture alpha 179/255) in front of a stone wall.
 fn water_wall() -> Scene {
-    let world = box_world(&[
+    let world = thin_water_world(&[
         ([-60, -40, -20], [60, 40, -18], STONE),
         ([-50, -30, -5], [50, 30, -5], WATER),
     ]);
@@ -249,7 +249,12 @@ fn new_chunks_fade_in_through_the_stipple_pattern() {
     let mut c = config(Technique::WboitMrt);
     c.fade_in_frames = 8;
     let settled = render_with(&ctx, &scene, config(Technique::WboitMrt));
-    let nothing = tests::scene("empty", box_world(&[]), [0.5, 0.5, 10.0], [0.5, 0.5, 0.0]);
+    let nothing = tests::scene(
+        "empty",
+        thin_water_world(&[]),
+        [0.5, 0.5, 10.0],
+        [0.5, 0.5, 0.0],
+    );
     let empty = render_with(&ctx, &nothing, config(Technique::WboitMrt));
 
     let mut r: Renderer = renderer_for(&ctx, &scene, c).unwrap().renderer;
@@ -282,7 +287,7 @@ fn failing_class_scenes() -> Vec<(Scene, bool)> {
         (
             scene(
                 "water_and_pillar",
-                box_world(&[
+                thin_water_world(&[
                     floor,
                     ([0, -3, 0], [31, 9, 31], WATER),
                     ([20, 11, 16], [20, 14, 16], GLASS),
@@ -298,7 +303,7 @@ fn failing_class_scenes() -> Vec<(Scene, bool)> {
         (
             scene(
                 "floor_and_ceiling",
-                box_world(&[
+                thin_water_world(&[
                     floor,
                     ([0, 2, 0], [31, 2, 31], GLASS),
                     ([0, 12, 0], [31, 12, 31], ICE),
@@ -314,7 +319,7 @@ fn failing_class_scenes() -> Vec<(Scene, bool)> {
         (
             scene(
                 "stairs",
-                box_world(&[
+                thin_water_world(&[
                     floor,
                     ([0, 0, 0], [31, 0, 3], WATER),
                     ([0, 0, 4], [31, 1, 7], GLASS),
