@@ -266,3 +266,56 @@ fn the_holes_of_a_cutout_block_in_water_show_the_water_as_the_ray_march_computes
         );
     }
 }
+
+/// Translucent things inside water (a game's plates and bubbles under the surface of the
+/// deep lake, seen from above): the sorted techniques compose them against the volume's
+/// entry (`inside_volume.wgsl`) and come out as the reference, which splits the path at
+/// each; the weighted ones put the whole path in front of them and are measured only.
+#[test]
+fn things_inside_water_are_composed_with_the_path_split_at_them() {
+    use voxel_lab::content::{Content, Entity, Particle};
+    let Some(ctx) = gpu() else { return };
+    let lake = load("lake_depths.toml");
+    let content = Content {
+        particles: (0..60)
+            .map(|i| Particle {
+                center: DVec3::new(
+                    -12.0 + f64::from(i % 10) * 2.5,
+                    -3.0 - f64::from(i / 10) * 3.0,
+                    -6.0 + f64::from(i % 7),
+                ),
+                half_size: 0.8,
+                color: [225, 240, 255],
+                opacity: 0.5,
+            })
+            .collect(),
+        entities: vec![Entity {
+            center: DVec3::new(6.0, -1.6, -4.0),
+            half_extents: [2.0, 0.3, 2.0],
+            rotation: glam::DQuat::IDENTITY,
+            color: [230, 60, 40],
+            opacity: 0.6,
+        }],
+    };
+    let scene = Scene { content, ..lake };
+    let reference = render_with(&ctx, &scene, config(Technique::Reference));
+    let without = render_with(
+        &ctx,
+        &Scene {
+            content: Content::default(),
+            ..scene.clone()
+        },
+        config(Technique::Reference),
+    );
+    let seen = diff(&reference, &without).over_one;
+    assert!(seen > 1000, "the things are seen on {seen} px");
+    for t in [
+        Technique::SortedQuads,
+        Technique::Sorted,
+        Technique::DepthPeeling,
+        Technique::PeelReference,
+    ] {
+        let img = render_with(&ctx, &scene, config(t));
+        assert_close(&format!("things_in_water_{t}"), &img, &reference, 2);
+    }
+}

@@ -23,7 +23,11 @@ pub fn common_wgsl() -> String {
         + gpu::DEPTH_UV_WGSL
         + include_str!("shaders/common.wgsl")
         + VOLUME_WGSL
+        + INSIDE_VOLUME_WGSL
 }
+
+/// Fragments inside a volume in the sorted techniques (`shaders/inside_volume.wgsl`).
+pub const INSIDE_VOLUME_WGSL: &str = include_str!("shaders/inside_volume.wgsl");
 
 /// The volume functions (`shaders/volume.wgsl`): they read `frame`, `block_media` and
 /// `TABLE_WIDTH`, `FLAG_INTERFACE`, which the including shader declares.
@@ -120,6 +124,8 @@ pub struct FrameUniforms {
     pub volumes: u32,
     /// Padding to 16 bytes.
     pub _pad2: f32,
+    /// The look of the medium the eye is in: linear colour and absorption, zero for none.
+    pub medium_look: [f32; 4],
 }
 
 // A record is one texel of the records' table texture (`fetch.rs`).
@@ -183,6 +189,9 @@ impl SharedLayouts {
             // The opaque depth as volumes read it, and each block's look as a medium.
             gpu::texture_entry(7, gpu::DEPTH_READ),
             gpu::texture_entry(8, wgpu::TextureSampleType::Float { filterable: false }),
+            // The nearest entry into a volume and its medium's look.
+            gpu::texture_entry(9, gpu::DEPTH_READ),
+            gpu::texture_entry(10, wgpu::TextureSampleType::Float { filterable: false }),
         ];
         // Group 0's block layers (read where the quad is expanded) and group 1, as
         // `common.wgsl` declares them for each way of fetching quads.

@@ -127,12 +127,17 @@ pub fn fog_wgsl() -> String {
     gpu::DEPTH_UV_WGSL.to_owned() + include_str!("shaders/medium_fog.wgsl")
 }
 
+/// The format of the nearest volume entry's look (linear colour, absorption).
+pub const ENTRY_LOOK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
 /// The pipelines of the two passes a frame inside a medium adds.
 #[derive(Debug)]
 pub struct MediumPass {
     boundary: wgpu::RenderPipeline,
     /// The nearest back face of a volume in front of the opaque surface (`volume_exit.wgsl`).
     volume_exit: wgpu::RenderPipeline,
+    /// The nearest front face of a volume and its look (`volume_exit.wgsl`).
+    volume_entry: wgpu::RenderPipeline,
     fog: wgpu::RenderPipeline,
     /// Group 0 of the fog: the boundary depth and the parameters.
     pub fog_layout: wgpu::BindGroupLayout,
@@ -172,6 +177,20 @@ impl MediumPass {
             samples: 1,
         }
         .build_two_sided(device);
+        let volume_entry = ChunkPipeline {
+            label: "volume_entry",
+            module: &exit_module,
+            fragment_entry: "fs_volume_entry",
+            groups: &groups,
+            targets: &[Some(wgpu::ColorTargetState {
+                format: ENTRY_LOOK_FORMAT,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+            depth: DepthMode::Write,
+            samples: 1,
+        }
+        .build_two_sided(device);
         let fog_layout = gpu::layout(
             device,
             "medium_fog_layout",
@@ -204,6 +223,7 @@ impl MediumPass {
         Self {
             boundary,
             volume_exit,
+            volume_entry,
             fog,
             fog_layout,
             fog_params,
@@ -273,6 +293,32 @@ impl MediumPass {
             .depth(Depth::Load(&volume_depth.view))
             .record(encoder, timer, |pass| {
                 pass.set_pipeline(&self.volume_exit);
+                pass.set_bind_group(0, scene, &[]);
+                draws.draw(chunks, pass);
+            });
+    }
+
+    /// Writes into `entry_depth` and `entry_look` the nearest front face of a volume in
+    /// front of `opaque_depth` and its medium's look (`scene`: group 0 with the opaque depth
+    /// in `volume_entry`'s place). After [`Self::volume_depth_pass`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn volume_entry_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        opaque_depth: &Target,
+        (entry_depth, entry_look): (&Target, &Target),
+        scene: &wgpu::BindGroup,
+        draws: &FrameDraws<'_>,
+        chunks: &DrawList,
+        timer: Option<&Timer>,
+    ) {
+        self.depth_copy
+            .record(encoder, opaque_depth, entry_depth, GpuPass::Medium, timer);
+        let colors = [gpu::clear(&entry_look.view, wgpu::Color::TRANSPARENT)];
+        Pass::new("volume_entry", GpuPass::Medium, &colors)
+            .depth(Depth::Load(&entry_depth.view))
+            .record(encoder, timer, |pass| {
+                pass.set_pipeline(&self.volume_entry);
                 pass.set_bind_group(0, scene, &[]);
                 draws.draw(chunks, pass);
             });

@@ -184,6 +184,12 @@ struct SceneTargets {
     boundary_scene_group: wgpu::BindGroup,
     /// The scene group of the pass writing `volume_depth` (the opaque depth in its place).
     exit_scene_group: wgpu::BindGroup,
+    /// The scene group of the pass writing `volume_entry` and `entry_look`.
+    entry_scene_group: wgpu::BindGroup,
+    /// The nearest front face of a volume (`shaders/inside_volume.wgsl`).
+    volume_entry: Target,
+    /// Its medium's look.
+    entry_look: Target,
     fog_group: wgpu::BindGroup,
     /// MSAA colour and depth, resolved into `color` and `depth`.
     msaa: Option<(Target, Target)>,
@@ -1008,7 +1014,23 @@ impl Renderer {
         } else {
             game.translucent_objects().len()
         };
-        self.write_frame_uniforms(camera, view_proj, medium.map(|(b, _)| b), volumes);
+        // The sorted techniques (drawn in order, one blend per fragment) compose a fragment
+        // inside a volume against the volume's entry (`inside_volume.wgsl`).
+        let ordered = matches!(
+            self.oit.technique(),
+            Technique::Sorted | Technique::SortedQuads | Technique::DepthPeeling
+        );
+        let volume_mode = match (volumes, ordered) {
+            (false, _) => 0,
+            (true, false) => 1,
+            (true, true) => 2,
+        };
+        self.write_frame_uniforms(
+            camera,
+            view_proj,
+            medium.as_ref().map(|(b, look)| (*b, look)),
+            volume_mode,
+        );
         let (eye_int, eye_frac) = camera.eye_split();
         let game_frame = GameFrame {
             camera,
@@ -1070,6 +1092,17 @@ impl Renderer {
             ));
             self.medium
                 .volume_depth_pass(encoder, &t.depth, &t.volume_depth, exits, timer);
+            if volume_mode == 2 {
+                self.medium.volume_entry_pass(
+                    encoder,
+                    &t.depth,
+                    (&t.volume_entry, &t.entry_look),
+                    &t.entry_scene_group,
+                    &draws,
+                    translucent,
+                    timer,
+                );
+            }
         }
         let game_draw = stages.translucent.then(|| GameDraw {
             stages: game,
@@ -1079,6 +1112,9 @@ impl Renderer {
             frame_buffer: &self.scene.frame_buffer,
             boundary: &t.boundary.view,
             depth_sampler: &self.scene.depth_sampler,
+            volume_depth: &t.volume_depth.view,
+            volume_entry: &t.volume_entry.view,
+            entry_look: &t.entry_look.view,
         });
         self.oit.render(
             encoder,
@@ -1285,8 +1321,8 @@ impl Renderer {
         &self,
         camera: &Camera,
         view_proj: Mat4,
-        medium: Option<BlockId>,
-        volumes: bool,
+        medium: Option<(BlockId, &MediumLook)>,
+        volumes: u32,
     ) {
         let (eye_int, eye_frac) = camera.eye_split();
         let sun = sun_unit(self.config.sun_dir);
@@ -1303,10 +1339,14 @@ impl Renderer {
             ambient: self.config.ambient,
             sky: self.config.sky,
             viewport: [w as f32, h as f32],
-            medium: medium.map_or(NO_MEDIUM, |b| u32::from(b.0)),
+            medium: medium.map_or(NO_MEDIUM, |(b, _)| u32::from(b.0)),
             ao_strength: self.config.ao_strength,
             tan_half: [tan_x as f32, tan_y as f32],
-            volumes: u32::from(volumes),
+            volumes,
+            medium_look: medium.map_or([0.0; 4], |(_, look)| {
+                let [r, g, b] = look.color;
+                [r, g, b, look.absorption]
+            }),
             ..FrameUniforms::default()
         };
         self.ctx
@@ -1617,21 +1657,30 @@ impl SceneTargets {
             1,
             U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST,
         );
-        let volume_depth = gpu::TargetDesc {
-            label: "volume_depth",
-            format: DEPTH_FORMAT,
-            usage: U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST,
-            size: if volumes { size } else { (1, 1) },
-            samples: 1,
-        }
-        .create(device);
+        // The volumes' depths and the nearest entry's look: 1×1 until a volume is in view.
+        let volume_target = |label, format| {
+            gpu::TargetDesc {
+                label,
+                format,
+                usage: U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_DST,
+                size: if volumes { size } else { (1, 1) },
+                samples: 1,
+            }
+            .create(device)
+        };
+        let volume_depth = volume_target("volume_depth", DEPTH_FORMAT);
+        let volume_entry = volume_target("volume_entry", DEPTH_FORMAT);
+        let entry_look = volume_target("entry_look", medium::ENTRY_LOOK_FORMAT);
         // The block layers: binding 4 (a storage buffer) or 5 (a table texture),
         // `shaders/common.wgsl`.
         let layers = match &scene.layer_table {
             Some(table) => (5, wgpu::BindingResource::TextureView(&table.view)),
             None => (4, scene.textures.layers.as_entire_binding()),
         };
-        let group = |label, boundary: &Target, volume_depth: &Target| {
+        let group = |label,
+                     boundary: &Target,
+                     volume_depth: &Target,
+                     entry: (&Target, &wgpu::TextureView)| {
             let resources = [
                 (0, scene.frame_buffer.as_entire_binding()),
                 (1, wgpu::BindingResource::TextureView(&scene.textures.view)),
@@ -1641,6 +1690,8 @@ impl SceneTargets {
                 (6, wgpu::BindingResource::Sampler(&scene.depth_sampler)),
                 (7, wgpu::BindingResource::TextureView(&volume_depth.view)),
                 (8, wgpu::BindingResource::TextureView(&scene.media.view)),
+                (9, wgpu::BindingResource::TextureView(&entry.0.view)),
+                (10, wgpu::BindingResource::TextureView(entry.1)),
             ];
             let entries =
                 resources.map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
@@ -1650,12 +1701,19 @@ impl SceneTargets {
                 entries: &entries,
             })
         };
-        let scene_group = group("scene", &boundary, &volume_depth);
+        let entry = (&volume_entry, &entry_look.view);
+        let scene_group = group("scene", &boundary, &volume_depth, entry);
         // The pass writing the boundary reads the opaque depth in its place (ties with
-        // cutout faces, `shaders/medium_boundary.wgsl`), and so does the pass writing the
-        // volume depth.
-        let boundary_scene_group = group("scene_writing_boundary", &depth, &volume_depth);
-        let exit_scene_group = group("scene_writing_volume_depth", &boundary, &depth);
+        // cutout faces, `shaders/medium_boundary.wgsl`), and so do the passes writing the
+        // volume depth and the volume entry (which reads the media table for the look).
+        let boundary_scene_group = group("scene_writing_boundary", &depth, &volume_depth, entry);
+        let exit_scene_group = group("scene_writing_volume_depth", &boundary, &depth, entry);
+        let entry_scene_group = group(
+            "scene_writing_volume_entry",
+            &boundary,
+            &volume_depth,
+            (&depth, &scene.media.view),
+        );
         let fog_group = medium.fog_group(device, &boundary);
         let tonemap_group =
             gpu::texture_group(device, "tonemap", &post.tonemap_layout, &[&color.view]);
@@ -1677,6 +1735,9 @@ impl SceneTargets {
             scene_group,
             boundary_scene_group,
             exit_scene_group,
+            entry_scene_group,
+            volume_entry,
+            entry_look,
             fog_group,
             msaa,
             tonemap_group,

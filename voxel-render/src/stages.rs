@@ -261,6 +261,13 @@ pub struct GameDraw<'a> {
     pub boundary: &'a wgpu::TextureView,
     /// The nearest sampler depth textures are read with (`gpu::DEPTH_READ`).
     pub depth_sampler: &'a wgpu::Sampler,
+    /// Where volumes end, the nearest entry into a volume and its medium's look
+    /// (`shaders/inside_volume.wgsl`).
+    pub volume_depth: &'a wgpu::TextureView,
+    /// See `volume_depth`.
+    pub volume_entry: &'a wgpu::TextureView,
+    /// See `volume_depth`.
+    pub entry_look: &'a wgpu::TextureView,
 }
 
 impl std::fmt::Debug for GameDraw<'_> {
@@ -309,9 +316,10 @@ impl GameDraw<'_> {
 }
 
 /// The group a technique binds for games at [`OIT_GROUP`]: binding 0 the frame uniforms,
-/// 1 the medium boundary, 2 the sampler depth textures are read with (what the techniques'
-/// WGSL reads of group 0), then the technique's own entries (its chunk pipelines' group 2)
-/// moved up by [`OWN_SHIFT`].
+/// 1 the medium boundary, 2 the sampler depth textures are read with, 3 where volumes end,
+/// 4 and 5 the nearest entry into a volume and its look (what the techniques' WGSL reads
+/// of group 0), then the technique's own entries (its chunk pipelines' group 2) moved up by
+/// [`OWN_SHIFT`].
 pub(crate) fn game_layout(
     device: &wgpu::Device,
     label: &str,
@@ -322,6 +330,9 @@ pub(crate) fn game_layout(
         crate::gpu::buffer_entry(0, S::VERTEX_FRAGMENT, wgpu::BufferBindingType::Uniform),
         crate::gpu::texture_entry(1, crate::gpu::DEPTH_READ),
         crate::gpu::depth_sampler_entry(2),
+        crate::gpu::texture_entry(3, crate::gpu::DEPTH_READ),
+        crate::gpu::texture_entry(4, crate::gpu::DEPTH_READ),
+        crate::gpu::texture_entry(5, wgpu::TextureSampleType::Float { filterable: false }),
     ];
     entries.extend(own.iter().map(|e| wgpu::BindGroupLayoutEntry {
         binding: e.binding + OWN_SHIFT,
@@ -344,13 +355,16 @@ pub(crate) fn game_group(
         draw.frame_buffer.as_entire_binding(),
         wgpu::BindingResource::TextureView(draw.boundary),
         wgpu::BindingResource::Sampler(draw.depth_sampler),
+        wgpu::BindingResource::TextureView(draw.volume_depth),
+        wgpu::BindingResource::TextureView(draw.volume_entry),
+        wgpu::BindingResource::TextureView(draw.entry_look),
     ];
     resources.extend(own.iter().cloned());
     crate::gpu::bind_group(device, label, layout, &resources)
 }
 
 /// How far a technique's own bindings (its group 2) move up in the game's group.
-const OWN_SHIFT: u32 = 3;
+const OWN_SHIFT: u32 = 6;
 
 /// A game's prelude: the frame uniforms, the medium boundary and the depth sampler at
 /// [`OIT_GROUP`], the technique's WGSL `own` (its group-2 bindings moved to [`OIT_GROUP`],
@@ -366,7 +380,10 @@ pub(crate) fn game_prelude(own: &str, output: &str) -> String {
         + &format!(
             "@group({OIT_GROUP}) @binding(0) var<uniform> frame: Frame;\n\
              @group({OIT_GROUP}) @binding(1) var medium_boundary: texture_2d<f32>;\n\
-             @group({OIT_GROUP}) @binding(2) var depth_sampler: sampler;\n\n\
+             @group({OIT_GROUP}) @binding(2) var depth_sampler: sampler;\n\
+             @group({OIT_GROUP}) @binding(3) var volume_depth: texture_2d<f32>;\n\
+             @group({OIT_GROUP}) @binding(4) var volume_entry: texture_2d<f32>;\n\
+             @group({OIT_GROUP}) @binding(5) var entry_look: texture_2d<f32>;\n\n\
              // The medium boundary's depth at pixel `xy`.\n\
              fn boundary_depth(xy: vec2<f32>) -> f32 {{\n    \
              let uv = depth_uv(xy, textureDimensions(medium_boundary));\n    \
@@ -379,7 +396,12 @@ pub(crate) fn game_prelude(own: &str, output: &str) -> String {
              fn oit_object_position(position: vec4<f32>) -> vec4<f32> {{\n    \
              return vec4<f32>(position.xy, position.z * (1.0 - OIT_OBJECT_DEPTH_BIAS), position.w);\n}}\n\n"
         );
-    header + &regroup(own, 2, OIT_GROUP, OWN_SHIFT) + "\n" + output
+    header
+        + crate::bindings::VOLUME_WGSL
+        + crate::bindings::INSIDE_VOLUME_WGSL
+        + &regroup(own, 2, OIT_GROUP, OWN_SHIFT)
+        + "\n"
+        + output
 }
 
 /// `src` with every `@group(from) @binding(k)` made `@group(to) @binding(k + shift)`.

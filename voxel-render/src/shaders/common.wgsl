@@ -31,6 +31,10 @@ struct ChunkInfo {
 // row: linear colour and absorption per block (0: a thin surface).
 @group(0) @binding(7) var volume_depth: texture_2d<f32>;
 @group(0) @binding(8) var block_media: texture_2d<f32>;
+// The nearest entry into a volume (a depth texture, read as a float one) and its medium's
+// look, when `frame.volumes` is 2 (`inside_volume.wgsl`).
+@group(0) @binding(9) var volume_entry: texture_2d<f32>;
+@group(0) @binding(10) var entry_look: texture_2d<f32>;
 
 // How quads and their tables reach the vertex stage (`fetch.rs`); a pipeline uses one of
 // the two, and binds only that one's resources.
@@ -310,12 +314,12 @@ fn medium_look(block: u32) -> vec4<f32> {
 // exit (the exact references split the path at every face).
 fn translucent_color(in: VsOut, front: bool) -> vec4<f32> {
     let c = surface_color(in, front);
-    if frame.volumes == 0u || !front || c.a <= 0.0 {
+    if frame.volumes == 0u || c.a <= 0.0 {
         return c;
     }
     let m = medium_look(in.block);
-    if m.a <= 0.0 {
-        return c;
+    if !front || m.a <= 0.0 {
+        return inside_volume(in.clip.xy, in.clip.z, c);
     }
     let size = textureDimensions(volume_depth);
     let z = textureSampleLevel(volume_depth, depth_sampler, depth_uv(in.clip.xy, size), 0.0).x;

@@ -18,6 +18,11 @@ struct Frame {
     ao_strength: f32,
     // tan of half the horizontal and vertical field of view.
     tan_half: vec2<f32>,
-    // 1 when a volume is in view and `volume_depth` holds this frame's opaque depth.
+    // 0: no volume in view. 1: a volume is in view and `volume_depth` holds where volumes
+    // end (the exact references: the opaque depth). 2: besides, `volume_entry` and
+    // `entry_look` hold the nearest entry into a volume, and fragments inside a volume are
+    // composed as the sorted techniques need (`inside_volume`).
     volumes: u32,
+    // The look of the medium the eye is in (linear colour, absorption), or zero.
+    medium_look: vec4<f32>,
 };

@@ -16,3 +16,16 @@ fn fs_volume_exit(in: VsOut, @builtin(front_facing) front: bool) {
         discard;
     }
 }
+
+// The nearest entry into a volume in front of the opaque surface (a front face of a
+// volume), its medium's look in the colour target, for the sorted techniques' fragments
+// inside a volume (`inside_volume.wgsl`). In this pass group 0's `volume_entry` binding
+// holds the opaque depth itself.
+@fragment
+fn fs_volume_entry(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let m = medium_look(in.block);
+    if !front || m.a <= 0.0 {
+        discard;
+    }
+    return m;
+}

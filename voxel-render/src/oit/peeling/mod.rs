@@ -147,8 +147,7 @@ fn limit_entries() -> [wgpu::BindGroupLayoutEntry; 3] {
 /// The medium state's format (`peel_state` in `limits.wgsl`).
 const STATE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 
-/// The peel pass's own WGSL (after the shared chunk code, or a game's prelude with the
-/// volume functions).
+/// The peel pass's own WGSL (after the shared chunk code or a game's prelude).
 fn peel_own_wgsl() -> String {
     [include_str!("limits.wgsl"), include_str!("state.wgsl")].concat()
 }
@@ -657,10 +656,10 @@ impl TranslucentTechnique for Peeling {
             fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
             let p = oit_object_position(position);\n    \
             if !peel_candidate(p) || color.a <= 0.0 {\n        discard;\n    }\n    \
-            return OitOutput(color, p.z);\n}\n";
+            return OitOutput(inside_volume(p.xy, p.z, color), p.z);\n}\n";
         let variant = |name, depth| TranslucentVariant {
             name,
-            wgsl: game_prelude(&(peel_own_wgsl() + crate::bindings::VOLUME_WGSL), output),
+            wgsl: game_prelude(&peel_own_wgsl(), output),
             targets: peel_targets(false),
             depth_stencil: gpu::depth_state(depth),
             layout: self.game_layout.clone(),
@@ -673,10 +672,7 @@ impl TranslucentTechnique for Peeling {
             // The layer holds the volume in front of the object; the medium goes on.
             PeelMode::Converge => vec![TranslucentVariant {
                 name: "peel_front",
-                wgsl: game_prelude(
-                    &(peel_own_wgsl() + crate::bindings::VOLUME_WGSL),
-                    CONVERGE_OUTPUT,
-                ),
+                wgsl: game_prelude(&peel_own_wgsl(), CONVERGE_OUTPUT),
                 targets: peel_targets(true),
                 depth_stencil: gpu::depth_state(DepthMode::Write),
                 layout: self.game_layout.clone(),
