@@ -99,8 +99,9 @@ fn inside_glass_the_glass_tints_the_view_and_fogs_it() {
 #[test]
 fn a_dive_through_the_surface_keeps_the_surface_on_every_frame() {
     let Some(ctx) = gpu() else { return };
-    // No glass under the water: glass inside a volume is approximate in sorted-quads
-    // (docs/techniques.md, "Volumes"), and this test is about the surface.
+    // No glass under the water: the water behind a glass block that stands in it is a
+    // second passage, approximate in sorted-quads (docs/techniques.md, "Volumes"), and
+    // this test is about the surface.
     let s = sea([0.5, 3.0, 4.0], [0.5, 0.0, -12.0], false);
     let mut reference = renderer_for(&ctx, &s, config(Technique::Reference)).unwrap();
     let mut opaque = renderer_for(&ctx, &s, config(Technique::OpaqueOnly)).unwrap();

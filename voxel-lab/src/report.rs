@@ -256,6 +256,15 @@ fn header(s: &mut String, summary: &Summary, opts: &EvalOptions) {
             )
         }
     );
+    let _ = writeln!(
+        s,
+        "Where each technique is exact: `sorted-quads` on block scenes wherever an order exists (a cycle of \
+         quads has none) and for a game's objects where its tests decide; `depth-peeling` up to its layer count; \
+         `wboit-*` and `mboit` for one layer per pixel; `stipple` never. Water is a volume (light kept \
+         exp(-absorption d) over d blocks): the exact references split every path through it, `sorted`, \
+         `sorted-quads` and `depth-peeling` are exact for one volume along a ray (things inside it included), and \
+         a volume behind another is approximate in every real-time technique (docs/techniques.md, Volumes).\n"
+    );
     let _ = writeln!(s, "![speed against accuracy](speed_vs_accuracy.png)\n");
 }
 

@@ -255,6 +255,7 @@ mod tests {
                 field!(FrameUniforms, ao_strength),
                 field!(FrameUniforms, tan_half),
                 field!(FrameUniforms, volumes),
+                field!(FrameUniforms, medium_look),
             ],
         );
         let tonemap = include_str!("shaders/tonemap.wgsl");

@@ -40,7 +40,10 @@ pub struct Stages {
     /// An overlay into the HDR scene colour with the scene depth (read-only) after
     /// translucency and fog, before tonemapping: a selection box.
     pub hdr_overlay: bool,
-    /// An overlay into the output after tonemapping: a HUD.
+    /// An overlay into the output after tonemapping: a HUD. Its one colour target is the
+    /// view the frame renders into, in that view's format ([`GameFrame::output_format`],
+    /// one of `OUTPUT_FORMATS`; it changes only when the game renders into another view),
+    /// single-sampled and without depth: the game builds its overlay pipelines for it.
     pub overlay: bool,
 }
 

@@ -456,7 +456,7 @@ impl TranslucentFrame<'_> {
 
 /// One transparency technique: its pipelines, targets and caches, created when it becomes
 /// active and dropped when another one does.
-pub trait TranslucentTechnique: fmt::Debug + Send {
+pub trait TranslucentTechnique: fmt::Debug + Send + Sync {
     /// Rebuilds size-dependent targets; called only when the size really changed.
     fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<()>;
 
