@@ -1,0 +1,133 @@
+//! The blocks as the ray march reads them: lookups, classes, colours and textures, and
+//! ambient occlusion from the blocks themselves.
+
+use voxel_core::{BlockId, CHUNK_SIZE, Chunk, ChunkPos, Face, RenderClass};
+
+use super::{RayMarcher, Texturing};
+
+pub(super) fn srgb_to_linear(c: u8) -> f64 {
+    let c = f64::from(c) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The brightness factor of an AO value (0 to 3) at `strength`.
+fn ao_brightness(value: u8, strength: f64) -> f64 {
+    1.0 - strength * f64::from(voxel_render::AO_DEPTH) * f64::from(3 - value) / 3.0
+}
+
+impl RayMarcher {
+    /// The blocks of the chunk at chunk coordinates `c`, if it holds any.
+    pub(super) fn chunk_blocks(&self, c: [i64; 3]) -> Option<&[BlockId]> {
+        let pos = ChunkPos::new(
+            i32::try_from(c[0]).ok()?,
+            i32::try_from(c[1]).ok()?,
+            i32::try_from(c[2]).ok()?,
+        );
+        self.chunks.get(&pos).map(|c| &**c)
+    }
+
+    /// The block at `p` (air outside the loaded chunks).
+    pub(super) fn get(&self, p: [i64; 3]) -> BlockId {
+        let s = CHUNK_SIZE as i64;
+        let c = p.map(|v| v.div_euclid(s));
+        let Some(chunk) = self
+            .chunks
+            .get(&ChunkPos::new(c[0] as i32, c[1] as i32, c[2] as i32))
+        else {
+            return BlockId::AIR;
+        };
+        let l = p.map(|v| v.rem_euclid(s) as usize);
+        chunk[Chunk::dense_index(l[0], l[1], l[2])]
+    }
+
+    pub(super) fn class(&self, id: BlockId) -> RenderClass {
+        self.classes
+            .get(id.index())
+            .copied()
+            .unwrap_or(RenderClass::Air)
+    }
+
+    fn opaque(&self, p: [i64; 3]) -> bool {
+        self.class(self.get(p)) == RenderClass::Opaque
+    }
+
+    /// Colour (linear) and alpha of face `face` of block `id` at face coordinates `(u, v)`
+    /// (in blocks along the face's U and V axes).
+    pub(super) fn albedo(
+        &self,
+        id: BlockId,
+        face: Face,
+        u: f64,
+        v: f64,
+        texturing: Texturing,
+    ) -> [f64; 4] {
+        match texturing {
+            Texturing::Flat => self.flat[id.index()],
+            Texturing::Nearest => {
+                // Stored as 8-bit sRGB and 8-bit alpha.
+                let t = self.textures.texel(id, face, u, v);
+                [
+                    srgb_to_linear(t[0]),
+                    srgb_to_linear(t[1]),
+                    srgb_to_linear(t[2]),
+                    f64::from(t[3]) / 255.0,
+                ]
+            }
+        }
+    }
+
+    /// The AO brightness at face coordinates `(s, t)` in 0..1 of the unit face `face` of
+    /// the block at `b`: each corner's value from the opaque blocks around it in the layer
+    /// in front, interpolated over the triangle the renderer's diagonal rule picks.
+    pub(super) fn ao(&self, b: [i64; 3], face: Face, s: f64, t: f64, strength: f64) -> f64 {
+        if strength == 0.0 {
+            return 1.0;
+        }
+        let axis = face.axis();
+        let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
+        let n = face.normal();
+        let front = [0, 1, 2].map(|a| b[a] + i64::from(n[a]));
+        let value = |du: i64, dv: i64| -> u8 {
+            let mut s1 = front;
+            s1[ua] += du;
+            let mut s2 = front;
+            s2[va] += dv;
+            let mut c = s1;
+            c[va] += dv;
+            let (s1, s2, c) = (self.opaque(s1), self.opaque(s2), self.opaque(c));
+            if s1 && s2 {
+                0
+            } else {
+                3 - u8::from(s1) - u8::from(s2) - u8::from(c)
+            }
+        };
+        let v00 = value(-1, -1);
+        let v10 = value(1, -1);
+        let v01 = value(-1, 1);
+        let v11 = value(1, 1);
+        let [b00, b10, b01, b11] = [v00, v10, v01, v11].map(|v| ao_brightness(v, strength));
+        if u16::from(v10) + u16::from(v01) > u16::from(v00) + u16::from(v11) {
+            // Diagonal (1,0)-(0,1).
+            if s + t <= 1.0 {
+                b00 + s * (b10 - b00) + t * (b01 - b00)
+            } else {
+                b11 + (1.0 - s) * (b01 - b11) + (1.0 - t) * (b10 - b11)
+            }
+        } else if s >= t {
+            // Diagonal (0,0)-(1,1): triangle (00, 10, 11).
+            b00 + s * (b10 - b00) + t * (b11 - b10)
+        } else {
+            // Triangle (00, 11, 01).
+            b00 + t * (b01 - b00) + s * (b11 - b01)
+        }
+    }
+
+    /// The block whose medium a cutout block `id` stands in.
+    pub(super) fn medium_block(&self, id: BlockId) -> Option<BlockId> {
+        self.medium_of.get(id.index()).copied().flatten()
+    }
+}

@@ -1,0 +1,104 @@
+//! Lighting a surface (Lambert plus ambient, shaded by its ambient occlusion), the
+//! per-picture light (sun, sky, the fog of a medium), and the tonemap.
+
+use glam::DVec3;
+use voxel_core::RenderClass;
+use voxel_render::Camera;
+
+use super::walk::Walker;
+use super::{RayMarcher, Shading, Surface};
+
+/// The tonemap of `shaders/tonemap.wgsl` (values up to the shoulder unchanged, then a
+/// smooth roll-off towards 1), then sRGB encoding and 8-bit rounding.
+pub(super) fn output(x: f64) -> u8 {
+    let shoulder = f64::from(voxel_render::TONEMAP_SHOULDER);
+    let t = if x <= shoulder {
+        x.max(0.0)
+    } else {
+        let room = 1.0 - shoulder;
+        shoulder + room * (1.0 - (-(x - shoulder) / room).exp())
+    };
+    let s = if t <= 0.003_130_8 {
+        t * 12.92
+    } else {
+        1.055 * t.powf(1.0 / 2.4) - 0.055
+    };
+    (s.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+impl RayMarcher {
+    /// The lit colour of `surface` at point `p` with albedo `a`.
+    pub(super) fn lit(&self, surface: Surface, p: DVec3, a: [f64; 4], w: &Walker<'_>) -> [f64; 3] {
+        let face = surface.face;
+        let n = face.normal();
+        let sun = w.light.sun;
+        let n_dot_l =
+            (f64::from(n[0]) * sun[0] + f64::from(n[1]) * sun[1] + f64::from(n[2]) * sun[2])
+                .max(0.0);
+        let ambient = f64::from(w.shading.ambient);
+        let light = ambient + (1.0 - ambient) * n_dot_l;
+        let translucent = self.class(surface.id) == RenderClass::Translucent;
+        let shade = if translucent {
+            1.0
+        } else {
+            let axis = face.axis();
+            let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
+            let s = (p[ua] - surface.block[ua] as f64).clamp(0.0, 1.0);
+            let t = (p[va] - surface.block[va] as f64).clamp(0.0, 1.0);
+            self.ao(surface.block, face, s, t, f64::from(w.shading.ao_strength))
+        };
+        [
+            a[0] * light * shade,
+            a[1] * light * shade,
+            a[2] * light * shade,
+        ]
+    }
+}
+
+/// Per-picture lighting: the sun, the sky, the medium's fog.
+pub(super) struct Light {
+    pub(super) sun: DVec3,
+    pub(super) ambient: f64,
+    pub(super) sky: [f64; 3],
+    pub(super) fog: Option<Fog>,
+    /// What a medium's colour is lit by: a face turned to the sky.
+    pub(super) medium_light: f64,
+    /// The camera's forward, right and up (unit): particles face the camera.
+    pub(super) basis: [DVec3; 3],
+}
+
+pub(super) struct Fog {
+    pub(super) color: [f64; 3],
+    pub(super) density: f64,
+}
+
+impl Light {
+    pub(super) fn new(m: &RayMarcher, camera: &Camera, shading: &Shading) -> Self {
+        let s = shading.sun_dir.map(f64::from);
+        let sun = DVec3::from(s).try_normalize().unwrap_or(DVec3::Y);
+        let ambient = f64::from(shading.ambient);
+        let medium_light = ambient + (1.0 - ambient) * sun.y.max(0.0);
+        let fog = camera
+            .medium
+            .and_then(|id| m.media.get(id.index()).copied().flatten())
+            .map(|look| Fog {
+                color: look.color.map(|c| c * medium_light),
+                density: look.absorption,
+            });
+        let f = camera.unit_forward();
+        let up = if f.y.abs() > 0.999 {
+            DVec3::Z
+        } else {
+            DVec3::Y
+        };
+        let right = f.cross(up).normalize();
+        Self {
+            sun,
+            ambient,
+            sky: shading.sky.map(f64::from),
+            fog,
+            medium_light,
+            basis: [f, right, right.cross(f)],
+        }
+    }
+}

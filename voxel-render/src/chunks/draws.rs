@@ -1,0 +1,207 @@
+//! A frame's draw commands: the indirect commands, the runs per page, the draw lists of
+//! the passes and the builder that fills them.
+
+use bytemuck::{Pod, Zeroable};
+
+#[cfg(doc)]
+use super::Culled;
+use super::DrawMode;
+use super::store::ChunkStore;
+#[cfg(doc)]
+use crate::QuadFetch;
+use crate::arena::Alloc;
+
+/// One draw command, as `multi_draw_indirect` reads it with [`QuadFetch::Storage`] (with
+/// [`QuadFetch::Instanced`] each is a direct draw of its own).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct DrawCommand {
+    /// Vertices: 6 per quad.
+    pub vertex_count: u32,
+    /// Always 1.
+    pub instance_count: u32,
+    /// The mesh's first quad in its page, times 6.
+    pub first_vertex: u32,
+    /// The chunk's slot.
+    pub first_instance: u32,
+}
+
+/// A run of commands drawing from one page.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Run {
+    page: u32,
+    first: u32,
+    count: u32,
+}
+
+/// The draws of one pass: runs of commands in a frame's [`FrameDraws`].
+#[derive(Clone, Debug, Default)]
+pub struct DrawList {
+    runs: Vec<Run>,
+    meshes: usize,
+    quads: u64,
+}
+
+impl DrawList {
+    /// Whether it draws nothing.
+    pub fn is_empty(&self) -> bool {
+        self.meshes == 0
+    }
+
+    /// Meshes drawn.
+    pub fn meshes(&self) -> usize {
+        self.meshes
+    }
+
+    /// Quads drawn.
+    pub fn quads(&self) -> u64 {
+        self.quads
+    }
+
+    /// Draw calls it records: one per run of a page with indirect draws, one per mesh
+    /// without.
+    pub fn calls(&self, mode: DrawMode) -> usize {
+        match mode {
+            DrawMode::Indirect => self.runs.len(),
+            DrawMode::PerChunk => self.meshes,
+        }
+    }
+}
+
+/// Every draw command of a frame, on the CPU and in the indirect buffer.
+#[derive(Debug)]
+pub struct FrameDraws<'a> {
+    /// The store whose pages the commands draw from.
+    pub store: &'a ChunkStore,
+    /// The commands.
+    pub commands: &'a [DrawCommand],
+    /// How they are issued.
+    pub mode: DrawMode,
+}
+
+impl FrameDraws<'_> {
+    /// Records the draws of `list` (pipeline and group 0 already set; group 1 set here).
+    pub fn draw(&self, list: &DrawList, pass: &mut wgpu::RenderPass<'_>) {
+        self.draw_range(list, 0..list.meshes, pass);
+    }
+
+    /// Records the draws of meshes `range` of `list` (in its order), like [`Self::draw`].
+    pub fn draw_range(
+        &self,
+        list: &DrawList,
+        range: std::ops::Range<usize>,
+        pass: &mut wgpu::RenderPass<'_>,
+    ) {
+        let Some(base) = list.runs.first().map(|r| r.first as usize) else {
+            return;
+        };
+        let (lo, hi) = (base + range.start, base + range.end.min(list.meshes));
+        for run in &list.runs {
+            let (first, end) = (run.first as usize, (run.first + run.count) as usize);
+            let (a, b) = (first.max(lo), end.min(hi));
+            if a >= b {
+                continue;
+            }
+            let run = &Run {
+                page: run.page,
+                first: a as u32,
+                count: (b - a) as u32,
+            };
+            if !self.store.bind_page(run.page, pass) {
+                continue;
+            }
+            match self.mode {
+                DrawMode::Indirect if self.store.fetch.indirect() => pass.multi_draw_indirect(
+                    &self.store.indirect,
+                    u64::from(run.first) * std::mem::size_of::<DrawCommand>() as u64,
+                    run.count,
+                ),
+                _ => {
+                    let cmds = &self.commands[run.first as usize..(run.first + run.count) as usize];
+                    for c in cmds {
+                        self.store.draw(run.page, c, 0..c.vertex_count / 6, pass);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Draws quads `quads` (positions in the mesh's drawn order, clamped to it) of mesh
+    /// `index` of `list`: part of a chunk, for objects drawn among its quads.
+    pub fn draw_quads(
+        &self,
+        list: &DrawList,
+        index: usize,
+        quads: std::ops::Range<u32>,
+        pass: &mut wgpu::RenderPass<'_>,
+    ) {
+        let Some(base) = list.runs.first().map(|r| r.first as usize) else {
+            return;
+        };
+        if index >= list.meshes {
+            return;
+        }
+        let at = (base + index) as u32;
+        let Some(run) = list
+            .runs
+            .iter()
+            .find(|r| (r.first..r.first + r.count).contains(&at))
+        else {
+            return;
+        };
+        let Some(c) = self.commands.get(at as usize) else {
+            return;
+        };
+        let n = c.vertex_count / 6;
+        let (a, b) = (quads.start.min(n), quads.end.min(n));
+        if a >= b || !self.store.bind_page(run.page, pass) {
+            return;
+        }
+        self.store.draw(run.page, c, a..b, pass);
+    }
+}
+
+/// Builds a frame's draw lists: commands appended per list, runs split where the page
+/// changes.
+#[derive(Debug, Default)]
+pub struct DrawBuilder {
+    commands: Vec<DrawCommand>,
+}
+
+impl DrawBuilder {
+    /// A list drawing `meshes` (slot and place of each, as [`Culled::meshes`] gives them),
+    /// in order.
+    pub fn list(&mut self, meshes: impl IntoIterator<Item = (u32, Alloc)>) -> DrawList {
+        let mut list = DrawList::default();
+        for (slot, mesh) in meshes {
+            let index = self.commands.len() as u32;
+            self.commands.push(DrawCommand {
+                vertex_count: mesh.quads * 6,
+                instance_count: 1,
+                first_vertex: mesh.offset * 6,
+                first_instance: slot,
+            });
+            match list.runs.last_mut() {
+                Some(r) if r.page == mesh.page => r.count += 1,
+                _ => list.runs.push(Run {
+                    page: mesh.page,
+                    first: index,
+                    count: 1,
+                }),
+            }
+            list.meshes += 1;
+            list.quads += u64::from(mesh.quads);
+        }
+        list
+    }
+
+    /// Forgets the commands (keeping their room), for the next frame.
+    pub fn clear(&mut self) {
+        self.commands.clear();
+    }
+
+    /// The commands of every list, to be uploaded with [`ChunkStore::upload_draws`].
+    pub fn commands(&self) -> &[DrawCommand] {
+        &self.commands
+    }
+}

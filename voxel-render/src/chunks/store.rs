@@ -1,0 +1,543 @@
+//! The store of every chunk on the GPU: uploads and removals into the quad arena, the
+//! records, and the frame's culling and draw lists.
+
+use std::sync::Arc;
+
+use voxel_core::ChunkPos;
+use voxel_mesh::{ChunkMeshes, PackedQuad};
+
+use super::cull::{Culled, FarEntry, Frustum, NearEntry, Regions, near_key};
+use super::draws::DrawCommand;
+use super::gpu_chunk::{GpuChunk, distinct_planes, layers_bounds};
+use super::{MeshKind, PosMap};
+use crate::arena::{Alloc, ArenaStats, QuadArena};
+use crate::bindings::ChunkUniforms;
+use crate::fetch::{QuadFetch, Records};
+use crate::gpu;
+use crate::layers;
+use crate::{Error, GpuContext, Result};
+
+/// All chunks on the GPU.
+#[derive(Debug)]
+pub struct ChunkStore {
+    layout: wgpu::BindGroupLayout,
+    /// How the chunk pipelines fetch quads: what the pages and records are.
+    pub(super) fetch: QuadFetch,
+    arena: QuadArena,
+    /// One [`ChunkUniforms`] per slot, and its CPU copy.
+    infos: Records,
+    info_data: Vec<ChunkUniforms>,
+    /// Group 1 per page index: the page's quads and the chunk records (`None` for a page
+    /// given back).
+    groups: Vec<Option<wgpu::BindGroup>>,
+    slots: Vec<Option<GpuChunk>>,
+    free_slots: Vec<u32>,
+    by_pos: PosMap<ChunkPos, u32>,
+    /// The chunks by region, for culling.
+    regions: Regions,
+    pub(super) indirect: wgpu::Buffer,
+    next_generation: u64,
+    /// Whether a frame's draw lists hold places that its submit has not yet drawn (from
+    /// [`ChunkStore::lists_built`] to [`ChunkStore::frame_submitted`]).
+    in_flight: bool,
+    /// Places and slots freed while a frame was in flight: reused only once it is
+    /// submitted, so that nothing written before its submit changes what it draws.
+    retired: Vec<Alloc>,
+    retired_slots: Vec<u32>,
+    /// Opacity by block id, for the planes of translucent meshes.
+    block_opacity: Arc<[f32]>,
+    /// Whether each block id is a volume (has absorption).
+    volume_blocks: Arc<[bool]>,
+}
+
+const FIRST_SLOTS: usize = 1024;
+
+impl ChunkStore {
+    /// An empty store whose bind groups use `layout` (group 1 of
+    /// [`crate::SharedLayouts`], for `fetch`).
+    /// `block_opacity` (by block id) weighs the planes of translucent meshes
+    /// ([`crate::layers`]); `volume_blocks` (by block id) says which block types are
+    /// volumes.
+    pub fn new(
+        ctx: &GpuContext,
+        layout: wgpu::BindGroupLayout,
+        fetch: QuadFetch,
+        block_opacity: Arc<[f32]>,
+        volume_blocks: Arc<[bool]>,
+    ) -> Self {
+        let l = &ctx.caps.limits;
+        let infos = Records::new(&ctx.device, fetch, l, FIRST_SLOTS);
+        let indirect = Self::indirect_buffer(&ctx.device, FIRST_SLOTS);
+        Self {
+            layout,
+            fetch,
+            arena: QuadArena::new(fetch.max_page_bytes(l), fetch.page_usage()),
+            infos,
+            info_data: Vec::new(),
+            groups: Vec::new(),
+            slots: Vec::new(),
+            free_slots: Vec::new(),
+            by_pos: PosMap::default(),
+            regions: Regions::default(),
+            indirect,
+            next_generation: 1,
+            in_flight: false,
+            retired: Vec::new(),
+            retired_slots: Vec::new(),
+            block_opacity,
+            volume_blocks,
+        }
+    }
+
+    fn indirect_buffer(device: &wgpu::Device, commands: usize) -> wgpu::Buffer {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("chunk_draws"),
+            size: (commands.max(1) * std::mem::size_of::<DrawCommand>()) as u64,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// Group 1 of every page, remade after the pages or the record buffer changed. With
+    /// [`QuadFetch::Instanced`] the group holds a record only (the page is a vertex
+    /// buffer; each draw picks its chunk's record), the same for every page.
+    fn remake_groups(&mut self, device: &wgpu::Device) {
+        let records = match self.fetch {
+            QuadFetch::Storage => None,
+            QuadFetch::Instanced => Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("chunk_record"),
+                layout: &self.layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.infos.binding(),
+                }],
+            })),
+        };
+        self.groups = (0..self.arena.pages())
+            .map(|i| {
+                let page = self.arena.page(i)?;
+                Some(match &records {
+                    Some(group) => group.clone(),
+                    None => gpu::bind_group(
+                        device,
+                        "chunk_page",
+                        &self.layout,
+                        &[page.as_entire_binding(), self.infos.binding()],
+                    ),
+                })
+            })
+            .collect();
+    }
+
+    /// Sets what draws from page `page` read: its group 1, or with
+    /// [`QuadFetch::Instanced`] the page as vertex buffer 0 (the group goes with each
+    /// draw). `false` for a page given back.
+    pub(super) fn bind_page(&self, page: u32, pass: &mut wgpu::RenderPass<'_>) -> bool {
+        let (Some(Some(group)), Some(buffer)) = (
+            self.groups.get(page as usize),
+            self.arena.page(page as usize),
+        ) else {
+            return false;
+        };
+        match self.fetch {
+            QuadFetch::Storage => pass.set_bind_group(1, group, &[]),
+            QuadFetch::Instanced => pass.set_vertex_buffer(0, buffer.slice(..)),
+        }
+        true
+    }
+
+    /// Draws quads `quads` (positions in the mesh) of the mesh of command `c`, in page
+    /// `page`, which is bound ([`ChunkStore::bind_page`]).
+    pub(super) fn draw(
+        &self,
+        page: u32,
+        c: &DrawCommand,
+        quads: std::ops::Range<u32>,
+        pass: &mut wgpu::RenderPass<'_>,
+    ) {
+        let slot = c.first_instance;
+        let first = c.first_vertex / 6 + quads.start;
+        let (vertices, instances) = self.fetch.draw_ranges(slot, first, quads.len() as u32);
+        if self.fetch == QuadFetch::Instanced
+            && let Some(Some(group)) = self.groups.get(page as usize)
+        {
+            pass.set_bind_group(1, group, &[self.infos.offset(slot)]);
+        }
+        pass.draw(vertices, instances);
+    }
+
+    /// Call once a frame's draw lists hold the meshes' places: from now until
+    /// [`ChunkStore::frame_submitted`], freed places and slots are kept from reuse.
+    pub fn lists_built(&mut self) {
+        self.in_flight = true;
+    }
+
+    /// Call once the frame whose lists were built is submitted (or before the next
+    /// frame's lists are built, which implies it): the places and slots freed meanwhile
+    /// become free, and pages left empty are given back.
+    pub fn frame_submitted(&mut self, ctx: &GpuContext) {
+        self.in_flight = false;
+        let mut dropped = false;
+        for a in std::mem::take(&mut self.retired) {
+            if self.arena.free(a) {
+                dropped |= self.arena.drop_page(a.page);
+            }
+        }
+        self.free_slots.append(&mut self.retired_slots);
+        if dropped {
+            self.remake_groups(&ctx.device);
+        }
+    }
+
+    /// Frees a place now, or once the frame in flight is submitted; gives its page back
+    /// when that leaves it empty. Returns whether the pages changed.
+    fn free_place(&mut self, a: Alloc) -> bool {
+        if self.in_flight {
+            self.retired.push(a);
+            return false;
+        }
+        self.arena.free(a) && self.arena.drop_page(a.page)
+    }
+
+    /// The layout of group 1.
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// Writes slot `slot`'s record (growing the record buffer when needed).
+    fn write_info(&mut self, ctx: &GpuContext, slot: u32, info: ChunkUniforms) {
+        let i = slot as usize;
+        if i >= self.info_data.len() {
+            self.info_data.resize(i + 1, ChunkUniforms::default());
+        }
+        self.info_data[i] = info;
+        if i >= self.infos.capacity() {
+            let slots = (self.infos.capacity() * 2).max(i + 1);
+            self.infos = Records::new(&ctx.device, self.fetch, &ctx.caps.limits, slots);
+            self.infos
+                .write(&ctx.queue, 0, bytemuck::cast_slice(&self.info_data));
+            self.remake_groups(&ctx.device);
+        } else {
+            self.infos.write(&ctx.queue, i, bytemuck::bytes_of(&info));
+        }
+    }
+
+    /// Room for `quads` in the arena (a new page, with its bind group, when needed), with
+    /// the quads written. `Ok(None)` for a mesh the arena refuses (checked before).
+    fn alloc(&mut self, ctx: &GpuContext, quads: &[PackedQuad]) -> Result<Option<Alloc>> {
+        let Ok(n) = u32::try_from(quads.len()) else {
+            return Ok(None);
+        };
+        let Some((a, grew)) = self.arena.alloc(&ctx.device, n)? else {
+            return Ok(None);
+        };
+        if grew {
+            self.remake_groups(&ctx.device);
+        }
+        self.arena.write(&ctx.queue, a, quads);
+        Ok(Some(a))
+    }
+
+    /// Uploads (or replaces) a chunk's meshes. A chunk whose meshes are all empty is
+    /// removed: no quad and no draw exists for an empty mesh. A mesh of more quads than
+    /// one page holds ([`crate::arena::QuadArena::max_mesh_quads`]: the adapter's storage
+    /// binding; a 32³ chunk has at most 196 608 quads) is an [`Error::TooLarge`] and
+    /// changes nothing. A new page the device cannot make is an [`Error::Gpu`].
+    ///
+    /// The places a frame in flight draws are never written: a replaced mesh keeps its
+    /// place until that frame is submitted ([`ChunkStore::frame_submitted`]).
+    pub fn upload(&mut self, ctx: &GpuContext, pos: ChunkPos, meshes: &ChunkMeshes) -> Result<()> {
+        let limit = self.arena.max_mesh_quads();
+        for (kind, quads) in [
+            ("opaque", &meshes.opaque),
+            ("cutout", &meshes.cutout),
+            ("translucent", &meshes.translucent),
+        ] {
+            if quads.len() as u64 > u64::from(limit) {
+                return Err(Error::TooLarge {
+                    what: format!("the {kind} mesh of chunk {pos:?}, in quads,"),
+                    value: quads.len() as u64,
+                    limit_name: match self.fetch {
+                        QuadFetch::Storage => "max_storage_buffer_binding_size (in 8-byte quads)",
+                        QuadFetch::Instanced => "max_buffer_size (in 8-byte quads)",
+                    },
+                    limit: u64::from(limit),
+                });
+            }
+        }
+        if meshes.is_empty() {
+            self.remove(ctx, pos);
+            return Ok(());
+        }
+        // Place the new meshes before freeing the old ones: a failure changes nothing, and
+        // the old places (which a frame in flight may draw) are not reused by the new.
+        let mut allocs = [None; 3];
+        for (k, quads) in [&meshes.opaque, &meshes.cutout, &meshes.translucent]
+            .into_iter()
+            .enumerate()
+        {
+            if quads.is_empty() {
+                continue;
+            }
+            match self.alloc(ctx, quads) {
+                Ok(Some(a)) => allocs[k] = Some(a),
+                failed => {
+                    let mut changed = false;
+                    for a in allocs.into_iter().flatten() {
+                        changed |= self.arena.free(a) && self.arena.drop_page(a.page);
+                    }
+                    if changed {
+                        self.remake_groups(&ctx.device);
+                    }
+                    return Err(failed.err().unwrap_or_else(|| {
+                        Error::Unsupported(format!(
+                            "the quad arena found no room for {} quads",
+                            quads.len()
+                        ))
+                    }));
+                }
+            }
+        }
+        let (slot, alpha) = match self.by_pos.get(&pos) {
+            Some(&s) => {
+                self.free_meshes(ctx, s);
+                // A chunk fading in goes on fading from where it was.
+                (s, self.info_data.get(s as usize).map_or(1.0, |i| i.alpha))
+            }
+            None => {
+                let s = self.free_slots.pop().unwrap_or(self.slots.len() as u32);
+                if s as usize == self.slots.len() {
+                    self.slots.push(None);
+                }
+                self.by_pos.insert(pos, s);
+                (s, 1.0)
+            }
+        };
+        let origin = pos.origin().map(|v| v as i32);
+        self.write_info(ctx, slot, ChunkUniforms { origin, alpha });
+        // One pass over the translucent quads; their box and distinct planes follow.
+        let planes = layers::planes(&meshes.translucent, &self.block_opacity);
+        self.regions.set(slot, pos, allocs, Some(&planes));
+        self.slots[slot as usize] = Some(GpuChunk {
+            pos,
+            meshes: allocs,
+            translucent: meshes.translucent.clone(),
+            translucent_bounds: layers_bounds(&planes),
+            translucent_planes: distinct_planes(&planes),
+            volume: meshes.translucent.iter().any(|q| {
+                let block = q.unpack().map_or(0, |u| u.block.index());
+                self.volume_blocks.get(block).copied().unwrap_or(false)
+            }),
+            generation: self.next_generation,
+        });
+        self.next_generation += 1;
+        Ok(())
+    }
+
+    fn free_meshes(&mut self, ctx: &GpuContext, slot: u32) {
+        if let Some(c) = self.slots.get_mut(slot as usize).and_then(Option::take) {
+            let mut changed = false;
+            for a in c.meshes.into_iter().flatten() {
+                changed |= self.free_place(a);
+            }
+            if changed {
+                self.remake_groups(&ctx.device);
+            }
+        }
+    }
+
+    /// Removes a chunk and frees its quads (once the frame in flight is submitted, if
+    /// one is); a page left empty is given back.
+    pub fn remove(&mut self, ctx: &GpuContext, pos: ChunkPos) {
+        if let Some(slot) = self.by_pos.remove(&pos) {
+            self.free_meshes(ctx, slot);
+            self.regions.remove(slot);
+            if self.in_flight {
+                self.retired_slots.push(slot);
+            } else {
+                self.free_slots.push(slot);
+            }
+        }
+    }
+
+    /// Removes every chunk.
+    pub fn clear(&mut self, ctx: &GpuContext) {
+        let all: Vec<ChunkPos> = self.by_pos.keys().copied().collect();
+        for pos in all {
+            self.remove(ctx, pos);
+        }
+    }
+
+    /// The chunk at `pos`, if uploaded.
+    pub fn get(&self, pos: ChunkPos) -> Option<&GpuChunk> {
+        let slot = *self.by_pos.get(&pos)?;
+        self.by_slot(slot)
+    }
+
+    /// The chunk in `slot` (what [`Culled::translucent_slots`] names), without a lookup
+    /// by position.
+    pub fn by_slot(&self, slot: u32) -> Option<&GpuChunk> {
+        self.slots.get(slot as usize)?.as_ref()
+    }
+
+    /// Number of chunks on the GPU.
+    pub fn len(&self) -> usize {
+        self.by_pos.len()
+    }
+
+    /// Whether no chunk is on the GPU.
+    pub fn is_empty(&self) -> bool {
+        self.by_pos.is_empty()
+    }
+
+    /// The chunks on the GPU.
+    pub fn iter(&self) -> impl Iterator<Item = &GpuChunk> {
+        self.slots.iter().flatten()
+    }
+
+    /// What the arena holds, and the bytes of the chunk records.
+    pub fn memory(&self) -> (ArenaStats, u64) {
+        (self.arena.stats(), self.infos.bytes())
+    }
+
+    /// Bytes of the indirect command buffer.
+    pub fn indirect_bytes(&self) -> u64 {
+        self.indirect.size()
+    }
+
+    /// Rewrites a chunk's translucent quads in a new order (the same quads: a permutation
+    /// of [`GpuChunk::translucent_quads`]), for sorting. The generation stays.
+    pub fn reorder_translucent(&mut self, ctx: &GpuContext, pos: ChunkPos, quads: Vec<PackedQuad>) {
+        let Some(&slot) = self.by_pos.get(&pos) else {
+            return;
+        };
+        let Some(c) = self.slots[slot as usize].as_mut() else {
+            return;
+        };
+        if let Some(a) = c.meshes[MeshKind::Translucent as usize]
+            && quads.len() == a.quads as usize
+        {
+            self.arena.write(&ctx.queue, a, &quads);
+            c.translucent = quads;
+        }
+    }
+
+    /// Sets a chunk's whole-chunk opacity (fade-in).
+    pub fn set_alpha(&mut self, ctx: &GpuContext, pos: ChunkPos, alpha: f32) {
+        if let Some(&slot) = self.by_pos.get(&pos) {
+            let info = ChunkUniforms {
+                origin: pos.origin().map(|v| v as i32),
+                alpha: alpha.clamp(0.0, 1.0),
+            };
+            self.write_info(ctx, slot, info);
+        }
+    }
+
+    /// Finds the visible meshes of every kind in one pass over the regions (see the module
+    /// docs) and puts them in draw order into `out` (see [`Culled`]): the meshes of every
+    /// chunk whose box [`Frustum::chunk_distance`] does not put outside the frustum. With
+    /// `layers`, it also copies the visible translucent meshes' planes
+    /// ([`Culled::translucent_layers`]).
+    pub fn cull(&self, frustum: &Frustum, layers: bool, out: &mut Culled) {
+        for list in &mut out.near {
+            list.clear();
+        }
+        out.far.clear();
+        out.positions.clear();
+        out.keys.clear();
+        out.layers.clear();
+        let eye = frustum.eye.to_array();
+        let [opaque, cutout] = &mut out.near;
+        let (far, buffer) = (&mut out.far, &mut out.layers);
+        self.regions.cull(frustum, |m, distance, planes| {
+            for (list, mesh) in [(&mut *opaque, m.meshes[0]), (&mut *cutout, m.meshes[1])] {
+                if let Some(mesh) = mesh {
+                    list.push(NearEntry {
+                        key: near_key(mesh.page, distance, m.slot),
+                        mesh,
+                    });
+                }
+            }
+            if let Some(mesh) = m.meshes[2] {
+                far.push(FarEntry {
+                    key: voxel_mesh::order::chunk_order_key(m.pos, eye),
+                    pos: m.pos,
+                    slot: m.slot,
+                    mesh,
+                });
+                if layers {
+                    buffer.push(m.pos, planes);
+                }
+            }
+        });
+        // Every key is unique (it holds the slot, or the position): an unstable sort gives
+        // the one order.
+        for list in &mut out.near {
+            list.sort_unstable_by_key(|e| e.key);
+        }
+        out.far
+            .sort_unstable_by(|a, b| b.key.cmp(&a.key).then(a.pos.cmp(&b.pos)));
+        out.positions.extend(out.far.iter().map(|e| e.pos));
+        out.keys.extend(out.far.iter().map(|e| e.key));
+    }
+
+    /// Uploads a frame's draw commands to the indirect buffer (growing it when needed).
+    pub fn upload_draws(&mut self, ctx: &GpuContext, commands: &[DrawCommand]) {
+        let bytes = std::mem::size_of_val(commands) as u64;
+        if bytes > self.indirect.size() {
+            self.indirect = Self::indirect_buffer(&ctx.device, commands.len() * 2);
+        }
+        if !commands.is_empty() {
+            ctx.queue
+                .write_buffer(&self.indirect, 0, bytemuck::cast_slice(commands));
+        }
+    }
+
+    /// Moves the meshes off the arena's emptiest page when more than half of the arena is
+    /// free (see [`crate::arena`]). Returns whether a page was freed. Runs only between
+    /// frames (no frame in flight: see [`ChunkStore::frame_submitted`]).
+    ///
+    /// The copies are submitted at once, on an encoder of their own: a write to a moved
+    /// mesh's new place made after this (a technique re-sorting its quads this frame, an
+    /// upload before the frame's submit) lands after the copy, never under it.
+    pub fn compact(&mut self, ctx: &GpuContext) -> bool {
+        if self.in_flight {
+            return false;
+        }
+        let Some(page) = self.arena.page_to_compact() else {
+            return false;
+        };
+        let moving: Vec<(usize, usize, Alloc)> = self
+            .slots
+            .iter()
+            .enumerate()
+            .filter_map(|(s, c)| c.as_ref().map(|c| (s, c)))
+            .flat_map(|(s, c)| {
+                c.meshes
+                    .iter()
+                    .enumerate()
+                    .filter_map(move |(k, a)| a.filter(|a| a.page == page).map(|a| (s, k, a)))
+            })
+            .collect();
+        let allocs: Vec<Alloc> = moving.iter().map(|m| m.2).collect();
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("quad_arena_compaction"),
+            });
+        let Some(crate::arena::Compacted { placed }) =
+            self.arena.compact(&mut encoder, page, &allocs)
+        else {
+            return false;
+        };
+        ctx.queue.submit([encoder.finish()]);
+        for ((s, k, _), to) in moving.iter().zip(placed) {
+            if let Some(c) = self.slots[*s].as_mut() {
+                c.meshes[*k] = Some(to);
+                self.regions.set(*s as u32, c.pos, c.meshes, None);
+            }
+        }
+        self.remake_groups(&ctx.device);
+        true
+    }
+}

@@ -1,0 +1,647 @@
+//! Recording a frame: the camera and output checks, the frame uniforms, and the passes
+//! in order (opaque, the game's stages, the technique, tonemap).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::Mat4;
+use voxel_core::BlockId;
+
+#[cfg(doc)]
+use super::RendererConfig;
+use super::config::{OUTPUT_FORMATS, output_format, sun_unit};
+use super::targets::MSAA_SAMPLES;
+use super::{FrameStats, Renderer};
+use crate::bindings::{FrameUniforms, NO_MEDIUM};
+use crate::chunks::{DrawList, DrawMode, FrameDraws, Frustum, GpuChunk, MeshKind};
+use crate::error::scoped;
+use crate::gpu::{self, Depth, Pass};
+use crate::medium::{self, MediumLook};
+use crate::oit::sorted::interleave::ChunkSequence;
+use crate::oit::{FrameView, Technique, TechniqueReport, TranslucentFrame};
+use crate::stages::{GameDraw, GameFrame, GameStages, NoGame, Split, TranslucentContract};
+use crate::timing::{GpuPass, Timer};
+use crate::{Camera, Error, Result};
+
+impl Renderer {
+    /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of
+    /// mip level 0 of a single-layer, single-sample 2D texture of the renderer's size,
+    /// of one of [`OUTPUT_FORMATS`], with `RENDER_ATTACHMENT` usage. The view has its
+    /// texture's format, or [`RendererConfig::output_view_format`] when that is the
+    /// texture's twin. Anything else is an [`Error::Output`] before anything is recorded.
+    ///
+    /// Nothing needs calling after the frame's commands are submitted: GPU timings and
+    /// a technique's counters (depth peeling's layers) are read back once they are.
+    ///
+    /// Fails without recording anything on an invalid camera (NaN, zero direction, bad
+    /// planes), a mismatched output ([`Error::Output`]) or a lost device
+    /// ([`Error::DeviceLost`]).
+    ///
+    /// Submit each frame before recording the next: what changes between `render` and
+    /// the submit (chunks uploaded or removed) never changes what this frame draws, and
+    /// the arena places it draws are reused only after [`Renderer::after_submit`] or the
+    /// next `render`.
+    ///
+    /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
+    /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
+    /// encoder that replaces it (the order of commands is kept). Real-time techniques never
+    /// submit.
+    pub fn render(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        output: &wgpu::TextureView,
+        camera: &Camera,
+    ) -> Result<FrameStats> {
+        self.render_with(encoder, output, camera, &mut NoGame)
+    }
+
+    /// What a game's translucent pipelines must match for the technique in force, made
+    /// (with the technique's resources) when first asked for; its `id` changes when a
+    /// technique switch or a setting needs new pipelines ([`crate::stages`]).
+    pub fn translucent_contract(&mut self) -> Result<Arc<TranslucentContract>> {
+        self.ctx.check_device()?;
+        self.oit.contract()
+    }
+
+    /// [`Renderer::translucent_contract`] of `technique` (or what replaces it on this
+    /// device), before switching to it: a game builds its translucent pipelines for every
+    /// technique its settings offer at loading time, as [`Renderer::prebuild_technique`]
+    /// builds the renderer's (which this does too), so that a switch compiles nothing.
+    /// The id is the one the contract has once the technique is in force.
+    pub fn translucent_contract_for(
+        &mut self,
+        technique: Technique,
+    ) -> Result<Arc<TranslucentContract>> {
+        self.ctx.check_device()?;
+        let oit = &mut self.oit;
+        scoped(&self.ctx.device, "building a technique ahead", || {
+            oit.contract_for(technique)
+        })?
+    }
+
+    /// [`Renderer::render`] with a game's stages: its opaque geometry after the world's,
+    /// its translucent geometry composed by the technique with the chunks, its overlays
+    /// before and after tonemapping (see [`crate::stages`]). A stage the game does not
+    /// declare costs nothing.
+    pub fn render_with(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        output: &wgpu::TextureView,
+        camera: &Camera,
+        game: &mut dyn GameStages,
+    ) -> Result<FrameStats> {
+        self.ctx.check_device()?;
+        camera.validate()?;
+        // The output's format (its tonemap pipeline made the first time), checked with it.
+        let format = output_format(self.config.output_view_format, output.texture().format());
+        if OUTPUT_FORMATS.contains(&format) {
+            self.post.make_tonemap(&self.ctx, format);
+        }
+        self.check_output(output, format)?;
+        let stages = game.stages();
+        if stages.translucent {
+            let current = self.oit.contract()?.id;
+            let built_for = game.translucent_contract_id();
+            if built_for != Some(current) {
+                return Err(Error::StaleContract {
+                    built_for,
+                    current,
+                    technique: self.oit.technique().name(),
+                });
+            }
+        }
+        if format != self.config.output_format {
+            log::info!(
+                "drawing into {format:?} from now on (was {:?})",
+                self.config.output_format
+            );
+            self.config.output_format = format;
+        }
+        let start = Instant::now();
+        // Ends the last timed frame if it was submitted since; this one is timed unless
+        // it is not.
+        let last = self.settle_submission();
+        let ctx = &self.ctx;
+        let timed = self
+            .timer
+            .as_mut()
+            .is_some_and(|t| t.begin_frame(ctx, last));
+        self.update_fades();
+        // The previous frame is submitted (the contract above): what it drew may be reused.
+        self.chunks.frame_submitted(&self.ctx);
+        // Before any list of this frame takes the meshes' places.
+        self.chunks.compact(&self.ctx);
+        let (w, h) = self.size();
+        let aspect = f64::from(w) / f64::from(h);
+        let camera = &self.drawn_camera(camera);
+        let medium = camera
+            .medium
+            .and_then(|b| Some((b, self.looks.get(b.index()).copied().flatten()?)));
+        let view_proj = camera.view_proj(aspect);
+        let frustum = Frustum::new(view_proj, camera.eye);
+
+        // One pass over the chunks finds the visible meshes of every kind, in draw order:
+        // translucent chunks farthest first, by the integer key that is exact for a grid of
+        // equal cubes (`voxel_mesh::order`); opaque and cutout meshes grouped by page, front
+        // to back (early depth rejection).
+        let layers = self.oit.wants_layers();
+        self.chunks.cull(&frustum, layers, &mut self.culled);
+        self.chunks.lists_built();
+        // A volume in view: its faces read the opaque depth (a copy, made below), whose
+        // target is made the first time.
+        let volumes = self
+            .culled
+            .translucent_slots()
+            .any(|slot| self.chunks.by_slot(slot).is_some_and(GpuChunk::has_volume));
+        if volumes && !self.targets.volumes {
+            let (size, msaa) = (self.size(), self.config.msaa);
+            let targets = scoped(&self.ctx.device, "making the volume depth", || {
+                self.targets_for(size, msaa, true)
+            })?;
+            self.targets = targets;
+        }
+        // The technique's CPU work (it may reorder quads within their places).
+        let view = FrameView {
+            camera,
+            view_proj,
+            translucent: self.culled.translucent_positions(),
+            layers: self.culled.translucent_layers(),
+            game_objects: stages.translucent.then(|| game.translucent_objects()),
+        };
+        self.oit
+            .prepare(&mut self.chunks, &view, stages.translucent)?;
+        // A sorting technique orders the game's objects with the chunks (after `prepare`:
+        // sorted-quads splits a chunk's quads in their new order).
+        let sort_start = Instant::now();
+        let sorts = stages.translucent && self.oit.technique().sorts();
+        if sorts {
+            // Each visible translucent chunk's surfaces, in draw order.
+            let chunks: Vec<_> = self
+                .culled
+                .translucent_slots()
+                .map(|slot| {
+                    self.chunks
+                        .by_slot(slot)
+                        .and_then(|c| c.translucent_surfaces())
+                })
+                .collect();
+            let split_quads = self.oit.technique() == Technique::SortedQuads;
+            let sequence = ChunkSequence {
+                surfaces: &chunks,
+                keys: self.culled.translucent_keys(),
+                positions: self.culled.translucent_positions(),
+            };
+            self.interleaver.order(
+                game.translucent_objects(),
+                camera.eye,
+                &sequence,
+                medium.is_some(),
+                split_quads,
+            );
+        }
+        let (order, splits): (&[u32], &[Split]) = if sorts {
+            self.interleaver.result()
+        } else {
+            (&[], &[])
+        };
+        let game_sort_ms = sort_start.elapsed().as_secs_f64() * 1e3;
+        let objects = if sorts {
+            order.len()
+        } else {
+            game.translucent_objects().len()
+        };
+        // The sorted techniques (drawn in order, one blend per fragment) compose a fragment
+        // inside a volume against the volume's entry (`inside_volume.wgsl`).
+        let ordered = matches!(
+            self.oit.technique(),
+            Technique::Sorted | Technique::SortedQuads | Technique::DepthPeeling
+        );
+        let volume_mode = match (volumes, ordered) {
+            (false, _) => 0,
+            (true, false) => 1,
+            (true, true) => 2,
+        };
+        self.write_frame_uniforms(
+            camera,
+            view_proj,
+            medium.as_ref().map(|(b, look)| (*b, look)),
+            volume_mode,
+        );
+        let (eye_int, eye_frac) = camera.eye_split();
+        let game_frame = GameFrame {
+            camera,
+            view_proj,
+            eye_int,
+            eye_frac,
+            size: (w, h),
+            opaque_samples: if self.config.msaa { MSAA_SAMPLES } else { 1 },
+            output_format: self.config.output_format,
+            order: sorts.then_some(order),
+        };
+        if stages != crate::stages::Stages::default() {
+            game.prepare(&self.ctx, &game_frame);
+            // A device lost now (a reset can land in the game's code) makes nothing valid:
+            // nothing more is recorded.
+            self.ctx.check_device()?;
+        }
+        let game = &*game;
+
+        let builder = &mut self.builder;
+        builder.clear();
+        let lists = [MeshKind::Opaque, MeshKind::Cutout, MeshKind::Translucent]
+            .map(|kind| builder.list(self.culled.meshes(kind)));
+        // Per-chunk draws read the commands on the CPU.
+        if self.config.draw == DrawMode::Indirect {
+            self.chunks.upload_draws(&self.ctx, self.builder.commands());
+        }
+        let draws = FrameDraws {
+            store: &self.chunks,
+            commands: self.builder.commands(),
+            mode: self.config.draw,
+        };
+        let [opaque, cutout, translucent] = &lists;
+
+        let timer = self.timer.as_ref().filter(|_| timed);
+        let t = &self.targets;
+        let game_opaque = stages.opaque.then_some((game, &game_frame));
+        self.draw_opaque(encoder, &draws, opaque, cutout, game_opaque, timer);
+        if stages.opaque {
+            self.ctx.check_device()?;
+        }
+        if medium.is_some() {
+            let scene = &t.boundary_scene_group;
+            self.medium.boundary_pass(
+                encoder,
+                &t.depth,
+                &t.boundary,
+                scene,
+                &draws,
+                translucent,
+                timer,
+            );
+        }
+        if volumes {
+            let exits = (!self.oit.technique().is_exact()).then_some((
+                &t.exit_scene_group,
+                &draws,
+                translucent,
+            ));
+            self.medium
+                .volume_depth_pass(encoder, &t.depth, &t.volume_depth, exits, timer);
+            if volume_mode == 2 {
+                self.medium.volume_entry_pass(
+                    encoder,
+                    &t.depth,
+                    (&t.volume_entry, &t.entry_look),
+                    &t.entry_scene_group,
+                    &draws,
+                    translucent,
+                    timer,
+                );
+            }
+        }
+        let game_draw = stages.translucent.then(|| GameDraw {
+            stages: game,
+            frame: &game_frame,
+            objects,
+            splits,
+            frame_buffer: &self.scene.frame_buffer,
+            boundary: &t.boundary.view,
+            depth_sampler: &self.scene.depth_sampler,
+            volume_depth: &t.volume_depth.view,
+            volume_entry: &t.volume_entry.view,
+            entry_look: &t.entry_look.view,
+        });
+        self.oit.render(
+            encoder,
+            &TranslucentFrame {
+                target: &t.color,
+                depth: &t.depth,
+                scene: &t.scene_group,
+                draws: &draws,
+                chunks: translucent,
+                timer,
+                two_sided: medium.is_some(),
+                volumes,
+                game: game_draw.as_ref(),
+            },
+        )?;
+        if stages.translucent {
+            self.ctx.check_device()?;
+        }
+        if let Some((_, look)) = &medium {
+            let sun = sun_unit(self.config.sun_dir);
+            let light = self.config.ambient + (1.0 - self.config.ambient) * sun.y.max(0.0);
+            let params = medium::fog_params(look, camera, aspect, [w as f32, h as f32], light);
+            self.ctx
+                .queue
+                .write_buffer(&self.medium.fog_params, 0, bytemuck::bytes_of(&params));
+            self.medium.fog_pass(encoder, &t.color, &t.fog_group, timer);
+        }
+        if stages.hdr_overlay {
+            let colors = [gpu::load(&t.color.view)];
+            Pass::new("game_hdr_overlay", GpuPass::Game, &colors)
+                .depth(Depth::ReadOnly(&t.depth.view))
+                .record(encoder, timer, |pass| game.hdr_overlay(pass, &game_frame));
+            self.ctx.check_device()?;
+        }
+        self.tonemap(encoder, output, timer);
+        if stages.overlay {
+            let colors = [gpu::load(output)];
+            Pass::new("game_overlay", GpuPass::Game, &colors)
+                .record(encoder, timer, |pass| game.overlay(pass, &game_frame));
+            self.ctx.check_device()?;
+        }
+        let stats = FrameStats {
+            meshes_drawn: lists.each_ref().map(DrawList::meshes),
+            translucent_quads: translucent.quads() as usize,
+            draw_calls: lists.iter().map(|l| l.calls(self.config.draw)).sum(),
+            cpu_ms: 0.0,
+            technique: TechniqueReport::default(),
+            game_objects_sorted: order.len(),
+            game_sort_ms,
+        };
+        if timed && let Some(t) = &mut self.timer {
+            t.end_frame(&self.ctx, encoder);
+        }
+        self.submissions.attach(&self.ctx, encoder);
+        Ok(FrameStats {
+            cpu_ms: start.elapsed().as_secs_f64() * 1e3,
+            technique: self.oit.report(),
+            ..stats
+        })
+    }
+
+    /// The camera a frame of `camera` is drawn with: no translucent face closer than the
+    /// near plane's corners (the near plane shrinks for the frame), and an eye within
+    /// [`crate::MIN_NEAR`] of a translucent face moved off it to its medium's side
+    /// ([`medium::guard`]). Tools that reason about the picture's geometry (the lab's quad
+    /// edges) use this one.
+    pub fn drawn_camera(&self, camera: &Camera) -> Camera {
+        let (w, h) = self.size();
+        medium::guard(
+            &camera.normalized(),
+            f64::from(w) / f64::from(h),
+            &self.chunks,
+        )
+    }
+
+    /// Renders one frame into `output` and submits it (for tools and tests).
+    pub fn render_and_submit(
+        &mut self,
+        output: &wgpu::TextureView,
+        camera: &Camera,
+    ) -> Result<FrameStats> {
+        self.render_and_submit_with(output, camera, &mut NoGame)
+    }
+
+    /// [`Renderer::render_and_submit`] with a game's stages ([`Renderer::render_with`]).
+    pub fn render_and_submit_with(
+        &mut self,
+        output: &wgpu::TextureView,
+        camera: &Camera,
+        game: &mut dyn GameStages,
+    ) -> Result<FrameStats> {
+        let mut encoder = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame"),
+            });
+        let stats = self.render_with(&mut encoder, output, camera, game)?;
+        self.ctx.check_device()?;
+        self.ctx.queue.submit([encoder.finish()]);
+        // A loss during the submission is this frame's too.
+        self.ctx.check_device()?;
+        Ok(stats)
+    }
+
+    /// The output must match what the tonemap pipeline and the targets are made for: the
+    /// texture's size, format, usage, samples, dimension and layers here; what only the
+    /// view knows (its mip level, dimension and format; wgpu does not expose them) by
+    /// recording the tonemap's pass into a throwaway encoder inside an error scope, beside
+    /// the scene depth (the renderer's size, so that a view of another level fails).
+    fn check_output(
+        &mut self,
+        output: &wgpu::TextureView,
+        want: wgpu::TextureFormat,
+    ) -> Result<()> {
+        let t = output.texture();
+        let (w, h) = self.size();
+        if (t.width(), t.height()) != (w, h) {
+            return Err(Error::Output(format!(
+                "{}x{} pixels, but the renderer draws {w}x{h} (call resize first)",
+                t.width(),
+                t.height()
+            )));
+        }
+        if !OUTPUT_FORMATS.contains(&t.format()) {
+            return Err(Error::Output(format!(
+                "format {:?}: the renderer draws into {} (last {want:?})",
+                t.format(),
+                OUTPUT_FORMATS.map(|f| format!("{f:?}")).join(", ")
+            )));
+        }
+        if !t.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+            || t.sample_count() != 1
+            || t.dimension() != wgpu::TextureDimension::D2
+            || t.depth_or_array_layers() != 1
+        {
+            return Err(Error::Output(format!(
+                "must be a single-sample, single-layer 2D texture with RENDER_ATTACHMENT usage \
+                 (this one: {:?}, {} samples, {} layers, {:?})",
+                t.dimension(),
+                t.sample_count(),
+                t.depth_or_array_layers(),
+                t.usage()
+            )));
+        }
+        if self.checked_view.as_ref() == Some(output) {
+            return Ok(());
+        }
+        let Some((_, check)) = self.post.tonemap.get(&want) else {
+            return Err(Error::Output(format!("no tonemap pipeline for {want:?}")));
+        };
+        let device = &self.ctx.device;
+        let checked = scoped(device, "checking the output view", || {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("output_view_check"),
+            });
+            let color = [gpu::load(output)];
+            // One pass (about 10 µs on lavapipe): the scene depth beside the output fails
+            // on another size, the pipeline on another view format.
+            Pass::new("output_view_check", GpuPass::Tonemap, &color)
+                .depth(Depth::Load(&self.targets.depth.view))
+                .record(&mut encoder, None, |pass| pass.set_pipeline(check));
+            // Never submitted: recording and finishing are what validate.
+            drop(encoder.finish());
+        });
+        if checked.is_ok() {
+            self.checked_view = Some(output.clone());
+        }
+        checked.map_err(|e| {
+            let why = match &e {
+                Error::Gpu { error, .. } => error.to_string(),
+                other => other.to_string(),
+            };
+            Error::Output(format!(
+                "the view must be a 2D view of mip level 0 ({w}x{h}) viewed as {want:?}: {}",
+                why.lines()
+                    .map(str::trim)
+                    .filter(|l| !l.is_empty())
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            ))
+        })
+    }
+
+    /// Advances chunk fade-ins by one frame.
+    fn update_fades(&mut self) {
+        let frames = self.config.fade_in_frames.max(1);
+        let now = self.frame_index;
+        let mut done = Vec::new();
+        for (&pos, &start) in &self.fading {
+            let t = now.wrapping_sub(start) as f32 / frames as f32;
+            self.chunks.set_alpha(&self.ctx, pos, t.min(1.0));
+            if t >= 1.0 {
+                done.push(pos);
+            }
+        }
+        for pos in done {
+            self.fading.remove(&pos);
+        }
+        self.frame_index = self.frame_index.wrapping_add(1);
+    }
+
+    fn write_frame_uniforms(
+        &self,
+        camera: &Camera,
+        view_proj: Mat4,
+        medium: Option<(BlockId, &MediumLook)>,
+        volumes: u32,
+    ) {
+        let (eye_int, eye_frac) = camera.eye_split();
+        let sun = sun_unit(self.config.sun_dir);
+        let (w, h) = self.size();
+        let tan_y = (camera.fov_y_deg.to_radians() / 2.0).tan();
+        let tan_x = tan_y * f64::from(w) / f64::from(h);
+        let uniforms = FrameUniforms {
+            view_proj: view_proj.to_cols_array_2d(),
+            eye_int: eye_int.map(|v| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32),
+            near: camera.near as f32,
+            eye_frac: eye_frac.to_array(),
+            far: camera.far as f32,
+            sun_dir: sun.to_array(),
+            ambient: self.config.ambient,
+            sky: self.config.sky,
+            viewport: [w as f32, h as f32],
+            medium: medium.map_or(NO_MEDIUM, |(b, _)| u32::from(b.0)),
+            ao_strength: self.config.ao_strength,
+            tan_half: [tan_x as f32, tan_y as f32],
+            volumes,
+            medium_look: medium.map_or([0.0; 4], |(_, look)| {
+                let [r, g, b] = look.color;
+                [r, g, b, look.absorption]
+            }),
+            ..FrameUniforms::default()
+        };
+        self.ctx
+            .queue
+            .write_buffer(&self.scene.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
+    }
+
+    /// The opaque pass, the cutout pass, then the game's opaque stage; with MSAA the
+    /// colour resolves at the end of the last one and the depth in a pass of its own.
+    fn draw_opaque(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        draws: &FrameDraws<'_>,
+        opaque: &DrawList,
+        cutout: &DrawList,
+        game: Option<(&dyn GameStages, &GameFrame<'_>)>,
+        timer: Option<&Timer>,
+    ) {
+        let t = &self.targets;
+        let [r, g, b] = self.config.sky.map(f64::from);
+        let sky = wgpu::Color { r, g, b, a: 1.0 };
+        let (color, depth, resolve) = match &t.msaa {
+            Some((c, d)) => (&c.view, &d.view, Some(&t.color.view)),
+            None => (&t.color.view, &t.depth.view, None),
+        };
+        // The passes that run, in order: the opaque pass always (it clears), the others
+        // when they have something to draw. The last one resolves MSAA colour.
+        let runs = [
+            (GpuPass::Opaque, true),
+            (GpuPass::Cutout, !cutout.is_empty()),
+            (GpuPass::Game, game.is_some()),
+        ];
+        let last = runs.iter().rposition(|r| r.1).unwrap_or(0);
+        for (i, &(kind, run)) in runs.iter().enumerate() {
+            if !run {
+                continue;
+            }
+            let first = i == 0;
+            let colors = [gpu::attachment(
+                color,
+                if first {
+                    wgpu::LoadOp::Clear(sky)
+                } else {
+                    wgpu::LoadOp::Load
+                },
+                if i == last { resolve } else { None },
+            )];
+            // Reverse-Z: clear to 0, the far plane.
+            let depth = if first {
+                Depth::Clear(depth, 0.0)
+            } else {
+                Depth::Load(depth)
+            };
+            let label = if kind == GpuPass::Game {
+                "game_opaque"
+            } else {
+                kind.name()
+            };
+            Pass::new(label, kind, &colors)
+                .depth(depth)
+                .record(encoder, timer, |pass| match (kind, game) {
+                    (GpuPass::Game, Some((game, frame))) => game.opaque(pass, frame),
+                    _ => {
+                        let (pipeline, list) = if first {
+                            (&self.opaque, opaque)
+                        } else {
+                            (&self.cutout, cutout)
+                        };
+                        pass.set_pipeline(pipeline);
+                        pass.set_bind_group(0, &t.scene_group, &[]);
+                        draws.draw(list, pass);
+                    }
+                });
+        }
+        if let Some(group) = &t.depth_resolve_group {
+            Pass::new("depth_resolve", GpuPass::Opaque, &[])
+                .depth(Depth::Clear(&t.depth.view, 0.0))
+                .record(encoder, timer, |pass| {
+                    pass.set_pipeline(&self.post.depth_resolve);
+                    pass.set_bind_group(0, group, &[]);
+                    pass.draw(0..3, 0..1);
+                });
+        }
+    }
+
+    fn tonemap(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        output: &wgpu::TextureView,
+        timer: Option<&Timer>,
+    ) {
+        let Some((pipeline, _)) = self.post.tonemap.get(&self.config.output_format) else {
+            return;
+        };
+        let colors = [gpu::load(output)];
+        Pass::new("tonemap", GpuPass::Tonemap, &colors).record(encoder, timer, |pass| {
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &self.targets.tonemap_group, &[]);
+            pass.draw(0..3, 0..1);
+        });
+    }
+}

@@ -1,0 +1,583 @@
+//! The renderer a game embeds: chunks on the GPU and the passes of a frame in the usual
+//! forward order: opaque (optional 4× MSAA, resolved), cutout, translucent (the selected technique,
+//! depth-tested read-only against the opaque depth), composite over the opaque colour,
+//! tonemap to the output format.
+
+mod config;
+mod frame;
+mod targets;
+#[cfg(test)]
+mod tests;
+
+use std::sync::Arc;
+
+use voxel_core::{BlockRegistry, ChunkPos};
+use voxel_mesh::ChunkMeshes;
+use wgpu::util::DeviceExt;
+
+use crate::bindings::{FrameUniforms, SharedLayouts, common_wgsl};
+use crate::chunks::{ChunkStore, Culled, DrawBuilder, DrawMode, PosMap};
+use crate::error::scoped;
+use crate::fetch::{QuadFetch, TableTexture};
+use crate::gpu::{self, ChunkPipeline, DepthMode};
+use crate::ladder;
+use crate::medium::{self, MediumLook, MediumPass};
+use crate::oit::sorted::interleave::Interleaver;
+use crate::oit::{OitConfig, OitManager, Setup, Technique, TechniqueReport, WeightFunction};
+use crate::submission::{Outcome, Submissions};
+use crate::textures::BlockTextures;
+use crate::timing::{GpuTimes, Timer};
+use crate::{Error, GpuContext, Result};
+
+pub use config::{Lighting, OUTPUT_FORMATS, RendererConfig};
+use config::{check_ao_strength, check_lighting, check_output_format, check_size};
+use targets::{MSAA_SAMPLES, Post, SceneResources, SceneTargets};
+
+/// What a frame drew.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameStats {
+    /// Chunk meshes drawn: opaque, cutout, translucent.
+    pub meshes_drawn: [usize; 3],
+    /// Translucent quads drawn.
+    pub translucent_quads: usize,
+    /// Draw calls recorded for the chunks of the opaque, cutout and translucent lists (once
+    /// each: a technique's extra passes repeat them).
+    pub draw_calls: usize,
+    /// CPU time spent recording the frame, milliseconds (the technique's preparation
+    /// included).
+    pub cpu_ms: f64,
+    /// What the technique did (its CPU time, sorting, layers, overflow, weight fit).
+    pub technique: TechniqueReport,
+    /// The game's translucent objects ordered this frame ([`crate::stages`]; 0 when the
+    /// technique does not sort).
+    pub game_objects_sorted: usize,
+    /// CPU milliseconds ordering them.
+    pub game_sort_ms: f64,
+}
+
+/// GPU memory of the chunks ([`Renderer::chunk_memory`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ChunkMemory {
+    /// Bytes of the quad arena's pages.
+    pub arena_bytes: u64,
+    /// Of those, bytes holding quads (the rest is free room and fragmentation).
+    pub quad_bytes: u64,
+    /// Bytes of the chunk records (16 per slot, with room to grow).
+    pub record_bytes: u64,
+    /// Bytes of the indirect draw commands (16 per mesh drawn, with room to grow).
+    pub indirect_bytes: u64,
+    /// Pages of the arena.
+    pub pages: usize,
+    /// Free ranges over all pages.
+    pub free_ranges: usize,
+}
+
+/// Draws a voxel world. See the module docs for the passes.
+#[derive(Debug)]
+pub struct Renderer {
+    ctx: GpuContext,
+    config: RendererConfig,
+    layouts: SharedLayouts,
+    scene: SceneResources,
+    chunks: ChunkStore,
+    opaque: wgpu::RenderPipeline,
+    cutout: wgpu::RenderPipeline,
+    post: Post,
+    medium: MediumPass,
+    /// Per block id: its look as a medium (translucent blocks only).
+    looks: Vec<Option<MediumLook>>,
+    targets: SceneTargets,
+    oit: OitManager,
+    timer: Option<Timer>,
+    /// What became of each frame's encoder (timings, and flushing a dropped frame's
+    /// queue writes).
+    submissions: Submissions,
+    /// Orders a game's translucent objects among the chunks (sorted techniques), its
+    /// buffers kept between frames.
+    interleaver: Interleaver,
+    frame_index: u32,
+    /// Chunks fading in, with the frame they appeared.
+    fading: PosMap<ChunkPos, u32>,
+    /// The last frame's visible meshes (kept for the room of its lists).
+    culled: Culled,
+    /// The last frame's draw commands (likewise).
+    builder: DrawBuilder,
+    /// The last output view that passed [`Renderer::check_output`]'s recorded check, so
+    /// that drawing into the same view again skips it (a window's views are new each
+    /// frame and pay it: about 0.08 ms on this project's 2-core machine).
+    checked_view: Option<wgpu::TextureView>,
+}
+
+impl Renderer {
+    /// A renderer for the blocks of `registry`. Falls back (with a log line) where the
+    /// adapter lacks something: MSAA off without 4× support, a technique it cannot run.
+    /// A size beyond the adapter's limits or an invalid setting is an error.
+    pub fn new(ctx: &GpuContext, registry: &BlockRegistry, config: RendererConfig) -> Result<Self> {
+        ctx.check_device()?;
+        let mut config = config;
+        config.width = config.width.max(1);
+        config.height = config.height.max(1);
+        check_size(ctx, config.width, config.height)?;
+        check_output_format(ctx, config.output_format)?;
+        check_lighting(&config)?;
+        config.oit.validate()?;
+        check_ao_strength(config.ao_strength)?;
+        ladder::check("drawing the world", &ladder::world_needs(), &ctx.caps)?;
+        if !OUTPUT_FORMATS.contains(&config.output_format) {
+            return Err(Error::InvalidSetting(format!(
+                "output format {:?}: the renderer draws into {}",
+                config.output_format,
+                OUTPUT_FORMATS.map(|f| format!("{f:?}")).join(", ")
+            )));
+        }
+        if config.msaa && !ctx.caps.msaa4 {
+            log::warn!("4x MSAA is not supported for the scene formats: rendering without MSAA");
+            config.msaa = false;
+        }
+        let fetch = QuadFetch::choose(&ctx.caps, config.quad_fetch)?;
+        if config.draw == DrawMode::Indirect && !ctx.caps.indirect_draws() {
+            log::warn!(
+                "no indirect draws with a first instance on this adapter: one draw per chunk mesh"
+            );
+            config.draw = DrawMode::PerChunk;
+        }
+        if config.draw == DrawMode::Indirect && !fetch.indirect() {
+            log::info!("{} quad fetch: one draw per chunk mesh", fetch.name());
+            config.draw = DrawMode::PerChunk;
+        }
+        if fetch != QuadFetch::ALL[0] {
+            log::info!("drawing the world with {} quad fetch", fetch.name());
+        }
+        config.quad_fetch = Some(fetch);
+        scoped(&ctx.device, "creating the renderer", || {
+            Self::create(ctx, registry, config, fetch)
+        })?
+    }
+
+    fn create(
+        ctx: &GpuContext,
+        registry: &BlockRegistry,
+        mut config: RendererConfig,
+        fetch: QuadFetch,
+    ) -> Result<Self> {
+        let device = &ctx.device;
+        let layouts = SharedLayouts::new(device, fetch);
+        let textures = BlockTextures::new(ctx, registry, config.flat_textures)?;
+        let layer_table = (fetch == QuadFetch::Instanced).then(|| {
+            let t = TableTexture::new(
+                device,
+                "block_layer_table",
+                wgpu::TextureFormat::R32Uint,
+                textures.table.len(),
+            );
+            t.write(&ctx.queue, 0, bytemuck::cast_slice(&textures.table));
+            t
+        });
+        let looks = medium::looks(registry);
+        let media = TableTexture::new(
+            device,
+            "block_media",
+            wgpu::TextureFormat::Rgba32Float,
+            looks.len(),
+        );
+        let media_data: Vec<[f32; 4]> = looks
+            .iter()
+            .map(|l| {
+                l.map_or([0.0; 4], |l| {
+                    [l.color[0], l.color[1], l.color[2], l.absorption]
+                })
+            })
+            .collect();
+        media.write(&ctx.queue, 0, bytemuck::cast_slice(&media_data));
+        let scene = SceneResources {
+            frame_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("frame_uniforms"),
+                contents: bytemuck::bytes_of(&FrameUniforms::default()),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            }),
+            textures,
+            layer_table,
+            media,
+            depth_sampler: gpu::depth_sampler(device),
+        };
+        let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
+        let mut post = Post::new(device);
+        post.make_tonemap(ctx, config.output_format);
+        let medium = MediumPass::new(ctx, &layouts);
+        let size = (config.width, config.height);
+        let targets = SceneTargets::new(
+            ctx,
+            &post,
+            &layouts,
+            &scene,
+            &medium,
+            size,
+            (config.msaa, false),
+        );
+        let block_opacity = registry
+            .iter()
+            .map(|(_, def)| def.opacity)
+            .collect::<Arc<[f32]>>();
+        let setup = Setup {
+            ctx: ctx.clone(),
+            layouts: layouts.clone(),
+            size,
+            block_opacity: block_opacity.clone(),
+        };
+        let oit = OitManager::new(setup, config.oit.clone())?;
+        config_with(&mut config.oit, oit.config());
+        Ok(Self {
+            ctx: ctx.clone(),
+            chunks: ChunkStore::new(
+                ctx,
+                layouts.chunk.clone(),
+                fetch,
+                block_opacity,
+                looks
+                    .iter()
+                    .map(|l| l.is_some_and(|l| l.absorption > 0.0))
+                    .collect(),
+            ),
+            layouts,
+            scene,
+            opaque,
+            cutout,
+            post,
+            medium,
+            looks,
+            targets,
+            oit,
+            timer: Timer::new(ctx),
+            submissions: Submissions::default(),
+            interleaver: Interleaver::default(),
+            frame_index: 0,
+            fading: PosMap::default(),
+            culled: Culled::default(),
+            builder: DrawBuilder::default(),
+            checked_view: None,
+            config,
+        })
+    }
+
+    fn opaque_pipelines(
+        ctx: &GpuContext,
+        layouts: &SharedLayouts,
+        msaa: bool,
+    ) -> (wgpu::RenderPipeline, wgpu::RenderPipeline) {
+        let module = gpu::shader(
+            &ctx.device,
+            "opaque",
+            &[&common_wgsl(), include_str!("../shaders/opaque.wgsl")],
+        );
+        let groups = layouts.with(&[]);
+        // Opaque quads grow against T-junction cracks; cutout quads do not: leaves keep
+        // their faces toward other leaves, and a grown inner face would poke out along the
+        // seams of the faces in front of it.
+        let make = |label, fragment_entry, grow: bool| {
+            let pipeline = ChunkPipeline {
+                label,
+                module: &module,
+                fragment_entry,
+                groups: &groups,
+                targets: &[gpu::scene_target(None)],
+                depth: DepthMode::Write,
+                samples: if msaa { MSAA_SAMPLES } else { 1 },
+            };
+            if grow {
+                pipeline.build_solid(&ctx.device)
+            } else {
+                pipeline.build(&ctx.device)
+            }
+        };
+        (
+            make("opaque", "fs_opaque", true),
+            make("cutout", "fs_cutout", false),
+        )
+    }
+
+    /// The GPU context.
+    pub fn context(&self) -> &GpuContext {
+        &self.ctx
+    }
+
+    /// The configuration in force: after fallbacks, and after every `set_*` call.
+    pub fn config(&self) -> &RendererConfig {
+        &self.config
+    }
+
+    /// Output size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        self.targets.size
+    }
+
+    /// Uploads or replaces a chunk's meshes; empty meshes remove it. A chunk that was not
+    /// on the GPU fades in when [`RendererConfig::fade_in_frames`] is set. A position
+    /// outside the `i32` world ([`ChunkPos::is_valid`]) is an error.
+    pub fn upload_chunk(&mut self, pos: ChunkPos, meshes: &ChunkMeshes) -> Result<()> {
+        self.ctx.check_device()?;
+        if !pos.is_valid() {
+            return Err(Error::InvalidSetting(format!(
+                "chunk position {pos:?} lies outside the i32 world (coordinates {} to {})",
+                ChunkPos::MIN,
+                ChunkPos::MAX
+            )));
+        }
+        let new = self.chunks.get(pos).is_none();
+        self.chunks.upload(&self.ctx, pos, meshes)?;
+        if new && self.config.fade_in_frames > 0 && self.chunks.get(pos).is_some() {
+            self.fading.insert(pos, self.frame_index);
+            self.chunks.set_alpha(&self.ctx, pos, 0.0);
+        }
+        Ok(())
+    }
+
+    /// Removes a chunk from the GPU.
+    pub fn remove_chunk(&mut self, pos: ChunkPos) {
+        self.chunks.remove(&self.ctx, pos);
+        self.fading.remove(&pos);
+    }
+
+    /// Removes every chunk.
+    pub fn clear_chunks(&mut self) {
+        self.chunks.clear(&self.ctx);
+        self.fading.clear();
+    }
+
+    /// Changes the transparency settings. Resources are rebuilt only where the active
+    /// technique's pipelines depend on what changed. An invalid setting is an error and
+    /// changes nothing.
+    pub fn set_oit_config(&mut self, config: OitConfig) -> Result<()> {
+        self.ctx.check_device()?;
+        self.oit.set_config(config)?;
+        config_with(&mut self.config.oit, self.oit.config());
+        Ok(())
+    }
+
+    /// Switches the transparency technique (or what replaces it on this adapter) and
+    /// returns the one in force. A technique the device cannot run (nor a replacement) is
+    /// an [`Error::Unsupported`] naming what it lacks, and changes nothing
+    /// ([`Technique::supported`] lists what a device runs).
+    pub fn set_technique(&mut self, technique: Technique) -> Result<Technique> {
+        self.ctx.check_device()?;
+        let t = self.oit.set_technique(technique)?;
+        config_with(&mut self.config.oit, self.oit.config());
+        Ok(t)
+    }
+
+    /// Builds `technique`'s pipelines and targets now, so that a later
+    /// [`Renderer::set_technique`] to it builds nothing and its first frame costs what any
+    /// frame costs (a game prepares the techniques its settings menu offers at loading
+    /// time). It stays built until [`Renderer::release_technique`]; see
+    /// [`OitManager::prebuild`]. Returns the technique built (after its fallback on this
+    /// adapter); one the device cannot run is an [`Error::Unsupported`].
+    pub fn prebuild_technique(&mut self, technique: Technique) -> Result<Technique> {
+        self.ctx.check_device()?;
+        let oit = &mut self.oit;
+        let built = scoped(&self.ctx.device, "building a technique ahead", || {
+            oit.prebuild(technique)
+        })??;
+        self.oit.warm(built, &self.chunks);
+        Ok(built)
+    }
+
+    /// Frees what [`Renderer::prebuild_technique`] built for `technique`, unless it is
+    /// drawing.
+    pub fn release_technique(&mut self, technique: Technique) {
+        self.oit.release(technique);
+    }
+
+    /// Changes the WBOIT weight function (a uniform: no pipeline is rebuilt).
+    pub fn set_weight(&mut self, weight: WeightFunction) {
+        let mut config = self.oit.config().clone();
+        config.wboit.weight = weight;
+        // Only the weight changed: the configuration stays valid.
+        let _ = self.set_oit_config(config);
+    }
+
+    /// Changes how chunk meshes are drawn; indirect draws stay off on an adapter without
+    /// them (logged at creation) and with [`QuadFetch::Instanced`].
+    pub fn set_draw_mode(&mut self, mode: DrawMode) {
+        let indirect = self.ctx.caps.indirect_draws() && self.layouts.fetch.indirect();
+        self.config.draw = if mode == DrawMode::Indirect && !indirect {
+            DrawMode::PerChunk
+        } else {
+            mode
+        };
+    }
+
+    /// GPU bytes the chunks take: the quad arena (all pages, and the part holding quads)
+    /// and the chunk records.
+    pub fn chunk_memory(&self) -> ChunkMemory {
+        let (arena, records) = self.chunks.memory();
+        ChunkMemory {
+            arena_bytes: arena.bytes,
+            quad_bytes: arena.used_bytes,
+            record_bytes: records,
+            indirect_bytes: self.chunks.indirect_bytes(),
+            pages: arena.pages,
+            free_ranges: arena.fragments,
+        }
+    }
+
+    /// Changes the ambient-occlusion strength (0 to 1; see
+    /// [`RendererConfig::ao_strength`]) from the next frame on: a uniform, nothing is
+    /// rebuilt or uploaded again. A value outside 0..=1 or not finite is an error.
+    pub fn set_ao_strength(&mut self, strength: f32) -> Result<()> {
+        self.ctx.check_device()?;
+        check_ao_strength(strength)?;
+        self.config.ao_strength = strength;
+        Ok(())
+    }
+
+    /// The sun direction, ambient share and sky in force.
+    pub fn lighting(&self) -> Lighting {
+        Lighting {
+            sun_dir: self.config.sun_dir,
+            ambient: self.config.ambient,
+            sky: self.config.sky,
+        }
+    }
+
+    /// Changes the sun direction, ambient share and sky from the next frame on: they are
+    /// frame uniforms and the clear colour, so nothing is rebuilt and no chunk is uploaded
+    /// again. Invalid values ([`Lighting::validate`]) are an error and change nothing.
+    pub fn set_lighting(&mut self, lighting: Lighting) -> Result<()> {
+        lighting.validate()?;
+        self.config.sun_dir = lighting.sun_dir;
+        self.config.ambient = lighting.ambient;
+        self.config.sky = lighting.sky;
+        Ok(())
+    }
+
+    /// Changes how many frames new chunks take to fade in (0: no fade).
+    pub fn set_fade_in_frames(&mut self, frames: u32) {
+        self.config.fade_in_frames = frames;
+        if frames == 0 {
+            for (pos, _) in self.fading.drain() {
+                self.chunks.set_alpha(&self.ctx, pos, 1.0);
+            }
+        }
+    }
+
+    /// The chunks on the GPU.
+    pub fn chunks(&self) -> &ChunkStore {
+        &self.chunks
+    }
+
+    /// The transparency manager.
+    pub fn oit(&self) -> &OitManager {
+        &self.oit
+    }
+
+    /// Turns 4× MSAA on or off (rebuilds the opaque pipelines and targets). Without 4×
+    /// support it stays off (logged at creation).
+    pub fn set_msaa(&mut self, msaa: bool) -> Result<()> {
+        self.ctx.check_device()?;
+        let msaa = msaa && self.ctx.caps.msaa4;
+        if msaa == self.config.msaa {
+            return Ok(());
+        }
+        let (ctx, size) = (&self.ctx, self.size());
+        let (pipelines, targets) = scoped(&ctx.device, "switching MSAA", || {
+            (
+                Self::opaque_pipelines(ctx, &self.layouts, msaa),
+                self.targets_for(size, msaa, self.targets.volumes),
+            )
+        })?;
+        (self.opaque, self.cutout) = pipelines;
+        self.targets = targets;
+        self.config.msaa = msaa;
+        Ok(())
+    }
+
+    /// Resizes every target. The same size does nothing; a zero width or height (a
+    /// minimised window) does nothing either and keeps the old targets until a real size
+    /// comes. A size beyond the adapter's limit is an error and changes nothing.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        self.ctx.check_device()?;
+        if width == 0 || height == 0 || (width, height) == self.size() {
+            return Ok(());
+        }
+        check_size(&self.ctx, width, height)?;
+        let ctx = &self.ctx;
+        let targets = scoped(&ctx.device, "resizing", || {
+            self.targets_for((width, height), self.config.msaa, self.targets.volumes)
+        })?;
+        self.targets = targets;
+        self.checked_view = None;
+        self.config.width = width;
+        self.config.height = height;
+        let oit = &mut self.oit;
+        scoped(&self.ctx.device, "resizing", || oit.resize(width, height))?
+    }
+
+    /// GPU milliseconds per pass of the latest timed frame whose results have arrived
+    /// (empty without timestamps, and once the device is lost). Results arrive a frame or
+    /// more after submission, once wgpu is polled (each `queue.submit` polls).
+    pub fn gpu_times(&mut self) -> GpuTimes {
+        if self.ctx.check_device().is_err() {
+            return GpuTimes::default();
+        }
+        let last = self.settle_submission();
+        let ctx = &self.ctx;
+        self.timer
+            .as_mut()
+            .map(|t| t.poll(ctx, last))
+            .unwrap_or_default()
+    }
+
+    /// Like [`Renderer::gpu_times`], but waits for the last submitted frame's results
+    /// (empty once the device is lost: nothing will come).
+    pub fn gpu_times_blocking(&mut self) -> GpuTimes {
+        if self.ctx.check_device().is_err() {
+            return GpuTimes::default();
+        }
+        let ctx = self.ctx.clone();
+        let Some(mut timer) = self.timer.take() else {
+            return GpuTimes::default();
+        };
+        let times = timer.read_blocking(&ctx, || self.settle_submission());
+        self.timer = Some(timer);
+        times
+    }
+
+    /// What became of the last frame's encoder; a dropped one's queue writes are flushed
+    /// by an empty submit (wgpu keeps them, and their staging memory, until a submit).
+    fn settle_submission(&mut self) -> Outcome {
+        let last = self.submissions.settle(&self.ctx);
+        if last == Outcome::Dropped && self.ctx.check_device().is_ok() {
+            self.ctx.queue.submit([]);
+        }
+        last
+    }
+
+    /// Optional, after submitting a frame's encoder: frees for reuse now the arena places
+    /// the frame drew that were freed meanwhile (the next `render` frees them otherwise).
+    /// GPU timings and a technique's counters need no call: they are read back once a
+    /// frame's commands are submitted.
+    pub fn after_submit(&mut self) {
+        self.chunks.frame_submitted(&self.ctx);
+    }
+
+    /// The HDR scene colour (after the composite, before tonemapping).
+    pub fn scene_color(&self) -> &wgpu::Texture {
+        &self.targets.color.texture
+    }
+
+    /// The single-sample scene depth (reverse-Z).
+    pub fn scene_depth(&self) -> &wgpu::Texture {
+        &self.targets.depth.texture
+    }
+
+    /// A view of [`Renderer::scene_depth`], for a game's pass that draws over the frame
+    /// tested against it (attached read-only, [`gpu::Depth::ReadOnly`], with
+    /// [`gpu::overlay_depth`]). Valid until the next resize.
+    pub fn scene_depth_view(&self) -> &wgpu::TextureView {
+        &self.targets.depth.view
+    }
+}
+
+/// Copies what the manager holds (technique after fallback) into a renderer's config.
+fn config_with(mine: &mut OitConfig, manager: &OitConfig) {
+    mine.clone_from(manager);
+}
