@@ -254,7 +254,7 @@ fn small_scene(boxes_max: &str, camera_extra: &str) -> String {
     )
 }
 
-/// Issue 26: sizes, frame counts, warm-up frames, flicker frames and sweep points past
+/// Sizes, frame counts, warm-up frames, flicker frames and sweep points past
 /// their documented caps are errors naming the flag and the cap, before anything runs
 /// (these used to panic, fail to allocate, or run for ever).
 #[test]
@@ -305,7 +305,7 @@ fn counts_and_sizes_past_their_caps_are_refused_before_rendering() {
     );
 }
 
-/// Issue 26: scene files are read with a size limit (an endless device is an error after
+/// Scene files are read with a size limit (an endless device is an error after
 /// 1 MiB, naming it), boxes that touch too many chunks are an error (20 M blocks in one
 /// row passed the block count), and a `path_to` no camera can take is refused by
 /// `render` as by `eval`: all before any GPU work.

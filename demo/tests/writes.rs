@@ -1,4 +1,4 @@
-//! Issue 26: every file the tools write is checked: a failed write (a full disk, a folder
+//! Every file the tools write is checked: a failed write (a full disk, a folder
 //! in the way) is an error naming the file and a failing exit, never "wrote". And `render`
 //! and `eval` accept the same scene files. Needs a Vulkan adapter (lavapipe); without one
 //! it skips loudly, unless `CI` is set: then it fails.

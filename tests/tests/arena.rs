@@ -1,4 +1,4 @@
-//! The quad arena under a frame in flight (issue 26): no frame draws a page state that
+//! The quad arena under a frame in flight: no frame draws a page state that
 //! compaction or an upload changed after the frame's lists were built, for every
 //! technique (sorted-quads' first sort included), each compared with a fresh renderer
 //! given the same chunks; a mesh larger than a storage binding is an error; pages left

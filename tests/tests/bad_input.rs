@@ -307,7 +307,7 @@ fn texture(
     })
 }
 
-/// Issue 26: the output must be a whole level-0 2D view of the renderer's size, viewed
+/// The output must be a whole level-0 2D view of the renderer's size, viewed
 /// as a format the tonemap pipeline writes. A view of mip level 1 (the right size for a
 /// level but not the renderer), the sRGB twin viewed as the linear format, a 2D-array
 /// view or a layer of an array texture are errors before anything is recorded (under
@@ -419,7 +419,7 @@ fn output_views_other_than_a_whole_level_0_2d_view_are_errors() {
     );
 }
 
-/// Issue 26: an `output_format` the tonemap cannot write (integer, depth, not
+/// An `output_format` the tonemap cannot write (integer, depth, not
 /// renderable) is an error at `new`, naming it; NaN, infinite or out-of-range lighting
 /// values are errors at `new`, naming the field.
 #[test]

@@ -1,4 +1,4 @@
-//! Issue 26: after a device loss (here `Device::destroy`, what a driver reset looks like
+//! After a device loss (here `Device::destroy`, what a driver reset looks like
 //! to wgpu) every renderer call that returns a `Result` returns `Error::DeviceLost`, the
 //! others do nothing (no panic through wgpu's default error handler), making a renderer
 //! on the lost device is an error too, and a new renderer on a new device draws the same

@@ -1,4 +1,4 @@
-//! What a game needs to embed the renderer (issue 23), on lavapipe: its own images per face
+//! What a game needs to embed the renderer, on lavapipe: its own images per face
 //! group (checkers where they belong, cutout and translucent alpha from the image, bad
 //! images refused), lighting changed on a live renderer (the picture of a renderer built
 //! with it, no chunk uploaded again), every output format a surface offers, techniques

@@ -190,7 +190,7 @@ fn compacting_the_arena_keeps_the_picture() {
     tests::assert_close("compacted", &a, &b, 1);
 }
 
-/// Issue 26, the streamer's contract on a real renderer: edits near the eye, on the
+/// The streamer's contract on a real renderer: edits near the eye, on the
 /// outer face of the chunk at the view-distance edge, on the chunk past the margin next to
 /// a drawn one, and far away; the eye flies two chunks away and back (the edge chunk's
 /// outer neighbour passes the margin) and far away and back. Once idle, the streamed
@@ -334,7 +334,7 @@ fn settle_held(s: &mut ChunkStreamer, eye: DVec3, sink: &mut Held) {
     panic!("the streamer never settled: {s:?}");
 }
 
-/// Issue 23: a game saves the streamer's edits (loaded and unloaded chunks alike) and loads
+/// A game saves the streamer's edits (loaded and unloaded chunks alike) and loads
 /// them into a new streamer: the same edits, and the same blocks wherever it loads, near
 /// and far; a save naming a block the registry lacks is refused whole.
 #[test]

@@ -1,4 +1,4 @@
-//! Issue 26: the memory the streamer keeps for edits, counted by a counting allocator (this
+//! The memory the streamer keeps for edits, counted by a counting allocator (this
 //! test binary's global allocator): it stays within what `ChunkStreamer::edit_bytes`
 //! counts ([`voxel_render::stream::EDIT_BYTES`] per edited block,
 //! [`voxel_render::stream::EDITED_CHUNK_BYTES`] per edited chunk), the documented bound;

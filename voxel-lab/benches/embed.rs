@@ -1,4 +1,4 @@
-//! What a game pays at run time for three things it does (issue 23), on this machine's
+//! What a game pays at run time for three things it does, on this machine's
 //! adapter, CPU milliseconds:
 //!
 //! - a lighting change (dusk): `Renderer::set_lighting` and the next frame, against what a

@@ -628,7 +628,7 @@ mod tests {
         let _ = std::fs::remove_dir_all(dir);
     }
 
-    /// Issue 26: a chart that cannot be written (a folder in the way of the PNG, then of
+    /// A chart that cannot be written (a folder in the way of the PNG, then of
     /// the SVG) is an error naming the file, not a success.
     #[test]
     fn a_failed_chart_write_is_an_error_naming_the_file() {

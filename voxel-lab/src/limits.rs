@@ -1,4 +1,4 @@
-//! The lab's documented caps on what a run may ask for (issue 26: a typo must not run for
+//! The lab's documented caps on what a run may ask for (a typo must not run for
 //! ever or take the machine's memory). Each is checked before anything is rendered or
 //! written: by the command line's parsers, by scene parsing, and by
 //! `EvalOptions::validate`, which `evaluate` runs first.

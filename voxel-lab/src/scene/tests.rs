@@ -254,7 +254,7 @@ fn bad_values_are_errors_not_panics() {
     assert!(e.contains("at most 4096 chunks"), "{e}");
 }
 
-/// Issue 26: 20 M blocks in one row pass the block count but touch 625 000 chunks:
+/// 20 M blocks in one row pass the block count but touch 625 000 chunks:
 /// an error before any chunk is made. A 4096 × 4096 floor (16 384 chunks) is fine.
 #[test]
 fn the_box_check_bounds_chunks_too() {
@@ -268,7 +268,7 @@ fn the_box_check_bounds_chunks_too() {
     assert!(parse(&beyond).unwrap_err().contains("chunks"));
 }
 
-/// Issue 26: a `path_to` where no camera can be (NaN, infinite, on the target, outside
+/// A `path_to` where no camera can be (NaN, infinite, on the target, outside
 /// the world) is an error at parsing, for every command alike.
 #[test]
 fn a_bad_path_to_is_an_error() {
@@ -284,7 +284,7 @@ fn a_bad_path_to_is_an_error() {
     }
 }
 
-/// Issue 26: sizes past the lab's caps are errors naming the field and the cap.
+/// Sizes past the lab's caps are errors naming the field and the cap.
 #[test]
 fn sizes_past_the_caps_are_errors() {
     for (size, word) in [("[16384, 16384]", "8192"), ("[8192, 8192]", "pixels")] {
@@ -293,7 +293,7 @@ fn sizes_past_the_caps_are_errors() {
     }
 }
 
-/// Issue 26: an endless or huge file is read only up to the limit; the error names the
+/// An endless or huge file is read only up to the limit; the error names the
 /// file and the limit.
 #[test]
 fn scene_files_are_read_with_a_size_limit() {

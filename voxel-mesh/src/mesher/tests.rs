@@ -475,7 +475,7 @@ fn unknown_blocks_are_an_error() {
 
 #[test]
 fn uniform_cutout_chunks_keep_every_inner_face() {
-    // Leaves hide nothing, leaves included (issue 10: the uniform shortcut kept only
+    // Leaves hide nothing, leaves included (the uniform shortcut kept only
     // the borders, 6 quads alone and none between stone).
     let reg = registry();
     let leaves = Chunk::uniform(LEAVES);
@@ -660,7 +660,7 @@ fn mixed_chunk(rng: &mut XorShift, ids: &[BlockId]) -> Chunk {
 /// masks, packed) met every neighbour form (missing, uniform, masks, packed).
 ///
 /// The test this replaced drew only mixed centres, so it never met the uniform
-/// shortcut, and missed that uniform cutout centres lost every inner face (issue 10).
+/// shortcut, and missed that uniform cutout centres lost every inner face.
 #[test]
 fn random_chunks_match_the_naive_rules_exactly() {
     let mut extended = registry();

@@ -7,7 +7,7 @@ use voxel_mesh::{ChunkMeshes, Mesher};
 
 mod contract;
 
-/// Issue 23: a streamer over the default terrain with a game's registry whose ids name
+/// A streamer over the default terrain with a game's registry whose ids name
 /// other blocks is refused at `new`, naming the roles; with the default registry it is
 /// made.
 #[test]

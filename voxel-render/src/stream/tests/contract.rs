@@ -498,7 +498,7 @@ fn eye_in(c: ChunkPos) -> DVec3 {
     )
 }
 
-/// Issue 26, row 1: the eye flies two chunks away and back (the outer neighbour of the
+/// The eye flies two chunks away and back (the outer neighbour of the
 /// chunk at the view-distance edge passed the margin meanwhile), then a block is placed
 /// on that chunk's outer face: it is drawn and the streamer becomes idle (before, the
 /// remesh waited for the neighbour for ever and the old mesh stayed). Then far away and
@@ -573,7 +573,7 @@ fn return_trips_of_every_length_hold_the_truth() {
     }
 }
 
-/// Issue 26, row 2: a chunk drawn at the edge of the margin, whose outer neighbour lies
+/// A chunk drawn at the edge of the margin, whose outer neighbour lies
 /// past it, is edited: it is meshed again (its neighbour stayed resident for it) and the
 /// streamer becomes idle (it never did: it waited for a neighbour nobody loaded).
 #[test]
@@ -610,7 +610,7 @@ fn an_edit_of_a_chunk_whose_outer_neighbour_is_past_the_margin_is_remeshed() {
     settle_and_check(&mut s, &mut sink, &truth, eye, 20_000, "edited");
 }
 
-/// Issue 26, row 3: the chunk just past the margin next to a drawn one is edited on the
+/// The chunk just past the margin next to a drawn one is edited on the
 /// face they share: the drawn chunk's border faces follow (its neighbour is resident,
 /// so the edit remeshes it). And an edit of a chunk far away changes no drawn chunk.
 #[test]
@@ -644,7 +644,7 @@ fn an_edit_beside_a_drawn_chunk_remeshes_its_border() {
     assert!(s.is_resident(outer) || !sink.held.contains_key(&ChunkPos::new(2, 0, 0)));
 }
 
-/// Issue 26, row 4: a source that answers differently on each call; flying away and
+/// A source that answers differently on each call; flying away and
 /// back, every drawn chunk still equals a fresh mesh of the streamer's own blocks (a
 /// neighbour generated anew under a drawn chunk left it stale).
 #[test]
@@ -676,7 +676,7 @@ fn a_source_that_changes_leaves_no_stale_mesh() {
     }
 }
 
-/// Issue 26, rows 5 and 6: an edit of a chunk whose source panics or makes unknown ids
+/// An edit of a chunk whose source panics or makes unknown ids
 /// is an error (the panic never reaches the caller), whether the chunk is not loaded,
 /// on its way, or loaded (where it stands as air, reported by the update).
 #[test]
@@ -725,7 +725,7 @@ fn edits_of_chunks_whose_source_fails_are_errors() {
     s.set_block(WorldPos::new(31, 5, 5), blocks::STONE).unwrap();
 }
 
-/// Issue 26, row 7: the unload queue holds each chunk once. After a teleport, the eye
+/// The unload queue holds each chunk once. After a teleport, the eye
 /// moves to a new chunk every update while unloads trickle (one per update): the queue
 /// never holds more than the positions known (it used to take every far chunk again
 /// on every move: 730 MiB and 292 ms updates at view distance 64).
@@ -768,7 +768,7 @@ impl ChunkSource for Slow {
     }
 }
 
-/// Issue 26, row 8: dropping the streamer with 64 jobs queued stops them: at most the
+/// Dropping the streamer with 64 jobs queued stops them: at most the
 /// one running goes on (they all ran, 64 calls, before).
 #[test]
 fn dropping_the_streamer_stops_its_jobs() {
@@ -793,7 +793,7 @@ fn dropping_the_streamer_stops_its_jobs() {
     );
 }
 
-/// Issue 26, row 8: 10 000 edits of chunks far away are kept as edits, within the
+/// 10 000 edits of chunks far away are kept as edits, within the
 /// documented bound (they took 135 MB as whole chunks), and each comes back when its
 /// chunk loads; the edit list reports them for saving.
 #[test]
