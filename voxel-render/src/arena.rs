@@ -108,7 +108,7 @@ impl Allocator {
     }
 
     /// Units in all.
-    pub fn capacity(&self) -> u32 {
+    pub(crate) fn capacity(&self) -> u32 {
         self.capacity
     }
 
@@ -332,7 +332,7 @@ impl QuadArena {
     /// The page worth compacting away, if any: with more than one page and more than half
     /// of the arena's bytes free, the page with the fewest quads in use, when the other
     /// pages have room for them.
-    pub fn page_to_compact(&self) -> Option<u32> {
+    pub(crate) fn page_to_compact(&self) -> Option<u32> {
         let s = self.stats();
         if s.pages < 2 || s.used_bytes * 2 >= s.bytes {
             return None;
