@@ -10,7 +10,7 @@ use crate::gpu::{self, ChunkGroups, buffer_entry};
 
 /// WGSL shared by every chunk pipeline: the structs below, vertex pulling and shading,
 /// after the constants it shares with this module.
-pub fn common_wgsl() -> String {
+pub(crate) fn common_wgsl() -> String {
     gpu::WgslConsts::default()
         .u32("NO_MEDIUM", NO_MEDIUM)
         .u32("FLAG_INTERFACE", FLAG_INTERFACE)
@@ -27,17 +27,17 @@ pub fn common_wgsl() -> String {
 }
 
 /// Fragments inside a volume in the sorted techniques (`shaders/inside_volume.wgsl`).
-pub const INSIDE_VOLUME_WGSL: &str = include_str!("shaders/inside_volume.wgsl");
+pub(crate) const INSIDE_VOLUME_WGSL: &str = include_str!("shaders/inside_volume.wgsl");
 
 /// The volume functions (`shaders/volume.wgsl`): they read `frame`, `block_media` and
 /// `TABLE_WIDTH`, `FLAG_INTERFACE`, which the including shader declares.
-pub const VOLUME_WGSL: &str = include_str!("shaders/volume.wgsl");
+pub(crate) const VOLUME_WGSL: &str = include_str!("shaders/volume.wgsl");
 
 /// WGSL of a full-screen pass that binds the chunk passes' group 0 (the renderer's scene
 /// group, [`SharedLayouts::scene`]) as group `group`: the frame, the depth sampler, the
 /// volume depth and each block's look as a medium (`medium_look`), with the volume
 /// functions.
-pub fn scene_volume_wgsl(group: u32) -> String {
+pub(crate) fn scene_volume_wgsl(group: u32) -> String {
     gpu::WgslConsts::default()
         .u32("FLAG_INTERFACE", FLAG_INTERFACE)
         .u32("TABLE_WIDTH", crate::fetch::TABLE_WIDTH)
@@ -62,7 +62,7 @@ pub fn scene_volume_wgsl(group: u32) -> String {
 }
 
 /// The `Frame` struct (what [`FrameUniforms`] is in WGSL).
-pub const FRAME_WGSL: &str = include_str!("shaders/frame.wgsl");
+pub(crate) const FRAME_WGSL: &str = include_str!("shaders/frame.wgsl");
 
 /// How much ambient occlusion darkens at full strength: a vertex of AO value `v` (0 to 3,
 /// `voxel_mesh::ao`) gets brightness `1 − strength · AO_DEPTH · (3 − v) / 3`, so an inner
@@ -83,7 +83,7 @@ pub const OPAQUE_EXPANSION_PX: f32 = 1.0 / 64.0;
 
 /// The most an opaque quad grows along an axis, in blocks: a quad seen edge-on would need to
 /// grow without bound to move a vertex by [`OPAQUE_EXPANSION_PX`] on screen.
-pub const MAX_GROWTH: f32 = 1.0 / 16.0;
+pub(crate) const MAX_GROWTH: f32 = 1.0 / 16.0;
 
 /// The tonemap's shoulder (`shaders/tonemap.wgsl`): values up to it pass unchanged.
 pub const TONEMAP_SHOULDER: f32 = 0.8;
@@ -132,7 +132,7 @@ pub struct FrameUniforms {
 const _: () = assert!(std::mem::size_of::<ChunkUniforms>() == crate::fetch::RECORD_BYTES);
 
 /// [`FrameUniforms::medium`] when the eye is in no translucent volume.
-pub const NO_MEDIUM: u32 = u32::MAX;
+pub(crate) const NO_MEDIUM: u32 = u32::MAX;
 
 /// Quad flag (bit 16 of word 1 of a [`voxel_mesh::PackedQuad`]): a translucent face toward
 /// another translucent type (`FLAG_INTERFACE` in WGSL).

@@ -27,7 +27,7 @@ pub enum QuadFetch {
 
 /// Entries of a lookup table per texture row ([`TableTexture`]): 256, so that 65 536
 /// blocks' three layers fit in 768 rows, within WebGL2's 2 048.
-pub const TABLE_WIDTH: u32 = 256;
+pub(crate) const TABLE_WIDTH: u32 = 256;
 
 /// Storage buffers the vertex stage binds with [`QuadFetch::Storage`]: the page, the chunk
 /// records and the block layers.
@@ -114,7 +114,7 @@ impl QuadFetch {
 
     /// The vertex entry point of chunk pipelines: `vs_main` (translucent and cutout quads)
     /// or, `solid`, `vs_solid` (opaque quads, grown against cracks), of this fetch.
-    pub fn vertex_entry(self, solid: bool) -> &'static str {
+    pub(crate) fn vertex_entry(self, solid: bool) -> &'static str {
         match (self, solid) {
             (QuadFetch::Storage, false) => "vs_main",
             (QuadFetch::Storage, true) => "vs_solid",
@@ -125,7 +125,7 @@ impl QuadFetch {
 
     /// The vertex buffers of chunk pipelines: none, or the page as one 8-byte attribute
     /// per instance.
-    pub fn vertex_buffers(self) -> &'static [Option<wgpu::VertexBufferLayout<'static>>] {
+    pub(crate) fn vertex_buffers(self) -> &'static [Option<wgpu::VertexBufferLayout<'static>>] {
         match self {
             QuadFetch::Storage => &[],
             QuadFetch::Instanced => &[Some(QUAD_INSTANCES)],
@@ -133,7 +133,7 @@ impl QuadFetch {
     }
 
     /// The usages of the arena's pages.
-    pub fn page_usage(self) -> wgpu::BufferUsages {
+    pub(crate) fn page_usage(self) -> wgpu::BufferUsages {
         let copies = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
         match self {
             QuadFetch::Storage => wgpu::BufferUsages::STORAGE | copies,
@@ -143,7 +143,7 @@ impl QuadFetch {
 
     /// The largest page in bytes on a device of `limits`: a storage binding, or any
     /// buffer.
-    pub fn max_page_bytes(self, limits: &wgpu::Limits) -> u64 {
+    pub(crate) fn max_page_bytes(self, limits: &wgpu::Limits) -> u64 {
         match self {
             QuadFetch::Storage => limits
                 .max_storage_buffer_binding_size
@@ -155,7 +155,7 @@ impl QuadFetch {
     /// The draw of quads `quads` (first and count, in the page) of the chunk in `slot`:
     /// vertices and instances (with [`QuadFetch::Instanced`], the record is bound for
     /// the draw instead).
-    pub fn draw_ranges(
+    pub(crate) fn draw_ranges(
         self,
         slot: u32,
         first: u32,
@@ -193,7 +193,7 @@ const QUAD_INSTANCES: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayo
 /// the vertex stage reads where it has no storage buffers (the block layers: a game's
 /// registry may hold more blocks than a uniform buffer).
 #[derive(Debug)]
-pub struct TableTexture {
+pub(crate) struct TableTexture {
     texture: wgpu::Texture,
     /// Its view.
     pub view: wgpu::TextureView,
@@ -203,7 +203,7 @@ pub struct TableTexture {
 
 impl TableTexture {
     /// A table of at least `entries` entries of `format` (an integer format).
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         label: &str,
         format: wgpu::TextureFormat,
@@ -233,13 +233,13 @@ impl TableTexture {
     }
 
     /// Entries it holds.
-    pub fn capacity(&self) -> usize {
+    pub(crate) fn capacity(&self) -> usize {
         (TABLE_WIDTH * self.texture.height()) as usize
     }
 
     /// Writes `data` (whole entries) from entry `first` on; entries past the capacity are
     /// dropped.
-    pub fn write(&self, queue: &wgpu::Queue, first: usize, data: &[u8]) {
+    pub(crate) fn write(&self, queue: &wgpu::Queue, first: usize, data: &[u8]) {
         let texel = self.texel_bytes as usize;
         let width = TABLE_WIDTH as usize;
         let end = (first + data.len() / texel).min(self.capacity());
@@ -284,18 +284,18 @@ impl TableTexture {
 /// texture (as the block layers need: a game's registry can outgrow a uniform buffer)
 /// would be fetched by every vertex.
 #[derive(Debug)]
-pub struct Records {
+pub(crate) struct Records {
     buffer: wgpu::Buffer,
     /// Bytes from one record to the next.
     stride: u64,
 }
 
 /// Bytes of a chunk record (`ChunkUniforms`, checked by a test).
-pub const RECORD_BYTES: usize = 16;
+pub(crate) const RECORD_BYTES: usize = 16;
 
 impl Records {
     /// Room for `slots` records on a device of `limits`.
-    pub fn new(
+    pub(crate) fn new(
         device: &wgpu::Device,
         fetch: QuadFetch,
         limits: &wgpu::Limits,
@@ -318,17 +318,17 @@ impl Records {
     }
 
     /// Records it holds.
-    pub fn capacity(&self) -> usize {
+    pub(crate) fn capacity(&self) -> usize {
         (self.buffer.size() / self.stride) as usize
     }
 
     /// Bytes it takes.
-    pub fn bytes(&self) -> u64 {
+    pub(crate) fn bytes(&self) -> u64 {
         self.buffer.size()
     }
 
     /// Writes `records` ([`RECORD_BYTES`] each) from slot `first` on.
-    pub fn write(&self, queue: &wgpu::Queue, first: usize, records: &[u8]) {
+    pub(crate) fn write(&self, queue: &wgpu::Queue, first: usize, records: &[u8]) {
         let at = first as u64 * self.stride;
         if self.stride == RECORD_BYTES as u64 {
             queue.write_buffer(&self.buffer, at, records);
@@ -346,7 +346,7 @@ impl Records {
 
     /// Its bind group resource: the whole array, or one record (the dynamic offset picks
     /// which).
-    pub fn binding(&self) -> wgpu::BindingResource<'_> {
+    pub(crate) fn binding(&self) -> wgpu::BindingResource<'_> {
         if self.stride == RECORD_BYTES as u64 {
             return self.buffer.as_entire_binding();
         }
@@ -358,14 +358,14 @@ impl Records {
     }
 
     /// The dynamic offset of slot `slot`'s record.
-    pub fn offset(&self, slot: u32) -> u32 {
+    pub(crate) fn offset(&self, slot: u32) -> u32 {
         (u64::from(slot) * self.stride) as u32
     }
 }
 
 /// The layout entry of one chunk record, a uniform at a dynamic offset
 /// ([`QuadFetch::Instanced`]).
-pub fn record_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn record_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::VERTEX,
@@ -379,7 +379,7 @@ pub fn record_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 /// A layout entry for an unsigned integer table texture read in the vertex stage.
-pub fn table_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn table_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::VERTEX,

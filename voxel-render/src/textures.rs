@@ -17,7 +17,7 @@ use crate::readback::Image;
 use crate::{Error, GpuContext, Result};
 
 /// Texels along each side of a procedural texture.
-pub const TEXTURE_SIZE: u32 = 16;
+pub(crate) const TEXTURE_SIZE: u32 = 16;
 
 fn hash(a: u32, b: u32, c: u32) -> u32 {
     let mut h =
@@ -232,7 +232,7 @@ impl TextureSet {
     }
 
     /// Mip levels of every layer: down to 1 × 1.
-    pub fn mip_levels(&self) -> u32 {
+    pub(crate) fn mip_levels(&self) -> u32 {
         self.size.ilog2() + 1
     }
 
@@ -248,12 +248,12 @@ impl TextureSet {
 
     /// The layers of block `id`'s top, bottom and side faces (layer 0, air's, for an id
     /// the registry does not hold).
-    pub fn layers_of(&self, id: BlockId) -> [u32; 3] {
+    pub(crate) fn layers_of(&self, id: BlockId) -> [u32; 3] {
         self.table.get(id.index()).copied().unwrap_or([0; 3])
     }
 
     /// The layer `face` of block `id` samples.
-    pub fn layer_of(&self, id: BlockId, face: Face) -> u32 {
+    pub(crate) fn layer_of(&self, id: BlockId, face: Face) -> u32 {
         self.layers_of(id)[FaceGroup::of(face) as usize]
     }
 
@@ -272,7 +272,7 @@ impl TextureSet {
     /// Every level of layer `i`, level 0 first, each the average of 2 × 2 texels of the one
     /// above in linear colour, weighted by alpha (a transparent texel's colour does not
     /// bleed into its neighbours'; where all four are transparent, their plain average).
-    pub fn mip_chain(&self, i: usize) -> Vec<Vec<[u8; 4]>> {
+    pub(crate) fn mip_chain(&self, i: usize) -> Vec<Vec<[u8; 4]>> {
         let mut levels = vec![self.layers[i].clone()];
         let mut size = self.size as usize;
         while size > 1 {
@@ -314,7 +314,7 @@ fn average(texels: &[[u8; 4]; 4]) -> [u8; 4] {
 /// repeats once per block) of the point at face coordinates `(u, v)` of `face`: side
 /// faces upright and seen from outside, top and bottom with s along +x and t along +z.
 /// The WGSL twin is `image_uv()` in `shaders/common.wgsl`.
-pub fn image_coords(face: Face, u: f64, v: f64) -> (f64, f64) {
+pub(crate) fn image_coords(face: Face, u: f64, v: f64) -> (f64, f64) {
     match face {
         // U = y, V = z; seen from +x, right is −z.
         Face::PosX => (-v, -u),
