@@ -131,7 +131,7 @@ impl Camera {
     }
 
     /// The same camera with [`Camera::forward`] at length 1 ([`Camera::unit_forward`]).
-    pub fn normalized(self) -> Self {
+    pub(crate) fn normalized(self) -> Self {
         Self {
             forward: self.unit_forward(),
             ..self
@@ -145,7 +145,7 @@ impl Camera {
     }
 
     /// The eye split into an integer part (`floor`) and a fraction in [0, 1).
-    pub fn eye_split(&self) -> ([i64; 3], Vec3) {
+    pub(crate) fn eye_split(&self) -> ([i64; 3], Vec3) {
         let fl = self.eye.floor();
         let frac = (self.eye - fl).as_vec3();
         ([fl.x as i64, fl.y as i64, fl.z as i64], frac)

@@ -69,7 +69,7 @@ impl Capabilities {
     /// what the adapter does, within what wgpu validates without
     /// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES` (the format's guaranteed features, with
     /// the device's features: `FLOAT32_BLENDABLE` for 32-bit floats).
-    pub fn renders_to(&self, format: wgpu::TextureFormat, blend: bool) -> bool {
+    pub(crate) fn renders_to(&self, format: wgpu::TextureFormat, blend: bool) -> bool {
         let ok = |f: wgpu::TextureFormatFeatures| {
             f.allowed_usages
                 .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
@@ -92,7 +92,7 @@ impl Capabilities {
 
     /// Whether chunks can be drawn with `multi_draw_indirect` (indirect execution, and
     /// indirect draws whose first instance is not zero).
-    pub fn indirect_draws(&self) -> bool {
+    pub(crate) fn indirect_draws(&self) -> bool {
         self.downlevel
             .contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION)
             && self
@@ -102,7 +102,7 @@ impl Capabilities {
 
     /// Whether 32-bit float targets (R32Float, Rgba32Float) can be blended (MBOIT's
     /// moments; 16-bit ones otherwise).
-    pub fn float32_blendable(&self) -> bool {
+    pub(crate) fn float32_blendable(&self) -> bool {
         self.features.contains(wgpu::Features::FLOAT32_BLENDABLE)
     }
 
@@ -295,7 +295,7 @@ impl LimitsPreset {
     }
 
     /// The limits and features to request of `adapter`.
-    pub fn request(self, adapter: &wgpu::Adapter) -> (wgpu::Limits, wgpu::Features) {
+    pub(crate) fn request(self, adapter: &wgpu::Adapter) -> (wgpu::Limits, wgpu::Features) {
         match self {
             LimitsPreset::Adapter => (adapter.limits(), adapter.features() & WANTED_FEATURES),
             LimitsPreset::WebGl2 => (

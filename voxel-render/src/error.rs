@@ -171,7 +171,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
     /// An [`Error::UnknownName`] listing `known`.
-    pub fn unknown_name<'a>(
+    pub(crate) fn unknown_name<'a>(
         kind: &'static str,
         name: &str,
         known: impl IntoIterator<Item = &'a str>,
@@ -187,7 +187,7 @@ impl Error {
 /// Runs `f` inside a wgpu validation and out-of-memory error scope, so that what wgpu
 /// would report to the device's uncaptured-error handler (a panic by default) comes back
 /// as an [`Error::Gpu`] instead.
-pub fn scoped<T>(
+pub(crate) fn scoped<T>(
     device: &wgpu::Device,
     operation: &'static str,
     f: impl FnOnce() -> T,

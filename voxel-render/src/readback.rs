@@ -225,7 +225,7 @@ pub fn read_image(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Image> {
 }
 
 /// Maps a `MAP_READ` buffer, waits, and copies its contents out.
-pub fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+pub(crate) fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     ctx.check_device()?;
     let (tx, rx) = std::sync::mpsc::channel();
     buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
@@ -314,7 +314,7 @@ const FAILED: u8 = 3;
 /// in flight, further copies are skipped rather than waited for; a copy whose encoder is
 /// dropped unsubmitted frees the buffer again.
 #[derive(Debug)]
-pub struct QueryReadback {
+pub(crate) struct QueryReadback {
     set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
     readback: wgpu::Buffer,
@@ -337,7 +337,7 @@ impl Drop for Mapping {
 
 impl QueryReadback {
     /// `count` queries of `ty`.
-    pub fn new(ctx: &GpuContext, label: &str, ty: wgpu::QueryType, count: u32) -> Self {
+    pub(crate) fn new(ctx: &GpuContext, label: &str, ty: wgpu::QueryType, count: u32) -> Self {
         let size = u64::from(count) * 8;
         let buffer = |suffix: &str, usage| {
             ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -367,14 +367,14 @@ impl QueryReadback {
     }
 
     /// The query set passes write to.
-    pub fn set(&self) -> &wgpu::QuerySet {
+    pub(crate) fn set(&self) -> &wgpu::QuerySet {
         &self.set
     }
 
     /// Records the copy of queries `range` (to be read as results `0..len`) and its
     /// mapping when `encoder` is submitted, unless a copy is already in flight. Returns
     /// whether it was recorded.
-    pub fn copy(
+    pub(crate) fn copy(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         range: std::ops::Range<u32>,
@@ -399,7 +399,7 @@ impl QueryReadback {
 
     /// The results once mapped (`Ok(None)` until then; needs `device.poll` now and then),
     /// and frees the buffer for the next copy. A failed mapping is an error.
-    pub fn take(&mut self) -> Result<Option<Vec<u64>>> {
+    pub(crate) fn take(&mut self) -> Result<Option<Vec<u64>>> {
         use std::sync::atomic::Ordering;
         match self.state.load(Ordering::Acquire) {
             MAPPED => {
@@ -422,7 +422,7 @@ impl QueryReadback {
 
     /// Waits for the copy in flight, then [`QueryReadback::take`]. An error when no copy
     /// is in flight or it does not arrive.
-    pub fn wait(&mut self, ctx: &GpuContext) -> Result<Vec<u64>> {
+    pub(crate) fn wait(&mut self, ctx: &GpuContext) -> Result<Vec<u64>> {
         if self.state.load(std::sync::atomic::Ordering::Acquire) == MAPPING {
             ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
         }
