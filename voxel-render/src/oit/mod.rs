@@ -448,7 +448,7 @@ pub struct TranslucentFrame<'a> {
 impl TranslucentFrame<'_> {
     /// Records the draws of every visible translucent mesh (group 0 and each chunk's
     /// group 1 set here; the pipeline and groups from 2 on set by the caller).
-    pub fn draw_chunks(&self, pass: &mut wgpu::RenderPass<'_>) {
+    pub(crate) fn draw_chunks(&self, pass: &mut wgpu::RenderPass<'_>) {
         pass.set_bind_group(0, self.scene, &[]);
         self.draws.draw(self.chunks, pass);
     }
@@ -676,7 +676,7 @@ impl OitManager {
     /// that a game builds its pipelines ahead as [`OitManager::prebuild`] builds the
     /// technique's (which this does too: the technique stays built). An
     /// [`Error::Unsupported`] for a technique the device cannot run.
-    pub fn contract_for(&mut self, technique: Technique) -> Result<Arc<TranslucentContract>> {
+    pub(crate) fn contract_for(&mut self, technique: Technique) -> Result<Arc<TranslucentContract>> {
         let technique = self.resolve(technique)?;
         if technique == self.config.technique {
             return self.contract();

@@ -37,19 +37,19 @@ use crate::{Error, GpuContext, Result};
 
 /// The largest absorbance one fragment adds (α = 1 would add infinity): e^−10 ≈ 4.5·10⁻⁵
 /// of the light passes, below what an 8-bit output shows.
-pub const ABSORBANCE_MAX: f32 = 10.0;
+pub(crate) const ABSORBANCE_MAX: f32 = 10.0;
 /// The moment bias with 32-bit moments: the value of the paper's code for 4 power moments
 /// in single precision.
-pub const BIAS_F32: f32 = 5e-7;
+pub(crate) const BIAS_F32: f32 = 5e-7;
 /// The moment bias with 16-bit moments: about their rounding step (2⁻¹¹ ≈ 4.9·10⁻⁴
 /// relative), not tuned further (suite mean FLIP 0.0240 with it against 0.0190 with 32-bit
 /// moments, results/mboit/report.md). The paper's 16-bit setting goes with its
 /// quantisation transform, which additive blending into half floats cannot apply.
 pub const BIAS_F16: f32 = 5e-4;
 /// The moments' depth-warp vector the bias pulls toward (the paper's, for [−1, 1]).
-pub const BIAS_VECTOR: [f32; 4] = [0.0, 0.375, 0.0, 0.375];
+pub(crate) const BIAS_VECTOR: [f32; 4] = [0.0, 0.375, 0.0, 0.375];
 /// The colour accumulation format of the resolve.
-pub const ACCUMULATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub(crate) const ACCUMULATION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// Settings of moment-based OIT. Every field has a reasoned default.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -242,7 +242,7 @@ pub fn depth_range(
 
 /// The shader of pass 1 (`resolve` false) or pass 2: constants from Rust, the shared
 /// code, the moments' maths, the chunk entries.
-pub fn mboit_wgsl(resolve: bool) -> String {
+pub(crate) fn mboit_wgsl(resolve: bool) -> String {
     let mut s = consts() + &crate::bindings::common_wgsl() + include_str!("moments.wgsl");
     if resolve {
         s += include_str!("resolve.wgsl");

@@ -38,9 +38,9 @@ use crate::timing::GpuPass;
 use crate::{Error, GpuContext, Result, readback};
 
 /// Bytes per node (`Node`).
-pub const NODE_BYTES: u64 = std::mem::size_of::<Node>() as u64;
+pub(crate) const NODE_BYTES: u64 = std::mem::size_of::<Node>() as u64;
 /// Initial pool: nodes per pixel.
-pub const INITIAL_NODES_PER_PIXEL: u64 = 4;
+pub(crate) const INITIAL_NODES_PER_PIXEL: u64 = 4;
 /// Most tiles per axis before giving up on fitting a frame.
 pub const MAX_TILES: u32 = 16;
 /// Fragments a pixel blends at most (its nearest ones).
@@ -94,7 +94,7 @@ pub struct Node {
 /// The counters read back per tile (`Counters` in `types.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct Counters {
+pub(crate) struct Counters {
     /// Nodes asked for.
     pub nodes: u32,
     /// Pixels with more than [`MAX_LAYERS`] fragments.
@@ -108,7 +108,7 @@ pub struct Counters {
 /// The tile being drawn (`Params` in `types.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct Params {
+pub(crate) struct Params {
     /// Top-left pixel of the tile.
     pub origin: [u32; 2],
     /// Width of the tile (row length of its head pointers).
@@ -129,7 +129,7 @@ fn types_wgsl() -> String {
 }
 
 /// The build pass's shader.
-pub fn build_wgsl() -> String {
+pub(crate) fn build_wgsl() -> String {
     [
         &crate::bindings::common_wgsl(),
         &types_wgsl(),
@@ -178,7 +178,7 @@ fn params_entry() -> wgpu::BindGroupLayoutEntry {
 }
 
 /// The resolve pass's shader (after `fullscreen.wgsl`); the scene group is its group 1.
-pub fn resolve_wgsl() -> String {
+pub(crate) fn resolve_wgsl() -> String {
     [
         &crate::bindings::scene_volume_wgsl(1),
         &types_wgsl(),

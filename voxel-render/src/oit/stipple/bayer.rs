@@ -32,7 +32,7 @@ impl BayerSize {
     }
 
     /// The size with pattern code `code` (its low two bits).
-    pub fn from_code(code: u32) -> Self {
+    pub(crate) fn from_code(code: u32) -> Self {
         Self::ALL[(code & 3) as usize]
     }
 
@@ -70,7 +70,7 @@ pub fn bayer(n: usize) -> Vec<u32> {
 /// shaders read them from a storage buffer: the GPU uses exactly the tested tables. (As
 /// WGSL `const` arrays indexed at run time, lavapipe copies all of them into every
 /// fragment's private memory, which made the opaque pass five times slower.)
-pub fn bayer_levels() -> Vec<u32> {
+pub(crate) fn bayer_levels() -> Vec<u32> {
     BayerSize::ALL
         .iter()
         .flat_map(|b| bayer(b.side() as usize))
@@ -78,7 +78,7 @@ pub fn bayer_levels() -> Vec<u32> {
 }
 
 /// Where the matrix of `size` starts in [`bayer_levels`].
-pub fn bayer_offset(size: BayerSize) -> usize {
+pub(crate) fn bayer_offset(size: BayerSize) -> usize {
     BayerSize::ALL
         .iter()
         .take_while(|b| **b != size)
@@ -103,7 +103,7 @@ pub struct ShadingState {
 
 impl ShadingState {
     /// Packs into the 32-bit layout.
-    pub fn pack(self) -> u32 {
+    pub(crate) fn pack(self) -> u32 {
         u32::from(self.alpha) | STIPPLE_MODE << 8 | self.pattern.code() << 10
     }
 

@@ -53,7 +53,7 @@ impl Default for StippleSettings {
 
 impl StippleSettings {
     /// The packed 32-bit shading state for these settings.
-    pub fn shading_state(&self) -> ShadingState {
+    pub(crate) fn shading_state(&self) -> ShadingState {
         ShadingState {
             alpha: self.alpha,
             pattern: self.bayer,
@@ -69,13 +69,13 @@ impl StippleSettings {
 /// The technique's uniform (`StippleParams` in `dither.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct StippleParams {
+pub(crate) struct StippleParams {
     /// [`ShadingState::pack`].
     pub shading_state: u32,
 }
 
 /// The stipple shader: the Bayer offsets from Rust, the shared code, the screen door.
-pub fn stipple_wgsl() -> String {
+pub(crate) fn stipple_wgsl() -> String {
     [
         bayer_consts().as_str(),
         &crate::bindings::common_wgsl(),

@@ -49,14 +49,14 @@ pub const TILES: usize = 8;
 /// planes seen, and for the next table (fresh allocations of these cost more, in page
 /// faults, than the arithmetic: 2 000 planes at view distance 32). A technique keeps one.
 #[derive(Debug, Default)]
-pub struct Fitter {
+pub(crate) struct Fitter {
     seen: Vec<Seen>,
     table: Vec<f32>,
 }
 
 impl Fitter {
     /// Gives back the table of an earlier fit, to be filled by the next.
-    pub fn recycle(&mut self, fit: WeightFit) {
+    pub(crate) fn recycle(&mut self, fit: WeightFit) {
         self.table = fit.optical_depth;
     }
 
@@ -65,7 +65,7 @@ impl Fitter {
     /// `far` planes: the view depths the meshes span and, for each screen tile, the
     /// expected optical depth in front of [`PROFILE_LEN`] depths spaced evenly in log depth
     /// across them.
-    pub fn fit<'a>(
+    pub(crate) fn fit<'a>(
         &mut self,
         layers: impl IntoIterator<Item = (ChunkPos, &'a [Plane])>,
         view_proj: Mat4,
@@ -256,7 +256,7 @@ impl WeightFit {
     /// apart and above zero): the table index of view depth `d` is
     /// `(ln d − ln n) · (PROFILE_LEN − 1) / ln(f / n)`, which the shader computes with
     /// one log (these two numbers are in its uniform).
-    pub fn log_mapping(&self) -> [f32; 2] {
+    pub(crate) fn log_mapping(&self) -> [f32; 2] {
         let n = self.range[0].max(1e-4);
         let f = self.range[1].max(n * 1.001);
         [n.ln(), (PROFILE_LEN - 1) as f32 / (f / n).ln()]

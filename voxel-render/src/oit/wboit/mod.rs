@@ -68,7 +68,7 @@ pub const HEADROOM_SCALE: f32 = 1.0 / 64.0;
 /// Output scale with RGBA8 accumulation: eight layers of the largest weight (3000) fit in 1.
 pub const RGBA8_SCALE: f32 = 1.0 / (3000.0 * 8.0);
 /// `vec4`s of the fitted weight's optical-depth table.
-pub const TABLE_VEC4S: usize = TILES * TILES * PROFILE_LEN / 4;
+pub(crate) const TABLE_VEC4S: usize = TILES * TILES * PROFILE_LEN / 4;
 
 /// Settings of weighted blended OIT. Every field has a reasoned default.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -122,7 +122,7 @@ pub struct WboitReport {
 /// The technique's uniform (`WboitParams` in `accumulate.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct WboitParams {
+pub(crate) struct WboitParams {
     /// [`WeightFunction::id`] of the weight.
     pub weight_fn: u32,
     /// Scale of accumulation outputs (keeps fp16 sums finite).
@@ -145,7 +145,7 @@ pub struct WboitParams {
 }
 
 /// The accumulation format for `settings` on this adapter (RGBA16F, or the RGBA8 fallback).
-pub fn accumulation_format(caps: &Capabilities, settings: &WboitSettings) -> wgpu::TextureFormat {
+pub(crate) fn accumulation_format(caps: &Capabilities, settings: &WboitSettings) -> wgpu::TextureFormat {
     if settings.force_rgba8_accum || !caps.rgba16f_blendable {
         wgpu::TextureFormat::Rgba8Unorm
     } else {
@@ -154,7 +154,7 @@ pub fn accumulation_format(caps: &Capabilities, settings: &WboitSettings) -> wgp
 }
 
 /// The accumulation output scale for `settings` on this adapter.
-pub fn accum_scale(caps: &Capabilities, settings: &WboitSettings) -> f32 {
+pub(crate) fn accum_scale(caps: &Capabilities, settings: &WboitSettings) -> f32 {
     if accumulation_format(caps, settings) == wgpu::TextureFormat::Rgba8Unorm {
         RGBA8_SCALE
     } else if settings.headroom {
@@ -166,7 +166,7 @@ pub fn accum_scale(caps: &Capabilities, settings: &WboitSettings) -> f32 {
 
 /// The accumulation shader for chunk pipelines drawing with `weight` (`None`: any, read
 /// from the uniform): constants from Rust, the shared code, the weights, the chunk entries.
-pub fn accumulate_wgsl(weight: Option<WeightFunction>) -> String {
+pub(crate) fn accumulate_wgsl(weight: Option<WeightFunction>) -> String {
     [
         weight_consts(weight).as_str(),
         &crate::bindings::common_wgsl(),
@@ -335,7 +335,7 @@ struct Targets {
 /// WBOIT resources: pipelines, the two size-dependent targets, the uniform, and the fitted
 /// weight's summary of each translucent mesh.
 #[derive(Debug)]
-pub struct Wboit {
+pub(crate) struct Wboit {
     /// The chunk pipelines of each weight drawn with so far (built when first needed; a
     /// frame draws with the last one `prepare` asked for).
     accumulate: Vec<(WeightFunction, Accumulate)>,

@@ -82,7 +82,7 @@ impl WeightFunction {
     }
 
     /// WGSL constants `WEIGHT_FLAT`, `WEIGHT_ALPHA_CUBED`, ... holding each weight's id.
-    pub fn wgsl_ids() -> crate::gpu::WgslConsts {
+    pub(crate) fn wgsl_ids() -> crate::gpu::WgslConsts {
         Self::ALL
             .into_iter()
             .fold(crate::gpu::WgslConsts::default(), |c, w| {

@@ -40,7 +40,7 @@ use crate::chunks::Surfaces;
 /// An object as the order sees it: a ball, and along each axis how far the object
 /// reaches from the centre (the ball's radius, or less where its box is known).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ball {
+pub(crate) struct Ball {
     /// Centre, world blocks.
     pub center: DVec3,
     /// Radius, blocks (0: a point).
@@ -53,7 +53,7 @@ impl Ball {
     /// A ball of `radius` around `center` that also lies within `half` of it along each
     /// axis, where given. A radius or extent that is not a finite non-negative number
     /// counts as 0.
-    pub fn new(center: DVec3, radius: f64, half: Option<DVec3>) -> Self {
+    pub(crate) fn new(center: DVec3, radius: f64, half: Option<DVec3>) -> Self {
         let clean = |v: f64| if v.is_finite() { v.max(0.0) } else { 0.0 };
         let radius = clean(radius);
         let half = half.map_or(DVec3::splat(radius), |h| {
@@ -68,7 +68,7 @@ impl Ball {
 
     /// A ball of `radius` around `center`.
     #[cfg(test)]
-    pub fn sphere(center: DVec3, radius: f64) -> Self {
+    pub(crate) fn sphere(center: DVec3, radius: f64) -> Self {
         Self::new(center, radius, None)
     }
 }
@@ -201,7 +201,7 @@ fn quad_side(
 
 /// The visible translucent chunks of a frame in draw order, as [`Interleaver::order`] reads them.
 #[derive(Clone, Copy, Debug)]
-pub struct ChunkSequence<'a> {
+pub(crate) struct ChunkSequence<'a> {
     /// Each chunk's surfaces (`None`: it draws nothing translucent).
     pub surfaces: &'a [Option<Surfaces<'a>>],
     /// Each chunk's [`voxel_mesh::order::chunk_order_key`] for the frame's eye: the
@@ -430,7 +430,7 @@ struct ChunkFacts {
 
 /// [`Interleaver::order`] of `balls` in fresh buffers (for the tests).
 #[cfg(test)]
-pub fn interleave(
+pub(crate) fn interleave(
     balls: &[Ball],
     eye: DVec3,
     chunks: &ChunkSequence<'_>,
@@ -453,7 +453,7 @@ pub fn interleave(
 /// between frames (thousands of objects a frame would otherwise allocate and fault in
 /// megabytes each time): the renderer holds one.
 #[derive(Debug, Default)]
-pub struct Interleaver {
+pub(crate) struct Interleaver {
     /// Each object's place (chunk, quad).
     places: Vec<(u32, u32)>,
     /// Each object's distance as a key that orders farthest first, and the object.
@@ -500,7 +500,7 @@ impl Interleaver {
     /// An object whose centre or radius is not finite, and one the eye is inside of (a game's
     /// translucent volume seen from within: its far faces are nearer than any chunk outside
     /// it), go after every chunk.
-    pub fn order(
+    pub(crate) fn order(
         &mut self,
         objects: &[crate::stages::TranslucentObject],
         eye: DVec3,
@@ -516,7 +516,7 @@ impl Interleaver {
     }
 
     /// The last order: the objects in draw order, and where runs of them are drawn.
-    pub fn result(&self) -> (&[u32], &[Split]) {
+    pub(crate) fn result(&self) -> (&[u32], &[Split]) {
         (&self.order, &self.splits)
     }
 
