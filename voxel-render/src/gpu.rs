@@ -16,12 +16,12 @@ use crate::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
 /// of an incomplete texture as 0), which ANGLE, WebGL2 in Chrome, enforces. Mesa's
 /// llvmpipe returns the texel either way, so the tests here cannot tell: the nearest
 /// sampler keeps the read valid under the rule.
-pub const DEPTH_READ: wgpu::TextureSampleType =
+pub(crate) const DEPTH_READ: wgpu::TextureSampleType =
     wgpu::TextureSampleType::Float { filterable: false };
 
 /// WGSL: `depth_uv(xy, size)`, the coordinates of the centre of the texel under pixel `xy`
 /// of a texture of `size`, where a nearest sampler returns exactly that texel.
-pub const DEPTH_UV_WGSL: &str = "
+pub(crate) const DEPTH_UV_WGSL: &str = "
 // The centre of the texel under pixel `xy` of a depth texture of `size` (`gpu.rs`,
 // DEPTH_READ): sampled there with a nearest sampler, the texel's exact depth.
 fn depth_uv(xy: vec2<f32>, size: vec2<u32>) -> vec2<f32> {
@@ -31,7 +31,7 @@ fn depth_uv(xy: vec2<f32>, size: vec2<u32>) -> vec2<f32> {
 
 /// The sampler depth textures are read with ([`DEPTH_READ`]): nearest, no mipmaps,
 /// clamped.
-pub fn depth_sampler(device: &wgpu::Device) -> wgpu::Sampler {
+pub(crate) fn depth_sampler(device: &wgpu::Device) -> wgpu::Sampler {
     device.create_sampler(&wgpu::SamplerDescriptor {
         label: Some("depth_sampler"),
         ..Default::default()
@@ -39,7 +39,7 @@ pub fn depth_sampler(device: &wgpu::Device) -> wgpu::Sampler {
 }
 
 /// A layout entry for [`depth_sampler`] in the fragment stage.
-pub fn depth_sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+pub(crate) fn depth_sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
@@ -49,7 +49,7 @@ pub fn depth_sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 /// WGSL shared by every fullscreen pipeline.
-pub const FULLSCREEN_WGSL: &str = include_str!("shaders/fullscreen.wgsl");
+pub(crate) const FULLSCREEN_WGSL: &str = include_str!("shaders/fullscreen.wgsl");
 
 /// A shader module made of `parts` concatenated (shared code first).
 pub fn shader(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::ShaderModule {
@@ -62,23 +62,23 @@ pub fn shader(device: &wgpu::Device, label: &str, parts: &[&str]) -> wgpu::Shade
 /// WGSL `const` declarations made from Rust values, so that a constant the CPU and GPU
 /// share has one source: prepend [`WgslConsts::finish`] to the shader.
 #[derive(Debug, Default)]
-pub struct WgslConsts(String);
+pub(crate) struct WgslConsts(String);
 
 impl WgslConsts {
     /// A `u32` constant.
-    pub fn u32(mut self, name: &str, value: u32) -> Self {
+    pub(crate) fn u32(mut self, name: &str, value: u32) -> Self {
         self.0 += &format!("const {name}: u32 = {value}u;\n");
         self
     }
 
     /// An `f32` constant.
-    pub fn f32(mut self, name: &str, value: f32) -> Self {
+    pub(crate) fn f32(mut self, name: &str, value: f32) -> Self {
         self.0 += &format!("const {name}: f32 = {value:?};\n");
         self
     }
 
     /// A `u32` array constant.
-    pub fn u32_array(mut self, name: &str, values: &[u32]) -> Self {
+    pub(crate) fn u32_array(mut self, name: &str, values: &[u32]) -> Self {
         let items: Vec<String> = values.iter().map(|v| format!("{v}u")).collect();
         self.0 += &format!(
             "const {name} = array<u32, {}>({});\n",
@@ -89,7 +89,7 @@ impl WgslConsts {
     }
 
     /// The declarations.
-    pub fn finish(self) -> String {
+    pub(crate) fn finish(self) -> String {
         self.0
     }
 }
@@ -106,7 +106,7 @@ pub enum DepthMode {
 }
 
 /// The depth state of `mode` (format [`DEPTH_FORMAT`], reverse-Z).
-pub fn depth_state(mode: DepthMode) -> wgpu::DepthStencilState {
+pub(crate) fn depth_state(mode: DepthMode) -> wgpu::DepthStencilState {
     let (write, compare) = match mode {
         DepthMode::Write => (true, wgpu::CompareFunction::Greater),
         DepthMode::ReadOnly => (false, wgpu::CompareFunction::Greater),
@@ -180,17 +180,17 @@ impl ChunkPipeline<'_> {
 
     /// Creates an opaque pipeline: back faces culled, quads grown against T-junction
     /// cracks (`vs_solid`; see `OPAQUE_EXPANSION_PX` in `bindings.rs`).
-    pub fn build_solid(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+    pub(crate) fn build_solid(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         self.build_with(device, true, Some(wgpu::Face::Back))
     }
 
     /// Creates the pipeline drawing both sides of every face.
-    pub fn build_two_sided(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+    pub(crate) fn build_two_sided(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         self.build_with(device, false, None)
     }
 
     /// Creates both variants of a translucent pipeline (see [`SidedPipeline`]).
-    pub fn build_sided(&self, device: &wgpu::Device) -> SidedPipeline {
+    pub(crate) fn build_sided(&self, device: &wgpu::Device) -> SidedPipeline {
         SidedPipeline {
             culled: self.build_with(device, false, Some(wgpu::Face::Back)),
             two_sided: self.build_with(device, false, None),
@@ -264,7 +264,7 @@ pub fn pipelines_built() -> u64 {
 /// A fullscreen-triangle pipeline: `source` (a fragment shader, after `fullscreen.wgsl`,
 /// whose `vs_fullscreen` it uses).
 #[derive(Debug)]
-pub struct FullscreenPipeline<'a> {
+pub(crate) struct FullscreenPipeline<'a> {
     /// Debug label.
     pub label: &'a str,
     /// WGSL of the fragment shader and what it needs.
@@ -283,7 +283,7 @@ pub struct FullscreenPipeline<'a> {
 
 impl FullscreenPipeline<'_> {
     /// Creates the pipeline.
-    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+    pub(crate) fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         count_pipeline();
         let module = &shader(device, self.label, &[FULLSCREEN_WGSL, self.source]);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -325,7 +325,7 @@ impl FullscreenPipeline<'_> {
 }
 
 /// A colour target of the HDR scene format with `blend`.
-pub fn scene_target(blend: Option<wgpu::BlendState>) -> Option<wgpu::ColorTargetState> {
+pub(crate) fn scene_target(blend: Option<wgpu::BlendState>) -> Option<wgpu::ColorTargetState> {
     Some(wgpu::ColorTargetState {
         format: SCENE_FORMAT,
         blend,
@@ -335,7 +335,7 @@ pub fn scene_target(blend: Option<wgpu::BlendState>) -> Option<wgpu::ColorTarget
 
 /// A layout entry for a non-filterable 2D texture read with `textureLoad` in fragments
 /// (a depth texture: [`DEPTH_READ`]).
-pub fn texture_entry(
+pub(crate) fn texture_entry(
     binding: u32,
     sample_type: wgpu::TextureSampleType,
 ) -> wgpu::BindGroupLayoutEntry {
@@ -352,7 +352,7 @@ pub fn texture_entry(
 }
 
 /// A layout entry for a buffer seen by `visibility`.
-pub fn buffer_entry(
+pub(crate) fn buffer_entry(
     binding: u32,
     visibility: wgpu::ShaderStages,
     ty: wgpu::BufferBindingType,
@@ -385,7 +385,7 @@ pub fn layout(
 /// `ALPHA_BLENDING`, reading two unfilterable float textures: how the weighted (WBOIT) and
 /// moment-based (MBOIT) techniques lay their sums over the opaque image. Returns the
 /// textures' layout and the pipeline.
-pub fn composite_pipeline(
+pub(crate) fn composite_pipeline(
     device: &wgpu::Device,
     label: &str,
     source: &str,
@@ -406,7 +406,7 @@ pub fn composite_pipeline(
 }
 
 /// A layout of `count` fragment textures at bindings 0, 1, ... of `sample_type`.
-pub fn textures_layout(
+pub(crate) fn textures_layout(
     device: &wgpu::Device,
     label: &str,
     sample_type: wgpu::TextureSampleType,
@@ -440,7 +440,7 @@ pub fn bind_group(
 }
 
 /// A bind group of texture views at bindings 0, 1, ...
-pub fn texture_group(
+pub(crate) fn texture_group(
     device: &wgpu::Device,
     label: &str,
     layout: &wgpu::BindGroupLayout,
@@ -464,7 +464,7 @@ pub struct Target {
 
 /// What a [`Target`] is.
 #[derive(Clone, Copy, Debug)]
-pub struct TargetDesc<'a> {
+pub(crate) struct TargetDesc<'a> {
     /// Debug label.
     pub label: &'a str,
     /// Texel format.
@@ -479,7 +479,7 @@ pub struct TargetDesc<'a> {
 
 impl TargetDesc<'_> {
     /// Creates the texture and its view.
-    pub fn create(&self, device: &wgpu::Device) -> Target {
+    pub(crate) fn create(&self, device: &wgpu::Device) -> Target {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some(self.label),
             size: wgpu::Extent3d {
@@ -727,7 +727,7 @@ pub fn flush(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) -> crate::Res
 /// `DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES` ("GLES/WebGL don't support this"), and
 /// the flag decides.
 #[derive(Debug)]
-pub struct DepthCopy {
+pub(crate) struct DepthCopy {
     /// The pass, where texture copies cannot.
     pass: Option<CopyPass>,
 }
@@ -743,7 +743,7 @@ struct CopyPass {
 
 impl DepthCopy {
     /// The copy for the device of `ctx`.
-    pub fn new(ctx: &GpuContext) -> Self {
+    pub(crate) fn new(ctx: &GpuContext) -> Self {
         let copies = ctx
             .caps
             .downlevel
@@ -777,7 +777,7 @@ impl DepthCopy {
     }
 
     /// Records the copy of `src` into `dst` (timed as `timing`, when a pass).
-    pub fn record(
+    pub(crate) fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         src: &Target,
