@@ -251,19 +251,19 @@ impl Culled {
     }
 
     /// The positions of the visible translucent meshes, farthest first.
-    pub fn translucent_positions(&self) -> &[ChunkPos] {
+    pub(crate) fn translucent_positions(&self) -> &[ChunkPos] {
         &self.positions
     }
 
     /// The [`voxel_mesh::order::chunk_order_key`] of each visible translucent mesh, in
     /// the order of [`Culled::translucent_positions`] (largest first).
-    pub fn translucent_keys(&self) -> &[u128] {
+    pub(crate) fn translucent_keys(&self) -> &[u128] {
         &self.keys
     }
 
     /// The store's slot of each visible translucent mesh, in the order of
     /// [`Culled::translucent_positions`] ([`ChunkStore::by_slot`]).
-    pub fn translucent_slots(&self) -> impl Iterator<Item = u32> + '_ {
+    pub(crate) fn translucent_slots(&self) -> impl Iterator<Item = u32> + '_ {
         self.far.iter().map(|e| e.slot)
     }
 

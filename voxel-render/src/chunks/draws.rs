@@ -86,7 +86,7 @@ impl FrameDraws<'_> {
     }
 
     /// Records the draws of meshes `range` of `list` (in its order), like [`Self::draw`].
-    pub fn draw_range(
+    pub(crate) fn draw_range(
         &self,
         list: &DrawList,
         range: std::ops::Range<usize>,
@@ -128,7 +128,7 @@ impl FrameDraws<'_> {
 
     /// Draws quads `quads` (positions in the mesh's drawn order, clamped to it) of mesh
     /// `index` of `list`: part of a chunk, for objects drawn among its quads.
-    pub fn draw_quads(
+    pub(crate) fn draw_quads(
         &self,
         list: &DrawList,
         index: usize,

@@ -41,7 +41,7 @@ impl GpuChunk {
 
     /// Whether the translucent mesh has a face of a volume (a block type with absorption,
     /// [`voxel_core::BlockDef::absorption`]).
-    pub fn has_volume(&self) -> bool {
+    pub(crate) fn has_volume(&self) -> bool {
         self.volume
     }
 
@@ -51,7 +51,7 @@ impl GpuChunk {
     }
 
     /// The box the translucent quads span, in world blocks (min, max).
-    pub fn translucent_bounds(&self) -> Option<([f64; 3], [f64; 3])> {
+    pub(crate) fn translucent_bounds(&self) -> Option<([f64; 3], [f64; 3])> {
         let o = self.pos.origin().map(|v| v as f64);
         self.translucent_bounds.map(|(lo, hi)| {
             (
@@ -63,7 +63,7 @@ impl GpuChunk {
 
     /// The translucent quads as the sorted techniques order a game's objects against them
     /// (`oit::sorted::interleave`): their box and their distinct planes, world blocks.
-    pub fn translucent_surfaces(&self) -> Option<Surfaces<'_>> {
+    pub(crate) fn translucent_surfaces(&self) -> Option<Surfaces<'_>> {
         let (lo, hi) = self.translucent_bounds()?;
         Some(Surfaces {
             lo: DVec3::from(lo),

@@ -37,7 +37,7 @@ pub use store::ChunkStore;
 /// and a final mix, instead of SipHash (the store and the techniques look chunks up by
 /// position every frame; nothing here needs resistance to chosen keys).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct PosHasher(u64);
+pub(crate) struct PosHasher(u64);
 
 impl PosHasher {
     const K: u64 = 0x9e37_79b9_7f4a_7c15;
@@ -80,7 +80,7 @@ impl Hasher for PosHasher {
 }
 
 /// A hash map keyed by chunk position (or another small integer key), with [`PosHasher`].
-pub type PosMap<K, V> = HashMap<K, V, BuildHasherDefault<PosHasher>>;
+pub(crate) type PosMap<K, V> = HashMap<K, V, BuildHasherDefault<PosHasher>>;
 
 /// Which of a chunk's three meshes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -168,7 +168,7 @@ impl ChunkStore {
 
     /// Call once a frame's draw lists hold the meshes' places: from now until
     /// [`ChunkStore::frame_submitted`], freed places and slots are kept from reuse.
-    pub fn lists_built(&mut self) {
+    pub(crate) fn lists_built(&mut self) {
         self.in_flight = true;
     }
 
@@ -376,7 +376,7 @@ impl ChunkStore {
 
     /// The chunk in `slot` (what [`Culled::translucent_slots`] names), without a lookup
     /// by position.
-    pub fn by_slot(&self, slot: u32) -> Option<&GpuChunk> {
+    pub(crate) fn by_slot(&self, slot: u32) -> Option<&GpuChunk> {
         self.slots.get(slot as usize)?.as_ref()
     }
 
@@ -407,7 +407,7 @@ impl ChunkStore {
 
     /// Rewrites a chunk's translucent quads in a new order (the same quads: a permutation
     /// of [`GpuChunk::translucent_quads`]), for sorting. The generation stays.
-    pub fn reorder_translucent(&mut self, ctx: &GpuContext, pos: ChunkPos, quads: Vec<PackedQuad>) {
+    pub(crate) fn reorder_translucent(&mut self, ctx: &GpuContext, pos: ChunkPos, quads: Vec<PackedQuad>) {
         let Some(&slot) = self.by_pos.get(&pos) else {
             return;
         };
@@ -423,7 +423,7 @@ impl ChunkStore {
     }
 
     /// Sets a chunk's whole-chunk opacity (fade-in).
-    pub fn set_alpha(&mut self, ctx: &GpuContext, pos: ChunkPos, alpha: f32) {
+    pub(crate) fn set_alpha(&mut self, ctx: &GpuContext, pos: ChunkPos, alpha: f32) {
         if let Some(&slot) = self.by_pos.get(&pos) {
             let info = ChunkUniforms {
                 origin: pos.origin().map(|v| v as i32),
@@ -482,7 +482,7 @@ impl ChunkStore {
     }
 
     /// Uploads a frame's draw commands to the indirect buffer (growing it when needed).
-    pub fn upload_draws(&mut self, ctx: &GpuContext, commands: &[DrawCommand]) {
+    pub(crate) fn upload_draws(&mut self, ctx: &GpuContext, commands: &[DrawCommand]) {
         let bytes = std::mem::size_of_val(commands) as u64;
         if bytes > self.indirect.size() {
             self.indirect = Self::indirect_buffer(&ctx.device, commands.len() * 2);
