@@ -97,7 +97,7 @@ pub fn looks(registry: &BlockRegistry) -> Vec<Option<MediumLook>> {
 /// The fog pass's uniform (`FogParams` in `medium.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct FogParams {
+pub(crate) struct FogParams {
     /// Lit fog colour, linear.
     pub color: [f32; 3],
     /// Optical depth per block: the medium's absorption.
@@ -113,26 +113,26 @@ pub struct FogParams {
 }
 
 /// The medium shaders: the boundary pass (after the shared chunk code) and the fog.
-pub fn boundary_wgsl() -> String {
+pub(crate) fn boundary_wgsl() -> String {
     crate::bindings::common_wgsl() + include_str!("shaders/medium_boundary.wgsl")
 }
 
 /// The volume exit pass's shader.
-pub fn volume_exit_wgsl() -> String {
+pub(crate) fn volume_exit_wgsl() -> String {
     crate::bindings::common_wgsl() + include_str!("shaders/volume_exit.wgsl")
 }
 
 /// The fog pass's shader (after `fullscreen.wgsl`).
-pub fn fog_wgsl() -> String {
+pub(crate) fn fog_wgsl() -> String {
     gpu::DEPTH_UV_WGSL.to_owned() + include_str!("shaders/medium_fog.wgsl")
 }
 
 /// The format of the nearest volume entry's look (linear colour, absorption).
-pub const ENTRY_LOOK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub(crate) const ENTRY_LOOK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The pipelines of the two passes a frame inside a medium adds.
 #[derive(Debug)]
-pub struct MediumPass {
+pub(crate) struct MediumPass {
     boundary: wgpu::RenderPipeline,
     /// The nearest back face of a volume in front of the opaque surface (`volume_exit.wgsl`).
     volume_exit: wgpu::RenderPipeline,
@@ -151,7 +151,7 @@ pub struct MediumPass {
 
 impl MediumPass {
     /// Creates the pipelines.
-    pub fn new(ctx: &GpuContext, layouts: &SharedLayouts) -> Self {
+    pub(crate) fn new(ctx: &GpuContext, layouts: &SharedLayouts) -> Self {
         let device = &ctx.device;
         let module = gpu::shader(device, "medium_boundary", &[&boundary_wgsl()]);
         let groups = layouts.with(&[]);
@@ -233,7 +233,7 @@ impl MediumPass {
     }
 
     /// The fog's bind group over `boundary` (per render size).
-    pub fn fog_group(&self, device: &wgpu::Device, boundary: &Target) -> wgpu::BindGroup {
+    pub(crate) fn fog_group(&self, device: &wgpu::Device, boundary: &Target) -> wgpu::BindGroup {
         gpu::bind_group(
             device,
             "medium_fog",
@@ -250,7 +250,7 @@ impl MediumPass {
     /// `medium`) in front of `opaque_depth`, per pixel. `scene` is group 0 without the
     /// boundary in it (the pass writes it).
     #[allow(clippy::too_many_arguments)]
-    pub fn boundary_pass(
+    pub(crate) fn boundary_pass(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         opaque_depth: &Target,
@@ -276,7 +276,7 @@ impl MediumPass {
     /// `volume_depth`'s place) the nearest back face of a volume in front of it, where the
     /// techniques that compose a volume at its entry face end it. The exact references,
     /// which see every face, take the opaque depth alone. After the boundary pass.
-    pub fn volume_depth_pass(
+    pub(crate) fn volume_depth_pass(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         opaque_depth: &Target,
@@ -302,7 +302,7 @@ impl MediumPass {
     /// front of `opaque_depth` and its medium's look (`scene`: group 0 with the opaque depth
     /// in `volume_entry`'s place). After [`Self::volume_depth_pass`].
     #[allow(clippy::too_many_arguments)]
-    pub fn volume_entry_pass(
+    pub(crate) fn volume_entry_pass(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         opaque_depth: &Target,
@@ -325,7 +325,7 @@ impl MediumPass {
     }
 
     /// Blends the fog over `target` along the way to the boundary.
-    pub fn fog_pass(
+    pub(crate) fn fog_pass(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         target: &Target,
@@ -343,7 +343,7 @@ impl MediumPass {
 
 /// The fog of `look` seen with `camera` (already guarded) at `aspect`, lit by `sun` and
 /// `ambient` like a face turned to the sky.
-pub fn fog_params(
+pub(crate) fn fog_params(
     look: &MediumLook,
     camera: &Camera,
     aspect: f64,

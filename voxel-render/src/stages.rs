@@ -295,7 +295,7 @@ impl GameDraw<'_> {
     }
 
     /// Like [`GameDraw::draw`], with dynamic `offsets` for the group.
-    pub fn draw_offsets(
+    pub(crate) fn draw_offsets(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         variant: usize,
@@ -308,7 +308,7 @@ impl GameDraw<'_> {
     }
 
     /// Draws every object in pass `variant`.
-    pub fn draw_all(
+    pub(crate) fn draw_all(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         variant: usize,
