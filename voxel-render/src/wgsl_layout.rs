@@ -2,7 +2,7 @@
 //! as naga (the shader compiler wgpu uses) lays it out, so that the two cannot drift apart.
 
 /// A Rust field: name, byte offset, byte size.
-pub type Field = (&'static str, usize, usize);
+pub(crate) type Field = (&'static str, usize, usize);
 
 /// `(name, offset, size)` of a field of a Rust struct.
 macro_rules! field {
@@ -27,7 +27,7 @@ pub fn parse(source: &str) -> naga::Module {
 
 /// Asserts that WGSL struct `name` of `module` has exactly `fields` (same names in the same
 /// order, same offsets and sizes) and the size of `T`.
-pub fn assert_layout<T>(module: &naga::Module, name: &str, fields: &[Field]) {
+pub(crate) fn assert_layout<T>(module: &naga::Module, name: &str, fields: &[Field]) {
     let (members, span) = module
         .types
         .iter()
