@@ -45,7 +45,7 @@ pub struct Allocator {
 
 impl Allocator {
     /// An empty allocator of `capacity` units.
-    pub fn new(capacity: u32) -> Self {
+    pub(crate) fn new(capacity: u32) -> Self {
         let mut a = Self {
             capacity,
             free: BTreeMap::new(),
@@ -103,7 +103,7 @@ impl Allocator {
     }
 
     /// Units in use.
-    pub fn used(&self) -> u32 {
+    pub(crate) fn used(&self) -> u32 {
         self.used
     }
 
@@ -295,7 +295,7 @@ impl QuadArena {
     }
 
     /// Writes `quads` into `a` (as many as both hold).
-    pub fn write(&self, queue: &wgpu::Queue, a: Alloc, quads: &[PackedQuad]) {
+    pub(crate) fn write(&self, queue: &wgpu::Queue, a: Alloc, quads: &[PackedQuad]) {
         if let Some(Some(p)) = self.pages.get(a.page as usize) {
             let n = quads.len().min(a.quads as usize);
             queue.write_buffer(
@@ -307,12 +307,12 @@ impl QuadArena {
     }
 
     /// The buffer of page `i` (`None` for a page given back).
-    pub fn page(&self, i: usize) -> Option<&wgpu::Buffer> {
+    pub(crate) fn page(&self, i: usize) -> Option<&wgpu::Buffer> {
         self.pages.get(i)?.as_ref().map(|p| &p.buffer)
     }
 
     /// One past the highest page index (pages given back below it leave holes).
-    pub fn pages(&self) -> usize {
+    pub(crate) fn pages(&self) -> usize {
         self.pages.len()
     }
 

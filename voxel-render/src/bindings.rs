@@ -217,7 +217,7 @@ impl SharedLayouts {
 
     /// Groups 0 and 1, then `extra` (a technique's own groups from 2 on), with the way
     /// quads are fetched: what a [`gpu::ChunkPipeline`] is built against.
-    pub fn with<'a>(&'a self, extra: &[&'a wgpu::BindGroupLayout]) -> ChunkGroups<'a> {
+    pub(crate) fn with<'a>(&'a self, extra: &[&'a wgpu::BindGroupLayout]) -> ChunkGroups<'a> {
         ChunkGroups {
             layouts: [&self.scene, &self.chunk]
                 .into_iter()

@@ -169,7 +169,7 @@ impl QuadFetch {
 
     /// Whether chunks can be drawn with `multi_draw_indirect`: not with
     /// [`QuadFetch::Instanced`], whose draws each bind their chunk's record.
-    pub fn indirect(self) -> bool {
+    pub(crate) fn indirect(self) -> bool {
         self == QuadFetch::Storage
     }
 }

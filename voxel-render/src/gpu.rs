@@ -163,7 +163,7 @@ pub struct SidedPipeline {
 
 impl SidedPipeline {
     /// The variant for a frame.
-    pub fn get(&self, two_sided: bool) -> &wgpu::RenderPipeline {
+    pub(crate) fn get(&self, two_sided: bool) -> &wgpu::RenderPipeline {
         if two_sided {
             &self.two_sided
         } else {
@@ -616,7 +616,7 @@ impl<'a> Pass<'a> {
     }
 
     /// The same pass with `depth`.
-    pub fn depth(self, depth: Depth<'a>) -> Self {
+    pub(crate) fn depth(self, depth: Depth<'a>) -> Self {
         Self { depth, ..self }
     }
 

@@ -46,7 +46,7 @@ pub enum Limit {
 
 impl Limit {
     /// wgpu's name of the limit.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Limit::StorageBuffersPerStage => "max_storage_buffers_per_shader_stage",
             Limit::StorageBufferBindingSize => "max_storage_buffer_binding_size",
@@ -63,7 +63,7 @@ impl Limit {
     }
 
     /// Its value in `limits`.
-    pub fn of(self, limits: &wgpu::Limits) -> u64 {
+    pub(crate) fn of(self, limits: &wgpu::Limits) -> u64 {
         match self {
             Limit::StorageBuffersPerStage => limits.max_storage_buffers_per_shader_stage.into(),
             Limit::StorageBufferBindingSize => limits.max_storage_buffer_binding_size,
@@ -101,7 +101,7 @@ pub enum Need {
 
 impl Need {
     /// Whether the device of `caps` has it.
-    pub fn met(&self, caps: &Capabilities) -> bool {
+    pub(crate) fn met(&self, caps: &Capabilities) -> bool {
         match *self {
             Need::Feature(f) => caps.features.contains(f),
             Need::Downlevel(d) => caps.downlevel.contains(d),
@@ -112,7 +112,7 @@ impl Need {
     }
 
     /// What it is, and what the device of `caps` has instead.
-    pub fn describe(&self, caps: &Capabilities) -> String {
+    pub(crate) fn describe(&self, caps: &Capabilities) -> String {
         match *self {
             Need::Limit(limit, value) => format!(
                 "{} of at least {value} (this device: {})",

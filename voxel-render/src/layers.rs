@@ -131,7 +131,7 @@ pub struct VisibleLayers<'a> {
 
 impl<'a> VisibleLayers<'a> {
     /// Each chunk and its planes.
-    pub fn iter(&self) -> impl Iterator<Item = (ChunkPos, &'a [Plane])> + 'a {
+    pub(crate) fn iter(&self) -> impl Iterator<Item = (ChunkPos, &'a [Plane])> + 'a {
         let planes = self.planes;
         let mut start = 0;
         self.runs.iter().map(move |&(pos, end)| {
@@ -142,7 +142,7 @@ impl<'a> VisibleLayers<'a> {
     }
 
     /// The box of each chunk's translucent mesh, world blocks.
-    pub fn boxes(&self) -> impl Iterator<Item = (DVec3, DVec3)> + 'a {
+    pub(crate) fn boxes(&self) -> impl Iterator<Item = (DVec3, DVec3)> + 'a {
         self.iter().filter_map(|(pos, planes)| {
             let origin = DVec3::from(pos.origin().map(|v| v as f64));
             let (lo, hi) = bounds(planes)?;

@@ -283,7 +283,7 @@ impl std::fmt::Debug for GameDraw<'_> {
 
 impl GameDraw<'_> {
     /// Draws the objects `range` in pass `variant`, with `group` bound at [`OIT_GROUP`].
-    pub fn draw(
+    pub(crate) fn draw(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         variant: usize,

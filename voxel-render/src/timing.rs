@@ -52,7 +52,7 @@ impl GpuPass {
     ];
 
     /// The name used in labels and reports.
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             GpuPass::Opaque => "opaque",
             GpuPass::Cutout => "cutout",

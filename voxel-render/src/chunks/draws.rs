@@ -81,7 +81,7 @@ pub struct FrameDraws<'a> {
 
 impl FrameDraws<'_> {
     /// Records the draws of `list` (pipeline and group 0 already set; group 1 set here).
-    pub fn draw(&self, list: &DrawList, pass: &mut wgpu::RenderPass<'_>) {
+    pub(crate) fn draw(&self, list: &DrawList, pass: &mut wgpu::RenderPass<'_>) {
         self.draw_range(list, 0..list.meshes, pass);
     }
 

@@ -35,7 +35,7 @@ impl GpuChunk {
     }
 
     /// Where the chunk is.
-    pub fn pos(&self) -> ChunkPos {
+    pub(crate) fn pos(&self) -> ChunkPos {
         self.pos
     }
 
@@ -46,7 +46,7 @@ impl GpuChunk {
     }
 
     /// The translucent quads in their current GPU order.
-    pub fn translucent_quads(&self) -> &[PackedQuad] {
+    pub(crate) fn translucent_quads(&self) -> &[PackedQuad] {
         &self.translucent
     }
 

@@ -246,7 +246,7 @@ impl ChunkStore {
     ///
     /// The places a frame in flight draws are never written: a replaced mesh keeps its
     /// place until that frame is submitted ([`ChunkStore::frame_submitted`]).
-    pub fn upload(&mut self, ctx: &GpuContext, pos: ChunkPos, meshes: &ChunkMeshes) -> Result<()> {
+    pub(crate) fn upload(&mut self, ctx: &GpuContext, pos: ChunkPos, meshes: &ChunkMeshes) -> Result<()> {
         let limit = self.arena.max_mesh_quads();
         for (kind, quads) in [
             ("opaque", &meshes.opaque),
@@ -348,7 +348,7 @@ impl ChunkStore {
 
     /// Removes a chunk and frees its quads (once the frame in flight is submitted, if
     /// one is); a page left empty is given back.
-    pub fn remove(&mut self, ctx: &GpuContext, pos: ChunkPos) {
+    pub(crate) fn remove(&mut self, ctx: &GpuContext, pos: ChunkPos) {
         if let Some(slot) = self.by_pos.remove(&pos) {
             self.free_meshes(ctx, slot);
             self.regions.remove(slot);

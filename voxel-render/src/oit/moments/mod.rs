@@ -115,7 +115,7 @@ pub struct MboitParams {
 
 impl MboitParams {
     /// The parameters for a warp across `range` (view depths) with `bias`.
-    pub fn new(range: [f32; 2], bias: f32, overestimation: f32) -> Self {
+    pub(crate) fn new(range: [f32; 2], bias: f32, overestimation: f32) -> Self {
         let ln_near = range[0].max(1e-6).ln();
         let ln_far = range[1].max(range[0] * 1.001).max(1e-6).ln();
         Self {

@@ -27,7 +27,7 @@ impl BayerSize {
     }
 
     /// The state's 2-bit pattern code: 0 = 2×2, 1 = 4×4, 2 = 8×8, 3 = 16×16.
-    pub fn code(self) -> u32 {
+    pub(crate) fn code(self) -> u32 {
         self.side().trailing_zeros() - 1
     }
 

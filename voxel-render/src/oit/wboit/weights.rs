@@ -77,7 +77,7 @@ impl WeightFunction {
     }
 
     /// The id the shader switches on (`WEIGHT_<NAME>` constants, generated from this).
-    pub fn id(self) -> u32 {
+    pub(crate) fn id(self) -> u32 {
         self as u32
     }
 
