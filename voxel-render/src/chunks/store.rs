@@ -246,7 +246,12 @@ impl ChunkStore {
     ///
     /// The places a frame in flight draws are never written: a replaced mesh keeps its
     /// place until that frame is submitted ([`ChunkStore::frame_submitted`]).
-    pub(crate) fn upload(&mut self, ctx: &GpuContext, pos: ChunkPos, meshes: &ChunkMeshes) -> Result<()> {
+    pub(crate) fn upload(
+        &mut self,
+        ctx: &GpuContext,
+        pos: ChunkPos,
+        meshes: &ChunkMeshes,
+    ) -> Result<()> {
         let limit = self.arena.max_mesh_quads();
         for (kind, quads) in [
             ("opaque", &meshes.opaque),
@@ -407,7 +412,12 @@ impl ChunkStore {
 
     /// Rewrites a chunk's translucent quads in a new order (the same quads: a permutation
     /// of [`GpuChunk::translucent_quads`]), for sorting. The generation stays.
-    pub(crate) fn reorder_translucent(&mut self, ctx: &GpuContext, pos: ChunkPos, quads: Vec<PackedQuad>) {
+    pub(crate) fn reorder_translucent(
+        &mut self,
+        ctx: &GpuContext,
+        pos: ChunkPos,
+        quads: Vec<PackedQuad>,
+    ) {
         let Some(&slot) = self.by_pos.get(&pos) else {
             return;
         };

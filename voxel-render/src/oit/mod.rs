@@ -676,7 +676,10 @@ impl OitManager {
     /// that a game builds its pipelines ahead as [`OitManager::prebuild`] builds the
     /// technique's (which this does too: the technique stays built). An
     /// [`Error::Unsupported`] for a technique the device cannot run.
-    pub(crate) fn contract_for(&mut self, technique: Technique) -> Result<Arc<TranslucentContract>> {
+    pub(crate) fn contract_for(
+        &mut self,
+        technique: Technique,
+    ) -> Result<Arc<TranslucentContract>> {
         let technique = self.resolve(technique)?;
         if technique == self.config.technique {
             return self.contract();

@@ -145,7 +145,10 @@ pub(crate) struct WboitParams {
 }
 
 /// The accumulation format for `settings` on this adapter (RGBA16F, or the RGBA8 fallback).
-pub(crate) fn accumulation_format(caps: &Capabilities, settings: &WboitSettings) -> wgpu::TextureFormat {
+pub(crate) fn accumulation_format(
+    caps: &Capabilities,
+    settings: &WboitSettings,
+) -> wgpu::TextureFormat {
     if settings.force_rgba8_accum || !caps.rgba16f_blendable {
         wgpu::TextureFormat::Rgba8Unorm
     } else {
