@@ -112,7 +112,7 @@ pub struct FrameUniforms {
     pub _pad: f32,
     /// Render target size in pixels.
     pub viewport: [f32; 2],
-    /// Block id of the translucent type the eye is inside, or [`NO_MEDIUM`].
+    /// Block id of the translucent type the eye is inside, or `NO_MEDIUM` (`u32::MAX`).
     pub medium: u32,
     /// Ambient-occlusion strength, 0 (off) to 1.
     pub ao_strength: f32,

@@ -280,7 +280,7 @@ mod tests {
         let _ = std::fs::remove_file(path);
     }
 
-    /// Issue 26: a full disk is an error naming the file, not a silent success.
+    /// A full disk is an error naming the file, not a silent success.
     #[test]
     fn a_failed_png_write_is_an_error_naming_the_file() {
         let img = Image {
