@@ -47,8 +47,8 @@ fn patch(img: &Image, (x, y): (u32, u32)) -> [f64; 3] {
     for py in y - 2..=y + 2 {
         for px in x - 2..=x + 2 {
             let i = ((py * img.width + px) * 4) as usize;
-            for c in 0..3 {
-                sum[c] += f64::from(img.rgba[i + c]) / 25.0;
+            for (c, s) in sum.iter_mut().enumerate() {
+                *s += f64::from(img.rgba[i + c]) / 25.0;
             }
         }
     }

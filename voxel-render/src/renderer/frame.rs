@@ -300,7 +300,7 @@ impl Renderer {
                 );
             }
         }
-        let game_draw = stages.translucent.then(|| GameDraw {
+        let game_draw = stages.translucent.then_some(GameDraw {
             stages: game,
             frame: &game_frame,
             objects,

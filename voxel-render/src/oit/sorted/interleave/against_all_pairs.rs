@@ -9,6 +9,9 @@ use voxel_core::{BlockRegistry, Chunk, Neighbourhood, blocks};
 use voxel_mesh::Mesher;
 use voxel_mesh::order::{QuadOrder, chunk_order_key};
 
+/// An object's place, and what decided it (see [`all_pairs`]).
+type Placed = ((u32, u32), Vec<(u32, Option<u32>)>);
+
 /// The order before: every object against every chunk (the oracle of this test).
 /// Each object's place, and what decided it: `(chunk, None)` for a chunk a sound test
 /// decided, `(chunk, Some(quad))` for a quad whose plane did.
@@ -18,7 +21,7 @@ fn all_pairs(
     chunks: &[Option<Surfaces<'_>>],
     two_sided: bool,
     split_quads: bool,
-) -> Vec<((u32, u32), Vec<(u32, Option<u32>)>)> {
+) -> Vec<Placed> {
     let mut out = Vec::new();
     for &b in balls {
         let o = b.center.distance(eye);

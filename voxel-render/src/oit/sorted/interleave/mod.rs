@@ -698,7 +698,7 @@ fn radix_sort(v: &mut Vec<(u32, u32)>, other: &mut Vec<(u32, u32)>) {
         for &(k, _) in v.iter() {
             counts[((k >> shift) as usize & (BUCKETS - 1)) + 1] += 1;
         }
-        if counts[1..].iter().any(|&c| c == v.len()) {
+        if counts[1..].contains(&v.len()) {
             // Every key has the same digit here: nothing moves.
             continue;
         }
