@@ -97,7 +97,12 @@ pub fn out_dir(name: &str) -> PathBuf {
 
 /// A world of boxes of blocks (inclusive corners) over the default registry.
 pub fn box_world(boxes: &[([i32; 3], [i32; 3], BlockId)]) -> World {
-    let mut world = World::new(Arc::new(BlockRegistry::default()));
+    boxes_in(BlockRegistry::default(), boxes)
+}
+
+/// A world of boxes of blocks (inclusive corners) over `registry`.
+fn boxes_in(registry: BlockRegistry, boxes: &[([i32; 3], [i32; 3], BlockId)]) -> World {
+    let mut world = World::new(Arc::new(registry));
     for &(min, max, id) in boxes {
         voxel_lab::scene::fill_box(&mut world, min, max, id).unwrap();
     }
@@ -118,16 +123,18 @@ pub fn thin_water_world(boxes: &[([i32; 3], [i32; 3], BlockId)]) -> World {
             ..water
         })
         .unwrap();
-    let mut world = World::new(Arc::new(registry));
-    for &(min, max, id) in boxes {
-        let id = if id == voxel_core::blocks::WATER {
-            thin
-        } else {
-            id
-        };
-        voxel_lab::scene::fill_box(&mut world, min, max, id).unwrap();
-    }
-    world
+    let thin_boxes: Vec<_> = boxes
+        .iter()
+        .map(|&(min, max, id)| {
+            let id = if id == voxel_core::blocks::WATER {
+                thin
+            } else {
+                id
+            };
+            (min, max, id)
+        })
+        .collect();
+    boxes_in(registry, &thin_boxes)
 }
 
 /// A scene of `world` seen by one camera at `eye` looking at `target` (fov 60°).

@@ -262,13 +262,16 @@ impl MediumPass {
     ) {
         self.depth_copy
             .record(encoder, opaque_depth, boundary, GpuPass::Medium, timer);
-        Pass::new("medium_boundary", GpuPass::Medium, &[])
-            .depth(Depth::Load(&boundary.view))
-            .record(encoder, timer, |pass| {
-                pass.set_pipeline(&self.boundary);
-                pass.set_bind_group(0, scene, &[]);
-                draws.draw(chunks, pass);
-            });
+        let faces = (scene, draws, chunks);
+        nearest_faces(
+            encoder,
+            "medium_boundary",
+            &self.boundary,
+            boundary,
+            &[],
+            faces,
+            timer,
+        );
     }
 
     /// Writes `volume_depth`, what volumes read (`common.wgsl`): the opaque depth, and
@@ -286,16 +289,17 @@ impl MediumPass {
     ) {
         self.depth_copy
             .record(encoder, opaque_depth, volume_depth, GpuPass::Medium, timer);
-        let Some((scene, draws, chunks)) = exits else {
-            return;
-        };
-        Pass::new("volume_exit", GpuPass::Medium, &[])
-            .depth(Depth::Load(&volume_depth.view))
-            .record(encoder, timer, |pass| {
-                pass.set_pipeline(&self.volume_exit);
-                pass.set_bind_group(0, scene, &[]);
-                draws.draw(chunks, pass);
-            });
+        if let Some(faces) = exits {
+            nearest_faces(
+                encoder,
+                "volume_exit",
+                &self.volume_exit,
+                volume_depth,
+                &[],
+                faces,
+                timer,
+            );
+        }
     }
 
     /// Writes into `entry_depth` and `entry_look` the nearest front face of a volume in
@@ -315,13 +319,16 @@ impl MediumPass {
         self.depth_copy
             .record(encoder, opaque_depth, entry_depth, GpuPass::Medium, timer);
         let colors = [gpu::clear(&entry_look.view, wgpu::Color::TRANSPARENT)];
-        Pass::new("volume_entry", GpuPass::Medium, &colors)
-            .depth(Depth::Load(&entry_depth.view))
-            .record(encoder, timer, |pass| {
-                pass.set_pipeline(&self.volume_entry);
-                pass.set_bind_group(0, scene, &[]);
-                draws.draw(chunks, pass);
-            });
+        let faces = (scene, draws, chunks);
+        nearest_faces(
+            encoder,
+            "volume_entry",
+            &self.volume_entry,
+            entry_depth,
+            &colors,
+            faces,
+            timer,
+        );
     }
 
     /// Blends the fog over `target` along the way to the boundary.
@@ -339,6 +346,27 @@ impl MediumPass {
             pass.draw(0..3, 0..1);
         });
     }
+}
+
+/// The medium's depth passes: `chunks` drawn with `pipeline` (group 0 `scene`) into
+/// `depth`, which holds a copy of the opaque depth, the nearest fragment kept, with
+/// `colors` beside.
+fn nearest_faces(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::RenderPipeline,
+    depth: &Target,
+    colors: &[Option<wgpu::RenderPassColorAttachment<'_>>],
+    (scene, draws, chunks): (&wgpu::BindGroup, &FrameDraws<'_>, &DrawList),
+    timer: Option<&Timer>,
+) {
+    Pass::new(label, GpuPass::Medium, colors)
+        .depth(Depth::Load(&depth.view))
+        .record(encoder, timer, |pass| {
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, scene, &[]);
+            draws.draw(chunks, pass);
+        });
 }
 
 /// The fog of `look` seen with `camera` (already guarded) at `aspect`, lit by `sun` and

@@ -321,8 +321,7 @@ fn translucent_color(in: VsOut, front: bool) -> vec4<f32> {
     if !front || m.a <= 0.0 {
         return inside_volume(in.clip.xy, in.clip.z, c);
     }
-    let size = textureDimensions(volume_depth);
-    let z = textureSampleLevel(volume_depth, depth_sampler, depth_uv(in.clip.xy, size), 0.0).x;
+    let z = depth_at(volume_depth, in.clip.xy);
     let p = in_front_of(vec4<f32>(0.0), c);
     let v = medium_segment(m, ray_length(in.clip.xy, in.clip.z, z));
     let all = p + (1.0 - p.a) * v;
