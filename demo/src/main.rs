@@ -125,10 +125,10 @@ fn draw_mode(s: &str) -> Result<voxel_render::DrawMode, String> {
 #[derive(Args, Debug)]
 struct StreamArgs {
     /// Chunks loaded each way horizontally (1 to 64).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(voxel_render::MAX_VIEW_DISTANCE)))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(voxel_render::low_level::MAX_VIEW_DISTANCE)))]
     view_distance: u32,
     /// Chunks loaded above and below the eye (0 to 64).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(voxel_render::MAX_VIEW_DISTANCE)), default_value_t = 4)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(voxel_render::low_level::MAX_VIEW_DISTANCE)), default_value_t = 4)]
     vertical_distance: u32,
     /// Frames flown and measured (after loading the view distance).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]

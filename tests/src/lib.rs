@@ -289,7 +289,7 @@ pub fn gpu_with_limits(change: impl FnOnce(&mut wgpu::Limits)) -> Option<GpuCont
     change(&mut limits);
     let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
         label: Some("limited"),
-        required_features: adapter.features() & voxel_render::WANTED_FEATURES,
+        required_features: adapter.features() & voxel_render::low_level::WANTED_FEATURES,
         required_limits: limits,
         ..Default::default()
     }))

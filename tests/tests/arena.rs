@@ -9,7 +9,8 @@
 use glam::DVec3;
 use voxel_core::{BlockId, ChunkPos, Face, blocks};
 use voxel_mesh::{ChunkMeshes, PackedQuad};
-use voxel_render::{Camera, GpuContext, MeshKind, Renderer, Technique};
+use voxel_render::low_level::MeshKind;
+use voxel_render::{Camera, GpuContext, Renderer, Technique};
 
 use tests::*;
 

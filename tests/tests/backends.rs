@@ -18,7 +18,7 @@ use voxel_render::{
 const W: u32 = 320;
 const H: u32 = 180;
 
-/// What an [`Error::Unsupported`] names: one of the kinds of [`voxel_render::Need`].
+/// What an [`Error::Unsupported`] names: one of the kinds of [`voxel_render::low_level::Need`].
 const CAPABILITY_WORDS: [&str; 4] = ["downlevel flag", "of at least", "render targets", "feature"];
 
 /// The default scene (terrain, water, a greenhouse), the eye under water (the medium's
@@ -109,7 +109,7 @@ fn draw_or_refuse(
 fn vulkan_config(ctx: &GpuContext, technique: Technique) -> RendererConfig {
     let mut config = technique_config(technique, W, H);
     config.oit.mboit.half_precision =
-        !voxel_render::oit::moments::single_precision(&ctx.caps, &config.oit.mboit);
+        !voxel_render::low_level::moments::single_precision(&ctx.caps, &config.oit.mboit);
     config
 }
 

@@ -88,7 +88,7 @@ fn an_output_of_another_size_or_format_is_an_error() {
     );
     // Every format a surface offers is drawn (tests/tests/embed.rs); others are errors.
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-    let other = voxel_render::gpu::target(
+    let other = voxel_render::stages::target(
         &ctx.device,
         "rgba32",
         wgpu::TextureFormat::Rgba32Float,
@@ -123,7 +123,7 @@ fn peel_layers_beyond_the_limit_are_an_error_not_a_hang() {
     }
     assert_eq!(r.config().oit.peeling.layers, 8, "nothing changed");
     let mut c = r.config().oit.clone();
-    c.peeling.layers = voxel_render::oit::peeling::MAX_PEEL_LAYERS;
+    c.peeling.layers = voxel_render::low_level::peeling::MAX_PEEL_LAYERS;
     r.set_oit_config(c).unwrap();
     frame(&ctx, &mut r, &scene.cameras[0]);
 }
@@ -234,7 +234,7 @@ fn the_nearest_near_plane_still_shows_the_floor() {
         technique_config(Technique::WboitMrt, 64, 48),
     )
     .pixel(32, 2);
-    for near in [0.1, voxel_render::MIN_NEAR] {
+    for near in [0.1, voxel_render::low_level::MIN_NEAR] {
         let img = render_with(
             &ctx,
             &make(near),

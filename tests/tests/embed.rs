@@ -368,7 +368,7 @@ fn every_format_a_surface_offers_draws_the_same_picture() {
     let mut r = renderer_for(&ctx, &s, technique_config(Technique::SortedQuads, w, h)).unwrap();
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let draw = |r: &mut voxel_render::Renderer, format| {
-        let t = voxel_render::gpu::target(&ctx.device, "surface_like", format, usage, (w, h));
+        let t = voxel_render::stages::target(&ctx.device, "surface_like", format, usage, (w, h));
         r.render_and_submit(&t.view, &cam).unwrap();
         assert_eq!(
             r.config().output_format,
@@ -673,7 +673,7 @@ fn switching_to_prebuilt_techniques_builds_no_pipeline() {
     let target = Offscreen::new(&ctx, w, h);
     let game_built = game.pipelines_built();
     for (t, id) in Technique::REAL_TIME.into_iter().zip(ids).rev() {
-        let built = voxel_render::gpu::pipelines_built();
+        let built = voxel_render::low_level::pipelines_built();
         r.set_technique(t).unwrap();
         assert_eq!(
             r.translucent_contract().unwrap().id,
@@ -686,7 +686,7 @@ fn switching_to_prebuilt_techniques_builds_no_pipeline() {
             .unwrap();
         let got = target.read(&ctx).unwrap();
         assert_eq!(
-            voxel_render::gpu::pipelines_built(),
+            voxel_render::low_level::pipelines_built(),
             built,
             "{t}: the switch built a pipeline"
         );

@@ -6,7 +6,7 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use voxel_core::blocks::*;
-use voxel_render::oit::wboit::{self, HEADROOM_SCALE};
+use voxel_render::low_level::wboit::{self, HEADROOM_SCALE};
 use voxel_render::{GpuPass, Renderer, RendererConfig, Technique, WeightFunction};
 
 use tests::*;

@@ -1,7 +1,7 @@
 //! The memory the streamer keeps for edits, counted by a counting allocator (this
 //! test binary's global allocator): it stays within what `ChunkStreamer::edit_bytes`
-//! counts ([`voxel_render::stream::EDIT_BYTES`] per edited block,
-//! [`voxel_render::stream::EDITED_CHUNK_BYTES`] per edited chunk), the documented bound;
+//! counts ([`voxel_render::low_level::EDIT_BYTES`] per edited block,
+//! [`voxel_render::low_level::EDITED_CHUNK_BYTES`] per edited chunk), the documented bound;
 //! 10 000 edits far away took 135 MB as whole chunks before.
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
@@ -90,7 +90,8 @@ fn edits_kept_stay_within_the_documented_bound() {
     assert!(
         one_each as usize
             <= 10_000
-                * (voxel_render::stream::EDIT_BYTES + voxel_render::stream::EDITED_CHUNK_BYTES)
+                * (voxel_render::low_level::EDIT_BYTES
+                    + voxel_render::low_level::EDITED_CHUNK_BYTES)
     );
     assert!(
         all as usize <= s.edit_bytes(),

@@ -26,7 +26,7 @@ use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, World
 use voxel_lab::headless::Offscreen;
 use voxel_mesh::mesh_chunks;
 use voxel_render::{
-    Camera, GpuContext, Lighting, Renderer, RendererConfig, Technique, gpu, readback,
+    Camera, GpuContext, Lighting, Renderer, RendererConfig, Technique, readback, stages,
 };
 
 const W: u32 = 640;
@@ -169,7 +169,7 @@ fn main() -> Result<(), String> {
     let mut r = renderer(&ctx, &world, &positions, config(Technique::SortedQuads))?;
     let rgba = steady(&ctx, &mut r, &target.view, &cam);
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-    let bgra = gpu::target(
+    let bgra = stages::target(
         &ctx.device,
         "bgra_output",
         wgpu::TextureFormat::Bgra8UnormSrgb,

@@ -1,7 +1,7 @@
 //! What a game's technique switch costs once it prepared every technique at loading time:
 //! the first frame after `set_technique` against a steady frame of the same technique, CPU
 //! milliseconds of `Renderer::render_with` (`FrameStats::cpu_ms`), and the render
-//! pipelines the renderer built in that frame (`gpu::pipelines_built`).
+//! pipelines the renderer built in that frame (`low_level::pipelines_built`).
 //!
 //! The world is the record bench's generated terrain at view distance `SWITCH_VD` (default
 //! 16), seen from 40 blocks above the ground at 640×360; the game draws 2 000 bubbles
@@ -21,7 +21,7 @@ use std::time::Instant;
 use glam::{DQuat, DVec3};
 use voxel_lab::content::{Content, ContentStages, Entity, Particle};
 use voxel_lab::headless::Offscreen;
-use voxel_render::{Camera, GpuContext, Renderer, Technique, gpu};
+use voxel_render::{Camera, GpuContext, Renderer, Technique, low_level};
 
 #[path = "common/record_world.rs"]
 mod record_world;
@@ -37,12 +37,12 @@ fn frame(
 ) -> Result<(f64, u64), String> {
     let chain = |e: voxel_render::Error| voxel_lab::chain(&e);
     game.update_pipelines(r).map_err(chain)?;
-    let before = gpu::pipelines_built();
+    let before = low_level::pipelines_built();
     let stats = r
         .render_and_submit_with(&target.view, cam, game)
         .map_err(chain)?;
     let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
-    Ok((stats.cpu_ms, gpu::pipelines_built() - before))
+    Ok((stats.cpu_ms, low_level::pipelines_built() - before))
 }
 
 /// The game's things: bubbles rising ahead of the camera, and a glass crate.

@@ -14,7 +14,7 @@ use std::path::Path;
 use voxel_lab::eval::oit_config;
 use voxel_lab::headless::{self, Offscreen, SceneRenderer};
 use voxel_lab::scene::{Scene, scene_files};
-use voxel_render::oit::wboit;
+use voxel_render::low_level::wboit;
 use voxel_render::{GpuContext, GpuPass, OitConfig, RendererConfig, Technique, WeightFunction};
 
 const WARMUP: usize = 3;

@@ -219,7 +219,7 @@ impl Buffer {
             mapped_at_creation: false,
         });
         let group =
-            voxel_render::gpu::bind_group(device, label, layout, &[buffer.as_entire_binding()]);
+            voxel_render::stages::bind_group(device, label, layout, &[buffer.as_entire_binding()]);
         Self {
             buffer,
             group,

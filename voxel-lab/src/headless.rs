@@ -1,9 +1,9 @@
 //! Rendering without a window: a headless GPU, an offscreen target, PNG output.
 
 use voxel_mesh::mesh_chunks;
+use voxel_render::low_level::{Limit, Need};
 use voxel_render::{
-    Camera, FrameStats, GpuContext, Image, Limit, LimitsPreset, Need, Renderer, RendererConfig,
-    readback,
+    Camera, FrameStats, GpuContext, Image, LimitsPreset, Renderer, RendererConfig, readback,
 };
 
 use crate::content::ContentStages;
@@ -85,7 +85,7 @@ impl Offscreen {
     /// A `width` × `height` target.
     pub fn new(ctx: &GpuContext, width: u32, height: u32) -> Self {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-        let t = voxel_render::gpu::target(
+        let t = voxel_render::stages::target(
             &ctx.device,
             "offscreen_output",
             wgpu::TextureFormat::Rgba8UnormSrgb,
@@ -170,7 +170,7 @@ pub fn renderer_for(
 ) -> Result<SceneRenderer, String> {
     if !scene.content.is_empty() {
         let what = format!("{}: the lab's game content", scene.name);
-        voxel_render::ladder::check(&what, &content_needs(), &ctx.caps)
+        voxel_render::low_level::check(&what, &content_needs(), &ctx.caps)
             .map_err(|e| crate::chain(&e))?;
     }
     let mut renderer =

@@ -14,9 +14,9 @@ use std::time::Instant;
 use glam::DVec3;
 use serde::Serialize;
 use voxel_core::{BlockRegistry, TerrainConfig, TerrainGenerator};
+use voxel_render::low_level::MAX_VIEW_DISTANCE;
 use voxel_render::{
-    Camera, ChunkStreamer, DrawMode, GpuContext, MAX_VIEW_DISTANCE, Renderer, RendererConfig,
-    StreamConfig,
+    Camera, ChunkStreamer, DrawMode, GpuContext, Renderer, RendererConfig, StreamConfig,
 };
 
 use crate::charts::{self, Series};
@@ -370,7 +370,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
         upload_bytes_per_frame_p95: Spread::of(&col(|r| r.upload_bytes as f64)).p95,
         gpu_buffer_bytes: memory.arena_bytes + memory.record_bytes + memory.indirect_bytes,
         gpu_quad_bytes: memory.quad_bytes,
-        quads: memory.quad_bytes / voxel_render::arena::QUAD_BYTES,
+        quads: memory.quad_bytes / voxel_render::low_level::QUAD_BYTES,
         chunk_storage_bytes: streamer.memory_bytes() as u64,
         packed_index_bytes: world.packed_index_bytes() as u64,
         rss_bytes: rss_bytes(),

@@ -35,7 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let output =
-        voxel_render::gpu::target(&ctx.device, "game_output", format, usage, (width, height));
+        voxel_render::stages::target(&ctx.device, "game_output", format, usage, (width, height));
 
     for frame in 0..60u32 {
         // Game logic: a glass pillar grows in front of the camera.

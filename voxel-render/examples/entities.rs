@@ -431,7 +431,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         renderer.upload_chunk(pos, &meshes)?;
     }
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-    let output = voxel_render::gpu::target(
+    let output = voxel_render::stages::target(
         &ctx.device,
         "game_output",
         wgpu::TextureFormat::Rgba8UnormSrgb,

@@ -10,13 +10,13 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use voxel_core::{BlockRegistry, ChunkPos, RenderClass, TerrainConfig, TerrainGenerator, World};
-use voxel_render::{Camera, GpuContext, Renderer, RendererConfig, Technique, gpu};
-use wgpu::CurrentSurfaceTexture::Success;
-use wgpu::PrimitiveTopology::{LineList, TriangleList};
-use wgpu::util::DeviceExt;
+use voxel_render::{Camera, GpuContext, Renderer, RendererConfig, Technique, stages};
 use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
+use wgpu::CurrentSurfaceTexture::Success;
+use wgpu::PrimitiveTopology::{LineList, TriangleList};
+use wgpu::util::DeviceExt;
 
 /// Where the game's camera stands and what it looks at.
 const EYE: DVec3 = DVec3::new(8.5, 33.5, -1.5);
@@ -43,7 +43,8 @@ struct Game {
 }
 
 fn setup(window: Arc<Window>, world: World) -> Result<Gfx, Box<dyn std::error::Error>> {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
     let surface = instance.create_surface(window.clone())?;
     let (ctx, adapter) = GpuContext::for_surface(&instance, &surface)?;
     let (width, height) = window.inner_size().into();
@@ -61,7 +62,7 @@ fn setup(window: Arc<Window>, world: World) -> Result<Gfx, Box<dyn std::error::E
         renderer.prebuild_technique(technique)?;
     }
     let d = &ctx.device;
-    let module = gpu::shader(d, "game_overlay", &[include_str!("window.wgsl")]);
+    let module = stages::shader(d, "game_overlay", &[include_str!("window.wgsl")]);
     let uniforms = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("game_uniforms"),
         contents: &[0; 96],
@@ -70,9 +71,9 @@ fn setup(window: Arc<Window>, world: World) -> Result<Gfx, Box<dyn std::error::E
     let box_pass = (("vs_box", "fs_box"), LineList, true);
     let passes = [box_pass, (("vs_hud", "fs_hud"), TriangleList, false)];
     let passes = passes.map(|(entry, topology, depth)| {
-        let p = gpu::overlay_pipeline(d, &module, entry, config.format, topology, depth);
+        let p = stages::overlay_pipeline(d, &module, entry, config.format, topology, depth);
         let uniform = [uniforms.as_entire_binding()];
-        let group = gpu::bind_group(d, entry.1, &p.get_bind_group_layout(0), &uniform);
+        let group = stages::bind_group(d, entry.1, &p.get_bind_group_layout(0), &uniform);
         (p, group)
     });
     Ok(Gfx {
@@ -116,9 +117,9 @@ impl Game {
         let counts = [24 * u32::from(hit.is_some()), 12];
         for (i, (pipeline, group)) in g.passes.iter().enumerate() {
             // The box tests the frame's depth, read only: nearer blocks hide it.
-            let depth = gpu::Depth::ReadOnly(g.renderer.scene_depth_view());
+            let depth = stages::Depth::ReadOnly(g.renderer.scene_depth_view());
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                color_attachments: &[gpu::load(&view)],
+                color_attachments: &[stages::load(&view)],
                 depth_stencil_attachment: depth.attachment().filter(|_| i == 0),
                 ..Default::default()
             });

@@ -113,12 +113,14 @@ impl Allocator {
     }
 
     /// The longest free range.
+    #[cfg(test)]
     pub fn largest_free(&self) -> u32 {
         self.by_len.last().map_or(0, |r| r.0)
     }
 
     /// One past the highest unit in use (0 when nothing is): what the live meshes span,
     /// holes included.
+    #[cfg(test)]
     pub fn high_water(&self) -> u32 {
         match self.free.last_key_value() {
             Some((&start, &len)) if start + len == self.capacity => start,

@@ -55,10 +55,11 @@ use glam::DVec3;
 use voxel_core::{BlockId, BlockRegistry, CHUNK_SIZE, ChunkPos, RenderClass};
 
 use crate::bindings::SharedLayouts;
+use crate::camera::MIN_NEAR;
 use crate::chunks::{ChunkStore, DrawList, FrameDraws, MeshKind};
 use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, Target};
 use crate::timing::{GpuPass, Timer};
-use crate::{Camera, GpuContext, MIN_NEAR};
+use crate::{Camera, GpuContext};
 
 /// What the renderer needs of a block type to treat it as a medium.
 #[derive(Clone, Copy, Debug, PartialEq)]

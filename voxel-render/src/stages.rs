@@ -25,6 +25,10 @@ use glam::{DVec3, Mat4, Vec3};
 
 use crate::{Camera, GpuContext};
 
+pub use crate::gpu::{
+    Depth, Target, bind_group, load, overlay_depth, overlay_pipeline, shader, target,
+};
+
 /// The bind group index the renderer reserves in a game's translucent pipelines (the last
 /// of the four every adapter offers): the game's own groups are 0, 1 and 2.
 pub const OIT_GROUP: u32 = 3;

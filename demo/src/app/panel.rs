@@ -93,7 +93,7 @@ impl Gfx {
         );
         let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("egui"),
-            color_attachments: &[voxel_render::gpu::load(&frame.view)],
+            color_attachments: &[voxel_render::stages::load(&frame.view)],
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,

@@ -1,7 +1,8 @@
 //! The demo's own passes: the blit of a finished frame to the surface and the error map
 //! against the reference, and the targets of one window size.
 
-use voxel_render::gpu::{self, Pass, Target};
+use voxel_render::low_level::{self, Pass};
+use voxel_render::stages::{self, Target};
 
 /// The format frames are drawn in before they reach the surface.
 pub const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -9,7 +10,7 @@ pub const FRAME_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrg
 fn target(device: &wgpu::Device, label: &str, w: u32, h: u32) -> Target {
     use wgpu::TextureUsages as U;
     let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
-    gpu::target(device, label, FRAME_FORMAT, usage, (w, h))
+    stages::target(device, label, FRAME_FORMAT, usage, (w, h))
 }
 
 /// Fullscreen passes of the demo: the blit to the surface and the error map.
@@ -178,7 +179,7 @@ impl Post {
         group: &wgpu::BindGroup,
         target: &wgpu::TextureView,
     ) {
-        let colors = [gpu::clear(target, wgpu::Color::BLACK)];
+        let colors = [low_level::clear(target, wgpu::Color::BLACK)];
         Pass {
             timing: None,
             ..Pass::new("demo_post", voxel_render::GpuPass::Tonemap, &colors)

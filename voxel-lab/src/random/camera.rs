@@ -2,7 +2,7 @@
 //! aimed at a box (a stack along its axis, through a floor or ceiling, a distant telephoto
 //! view); the eye snapped onto a face plane; the near and far planes and the field of view.
 
-use voxel_render::{MAX_FAR, MAX_FOV_DEG, MIN_FOV_DEG, MIN_NEAR};
+use voxel_render::low_level::{MAX_FAR, MAX_FOV_DEG, MIN_FOV_DEG, MIN_NEAR};
 
 use super::boxes::{Class, Gen, L, add, length, off_grid, scale, sub};
 

@@ -16,7 +16,7 @@ pub(super) fn srgb_to_linear(c: u8) -> f64 {
 
 /// The brightness factor of an AO value (0 to 3) at `strength`.
 fn ao_brightness(value: u8, strength: f64) -> f64 {
-    1.0 - strength * f64::from(voxel_render::AO_DEPTH) * f64::from(3 - value) / 3.0
+    1.0 - strength * f64::from(voxel_render::low_level::AO_DEPTH) * f64::from(3 - value) / 3.0
 }
 
 impl RayMarcher {

@@ -55,7 +55,7 @@ pub struct DifferingPixel {
 /// the edge, in pixels: the GPU samples the centre, and where an edge passes this close
 /// the rasteriser's rules decide (its sub-pixel snapping moves vertices by up to 1/512 px
 /// with 8 sub-pixel bits, and the opaque quads' growth against cracks,
-/// `voxel_render::OPAQUE_EXPANSION_PX`, by 1/64 px).
+/// `voxel_render::low_level::OPAQUE_EXPANSION_PX`, by 1/64 px).
 pub const EDGE_RADIUS_PX: f64 = 1.0 / 32.0;
 
 impl RayMarcher {

@@ -11,7 +11,7 @@ use super::{RayMarcher, Shading, Surface};
 /// The tonemap of `shaders/tonemap.wgsl` (values up to the shoulder unchanged, then a
 /// smooth roll-off towards 1), then sRGB encoding and 8-bit rounding.
 pub(super) fn output(x: f64) -> u8 {
-    let shoulder = f64::from(voxel_render::TONEMAP_SHOULDER);
+    let shoulder = f64::from(voxel_render::low_level::TONEMAP_SHOULDER);
     let t = if x <= shoulder {
         x.max(0.0)
     } else {

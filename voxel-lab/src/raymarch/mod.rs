@@ -6,7 +6,7 @@
 //! ambient occlusion computed from the blocks themselves, fog, blending and tonemapping.
 //!
 //! What it shares with the renderer is the specification, not the code: the face rules,
-//! the AO rule and curve ([`voxel_render::AO_DEPTH`]), the Lambert-plus-ambient lighting,
+//! the AO rule and curve ([`voxel_render::low_level::AO_DEPTH`]), the Lambert-plus-ambient lighting,
 //! the fog constant and the tonemap curve. Block colours come from the registry; in
 //! [`Texturing::Flat`] (each block one colour, what the renderer draws with
 //! `RendererConfig::flat_textures`) it agrees with the GPU references to 1/255 off

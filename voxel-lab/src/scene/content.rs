@@ -1,7 +1,7 @@
 //! A scene file's particles and entities, checked, as a game's content.
 
 use glam::DVec3;
-use voxel_render::WORLD_EXTENT;
+use voxel_render::low_level::WORLD_EXTENT;
 
 use super::format::SceneFile;
 use super::parse::at_line;

@@ -28,8 +28,8 @@ mod tests;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
-pub use cull::{Culled, Frustum, REGION_CHUNKS};
-pub use draws::{DrawBuilder, DrawCommand, DrawList, FrameDraws};
+pub use cull::{Culled, Frustum};
+pub use draws::{DrawBuilder, DrawList, FrameDraws};
 pub use gpu_chunk::{GpuChunk, Surfaces};
 pub use store::ChunkStore;
 

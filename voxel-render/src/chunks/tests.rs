@@ -2,7 +2,7 @@ use glam::{DVec3, Vec3};
 use voxel_core::{CHUNK_SIZE, ChunkPos, Face};
 use voxel_mesh::PackedQuad;
 
-use super::cull::{Place, Regions};
+use super::cull::{Place, REGION_CHUNKS, Regions};
 use super::gpu_chunk::{distinct_planes, layers_bounds};
 use super::*;
 use crate::Camera;
@@ -219,13 +219,13 @@ fn region_culling_finds_what_testing_every_chunk_finds() {
                 (f64::from(centre[1]) + unit() * 8.0 - 4.0) * s,
                 (f64::from(centre[2]) + unit() * 60.0 - 30.0) * s,
             );
-            let far = [50.0, 500.0, 5000.0, crate::MAX_FAR][(unit() * 4.0) as usize];
+            let far = [50.0, 500.0, 5000.0, crate::camera::MAX_FAR][(unit() * 4.0) as usize];
             let cam = Camera::from_yaw_pitch(
                 eye,
                 unit() * 7.0,
                 unit() * 3.0 - 1.5,
                 10.0 + unit() * 150.0,
-                crate::MIN_NEAR + unit(),
+                crate::camera::MIN_NEAR + unit(),
                 far,
             )
             .unwrap();

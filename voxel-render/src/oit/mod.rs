@@ -37,7 +37,7 @@ pub use moments::{MboitReport, MboitSettings};
 pub use peeling::{PeelReport, PeelingSettings};
 pub use reference::ReferenceReport;
 pub use sorted::SortReport;
-pub use stipple::{BayerSize, ShadingState, StippleSettings};
+pub use stipple::{BayerSize, StippleSettings};
 pub use wboit::weights::{WeightFit, WeightFunction};
 pub use wboit::{WboitReport, WboitSettings};
 

@@ -274,7 +274,7 @@ enum Accumulate {
 #[derive(Debug)]
 struct AccumulateBuilder {
     two_pass: bool,
-    layouts: crate::SharedLayouts,
+    layouts: crate::bindings::SharedLayouts,
     params_layout: wgpu::BindGroupLayout,
     /// The accumulation and revealage target states.
     targets: [Option<wgpu::ColorTargetState>; 2],
