@@ -56,7 +56,7 @@ pub(crate) fn greedy_rects_live(
 }
 
 /// Transposes a 32×32 bit matrix: bit `c` of row `r` becomes bit `r` of row `c`.
-pub fn transpose32(rows: &[u32; 32]) -> [u32; 32] {
+pub(crate) fn transpose32(rows: &[u32; 32]) -> [u32; 32] {
     let mut a = *rows;
     // Swap ever smaller blocks across the diagonal (Hacker's Delight 7-3, with bit 0 as the
     // first column): the upper-right block of each 2j × 2j square with the lower-left one.

@@ -26,7 +26,7 @@ use crate::Result;
 use crate::error::scoped;
 
 /// Quads in the first page: 4 MiB.
-pub const FIRST_PAGE_QUADS: u32 = 1 << 19;
+pub(crate) const FIRST_PAGE_QUADS: u32 = 1 << 19;
 /// Bytes of one quad.
 pub const QUAD_BYTES: u64 = std::mem::size_of::<PackedQuad>() as u64;
 
@@ -34,7 +34,7 @@ pub const QUAD_BYTES: u64 = std::mem::size_of::<PackedQuad>() as u64;
 /// takes the smallest free range that holds it (the lowest-addressed among equals), in
 /// O(log n) of the free ranges, which keeps large ranges whole for large meshes.
 #[derive(Clone, Debug)]
-pub struct Allocator {
+pub(crate) struct Allocator {
     capacity: u32,
     /// Free ranges: start → length, in address order, never adjacent (coalesced).
     free: BTreeMap<u32, u32>,
@@ -70,7 +70,7 @@ impl Allocator {
 
     /// The smallest free range of at least `len` units (lowest address among equals),
     /// taken from its start; `None` when no free range is that long (or `len` is 0).
-    pub fn alloc(&mut self, len: u32) -> Option<u32> {
+    pub(crate) fn alloc(&mut self, len: u32) -> Option<u32> {
         if len == 0 {
             return None;
         }
@@ -84,7 +84,7 @@ impl Allocator {
     }
 
     /// Gives back `len` units at `start` (a range [`Allocator::alloc`] returned).
-    pub fn free(&mut self, start: u32, len: u32) {
+    pub(crate) fn free(&mut self, start: u32, len: u32) {
         debug_assert!(start + len <= self.capacity);
         self.used = self.used.saturating_sub(len);
         let (mut start, mut len) = (start, len);
@@ -114,14 +114,14 @@ impl Allocator {
 
     /// The longest free range.
     #[cfg(test)]
-    pub fn largest_free(&self) -> u32 {
+    pub(crate) fn largest_free(&self) -> u32 {
         self.by_len.last().map_or(0, |r| r.0)
     }
 
     /// One past the highest unit in use (0 when nothing is): what the live meshes span,
     /// holes included.
     #[cfg(test)]
-    pub fn high_water(&self) -> u32 {
+    pub(crate) fn high_water(&self) -> u32 {
         match self.free.last_key_value() {
             Some((&start, &len)) if start + len == self.capacity => start,
             _ => self.capacity,
@@ -129,7 +129,7 @@ impl Allocator {
     }
 
     /// Number of free ranges (1 when nothing is fragmented).
-    pub fn fragments(&self) -> usize {
+    pub(crate) fn fragments(&self) -> usize {
         self.free.len()
     }
 }
@@ -166,7 +166,7 @@ pub struct ArenaStats {
 
 /// The pages and their allocators.
 #[derive(Debug)]
-pub struct QuadArena {
+pub(crate) struct QuadArena {
     /// Indexed by page number; `None` where a page was given back.
     pages: Vec<Option<Page>>,
     /// Largest page, in quads (the adapter's storage binding limit).
@@ -178,7 +178,7 @@ pub struct QuadArena {
 impl QuadArena {
     /// An empty arena whose pages may hold up to `max_binding` bytes, made with `usage`
     /// (copies are added).
-    pub fn new(max_binding: u64, usage: wgpu::BufferUsages) -> Self {
+    pub(crate) fn new(max_binding: u64, usage: wgpu::BufferUsages) -> Self {
         // A draw counts 6 vertices per quad in a `u32` (first vertex and count): a page
         // holds no more quads than that can address.
         let addressable = u64::from(u32::MAX / 6);
@@ -190,7 +190,7 @@ impl QuadArena {
     }
 
     /// The most quads one mesh may have: a page as large as the adapter's storage binding.
-    pub fn max_mesh_quads(&self) -> u32 {
+    pub(crate) fn max_mesh_quads(&self) -> u32 {
         self.max_page_quads
     }
 
@@ -205,7 +205,7 @@ impl QuadArena {
     /// the returned flag is true (bind groups over the pages must be remade). `Ok(None)`
     /// for 0 quads or more than [`QuadArena::max_mesh_quads`]; an error (and no new page)
     /// when the device cannot make the page.
-    pub fn alloc(&mut self, device: &wgpu::Device, quads: u32) -> Result<Option<(Alloc, bool)>> {
+    pub(crate) fn alloc(&mut self, device: &wgpu::Device, quads: u32) -> Result<Option<(Alloc, bool)>> {
         if quads == 0 || quads > self.max_page_quads {
             return Ok(None);
         }
@@ -270,7 +270,7 @@ impl QuadArena {
 
     /// Gives back a mesh's quads; returns whether its page now holds none (see
     /// [`QuadArena::drop_page`]).
-    pub fn free(&mut self, a: Alloc) -> bool {
+    pub(crate) fn free(&mut self, a: Alloc) -> bool {
         match self.pages.get_mut(a.page as usize) {
             Some(Some(p)) => {
                 p.alloc.free(a.offset, a.quads);
@@ -282,7 +282,7 @@ impl QuadArena {
 
     /// Gives back page `page` if it holds no quads; returns whether it did. Its index
     /// stays free for the next new page.
-    pub fn drop_page(&mut self, page: u32) -> bool {
+    pub(crate) fn drop_page(&mut self, page: u32) -> bool {
         let Some(slot) = self.pages.get_mut(page as usize) else {
             return false;
         };
@@ -319,7 +319,7 @@ impl QuadArena {
     }
 
     /// Bytes held and used.
-    pub fn stats(&self) -> ArenaStats {
+    pub(crate) fn stats(&self) -> ArenaStats {
         ArenaStats {
             pages: self.live().count(),
             bytes: self.live().map(|(_, p)| p.buffer.size()).sum(),
@@ -353,7 +353,7 @@ impl QuadArena {
     /// (nothing changed) when the other pages lack room. The copies read the page as the
     /// queue holds it when `encoder` runs: submit `encoder` before writing to the new
     /// places, or the copies overwrite what was written.
-    pub fn compact(
+    pub(crate) fn compact(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         page: u32,
@@ -401,7 +401,7 @@ impl QuadArena {
 
 /// What [`QuadArena::compact`] did.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Compacted {
+pub(crate) struct Compacted {
     /// The new place of each mesh moved, in the order given.
     pub placed: Vec<Alloc>,
 }

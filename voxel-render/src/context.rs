@@ -84,12 +84,6 @@ impl Capabilities {
         self.features.contains(wgpu::Features::TIMESTAMP_QUERY)
     }
 
-    /// Whether colour targets of one pass may use different blend states (MRT WBOIT).
-    pub fn independent_blend(&self) -> bool {
-        self.downlevel
-            .contains(wgpu::DownlevelFlags::INDEPENDENT_BLEND)
-    }
-
     /// Whether chunks can be drawn with `multi_draw_indirect` (indirect execution, and
     /// indirect draws whose first instance is not zero).
     pub(crate) fn indirect_draws(&self) -> bool {
@@ -106,15 +100,6 @@ impl Capabilities {
         self.features.contains(wgpu::Features::FLOAT32_BLENDABLE)
     }
 
-    /// Whether fragment shaders may write storage buffers (the A-buffer reference): the
-    /// adapter can, and the device's limits leave room for them (a device made with
-    /// WebGL2's limits has none).
-    pub fn fragment_storage(&self) -> bool {
-        self.downlevel
-            .contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE)
-            && self.limits.max_storage_buffers_per_shader_stage > 0
-            && self.limits.max_storage_buffer_binding_size > 0
-    }
 }
 
 /// A device, its queue and its capabilities. Cheap to clone (wgpu handles are shared).
@@ -182,7 +167,7 @@ impl GpuContext {
     /// destroyed or lost with work in flight is found by a four-byte queue write, which
     /// wgpu refuses at once on such a device (a few microseconds; the write lands in a
     /// buffer of the context's own at the next submit).
-    pub fn check_device(&self) -> Result<()> {
+    pub(crate) fn check_device(&self) -> Result<()> {
         // A poll error on a lost device says no more than the callback does.
         let _ = self.device.poll(wgpu::PollType::Poll);
         let mut lost = self.lost.lock().unwrap_or_else(PoisonError::into_inner);

@@ -96,7 +96,7 @@ impl WgslConsts {
 
 /// How a chunk pipeline tests and writes depth.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum DepthMode {
+pub(crate) enum DepthMode {
     /// Reverse-Z test (nearer passes) and write: opaque, cutout, stipple.
     Write,
     /// Reverse-Z test, no write: blended translucent passes.
@@ -124,7 +124,7 @@ pub(crate) fn depth_state(mode: DepthMode) -> wgpu::DepthStencilState {
 /// A pipeline that draws chunk quads with `common.wgsl`'s vertex entry points (`vs_main`,
 /// or `vs_solid` for opaque quads, of the groups' [`crate::QuadFetch`]).
 #[derive(Debug)]
-pub struct ChunkPipeline<'a> {
+pub(crate) struct ChunkPipeline<'a> {
     /// Debug label.
     pub label: &'a str,
     /// The module holding `common.wgsl`'s vertex entries and the fragment entry.
@@ -145,7 +145,7 @@ pub struct ChunkPipeline<'a> {
 /// The bind group layouts of a chunk pipeline, and how it fetches quads
 /// (`SharedLayouts::with`).
 #[derive(Debug, Clone)]
-pub struct ChunkGroups<'a> {
+pub(crate) struct ChunkGroups<'a> {
     /// Groups 0, 1, then the technique's.
     pub layouts: Vec<Option<&'a wgpu::BindGroupLayout>>,
     /// How the pipeline fetches quads: its vertex entry point and buffers.
@@ -156,7 +156,7 @@ pub struct ChunkGroups<'a> {
 /// and drawing both sides (the eye inside a translucent volume, whose surfaces it sees from
 /// behind; see `medium.rs`).
 #[derive(Debug)]
-pub struct SidedPipeline {
+pub(crate) struct SidedPipeline {
     culled: wgpu::RenderPipeline,
     two_sided: wgpu::RenderPipeline,
 }
@@ -174,7 +174,7 @@ impl SidedPipeline {
 
 impl ChunkPipeline<'_> {
     /// Creates the pipeline (back faces culled).
-    pub fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+    pub(crate) fn build(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         self.build_with(device, false, Some(wgpu::Face::Back))
     }
 
@@ -370,7 +370,7 @@ pub(crate) fn buffer_entry(
 }
 
 /// A bind group layout of `entries`.
-pub fn layout(
+pub(crate) fn layout(
     device: &wgpu::Device,
     label: &str,
     entries: &[wgpu::BindGroupLayoutEntry],
@@ -531,7 +531,7 @@ pub fn clear(
 }
 
 /// A colour attachment with `load`, resolved into `resolve` when given (MSAA).
-pub fn attachment<'a>(
+pub(crate) fn attachment<'a>(
     view: &'a wgpu::TextureView,
     load: wgpu::LoadOp<wgpu::Color>,
     resolve: Option<&'a wgpu::TextureView>,
@@ -708,7 +708,7 @@ pub fn overlay_pipeline(
 /// On a device lost meanwhile (a game's draw can land anywhere) nothing is submitted and
 /// the error says so: what was recorded after the loss may refer to resources the lost
 /// device never made.
-pub fn flush(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) -> crate::Result<()> {
+pub(crate) fn flush(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) -> crate::Result<()> {
     ctx.check_device()?;
     let fresh = ctx
         .device

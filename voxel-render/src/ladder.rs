@@ -138,7 +138,7 @@ impl fmt::Display for Need {
 
 /// The needs of `needs` that the device of `caps` lacks, described, joined with "; "
 /// (`None` when it has them all).
-pub fn missing(needs: &[Need], caps: &Capabilities) -> Option<String> {
+pub(crate) fn missing(needs: &[Need], caps: &Capabilities) -> Option<String> {
     let lacking: Vec<String> = needs
         .iter()
         .filter(|n| !n.met(caps))
@@ -164,7 +164,7 @@ pub fn check(what: &str, needs: &[Need], caps: &Capabilities) -> Result<()> {
 /// rendered to and blended into (the medium's fog, the composites, a game's overlays),
 /// and the chunk shaders' eight values passed from vertex to fragment (`VsOut` in
 /// `shaders/common.wgsl`).
-pub fn world_needs() -> Vec<Need> {
+pub(crate) fn world_needs() -> Vec<Need> {
     vec![
         Need::BlendableTarget(crate::SCENE_FORMAT),
         Need::Limit(Limit::InterStageShaderVariables, 8),

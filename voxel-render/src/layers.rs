@@ -17,17 +17,17 @@ use voxel_mesh::PackedQuad;
 
 /// Optical depth of the most opaque layer the estimate counts (`α` 0.99); a fully opaque
 /// translucent block would otherwise hide everything behind it for the weight.
-pub const MAX_LAYER_DEPTH: f64 = 4.605;
+pub(crate) const MAX_LAYER_DEPTH: f64 = 4.605;
 
 /// The optical depth `−ln(1 − α)` of one layer of opacity `alpha`, at most
 /// [`MAX_LAYER_DEPTH`].
-pub fn layer_depth(alpha: f32) -> f64 {
+pub(crate) fn layer_depth(alpha: f32) -> f64 {
     (-f64::from(1.0 - alpha.clamp(0.0, 1.0)).ln()).min(MAX_LAYER_DEPTH)
 }
 
 /// The quads of one block in a mesh that lie in one plane and face one way.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Plane {
+pub(crate) struct Plane {
     /// Which way the quads face.
     pub face: Face,
     /// Chunk-local rectangle around the quads (flat along the face's axis): small whole
@@ -50,7 +50,7 @@ type PlaneSum = (Face, DVec3, DVec3, f64);
 /// Sums up the translucent `quads` of a chunk per plane, facing and block, in a fixed
 /// order (the same sums in the same order every time); `opacity` is indexed by block id
 /// (a block past its end counts as clear).
-pub fn planes(quads: &[PackedQuad], opacity: &[f32]) -> Vec<Plane> {
+pub(crate) fn planes(quads: &[PackedQuad], opacity: &[f32]) -> Vec<Plane> {
     let mut planes: BTreeMap<PlaneKey, PlaneSum> = BTreeMap::new();
     for q in quads {
         let Some(u) = q.unpack() else { continue };
@@ -82,7 +82,7 @@ pub fn planes(quads: &[PackedQuad], opacity: &[f32]) -> Vec<Plane> {
 
 /// The box around `planes` (each the box of its quads), chunk-local blocks: the box of the
 /// mesh they sum up.
-pub fn bounds(planes: &[Plane]) -> Option<(Vec3, Vec3)> {
+pub(crate) fn bounds(planes: &[Plane]) -> Option<(Vec3, Vec3)> {
     planes
         .iter()
         .map(|p| (p.lo, p.hi))
@@ -92,7 +92,7 @@ pub fn bounds(planes: &[Plane]) -> Option<(Vec3, Vec3)> {
 /// The planes of a frame's visible translucent chunks, chunk by chunk, in one buffer
 /// (filled by the chunk store's culling when asked for).
 #[derive(Clone, Debug, Default)]
-pub struct LayerBuffer {
+pub(crate) struct LayerBuffer {
     /// Each chunk and the end of its planes in `planes` (its start is the previous end).
     runs: Vec<(ChunkPos, u32)>,
     planes: Vec<Plane>,
@@ -100,13 +100,13 @@ pub struct LayerBuffer {
 
 impl LayerBuffer {
     /// Empties it, keeping its room.
-    pub fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         self.runs.clear();
         self.planes.clear();
     }
 
     /// Adds the chunk at `pos` with its `planes` (nothing when it has none).
-    pub fn push(&mut self, pos: ChunkPos, planes: &[Plane]) {
+    pub(crate) fn push(&mut self, pos: ChunkPos, planes: &[Plane]) {
         if !planes.is_empty() {
             self.planes.extend_from_slice(planes);
             self.runs.push((pos, self.planes.len() as u32));
@@ -114,7 +114,7 @@ impl LayerBuffer {
     }
 
     /// A view of what it holds.
-    pub fn view(&self) -> VisibleLayers<'_> {
+    pub(crate) fn view(&self) -> VisibleLayers<'_> {
         VisibleLayers {
             runs: &self.runs,
             planes: &self.planes,

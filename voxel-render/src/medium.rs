@@ -63,7 +63,7 @@ use crate::{Camera, GpuContext};
 
 /// What the renderer needs of a block type to treat it as a medium.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct MediumLook {
+pub(crate) struct MediumLook {
     /// Linear base colour.
     pub color: [f32; 3],
     /// Opacity of one layer.
@@ -74,7 +74,7 @@ pub struct MediumLook {
 }
 
 /// The look of every translucent block type, by block id (`None`: not translucent).
-pub fn looks(registry: &BlockRegistry) -> Vec<Option<MediumLook>> {
+pub(crate) fn looks(registry: &BlockRegistry) -> Vec<Option<MediumLook>> {
     let linear = |c: u8| {
         let c = f32::from(c) / 255.0;
         if c <= 0.04045 {
@@ -463,7 +463,7 @@ fn translucent_near(chunks: &ChunkStore, eye: DVec3, reach: f64) -> Vec<NearFace
 /// planes (off both at an edge, all three at a corner) to the side of its medium.
 /// Unchanged when no translucent face is that close. The result does not depend on the
 /// order the quads are stored in (sorting rewrites it).
-pub fn guard(camera: &Camera, aspect: f64, chunks: &ChunkStore) -> Camera {
+pub(crate) fn guard(camera: &Camera, aspect: f64, chunks: &ChunkStore) -> Camera {
     let corner = corner_factor(camera, aspect);
     let reach = camera.near * corner;
     let mut near = translucent_near(chunks, camera.eye, reach);

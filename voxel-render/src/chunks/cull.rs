@@ -12,7 +12,7 @@ use crate::layers::{LayerBuffer, Plane, VisibleLayers};
 
 /// Chunks per region along x, y and z: 8 × 4 × 8 (Sodium's), 256 × 128 × 256 blocks. A
 /// frame tests a region's box before the chunks in it.
-pub const REGION_CHUNKS: [i32; 3] = [8, 4, 8];
+pub(super) const REGION_CHUNKS: [i32; 3] = [8, 4, 8];
 
 /// What culling needs of a chunk, kept with the other chunks of its region.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -269,7 +269,7 @@ impl Culled {
 
     /// The planes of the visible translucent meshes ([`crate::layers`]; in no particular
     /// order), when [`ChunkStore::cull`] was asked for them (else empty).
-    pub fn translucent_layers(&self) -> VisibleLayers<'_> {
+    pub(crate) fn translucent_layers(&self) -> VisibleLayers<'_> {
         self.layers.view()
     }
 }
@@ -309,7 +309,7 @@ impl Frustum {
 
     /// Distance from the eye to the chunk's centre, or `None` when the chunk's box lies
     /// wholly outside one plane.
-    pub fn chunk_distance(&self, pos: ChunkPos) -> Option<f64> {
+    pub(crate) fn chunk_distance(&self, pos: ChunkPos) -> Option<f64> {
         let s = CHUNK_SIZE as f64;
         let min = self.relative(pos);
         let lo = min.as_vec3();

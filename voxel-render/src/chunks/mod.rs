@@ -28,9 +28,11 @@ mod tests;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
-pub use cull::{Culled, Frustum};
-pub use draws::{DrawBuilder, DrawList, FrameDraws};
-pub use gpu_chunk::{GpuChunk, Surfaces};
+pub use cull::Culled;
+pub(crate) use cull::Frustum;
+pub(crate) use draws::{DrawBuilder, DrawList, FrameDraws};
+pub use gpu_chunk::GpuChunk;
+pub(crate) use gpu_chunk::Surfaces;
 pub use store::ChunkStore;
 
 /// A fast hasher for small keys of integers (chunk positions): a multiply-rotate per word

@@ -9,9 +9,9 @@
 //! struct as a field of [`OitConfig`]).
 
 pub mod moments;
-pub mod opaque_only;
+pub(crate) mod opaque_only;
 pub mod peeling;
-pub mod reference;
+pub(crate) mod reference;
 pub mod sorted;
 pub mod stipple;
 pub mod wboit;
@@ -279,7 +279,7 @@ impl fmt::Display for Technique {
 }
 
 /// How a technique's type is built; see the module docs.
-pub trait TechniqueKind: TranslucentTechnique + Sized + 'static {
+pub(crate) trait TechniqueKind: TranslucentTechnique + Sized + 'static {
     /// What its pipelines and targets are built from: the manager rebuilds the technique
     /// when the key changes. Settings outside the key are read every frame.
     type Key: Clone + PartialEq + fmt::Debug;
@@ -582,7 +582,7 @@ impl OitManager {
     /// Whether the technique in force reads the planes of the visible translucent meshes
     /// ([`FrameView::layers`]; WBOIT with the fitted weight, MBOIT). The renderer's culling copies
     /// them only then.
-    pub fn wants_layers(&self) -> bool {
+    pub(crate) fn wants_layers(&self) -> bool {
         self.config.technique.reads_layers(&self.config)
     }
 
@@ -602,7 +602,7 @@ impl OitManager {
     /// its pipelines and targets are built from) changes; other settings apply from the
     /// next frame. An invalid setting, or a technique the adapter cannot run
     /// ([`Error::Unsupported`]), is an error and changes nothing.
-    pub fn set_config(&mut self, config: OitConfig) -> Result<()> {
+    pub(crate) fn set_config(&mut self, config: OitConfig) -> Result<()> {
         config.validate()?;
         let technique = Self::resolve_with(&self.setup, &config, config.technique)?;
         self.config = config;
@@ -776,11 +776,6 @@ impl OitManager {
     /// The WBOIT accumulation target, when WBOIT is active and has drawn.
     pub fn accumulation_target(&self) -> Option<&wgpu::Texture> {
         self.active.as_ref().and_then(|(_, t)| t.accumulation())
-    }
-
-    /// The WBOIT revealage target, when WBOIT is active and has drawn.
-    pub fn revealage_target(&self) -> Option<&wgpu::Texture> {
-        self.active.as_ref().and_then(|(_, t)| t.revealage())
     }
 
     /// Whether the active technique's GPU resources exist.

@@ -9,7 +9,7 @@ use crate::{GpuContext, Result};
 
 /// Draws nothing; never created (it does not draw, so the manager skips it).
 #[derive(Debug)]
-pub struct OpaqueOnly;
+pub(crate) struct OpaqueOnly;
 
 impl TechniqueKind for OpaqueOnly {
     type Key = ();

@@ -91,7 +91,7 @@ impl Default for RendererConfig {
 /// not; 10-bit; half float, written linear) and what offscreen targets use. An sRGB format
 /// is encoded by the GPU, the 8- and 10-bit linear ones by the tonemap shader, so every
 /// one shows the same picture.
-pub const OUTPUT_FORMATS: [wgpu::TextureFormat; 6] = [
+pub(crate) const OUTPUT_FORMATS: [wgpu::TextureFormat; 6] = [
     wgpu::TextureFormat::Rgba8UnormSrgb,
     wgpu::TextureFormat::Rgba8Unorm,
     wgpu::TextureFormat::Bgra8UnormSrgb,

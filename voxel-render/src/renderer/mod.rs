@@ -29,7 +29,8 @@ use crate::textures::BlockTextures;
 use crate::timing::{GpuTimes, Timer};
 use crate::{Error, GpuContext, Result};
 
-pub use config::{Lighting, OUTPUT_FORMATS, RendererConfig};
+pub(crate) use config::OUTPUT_FORMATS;
+pub use config::{Lighting, RendererConfig};
 use config::{check_ao_strength, check_lighting, check_output_format, check_size};
 use targets::{MSAA_SAMPLES, Post, SceneResources, SceneTargets};
 

@@ -291,9 +291,10 @@ impl ChunkStreamer {
         self.slots.len()
     }
 
+    #[cfg(test)]
     /// Chunks in the unload queue (each at most once: never more than
     /// [`ChunkStreamer::positions`]).
-    pub fn queued_unloads(&self) -> usize {
+    pub(crate) fn queued_unloads(&self) -> usize {
         self.unload.len()
     }
 

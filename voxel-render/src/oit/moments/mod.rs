@@ -45,7 +45,7 @@ pub(crate) const BIAS_F32: f32 = 5e-7;
 /// relative), not tuned further (suite mean FLIP 0.0240 with it against 0.0190 with 32-bit
 /// moments, results/mboit/report.md). The paper's 16-bit setting goes with its
 /// quantisation transform, which additive blending into half floats cannot apply.
-pub const BIAS_F16: f32 = 5e-4;
+pub(crate) const BIAS_F16: f32 = 5e-4;
 /// The moments' depth-warp vector the bias pulls toward (the paper's, for [−1, 1]).
 pub(crate) const BIAS_VECTOR: [f32; 4] = [0.0, 0.375, 0.0, 0.375];
 /// The colour accumulation format of the resolve.
@@ -126,8 +126,9 @@ impl MboitParams {
         }
     }
 
+    #[cfg(test)]
     /// The warped depth of `view_depth` (`mboit_warp` in WGSL).
-    pub fn warp(&self, view_depth: f32) -> f32 {
+    pub(crate) fn warp(&self, view_depth: f32) -> f32 {
         let t = (view_depth.max(1e-6).ln() - self.ln_near) * self.inv_ln_range;
         t.clamp(0.0, 1.0) * 2.0 - 1.0
     }
@@ -149,7 +150,8 @@ fn moment_formats(single: bool) -> (wgpu::TextureFormat, wgpu::TextureFormat) {
 }
 
 /// Absorbance of one fragment of opacity `alpha` (`mboit_absorbance` in WGSL).
-pub fn absorbance(alpha: f32) -> f32 {
+#[cfg(test)]
+fn absorbance(alpha: f32) -> f32 {
     -(1.0 - alpha).max((-ABSORBANCE_MAX).exp()).ln()
 }
 

@@ -42,14 +42,14 @@ pub(crate) const NODE_BYTES: u64 = std::mem::size_of::<Node>() as u64;
 /// Initial pool: nodes per pixel.
 pub(crate) const INITIAL_NODES_PER_PIXEL: u64 = 4;
 /// Most tiles per axis before giving up on fitting a frame.
-pub const MAX_TILES: u32 = 16;
+pub(crate) const MAX_TILES: u32 = 16;
 /// Fragments a pixel blends at most (its nearest ones).
-pub const MAX_LAYERS: u32 = 128;
+pub(crate) const MAX_LAYERS: u32 = 128;
 /// Fragments of a pixel's list the resolve walks at most (the latest appended). Lavapipe
 /// (llvmpipe) stops a shader loop silently after about 4 000 iterations, which left pixels
 /// of a dense particle cloud empty; on any GPU an unbounded walk is a stall waiting to
 /// happen. A longer list counts as capped visibly: its picture is not exact.
-pub const MAX_WALK: u32 = 2048;
+pub(crate) const MAX_WALK: u32 = 2048;
 
 /// What the A-buffer did in the last frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -76,7 +76,7 @@ impl ReferenceReport {
 /// One fragment of a pixel's list (`Node` in `types.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct Node {
+pub(crate) struct Node {
     /// Colour and alpha as four halves.
     pub color: [u32; 2],
     /// Reverse-Z depth.
@@ -198,7 +198,7 @@ struct Buffers {
 
 /// A-buffer resources.
 #[derive(Debug)]
-pub struct Reference {
+pub(crate) struct Reference {
     build: SidedPipeline,
     resolve: wgpu::RenderPipeline,
     build_layout: wgpu::BindGroupLayout,

@@ -89,7 +89,7 @@ pub(crate) fn bayer_offset(size: BayerSize) -> usize {
 /// The mode code for stipple in bits 8–9 of the shading state. (The other modes,
 /// 0 opaque and 2 alpha test, are what the opaque and cutout passes do; the stipple
 /// technique always sends this one.)
-pub const STIPPLE_MODE: u32 = 1;
+pub(crate) const STIPPLE_MODE: u32 = 1;
 
 /// The 32-bit shading state: bits 0–7 uniform alpha (0–255), bits 8–9 transparency
 /// mode (always [`STIPPLE_MODE`] here), bits 10–11 dither pattern; bits 12–31 are left zero.

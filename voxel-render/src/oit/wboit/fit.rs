@@ -37,13 +37,13 @@ use glam::{DVec3, Mat4, Vec2, Vec4};
 use voxel_core::ChunkPos;
 
 use crate::layers::Plane;
-pub use crate::layers::layer_depth;
+pub(crate) use crate::layers::layer_depth;
 
 /// Number of distances of the optical-depth profile (log-spaced, ends included).
-pub const PROFILE_LEN: usize = 32;
+pub(crate) const PROFILE_LEN: usize = 32;
 
 /// The screen is cut into `TILES × TILES` tiles, each with its own profile.
-pub const TILES: usize = 8;
+pub(crate) const TILES: usize = 8;
 
 /// The fitted weight's estimate, with room it keeps from one frame to the next: for the
 /// planes seen, and for the next table (fresh allocations of these cost more, in page
@@ -249,7 +249,7 @@ pub struct WeightFit {
 
 /// The most optical depth the fitted weight falls by: `e^−12`, 6·10⁻⁶ (the weight must
 /// stay above fp16's smallest numbers once times α·3000).
-pub const MAX_FITTED_DEPTH: f32 = 12.0;
+pub(crate) const MAX_FITTED_DEPTH: f32 = 12.0;
 
 impl WeightFit {
     /// `[ln n, (PROFILE_LEN − 1) / ln(f / n)]` for the range's ends `n` and `f` (kept
