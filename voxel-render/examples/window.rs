@@ -11,12 +11,12 @@ use std::sync::Arc;
 use glam::DVec3;
 use voxel_core::{BlockRegistry, ChunkPos, RenderClass, TerrainConfig, TerrainGenerator, World};
 use voxel_render::{Camera, GpuContext, Renderer, RendererConfig, Technique, stages};
-use winit::event::WindowEvent;
-use winit::event_loop::{ActiveEventLoop, EventLoop};
-use winit::window::{Window, WindowId};
 use wgpu::CurrentSurfaceTexture::Success;
 use wgpu::PrimitiveTopology::{LineList, TriangleList};
 use wgpu::util::DeviceExt;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::window::{Window, WindowId};
 
 /// Where the game's camera stands and what it looks at.
 const EYE: DVec3 = DVec3::new(8.5, 33.5, -1.5);
@@ -43,8 +43,7 @@ struct Game {
 }
 
 fn setup(window: Arc<Window>, world: World) -> Result<Gfx, Box<dyn std::error::Error>> {
-    let instance =
-        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
     let surface = instance.create_surface(window.clone())?;
     let (ctx, adapter) = GpuContext::for_surface(&instance, &surface)?;
     let (width, height) = window.inner_size().into();

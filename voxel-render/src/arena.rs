@@ -153,7 +153,7 @@ struct Page {
 
 /// What the arena holds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct ArenaStats {
+pub(crate) struct ArenaStats {
     /// Pages.
     pub pages: usize,
     /// Bytes of all pages.
@@ -205,7 +205,11 @@ impl QuadArena {
     /// the returned flag is true (bind groups over the pages must be remade). `Ok(None)`
     /// for 0 quads or more than [`QuadArena::max_mesh_quads`]; an error (and no new page)
     /// when the device cannot make the page.
-    pub(crate) fn alloc(&mut self, device: &wgpu::Device, quads: u32) -> Result<Option<(Alloc, bool)>> {
+    pub(crate) fn alloc(
+        &mut self,
+        device: &wgpu::Device,
+        quads: u32,
+    ) -> Result<Option<(Alloc, bool)>> {
         if quads == 0 || quads > self.max_page_quads {
             return Ok(None);
         }

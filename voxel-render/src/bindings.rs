@@ -91,7 +91,7 @@ pub const TONEMAP_SHOULDER: f32 = 0.8;
 /// Per-frame uniforms every pass uses (`Frame` in WGSL).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct FrameUniforms {
+pub(crate) struct FrameUniforms {
     /// Camera-relative view × reverse-Z projection.
     pub view_proj: [[f32; 4]; 4],
     /// Integer part of the eye, clamped to the i32 world.
@@ -141,7 +141,7 @@ pub(crate) const FLAG_INTERFACE: u32 = 1;
 /// A chunk's record in the records array, by slot (`ChunkInfo` in WGSL).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct ChunkUniforms {
+pub(crate) struct ChunkUniforms {
     /// World coordinates of the chunk's block (0, 0, 0).
     pub origin: [i32; 3],
     /// Whole-chunk opacity multiplier (fade-in), 1 when settled.
@@ -150,7 +150,7 @@ pub struct ChunkUniforms {
 
 /// Layouts every chunk pipeline is built against.
 #[derive(Debug, Clone)]
-pub struct SharedLayouts {
+pub(crate) struct SharedLayouts {
     /// Group 0: frame uniforms, block textures, sampler, the medium's boundary depth, and
     /// the layer of each block's face groups in the block textures.
     pub scene: wgpu::BindGroupLayout,
@@ -163,7 +163,7 @@ pub struct SharedLayouts {
 
 impl SharedLayouts {
     /// Creates both layouts for `fetch`.
-    pub fn new(device: &wgpu::Device, fetch: QuadFetch) -> Self {
+    pub(crate) fn new(device: &wgpu::Device, fetch: QuadFetch) -> Self {
         use wgpu::BufferBindingType as B;
         use wgpu::ShaderStages as S;
         let mut scene_entries = vec![

@@ -99,7 +99,6 @@ impl Capabilities {
     pub(crate) fn float32_blendable(&self) -> bool {
         self.features.contains(wgpu::Features::FLOAT32_BLENDABLE)
     }
-
 }
 
 /// A device, its queue and its capabilities. Cheap to clone (wgpu handles are shared).

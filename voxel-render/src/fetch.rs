@@ -58,7 +58,7 @@ impl QuadFetch {
     }
 
     /// What the world's chunk pipelines need of the device when they fetch quads this way.
-    pub fn needs(self) -> Vec<Need> {
+    pub(crate) fn needs(self) -> Vec<Need> {
         match self {
             QuadFetch::Storage => vec![
                 Need::Downlevel(wgpu::DownlevelFlags::VERTEX_STORAGE),

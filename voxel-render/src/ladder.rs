@@ -46,7 +46,7 @@ pub enum Limit {
 
 impl Limit {
     /// wgpu's name of the limit.
-    pub(crate) fn name(self) -> &'static str {
+    pub fn name(self) -> &'static str {
         match self {
             Limit::StorageBuffersPerStage => "max_storage_buffers_per_shader_stage",
             Limit::StorageBufferBindingSize => "max_storage_buffer_binding_size",

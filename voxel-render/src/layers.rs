@@ -124,7 +124,7 @@ impl LayerBuffer {
 
 /// The planes of the visible translucent chunks of a frame (see [`LayerBuffer`]).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct VisibleLayers<'a> {
+pub(crate) struct VisibleLayers<'a> {
     runs: &'a [(ChunkPos, u32)],
     planes: &'a [Plane],
 }
@@ -149,15 +149,13 @@ impl<'a> VisibleLayers<'a> {
             Some((origin + lo.as_dvec3(), origin + hi.as_dvec3()))
         })
     }
+}
 
+#[cfg(test)]
+impl VisibleLayers<'_> {
     /// Number of planes.
-    pub fn len(&self) -> usize {
+    fn len(&self) -> usize {
         self.planes.len()
-    }
-
-    /// Whether it holds no plane.
-    pub fn is_empty(&self) -> bool {
-        self.planes.is_empty()
     }
 }
 

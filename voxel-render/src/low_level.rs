@@ -5,19 +5,15 @@
 //! crate root and [`crate::stages`] are); it changes more freely than the root.
 
 pub use crate::arena::QUAD_BYTES;
-pub use crate::bindings::{
-    AO_DEPTH, ChunkUniforms, FrameUniforms, OPAQUE_EXPANSION_PX, SharedLayouts, TONEMAP_SHOULDER,
-};
+pub use crate::bindings::{AO_DEPTH, OPAQUE_EXPANSION_PX, TONEMAP_SHOULDER};
 pub use crate::camera::{MAX_FAR, MAX_FOV_DEG, MIN_FOV_DEG, MIN_NEAR, WORLD_EXTENT};
-pub use crate::chunks::{ChunkStore, Culled, GpuChunk, MeshKind};
+pub use crate::chunks::{ChunkStore, GpuChunk, MeshKind};
 pub use crate::context::WANTED_FEATURES;
 pub use crate::gpu::{Pass, clear, pipelines_built};
 pub use crate::ladder::{Limit, Need, check};
 pub use crate::oit::{
-    MboitReport, OitManager, PeelReport, ReferenceReport, SortReport, TechniqueReport,
-    TranslucentFrame, TranslucentTechnique, WboitReport, WeightFit, moments, peeling, sorted,
-    stipple, wboit,
+    MboitReport, OitManager, PeelReport, ReferenceReport, SortReport, TechniqueReport, WboitReport,
+    WeightFit, moments, peeling, sorted, stipple, wboit,
 };
 pub use crate::renderer::ChunkMemory;
 pub use crate::stream::{EDIT_BYTES, EDITED_CHUNK_BYTES, MAX_VIEW_DISTANCE};
-pub use crate::timing::Timer;

@@ -52,7 +52,7 @@ impl GpuPass {
     ];
 
     /// The name used in labels and reports.
-    pub(crate) fn name(self) -> &'static str {
+    pub fn name(self) -> &'static str {
         match self {
             GpuPass::Opaque => "opaque",
             GpuPass::Cutout => "cutout",
@@ -136,7 +136,7 @@ impl fmt::Debug for Timer {
 impl Timer {
     /// A timer, or `None` when the device has no timestamp queries (frames then go
     /// untimed).
-    pub fn new(ctx: &GpuContext) -> Option<Self> {
+    pub(crate) fn new(ctx: &GpuContext) -> Option<Self> {
         if !ctx.caps.timestamps() {
             return None;
         }

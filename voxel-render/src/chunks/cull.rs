@@ -228,7 +228,7 @@ pub(super) struct FarEntry {
 /// [`voxel_mesh::order::chunk_order_key`] (equal keys by position). Keep one between
 /// frames: its vectors keep their room.
 #[derive(Debug, Default)]
-pub struct Culled {
+pub(crate) struct Culled {
     pub(super) near: [Vec<NearEntry>; 2],
     pub(super) far: Vec<FarEntry>,
     pub(super) positions: Vec<ChunkPos>,
@@ -239,7 +239,7 @@ pub struct Culled {
 
 impl Culled {
     /// The meshes of `kind` in draw order: (slot, place).
-    pub fn meshes(&self, kind: MeshKind) -> impl Iterator<Item = (u32, Alloc)> + '_ {
+    pub(crate) fn meshes(&self, kind: MeshKind) -> impl Iterator<Item = (u32, Alloc)> + '_ {
         let (near, far): (&[NearEntry], &[FarEntry]) = match kind {
             MeshKind::Opaque => (&self.near[0], &[]),
             MeshKind::Cutout => (&self.near[1], &[]),
@@ -282,14 +282,14 @@ pub(super) fn near_key(page: u32, distance: f64, slot: u32) -> u128 {
 
 /// The six planes of a camera-relative view frustum, and the eye they are relative to.
 #[derive(Clone, Debug)]
-pub struct Frustum {
+pub(crate) struct Frustum {
     planes: [Vec4; 6],
     pub(super) eye: DVec3,
 }
 
 impl Frustum {
     /// From a camera-relative view-projection (clip z in [0, w], either direction).
-    pub fn new(view_proj: Mat4, eye: DVec3) -> Self {
+    pub(crate) fn new(view_proj: Mat4, eye: DVec3) -> Self {
         let r = [
             view_proj.row(0),
             view_proj.row(1),

@@ -15,7 +15,7 @@ use crate::arena::Alloc;
 /// [`QuadFetch::Instanced`] each is a direct draw of its own).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
-pub struct DrawCommand {
+pub(crate) struct DrawCommand {
     /// Vertices: 6 per quad.
     pub vertex_count: u32,
     /// Always 1.
@@ -36,7 +36,7 @@ struct Run {
 
 /// The draws of one pass: runs of commands in a frame's [`FrameDraws`].
 #[derive(Clone, Debug, Default)]
-pub struct DrawList {
+pub(crate) struct DrawList {
     runs: Vec<Run>,
     meshes: usize,
     quads: u64,
@@ -44,23 +44,23 @@ pub struct DrawList {
 
 impl DrawList {
     /// Whether it draws nothing.
-    pub fn is_empty(&self) -> bool {
+    pub(crate) fn is_empty(&self) -> bool {
         self.meshes == 0
     }
 
     /// Meshes drawn.
-    pub fn meshes(&self) -> usize {
+    pub(crate) fn meshes(&self) -> usize {
         self.meshes
     }
 
     /// Quads drawn.
-    pub fn quads(&self) -> u64 {
+    pub(crate) fn quads(&self) -> u64 {
         self.quads
     }
 
     /// Draw calls it records: one per run of a page with indirect draws, one per mesh
     /// without.
-    pub fn calls(&self, mode: DrawMode) -> usize {
+    pub(crate) fn calls(&self, mode: DrawMode) -> usize {
         match mode {
             DrawMode::Indirect => self.runs.len(),
             DrawMode::PerChunk => self.meshes,
@@ -70,7 +70,7 @@ impl DrawList {
 
 /// Every draw command of a frame, on the CPU and in the indirect buffer.
 #[derive(Debug)]
-pub struct FrameDraws<'a> {
+pub(crate) struct FrameDraws<'a> {
     /// The store whose pages the commands draw from.
     pub store: &'a ChunkStore,
     /// The commands.

@@ -28,7 +28,7 @@ mod tests;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
-pub use cull::Culled;
+pub(crate) use cull::Culled;
 pub(crate) use cull::Frustum;
 pub(crate) use draws::{DrawBuilder, DrawList, FrameDraws};
 pub use gpu_chunk::GpuChunk;

@@ -58,7 +58,7 @@ impl ChunkStore {
     /// `block_opacity` (by block id) weighs the planes of translucent meshes
     /// ([`crate::layers`]); `volume_blocks` (by block id) says which block types are
     /// volumes.
-    pub fn new(
+    pub(crate) fn new(
         ctx: &GpuContext,
         layout: wgpu::BindGroupLayout,
         fetch: QuadFetch,
@@ -197,11 +197,6 @@ impl ChunkStore {
             return false;
         }
         self.arena.free(a) && self.arena.drop_page(a.page)
-    }
-
-    /// The layout of group 1.
-    pub fn layout(&self) -> &wgpu::BindGroupLayout {
-        &self.layout
     }
 
     /// Writes slot `slot`'s record (growing the record buffer when needed).
@@ -366,7 +361,7 @@ impl ChunkStore {
     }
 
     /// Removes every chunk.
-    pub fn clear(&mut self, ctx: &GpuContext) {
+    pub(crate) fn clear(&mut self, ctx: &GpuContext) {
         let all: Vec<ChunkPos> = self.by_pos.keys().copied().collect();
         for pos in all {
             self.remove(ctx, pos);
@@ -401,12 +396,12 @@ impl ChunkStore {
     }
 
     /// What the arena holds, and the bytes of the chunk records.
-    pub fn memory(&self) -> (ArenaStats, u64) {
+    pub(crate) fn memory(&self) -> (ArenaStats, u64) {
         (self.arena.stats(), self.infos.bytes())
     }
 
     /// Bytes of the indirect command buffer.
-    pub fn indirect_bytes(&self) -> u64 {
+    pub(crate) fn indirect_bytes(&self) -> u64 {
         self.indirect.size()
     }
 

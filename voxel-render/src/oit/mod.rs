@@ -66,7 +66,7 @@ macro_rules! techniques {
 
         impl Technique {
             /// Number of techniques.
-            pub const COUNT: usize = [$( stringify!($variant) ),*].len();
+            pub(crate) const COUNT: usize = [$( stringify!($variant) ),*].len();
 
             /// Every technique, in the order menus and reports list them.
             pub const ALL: [Technique; Self::COUNT] = [$( Technique::$variant ),*];
@@ -111,7 +111,7 @@ macro_rules! techniques {
 
             /// What the technique with `config` needs of a device beyond the world's own
             /// passes ([`crate::ladder::world_needs`], and the way quads are fetched).
-            pub fn needs(self, config: &OitConfig, caps: &Capabilities) -> Vec<Need> {
+            pub(crate) fn needs(self, config: &OitConfig, caps: &Capabilities) -> Vec<Need> {
                 match self { $( Technique::$variant => <$kind as TechniqueKind>::needs(self, config, caps), )* }
             }
 
@@ -322,7 +322,7 @@ pub(crate) trait TechniqueKind: TranslucentTechnique + Sized + 'static {
 
 /// What a technique is created with.
 #[derive(Debug, Clone)]
-pub struct Setup {
+pub(crate) struct Setup {
     /// The device.
     pub ctx: GpuContext,
     /// Groups 0 and 1 of every chunk pipeline.
@@ -404,7 +404,7 @@ pub struct TechniqueReport {
 
 /// The CPU side of a frame, for [`TranslucentTechnique::prepare`].
 #[derive(Debug)]
-pub struct FrameView<'a> {
+pub(crate) struct FrameView<'a> {
     /// The camera.
     pub camera: &'a Camera,
     /// Its camera-relative view-projection for the render target's aspect.
@@ -421,7 +421,7 @@ pub struct FrameView<'a> {
 
 /// What a technique draws with and into, for one frame.
 #[derive(Debug)]
-pub struct TranslucentFrame<'a> {
+pub(crate) struct TranslucentFrame<'a> {
     /// The HDR scene colour holding the opaque image; the composite blends into it.
     pub target: &'a Target,
     /// The opaque depth (single-sample): read-only attachment, or sampled by peeling.
@@ -456,7 +456,7 @@ impl TranslucentFrame<'_> {
 
 /// One transparency technique: its pipelines, targets and caches, created when it becomes
 /// active and dropped when another one does.
-pub trait TranslucentTechnique: fmt::Debug + Send + Sync {
+pub(crate) trait TranslucentTechnique: fmt::Debug + Send + Sync {
     /// Rebuilds size-dependent targets; called only when the size really changed.
     fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<()>;
 
@@ -497,11 +497,6 @@ pub trait TranslucentTechnique: fmt::Debug + Send + Sync {
     fn accumulation(&self) -> Option<&wgpu::Texture> {
         None
     }
-
-    /// The WBOIT revealage target, for techniques that have one.
-    fn revealage(&self) -> Option<&wgpu::Texture> {
-        None
-    }
 }
 
 /// Owns the active technique and records its passes (the life cycle of an engine's OIT
@@ -536,7 +531,7 @@ impl OitManager {
     /// independent blend, peel-to-convergence as the reference without fragment storage;
     /// one without a replacement it can run is an [`Error::Unsupported`] naming what the
     /// device lacks ([`Technique::resolve`]).
-    pub fn new(setup: Setup, config: OitConfig) -> Result<Self> {
+    pub(crate) fn new(setup: Setup, config: OitConfig) -> Result<Self> {
         config.validate()?;
         let technique = Self::resolve_with(&setup, &config, config.technique)?;
         let mut m = Self {
@@ -575,7 +570,7 @@ impl OitManager {
     }
 
     /// The active technique.
-    pub fn technique(&self) -> Technique {
+    pub(crate) fn technique(&self) -> Technique {
         self.config.technique
     }
 
@@ -589,7 +584,7 @@ impl OitManager {
     /// Switches technique at run time; the old one's resources are freed at once. Returns
     /// the technique in force (`technique`, or what replaces it on this adapter); one the
     /// adapter cannot run is an [`Error::Unsupported`] and changes nothing.
-    pub fn set_technique(&mut self, technique: Technique) -> Result<Technique> {
+    pub(crate) fn set_technique(&mut self, technique: Technique) -> Result<Technique> {
         let config = OitConfig {
             technique,
             ..self.config.clone()
@@ -638,7 +633,7 @@ impl OitManager {
     /// its resources if needed: a game builds its pipelines before the frame that needs
     /// them). Its `id` changes when a switch (or a setting the technique's pipelines depend
     /// on) needs new pipelines.
-    pub fn contract(&mut self) -> Result<Arc<TranslucentContract>> {
+    pub(crate) fn contract(&mut self) -> Result<Arc<TranslucentContract>> {
         if let Some(c) = &self.contract {
             return Ok(c.clone());
         }
@@ -705,7 +700,7 @@ impl OitManager {
     /// techniques draw, is resized with the others and rebuilt when a setting it is built
     /// from changes, until [`OitManager::release`]. Returns the technique built; one the
     /// adapter cannot run (nor its replacement) is an [`Error::Unsupported`].
-    pub fn prebuild(&mut self, technique: Technique) -> Result<Technique> {
+    pub(crate) fn prebuild(&mut self, technique: Technique) -> Result<Technique> {
         let technique = self.resolve(technique)?;
         if !self.prebuilt.contains(&technique) {
             self.prebuilt.push(technique);
@@ -725,7 +720,7 @@ impl OitManager {
 
     /// What [`TranslucentTechnique::warm`] prepares for `technique` (built ahead), for the
     /// chunks on the GPU now.
-    pub fn warm(&mut self, technique: Technique, chunks: &ChunkStore) {
+    pub(crate) fn warm(&mut self, technique: Technique, chunks: &ChunkStore) {
         let Ok(technique) = self.resolve(technique) else {
             return;
         };
@@ -738,7 +733,7 @@ impl OitManager {
     }
 
     /// Forgets a [`OitManager::prebuild`]: its resources are freed unless it is active.
-    pub fn release(&mut self, technique: Technique) {
+    pub(crate) fn release(&mut self, technique: Technique) {
         // A technique that cannot run was never built.
         let Ok(technique) = technique.resolve(&self.config, &self.setup.ctx.caps) else {
             return;
@@ -754,7 +749,7 @@ impl OitManager {
     }
 
     /// Technique-specific facts about the last frame.
-    pub fn report(&self) -> TechniqueReport {
+    pub(crate) fn report(&self) -> TechniqueReport {
         let mut r = self
             .active
             .as_ref()
@@ -765,7 +760,7 @@ impl OitManager {
     }
 
     /// Resizes the targets (the caller checks that the size is valid and new).
-    pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+    pub(crate) fn resize(&mut self, width: u32, height: u32) -> Result<()> {
         self.setup.size = (width, height);
         for (_, t) in self.active.iter_mut().chain(&mut self.kept) {
             t.resize(&self.setup.ctx, width, height)?;
@@ -806,7 +801,7 @@ impl OitManager {
     /// The technique's CPU work for the frame (see [`TranslucentTechnique::prepare`]). With
     /// no visible translucent mesh and no game geometry nothing happens and no resource is
     /// created.
-    pub fn prepare(
+    pub(crate) fn prepare(
         &mut self,
         chunks: &mut ChunkStore,
         view: &FrameView<'_>,
@@ -823,7 +818,7 @@ impl OitManager {
 
     /// Records the translucent pass(es) and the composite into `frame.target`. With no
     /// visible translucent mesh (or a technique that draws nothing) nothing is recorded.
-    pub fn render(
+    pub(crate) fn render(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         frame: &TranslucentFrame<'_>,

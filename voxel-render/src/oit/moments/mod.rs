@@ -46,6 +46,7 @@ pub(crate) const BIAS_F32: f32 = 5e-7;
 /// moments, results/mboit/report.md). The paper's 16-bit setting goes with its
 /// quantisation transform, which additive blending into half floats cannot apply.
 pub(crate) const BIAS_F16: f32 = 5e-4;
+#[cfg(test)]
 /// The moments' depth-warp vector the bias pulls toward (the paper's, for [−1, 1]).
 pub(crate) const BIAS_VECTOR: [f32; 4] = [0.0, 0.375, 0.0, 0.375];
 /// The colour accumulation format of the resolve.
@@ -155,10 +156,11 @@ fn absorbance(alpha: f32) -> f32 {
     -(1.0 - alpha).max((-ABSORBANCE_MAX).exp()).ln()
 }
 
+#[cfg(test)]
 /// The transmittance in front of warped depth `z` from the total absorbance `b0` and the
 /// sums `m` of the absorbance-weighted power moments (`mboit_transmittance` in WGSL, the
 /// paper's `computeTransmittanceAtDepthFrom4PowerMoments`), in f64 for the tests' sake.
-pub fn transmittance(b0: f64, m: [f64; 4], z: f64, bias: f64, overestimation: f64) -> f64 {
+pub(crate) fn transmittance(b0: f64, m: [f64; 4], z: f64, bias: f64, overestimation: f64) -> f64 {
     if b0 <= 0.0 {
         return 1.0;
     }
@@ -199,7 +201,7 @@ pub fn transmittance(b0: f64, m: [f64; 4], z: f64, bias: f64, overestimation: f6
 /// view direction) of `boxes` (world-space boxes around the visible translucent meshes) and
 /// of `game_objects`' balls, within the camera's near and far planes. A game that draws
 /// translucent geometry without declaring its objects gets the whole near-to-far range.
-pub fn depth_range(
+pub(crate) fn depth_range(
     camera: &crate::Camera,
     boxes: impl IntoIterator<Item = (DVec3, DVec3)>,
     game_objects: Option<&[TranslucentObject]>,

@@ -31,6 +31,7 @@ impl BayerSize {
         self.side().trailing_zeros() - 1
     }
 
+    #[cfg(test)]
     /// The size with pattern code `code` (its low two bits).
     pub(crate) fn from_code(code: u32) -> Self {
         Self::ALL[(code & 3) as usize]
@@ -107,8 +108,9 @@ impl ShadingState {
         u32::from(self.alpha) | STIPPLE_MODE << 8 | self.pattern.code() << 10
     }
 
+    #[cfg(test)]
     /// Unpacks the 32-bit layout (the mode and bits 12–31 are ignored).
-    pub fn unpack(packed: u32) -> Self {
+    pub(crate) fn unpack(packed: u32) -> Self {
         Self {
             alpha: (packed & 0xff) as u8,
             pattern: BayerSize::from_code(packed >> 10),

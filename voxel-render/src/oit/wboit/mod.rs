@@ -705,10 +705,6 @@ impl TranslucentTechnique for Wboit {
             )]
         }
     }
-
-    fn revealage(&self) -> Option<&wgpu::Texture> {
-        Some(&self.targets.revealage.texture)
-    }
 }
 
 #[cfg(test)]

@@ -8,8 +8,8 @@
 //! fragment's position on screen (0 to 1, y down), and `fit`, the frame's estimate of the
 //! translucent layers in view ([`WeightFit`]).
 
-pub use super::fit::WeightFit;
 pub(crate) use super::fit::MAX_FITTED_DEPTH;
+pub use super::fit::WeightFit;
 use crate::{Error, Result};
 
 /// A weight function.
