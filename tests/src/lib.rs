@@ -13,7 +13,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use voxel_core::{BlockId, BlockRegistry, World};
 use voxel_render::{
-    Camera, GpuContext, Image, LimitsPreset, Renderer, RendererConfig, Technique, readback,
+    Camera, GpuContext, Image, LimitsPreset, NoGame, Renderer, RendererConfig, Technique, readback,
 };
 
 pub use voxel_lab::headless::{Offscreen, renderer_for};
@@ -189,7 +189,9 @@ pub fn read_hdr(ctx: &GpuContext, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
 pub fn frame(ctx: &GpuContext, renderer: &mut Renderer, camera: &Camera) -> Image {
     let (w, h) = renderer.size();
     let target = Offscreen::new(ctx, w, h);
-    renderer.render_and_submit(&target.view, camera).unwrap();
+    renderer
+        .render_and_submit(&target.view, camera, &mut NoGame)
+        .unwrap();
     target.read(ctx).unwrap()
 }
 

@@ -10,7 +10,7 @@ use glam::DVec3;
 use voxel_core::{BlockId, ChunkPos, Face, blocks};
 use voxel_mesh::{ChunkMeshes, PackedQuad};
 use voxel_render::low_level::MeshKind;
-use voxel_render::{Camera, GpuContext, Renderer, Technique};
+use voxel_render::{Camera, GpuContext, NoGame, Renderer, Technique};
 
 use tests::*;
 
@@ -197,7 +197,8 @@ fn uploads_before_the_submit_never_change_the_frame_in_flight() {
         let (mut r, left) = about_to_compact(&ctx, technique, &kept);
         let target = Offscreen::new(&ctx, SIZE.0, SIZE.1);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        r.render(&mut encoder, &target.view, &cam).unwrap();
+        r.render(&mut encoder, &target.view, &cam, &mut NoGame)
+            .unwrap();
         assert_eq!(r.chunk_memory().pages, 2, "compacted in this frame");
         for (pos, m) in &new {
             r.upload_chunk(*pos, m).unwrap();
@@ -269,7 +270,9 @@ fn a_mesh_over_the_storage_binding_is_an_error() {
     )
     .unwrap();
     let target = Offscreen::new(&ctx, SIZE.0, SIZE.1);
-    let stats = r.render_and_submit(&target.view, &cam).unwrap();
+    let stats = r
+        .render_and_submit(&target.view, &cam, &mut NoGame)
+        .unwrap();
     assert_eq!(stats.meshes_drawn, [0, 0, 1]);
     assert_eq!(stats.translucent_quads, PAGE_QUADS);
 }
@@ -318,10 +321,12 @@ fn empty_pages_are_given_back() {
         peak.push(held.arena_bytes);
         let with_frame = round % 2 == 1;
         if with_frame {
-            r.render_and_submit(&target.view, &cam).unwrap();
+            r.render_and_submit(&target.view, &cam, &mut NoGame)
+                .unwrap();
             // A frame in flight: what it draws is kept until it is submitted.
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            r.render(&mut encoder, &target.view, &cam).unwrap();
+            r.render(&mut encoder, &target.view, &cam, &mut NoGame)
+                .unwrap();
             for pos in &positions {
                 r.remove_chunk(*pos);
             }

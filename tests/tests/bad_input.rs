@@ -5,6 +5,7 @@
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+use voxel_render::NoGame;
 use voxel_render::Technique;
 
 use tests::*;
@@ -326,9 +327,11 @@ fn output_views_other_than_a_whole_level_0_2d_view_are_errors() {
     assert!(distinct_colours(&plain) > 8);
 
     let expect_output_error =
-        |r: &mut voxel_render::Renderer, view: &wgpu::TextureView, what| match r
-            .render_and_submit(view, &cam)
-        {
+        |r: &mut voxel_render::Renderer, view: &wgpu::TextureView, what| match r.render_and_submit(
+            view,
+            &cam,
+            &mut NoGame,
+        ) {
             Err(e @ voxel_render::Error::Output(_)) => e.to_string(),
             Err(e) => panic!("{what}: {e:?}"),
             Ok(_) => panic!("{what}: accepted"),

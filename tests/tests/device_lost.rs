@@ -6,7 +6,7 @@
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use voxel_render::{Error, Renderer, Technique};
+use voxel_render::{Error, NoGame, Renderer, Technique};
 
 use tests::*;
 
@@ -33,7 +33,8 @@ fn a_lost_device_gives_errors_and_a_new_device_works() {
     );
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     lost(
-        r.render(&mut encoder, &target.view, &cam).unwrap_err(),
+        r.render(&mut encoder, &target.view, &cam, &mut NoGame)
+            .unwrap_err(),
         "render",
     );
     r.after_submit();
@@ -216,9 +217,7 @@ fn a_device_lost_at_any_point_of_a_frame_gives_errors_not_panics() {
             if between {
                 ctx.device.destroy();
             }
-            let result = r
-                .renderer
-                .render_and_submit_with(&target.view, &cam, &mut game);
+            let result = r.renderer.render_and_submit(&target.view, &cam, &mut game);
             if !between && !game.killed.get() {
                 // The technique draws the game in fewer passes: the device was not lost.
                 assert!(
@@ -235,7 +234,7 @@ fn a_device_lost_at_any_point_of_a_frame_gives_errors_not_panics() {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             lost(
                 r.renderer
-                    .render_with(&mut encoder, &target.view, &cam, &mut game)
+                    .render(&mut encoder, &target.view, &cam, &mut game)
                     .unwrap_err(),
                 &what,
             );

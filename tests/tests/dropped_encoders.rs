@@ -7,6 +7,7 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use tests::*;
+use voxel_render::NoGame;
 use voxel_render::Technique;
 
 /// Resident bytes of this process.
@@ -31,7 +32,8 @@ fn dropped_encoders_keep_memory_flat() {
     let mut frames = |n: usize| {
         for _ in 0..n {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            r.render(&mut encoder, &target.view, &cam).unwrap();
+            r.render(&mut encoder, &target.view, &cam, &mut NoGame)
+                .unwrap();
             drop(encoder);
         }
     };

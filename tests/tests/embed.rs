@@ -17,7 +17,7 @@ use tests::{
 use voxel_core::{BlockDef, BlockId, BlockImage, BlockRegistry, FaceImages, World, blocks};
 use voxel_lab::raymarch::{RayMarcher, Shading};
 use voxel_render::textures::{load_block_image, srgb_to_linear};
-use voxel_render::{Camera, Image, Lighting, RendererConfig, Technique, readback};
+use voxel_render::{Camera, Image, Lighting, NoGame, RendererConfig, Technique, readback};
 
 /// An `n` × `n` checker of `a` (where x + y is even) and `b`.
 fn checker(a: [u8; 4], b: [u8; 4], n: u32) -> BlockImage {
@@ -369,7 +369,7 @@ fn every_format_a_surface_offers_draws_the_same_picture() {
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let draw = |r: &mut voxel_render::Renderer, format| {
         let t = voxel_render::stages::target(&ctx.device, "surface_like", format, usage, (w, h));
-        r.render_and_submit(&t.view, &cam).unwrap();
+        r.render_and_submit(&t.view, &cam, &mut NoGame).unwrap();
         assert_eq!(
             r.config().output_format,
             format,
@@ -480,7 +480,8 @@ fn frames_need_nothing_called_after_the_submit() {
     for _ in 0..4 {
         let target = Offscreen::new(&ctx, 64, 48);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        r.render(&mut encoder, &target.view, &cam).unwrap();
+        r.render(&mut encoder, &target.view, &cam, &mut NoGame)
+            .unwrap();
         ctx.queue.submit([encoder.finish()]);
         ctx.device
             .poll(wgpu::PollType::wait_indefinitely())
@@ -505,11 +506,14 @@ fn frames_need_nothing_called_after_the_submit() {
     // dropped: no validation error, and timings keep coming.
     let target = Offscreen::new(&ctx, 64, 48);
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    r.render(&mut encoder, &target.view, &cam).unwrap();
-    r.render(&mut encoder, &target.view, &cam).unwrap();
+    r.render(&mut encoder, &target.view, &cam, &mut NoGame)
+        .unwrap();
+    r.render(&mut encoder, &target.view, &cam, &mut NoGame)
+        .unwrap();
     ctx.queue.submit([encoder.finish()]);
     let mut dropped = ctx.device.create_command_encoder(&Default::default());
-    r.render(&mut dropped, &target.view, &cam).unwrap();
+    r.render(&mut dropped, &target.view, &cam, &mut NoGame)
+        .unwrap();
     drop(dropped);
     for _ in 0..3 {
         r.render_and_submit(&target.view, &cam).unwrap();
@@ -682,7 +686,7 @@ fn switching_to_prebuilt_techniques_builds_no_pipeline() {
         );
         game.update_pipelines(&mut r.renderer).unwrap();
         r.renderer
-            .render_and_submit_with(&target.view, &cam, &mut game)
+            .render_and_submit(&target.view, &cam, &mut game)
             .unwrap();
         let got = target.read(&ctx).unwrap();
         assert_eq!(

@@ -375,7 +375,7 @@ fn stale_game_pipelines_are_refused_before_recording() {
         Some(wboit)
     );
     r.renderer
-        .render_and_submit_with(&target.view, &camera, &mut content)
+        .render_and_submit(&target.view, &camera, &mut content)
         .unwrap();
 
     r.set_technique(Technique::SortedQuads).unwrap();
@@ -384,7 +384,7 @@ fn stale_game_pipelines_are_refused_before_recording() {
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     let e = r
         .renderer
-        .render_with(&mut encoder, &target.view, &camera, &mut content)
+        .render(&mut encoder, &target.view, &camera, &mut content)
         .unwrap_err();
     match &e {
         voxel_render::Error::StaleContract {
@@ -398,7 +398,7 @@ fn stale_game_pipelines_are_refused_before_recording() {
 
     content.update_pipelines(&mut r.renderer).unwrap();
     r.renderer
-        .render_and_submit_with(&target.view, &camera, &mut content)
+        .render_and_submit(&target.view, &camera, &mut content)
         .unwrap();
     let got = target.read(&ctx).unwrap();
     let fresh = render(&scene, technique_config(Technique::SortedQuads, W, H));
@@ -410,7 +410,7 @@ fn stale_game_pipelines_are_refused_before_recording() {
     assert_eq!(r.translucent_contract().unwrap().id, wboit);
     let e = r
         .renderer
-        .render_and_submit_with(&target.view, &camera, &mut content)
+        .render_and_submit(&target.view, &camera, &mut content)
         .unwrap_err();
     assert!(
         matches!(e, voxel_render::Error::StaleContract { .. }),

@@ -26,7 +26,7 @@ use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, World
 use voxel_lab::headless::Offscreen;
 use voxel_mesh::mesh_chunks;
 use voxel_render::{
-    Camera, GpuContext, Lighting, Renderer, RendererConfig, Technique, readback, stages,
+    Camera, GpuContext, Lighting, NoGame, Renderer, RendererConfig, Technique, readback, stages,
 };
 
 const W: u32 = 640;
@@ -80,7 +80,9 @@ fn camera(vd: i32) -> Result<Camera, String> {
 /// One frame into `target`, waited for; its CPU milliseconds (`FrameStats::cpu_ms`, the
 /// recording, technique preparation and any pipeline built on the way).
 fn frame(ctx: &GpuContext, r: &mut Renderer, target: &wgpu::TextureView, cam: &Camera) -> f64 {
-    let stats = r.render_and_submit(target, cam).expect("a frame");
+    let stats = r
+        .render_and_submit(target, cam, &mut NoGame)
+        .expect("a frame");
     let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
     stats.cpu_ms
 }

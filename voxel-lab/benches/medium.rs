@@ -11,7 +11,7 @@ use std::path::Path;
 
 use voxel_lab::headless::{self, Offscreen};
 use voxel_lab::scene::Scene;
-use voxel_render::{Camera, GpuPass, RendererConfig, Technique};
+use voxel_render::{Camera, GpuPass, NoGame, RendererConfig, Technique};
 
 const FRAMES: usize = 15;
 
@@ -35,7 +35,7 @@ fn times(
     let (mut work, mut medium, mut total) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..FRAMES + 2 {
         renderer
-            .render_and_submit(&target.view, camera)
+            .render_and_submit(&target.view, camera, &mut NoGame)
             .map_err(|e| voxel_lab::chain(&e))?;
         let t = renderer.gpu_times_blocking();
         if i >= 2 {

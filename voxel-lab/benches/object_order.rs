@@ -1,5 +1,5 @@
 //! CPU cost of ordering a game's translucent objects among the chunks (what the sorted
-//! techniques do in `Renderer::render_with`, reported as `FrameStats::game_sort_ms`),
+//! techniques do in `Renderer::render`, reported as `FrameStats::game_sort_ms`),
 //! beside a plain `sort_unstable_by` of the same objects' view depths in the same run.
 //!
 //! The world is a sea: every chunk column within a circle of radius VD chunks around the
@@ -26,7 +26,7 @@ use voxel_lab::headless::{self, Offscreen};
 use voxel_mesh::mesh_chunks;
 use voxel_render::stages::{GameFrame, Stages};
 use voxel_render::{
-    Camera, GameStages, GpuContext, Renderer, RendererConfig, Technique, TranslucentObject,
+    Camera, GameStages, GpuContext, NoGame, Renderer, RendererConfig, Technique, TranslucentObject,
 };
 
 const W: u32 = 640;
@@ -198,7 +198,7 @@ fn measure(
     for i in 0..WARMUP + FRAMES {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let stats = renderer
-            .render_with(&mut encoder, &target.view, camera, game)
+            .render(&mut encoder, &target.view, camera, game)
             .map_err(|e| voxel_lab::chain(&e))?;
         ctx.queue.submit([encoder.finish()]);
         let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
@@ -267,7 +267,7 @@ fn main() -> Result<(), String> {
             let visible = {
                 let target = Offscreen::new(&ctx, W, H);
                 let stats = quads
-                    .render_and_submit(&target.view, &camera)
+                    .render_and_submit(&target.view, &camera, &mut NoGame)
                     .map_err(|e| voxel_lab::chain(&e))?;
                 stats.meshes_drawn[2]
             };

@@ -19,7 +19,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use voxel_lab::headless::{self, Offscreen};
-use voxel_render::{DrawMode, FrameStats, GpuContext, Technique};
+use voxel_render::{DrawMode, FrameStats, GpuContext, NoGame, Technique};
 
 #[path = "common/record_world.rs"]
 mod record_world;
@@ -75,7 +75,7 @@ fn measure(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Row, Strin
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
             let s = renderer
-                .render(&mut encoder, &target.view, &camera)
+                .render(&mut encoder, &target.view, &camera, &mut NoGame)
                 .map_err(|e| voxel_lab::chain(&e))?;
             let t = Instant::now();
             let commands = encoder.finish();

@@ -1,6 +1,6 @@
 //! What a game's technique switch costs once it prepared every technique at loading time:
 //! the first frame after `set_technique` against a steady frame of the same technique, CPU
-//! milliseconds of `Renderer::render_with` (`FrameStats::cpu_ms`), and the render
+//! milliseconds of `Renderer::render` (`FrameStats::cpu_ms`), and the render
 //! pipelines the renderer built in that frame (`low_level::pipelines_built`).
 //!
 //! The world is the record bench's generated terrain at view distance `SWITCH_VD` (default
@@ -39,7 +39,7 @@ fn frame(
     game.update_pipelines(r).map_err(chain)?;
     let before = low_level::pipelines_built();
     let stats = r
-        .render_and_submit_with(&target.view, cam, game)
+        .render_and_submit(&target.view, cam, game)
         .map_err(chain)?;
     let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
     Ok((stats.cpu_ms, low_level::pipelines_built() - before))

@@ -8,7 +8,7 @@
 
 use voxel_lab::eval::oit_config;
 use voxel_lab::headless::{self, Offscreen};
-use voxel_render::{Technique, WeightFunction};
+use voxel_render::{NoGame, Technique, WeightFunction};
 
 #[path = "common/record_world.rs"]
 mod record_world;
@@ -60,7 +60,7 @@ fn main() -> Result<(), String> {
                     .device
                     .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
                 let s = renderer
-                    .render(&mut encoder, &target.view, &camera)
+                    .render(&mut encoder, &target.view, &camera, &mut NoGame)
                     .map_err(|e| voxel_lab::chain(&e))?;
                 ctx.queue.submit([encoder.finish()]);
                 ctx.device

@@ -3,7 +3,7 @@
 use voxel_mesh::mesh_chunks;
 use voxel_render::low_level::{Limit, Need};
 use voxel_render::{
-    Camera, FrameStats, GpuContext, Image, LimitsPreset, Renderer, RendererConfig, readback,
+    Camera, FrameStats, GpuContext, Image, LimitsPreset, NoGame, Renderer, RendererConfig, readback,
 };
 
 use crate::content::ContentStages;
@@ -141,11 +141,10 @@ impl SceneRenderer {
         camera: &Camera,
     ) -> voxel_render::Result<FrameStats> {
         match &mut self.content {
-            None => self.renderer.render_and_submit(output, camera),
+            None => self.renderer.render_and_submit(output, camera, &mut NoGame),
             Some(content) => {
                 content.update_pipelines(&mut self.renderer)?;
-                self.renderer
-                    .render_and_submit_with(output, camera, content)
+                self.renderer.render_and_submit(output, camera, content)
             }
         }
     }

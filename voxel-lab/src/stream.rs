@@ -16,7 +16,7 @@ use serde::Serialize;
 use voxel_core::{BlockRegistry, TerrainConfig, TerrainGenerator};
 use voxel_render::low_level::MAX_VIEW_DISTANCE;
 use voxel_render::{
-    Camera, ChunkStreamer, DrawMode, GpuContext, Renderer, RendererConfig, StreamConfig,
+    Camera, ChunkStreamer, DrawMode, GpuContext, NoGame, Renderer, RendererConfig, StreamConfig,
 };
 
 use crate::charts::{self, Series};
@@ -317,7 +317,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
                 label: Some("stream_frame"),
             });
         let stats = renderer
-            .render(&mut encoder, &target.view, &camera)
+            .render(&mut encoder, &target.view, &camera, &mut NoGame)
             .map_err(|e| crate::chain(&e))?;
         let t1 = Instant::now();
         ctx.queue.submit([encoder.finish()]);

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, WorldPos, blocks};
-use voxel_render::{Camera, GpuContext, Renderer, RendererConfig, Technique, readback};
+use voxel_render::{Camera, GpuContext, NoGame, Renderer, RendererConfig, Technique, readback};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // The game's own GPU objects.
@@ -52,7 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let eye = DVec3::new(30.0 * a.cos(), 45.0, 30.0 * a.sin());
         let camera = Camera::look_at(eye, DVec3::new(0.0, 28.0, 0.0), 70.0, 0.1, 500.0)?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let stats = renderer.render(&mut encoder, &output.view, &camera)?;
+        let stats = renderer.render(&mut encoder, &output.view, &camera, &mut NoGame)?;
         ctx.queue.submit([encoder.finish()]);
         // Nothing to call after submitting: GPU timings (and depth peeling's layer
         // counts) are read back by themselves once the commands are submitted, and arrive

@@ -452,7 +452,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         // id changes and the game builds new translucent pipelines.
         game.update_pipelines(&mut renderer)?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        renderer.render_with(&mut encoder, &output.view, &camera, &mut game)?;
+        renderer.render(&mut encoder, &output.view, &camera, &mut game)?;
         ctx.queue.submit([encoder.finish()]);
     }
     let rgba = voxel_render::readback::read_texture(&ctx, &output.texture, 4)?;

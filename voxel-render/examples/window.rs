@@ -10,7 +10,7 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use voxel_core::{BlockRegistry, ChunkPos, RenderClass, TerrainConfig, TerrainGenerator, World};
-use voxel_render::{Camera, GpuContext, Renderer, RendererConfig, Technique, stages};
+use voxel_render::{Camera, GpuContext, NoGame, Renderer, RendererConfig, Technique, stages};
 use wgpu::CurrentSurfaceTexture::Success;
 use wgpu::PrimitiveTopology::{LineList, TriangleList};
 use wgpu::util::DeviceExt;
@@ -98,7 +98,8 @@ impl Game {
         let camera = Camera::look_at(EYE, TARGET, 70.0, 0.1, 400.0)?;
         let view = frame.texture.create_view(&Default::default());
         let mut encoder = g.ctx.device.create_command_encoder(&Default::default());
-        g.renderer.render(&mut encoder, &view, &camera)?;
+        g.renderer
+            .render(&mut encoder, &view, &camera, &mut NoGame)?;
         // The game's passes see what the renderer drew, from the camera it drew with.
         let drawn = g.renderer.drawn_camera(&camera);
         let (eye, forward) = (drawn.eye.to_array(), drawn.forward.to_array());

@@ -3,7 +3,7 @@
 //! passes, its translucent geometry composed by the active transparency technique together
 //! with the chunks, an HDR overlay before tonemapping and an overlay after it.
 //!
-//! A game implements [`GameStages`] and calls `Renderer::render_with`. The renderer
+//! A game implements [`GameStages`] and passes it to `Renderer::render`. The renderer
 //! calls [`GameStages::prepare`] once the frame's camera is known (write uniforms there),
 //! then records each stage the game declared ([`GameStages::stages`]) into a pass it opens.
 //!

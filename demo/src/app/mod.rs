@@ -894,7 +894,7 @@ impl Gfx {
             Some(reference) => {
                 self.status.stats = self
                     .renderer
-                    .render_with(encoder, &frames.technique.view, &camera, stages)
+                    .render(encoder, &frames.technique.view, &camera, stages)
                     .map_err(|e| chain(&e))?;
                 let mut no_game = voxel_render::NoGame;
                 let reference_stages: &mut dyn voxel_render::GameStages = match reference_stages {
@@ -902,7 +902,7 @@ impl Gfx {
                     None => &mut no_game,
                 };
                 reference
-                    .render_with(encoder, &frames.reference.view, &camera, reference_stages)
+                    .render(encoder, &frames.reference.view, &camera, reference_stages)
                     .map_err(|e| chain(&e))?;
                 Post::draw(
                     encoder,
@@ -914,7 +914,7 @@ impl Gfx {
             None => {
                 self.status.stats = self
                     .renderer
-                    .render_with(encoder, &frames.view.view, &camera, stages)
+                    .render(encoder, &frames.view.view, &camera, stages)
                     .map_err(|e| chain(&e))?;
             }
         }

@@ -19,42 +19,11 @@ use crate::gpu::{self, Depth, Pass};
 use crate::medium::{self, MediumLook};
 use crate::oit::sorted::interleave::ChunkSequence;
 use crate::oit::{FrameView, Technique, TechniqueReport, TranslucentFrame};
-use crate::stages::{GameDraw, GameFrame, GameStages, NoGame, Split, TranslucentContract};
+use crate::stages::{GameDraw, GameFrame, GameStages, Split, TranslucentContract};
 use crate::timing::{GpuPass, Timer};
 use crate::{Camera, Error, Result};
 
 impl Renderer {
-    /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of
-    /// mip level 0 of a single-layer, single-sample 2D texture of the renderer's size,
-    /// of one of [`OUTPUT_FORMATS`], with `RENDER_ATTACHMENT` usage. The view has its
-    /// texture's format, or [`RendererConfig::output_view_format`] when that is the
-    /// texture's twin. Anything else is an [`Error::Output`] before anything is recorded.
-    ///
-    /// Nothing needs calling after the frame's commands are submitted: GPU timings and
-    /// a technique's counters (depth peeling's layers) are read back once they are.
-    ///
-    /// Fails without recording anything on an invalid camera (NaN, zero direction, bad
-    /// planes), a mismatched output ([`Error::Output`]) or a lost device
-    /// ([`Error::DeviceLost`]).
-    ///
-    /// Submit each frame before recording the next: what changes between `render` and
-    /// the submit (chunks uploaded or removed) never changes what this frame draws, and
-    /// the arena places it draws are reused only after [`Renderer::after_submit`] or the
-    /// next `render`.
-    ///
-    /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
-    /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
-    /// encoder that replaces it (the order of commands is kept). Real-time techniques never
-    /// submit.
-    pub fn render(
-        &mut self,
-        encoder: &mut wgpu::CommandEncoder,
-        output: &wgpu::TextureView,
-        camera: &Camera,
-    ) -> Result<FrameStats> {
-        self.render_with(encoder, output, camera, &mut NoGame)
-    }
-
     /// What a game's translucent pipelines must match for the technique in force, made
     /// (with the technique's resources) when first asked for; its `id` changes when a
     /// technique switch or a setting needs new pipelines ([`crate::stages`]).
@@ -79,11 +48,34 @@ impl Renderer {
         })?
     }
 
-    /// [`Renderer::render`] with a game's stages: its opaque geometry after the world's,
-    /// its translucent geometry composed by the technique with the chunks, its overlays
-    /// before and after tonemapping (see [`crate::stages`]). A stage the game does not
-    /// declare costs nothing.
-    pub fn render_with(
+    /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of
+    /// mip level 0 of a single-layer, single-sample 2D texture of the renderer's size,
+    /// of one of [`OUTPUT_FORMATS`], with `RENDER_ATTACHMENT` usage. The view has its
+    /// texture's format, or [`RendererConfig::output_view_format`] when that is the
+    /// texture's twin. Anything else is an [`Error::Output`] before anything is recorded.
+    ///
+    /// Nothing needs calling after the frame's commands are submitted: GPU timings and
+    /// a technique's counters (depth peeling's layers) are read back once they are.
+    ///
+    /// Fails without recording anything on an invalid camera (NaN, zero direction, bad
+    /// planes), a mismatched output ([`Error::Output`]) or a lost device
+    /// ([`Error::DeviceLost`]).
+    ///
+    /// Submit each frame before recording the next: what changes between `render` and
+    /// the submit (chunks uploaded or removed) never changes what this frame draws, and
+    /// the arena places it draws are reused only after [`Renderer::after_submit`] or the
+    /// next `render`.
+    ///
+    /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
+    /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
+    /// encoder that replaces it (the order of commands is kept). Real-time techniques never
+    /// submit.
+    ///
+    /// `game` draws the game's own geometry in the frame's stages: its opaque geometry
+    /// after the world's, its translucent geometry composed by the technique with the
+    /// chunks, its overlays before and after tonemapping (see [`crate::stages`]); a stage
+    /// the game does not declare costs nothing, and [`NoGame`] declares none.
+    pub fn render(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         output: &wgpu::TextureView,
@@ -386,17 +378,8 @@ impl Renderer {
         )
     }
 
-    /// Renders one frame into `output` and submits it (for tools and tests).
+    /// [`Renderer::render`] into `output`, submitted (for tools and tests).
     pub fn render_and_submit(
-        &mut self,
-        output: &wgpu::TextureView,
-        camera: &Camera,
-    ) -> Result<FrameStats> {
-        self.render_and_submit_with(output, camera, &mut NoGame)
-    }
-
-    /// [`Renderer::render_and_submit`] with a game's stages ([`Renderer::render_with`]).
-    pub fn render_and_submit_with(
         &mut self,
         output: &wgpu::TextureView,
         camera: &Camera,
@@ -408,7 +391,7 @@ impl Renderer {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("frame"),
             });
-        let stats = self.render_with(&mut encoder, output, camera, game)?;
+        let stats = self.render(&mut encoder, output, camera, game)?;
         self.ctx.check_device()?;
         self.ctx.queue.submit([encoder.finish()]);
         // A loss during the submission is this frame's too.
