@@ -28,6 +28,7 @@ const RENDER: &[&str] = &[
     "oit",
     "renderer",
     "stream",
+    "low_level",
 ];
 
 /// voxel-lab, bottom up: the model, then the runs, then the report (its lib.rs docs).

@@ -131,7 +131,7 @@ impl GpuContext {
     /// Installs the device's lost callback (wgpu keeps one per device, so this replaces a
     /// callback set before): the renderer learns of a loss through it and answers every
     /// call after it with [`Error::DeviceLost`]. A game that wants to know too asks
-    /// [`GpuContext::check_device`] rather than setting a callback of its own (which would
+    /// `GpuContext::check_device` rather than setting a callback of its own (which would
     /// replace this one).
     pub fn from_device(adapter: &wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
         let caps = Capabilities::new(adapter, device.features(), device.limits());

@@ -589,7 +589,7 @@ impl<'a> Depth<'a> {
 pub struct Pass<'a> {
     /// Debug label.
     pub label: &'a str,
-    /// Colour attachments ([`load`], [`clear`], [`attachment`]).
+    /// Colour attachments ([`load`], [`clear`], `attachment`).
     pub colors: &'a [Option<wgpu::RenderPassColorAttachment<'a>>],
     /// Depth attachment.
     pub depth: Depth<'a>,

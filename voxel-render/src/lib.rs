@@ -1,17 +1,31 @@
 //! wgpu renderer for voxel worlds with selectable order-independent transparency.
 //!
-//! - [`GpuContext`]: the game's device and queue, or a headless one.
-//! - [`Renderer`]: chunks on the GPU and the passes of a frame; [`Camera`] to look with.
-//! - [`oit`]: the transparency techniques behind [`OitManager`], one folder each.
-//! - [`Image`] and [`readback`]: pictures back to the CPU, PNG files.
+//! What a game needs is at the root:
+//!
+//! - [`GpuContext`]: the game's device and queue, or a headless one; [`Capabilities`] and
+//!   [`LimitsPreset`] say what it can do.
+//! - [`Renderer`] with its [`RendererConfig`] and [`Lighting`]: chunks on the GPU and the
+//!   passes of a frame ([`Renderer::render`]); [`Camera`] to look with.
+//! - [`Technique`] and its settings in [`OitConfig`]: how translucent water, glass and
+//!   leaves are composed, switchable at run time.
 //! - [`ChunkStreamer`]: the chunks around a moving eye, generated, meshed and uploaded on
 //!   rayon's workers.
+//! - [`stages`]: the game's own geometry in the frame ([`GameStages`]), composed by every
+//!   technique, and the helpers its pipelines and overlays are built with.
+//! - [`Image`] and [`readback`]: pictures back to the CPU, PNG files; [`textures`]: a
+//!   game's block textures.
+//!
+//! [`low_level`] holds what the lab, the benchmarks and the tests reach into (the chunk
+//! store, the transparency manager, each technique's internals and the limits inputs are
+//! checked against); a game does not need it.
 //!
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `ladder`
-//! (what each pass needs of a device), `camera`, `readback`, `submission`, `timing`, `fetch`
-//! (how quads reach the vertex shader) → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
-//! pipeline binds), `textures`, `arena` (the quad arena), `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
-//! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` → `stream` (chunks loaded around a moving eye). A test
+//! (what each pass needs of a device), `camera`, `readback`, `submission`, `timing`,
+//! `fetch` (how quads reach the vertex shader) → `gpu` (pass and pipeline plumbing) →
+//! `bindings` (what every chunk pipeline binds), `textures`, `arena` (the quad arena),
+//! `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
+//! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` →
+//! `stream` (chunks loaded around a moving eye) → `low_level`. A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
 mod arena;

@@ -18,7 +18,7 @@ pub struct RendererConfig {
     pub height: u32,
     /// Format of the textures `render` draws into first (its tonemap pipeline is built
     /// with the renderer). Default `Rgba8UnormSrgb`, what offscreen readback and PNG files
-    /// want. Any of [`OUTPUT_FORMATS`] works without changing this: an output of another
+    /// want. Any of `OUTPUT_FORMATS` works without changing this: an output of another
     /// format gets its tonemap pipeline at its first frame (once per format, about a
     /// millisecond), and this field follows the format drawn last.
     pub output_format: wgpu::TextureFormat,

@@ -50,7 +50,7 @@ impl Renderer {
 
     /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of
     /// mip level 0 of a single-layer, single-sample 2D texture of the renderer's size,
-    /// of one of [`OUTPUT_FORMATS`], with `RENDER_ATTACHMENT` usage. The view has its
+    /// of one of `OUTPUT_FORMATS`, with `RENDER_ATTACHMENT` usage. The view has its
     /// texture's format, or [`RendererConfig::output_view_format`] when that is the
     /// texture's twin. Anything else is an [`Error::Output`] before anything is recorded.
     ///
@@ -74,7 +74,7 @@ impl Renderer {
     /// `game` draws the game's own geometry in the frame's stages: its opaque geometry
     /// after the world's, its translucent geometry composed by the technique with the
     /// chunks, its overlays before and after tonemapping (see [`crate::stages`]); a stage
-    /// the game does not declare costs nothing, and [`NoGame`] declares none.
+    /// the game does not declare costs nothing, and `NoGame` declares none.
     pub fn render(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
@@ -366,8 +366,8 @@ impl Renderer {
 
     /// The camera a frame of `camera` is drawn with: no translucent face closer than the
     /// near plane's corners (the near plane shrinks for the frame), and an eye within
-    /// [`crate::MIN_NEAR`] of a translucent face moved off it to its medium's side
-    /// ([`medium::guard`]). Tools that reason about the picture's geometry (the lab's quad
+    /// `crate::MIN_NEAR` of a translucent face moved off it to its medium's side
+    /// (`medium::guard`). Tools that reason about the picture's geometry (the lab's quad
     /// edges) use this one.
     pub fn drawn_camera(&self, camera: &Camera) -> Camera {
         let (w, h) = self.size();

@@ -369,7 +369,7 @@ impl Renderer {
     /// [`Renderer::set_technique`] to it builds nothing and its first frame costs what any
     /// frame costs (a game prepares the techniques its settings menu offers at loading
     /// time). It stays built until [`Renderer::release_technique`]; see
-    /// [`OitManager::prebuild`]. Returns the technique built (after its fallback on this
+    /// `OitManager::prebuild`. Returns the technique built (after its fallback on this
     /// adapter); one the device cannot run is an [`Error::Unsupported`].
     pub fn prebuild_technique(&mut self, technique: Technique) -> Result<Technique> {
         self.ctx.check_device()?;

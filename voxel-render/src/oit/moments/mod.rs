@@ -6,17 +6,17 @@
 //! 1. **Moments**: every translucent fragment adds its absorbance `a = −ln(1 − α)` to `b0`
 //!    (R32Float) and `a·(z, z², z³, z⁴)` to the moments (Rgba32Float), additive blend, `z`
 //!    its view depth warped logarithmically to [−1, 1] across the frame's translucent
-//!    depth range ([`depth_range`]).
+//!    depth range (`depth_range`).
 //! 2. **Resolve**: the translucent geometry again; each fragment reconstructs the
 //!    transmittance in front of it from the moments (the paper's Hamburger 4-moment bound,
-//!    [`transmittance`]) and adds `(C·α, α)·T` to an Rgba16Float accumulation.
+//!    `transmittance`) and adds `(C·α, α)·T` to an Rgba16Float accumulation.
 //! 3. **Composite**: `accum.rgb / accum.a` with coverage `1 − e^(−b0)` over the opaque
 //!    image, like WBOIT's composite: the total transmittance is exact, only the weights
 //!    of the average are estimated.
 //!
 //! Fallbacks: 32-bit moments need `FLOAT32_BLENDABLE`; without it (or with
 //! [`MboitSettings::half_precision`]) the moments are Rgba16Float and R16Float with a
-//! larger bias ([`BIAS_F16`]), logged. Without blendable Rgba16Float the technique is
+//! larger bias (`BIAS_F16`), logged. Without blendable Rgba16Float the technique is
 //! replaced by `wboit-two-pass` (which then accumulates in RGBA8), logged by the manager.
 
 use bytemuck::{Pod, Zeroable};

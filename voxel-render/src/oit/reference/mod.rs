@@ -60,7 +60,7 @@ pub struct ReferenceReport {
     pub tiles: u32,
     /// Fragments that did not fit in the pool even with the most tiles (should be 0).
     pub lost_fragments: u64,
-    /// Pixels with more than [`MAX_LAYERS`] fragments (their nearest ones were blended).
+    /// Pixels with more than `MAX_LAYERS` fragments (their nearest ones were blended).
     pub capped_pixels: u64,
     /// Capped pixels where the dropped fragments could change the 8-bit colour.
     pub capped_visible_pixels: u64,

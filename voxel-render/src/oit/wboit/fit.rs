@@ -8,7 +8,7 @@
 //! meshes:
 //!
 //! - once per upload of a chunk, the chunk store sums its translucent quads up per plane,
-//!   facing and block ([`crate::layers`]): the rectangle around those quads, and their
+//!   facing and block (`crate::layers`): the rectangle around those quads, and their
 //!   area times the block's optical depth `−ln(1 − α)`; the frame's culling copies the
 //!   visible chunks' planes into one buffer;
 //! - each frame, every plane that faces the eye (back faces are not drawn; the surface of
@@ -17,7 +17,7 @@
 //!   ray through the rectangle crosses (optical area / rectangle area) times the share of
 //!   the tile it covers, in front of the view depths past the rectangle's farthest point.
 //!
-//! The result, per tile, is the expected optical depth in front of [`PROFILE_LEN`] depths
+//! The result, per tile, is the expected optical depth in front of `PROFILE_LEN` depths
 //! spaced evenly in log depth across the translucent depth range in view; the weight is
 //! `3000 · e^−τ(d)` ([`super::WeightFunction::Fitted`]). An estimate, not the per-pixel
 //! truth: a layer covering a quarter of a tile dims what lies behind it in that tile by a
@@ -236,8 +236,8 @@ fn projection(plane: &Plane, base: Vec4, columns: &[Vec4; 3]) -> ([Vec2; 2], [f3
 pub struct WeightFit {
     /// Nearest and farthest view depth of the visible translucent meshes.
     pub range: [f32; 2],
-    /// For each screen tile (row by row, [`TILES`] × [`TILES`]), the expected optical
-    /// depth in front of [`PROFILE_LEN`] depths spaced evenly in log depth across `range`.
+    /// For each screen tile (row by row, `TILES` × `TILES`), the expected optical
+    /// depth in front of `PROFILE_LEN` depths spaced evenly in log depth across `range`.
     /// Empty: none anywhere.
     pub optical_depth: Vec<f32>,
     /// The screen rectangle (0 to 1, y down) around the planes of quads that face the eye
@@ -265,7 +265,7 @@ impl WeightFit {
     /// The optical depth in front of view depth `d` at `screen` (0 to 1, y down):
     /// interpolated in log depth in the tables of the four tiles around `screen`, then
     /// bilinearly between the tiles' centres (no seams at tile edges), and clamped at the
-    /// ends of the range and at [`MAX_FITTED_DEPTH`].
+    /// ends of the range and at `MAX_FITTED_DEPTH`.
     pub fn optical_depth_at(&self, screen: [f32; 2], d: f32) -> f32 {
         if self.optical_depth.len() < TILES * TILES * PROFILE_LEN {
             return 0.0;

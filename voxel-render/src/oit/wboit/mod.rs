@@ -24,7 +24,7 @@
 //! eight bits of precision at best. Logged when chosen.
 //!
 //! The weight's parameters (the fitted weight's table, [`fit`]) are the technique's own
-//! uniform, group 2, written each frame by [`Wboit::prepare`](TranslucentTechnique::prepare).
+//! uniform, group 2, written each frame by `Wboit::prepare`.
 //! The chunk pipelines are built per weight (the weight a shader constant, so that no
 //! fragment pays for the other weights' code), the first time a frame draws with it, and
 //! kept; games' pipelines read the weight from the uniform.
