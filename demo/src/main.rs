@@ -53,6 +53,14 @@ fn quad_fetch(s: &str) -> Result<voxel_render::QuadFetch, String> {
     voxel_render::QuadFetch::from_name(s).map_err(|e| e.to_string())
 }
 
+/// An hour of the day, 0 to 24.
+fn hour(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(h) if (0.0..=24.0).contains(&h) => Ok(h),
+        _ => Err(format!("{s:?}: an hour from 0 to 24 (e.g. 12 or 22.5)")),
+    }
+}
+
 fn limits_preset(s: &str) -> Result<voxel_render::LimitsPreset, String> {
     voxel_render::LimitsPreset::from_name(s).map_err(|e| e.to_string())
 }
@@ -315,6 +323,10 @@ struct RenderArgs {
     /// Every block one flat colour (what the lab compares with its CPU ray march).
     #[arg(long)]
     flat_textures: bool,
+    /// The lighting of this hour, 0 to 24 (`Lighting::daytime`: night is moonlit; default:
+    /// the renderer's default daylight).
+    #[arg(long, value_parser = hour)]
+    hour: Option<f32>,
     /// How quads reach the vertex shader: storage or instanced (default: the first the
     /// device can).
     #[arg(long, value_parser = quad_fetch)]
@@ -512,6 +524,11 @@ fn render(a: RenderArgs, device: &headless::Device) -> Result<(), String> {
         ..RendererConfig::default()
     };
     config.oit.technique = a.technique;
+    if let Some(hour) = a.hour {
+        let l = voxel_render::Lighting::daytime(hour);
+        (config.sun_dir, config.ambient) = (l.sun_dir, l.ambient);
+        (config.brightness, config.sky) = (l.brightness, l.sky);
+    }
     if let Some(w) = a.weight {
         config.oit.wboit.weight = w;
     }

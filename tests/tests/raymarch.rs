@@ -10,8 +10,9 @@ use std::path::Path;
 use glam::DVec3;
 use voxel_core::blocks::{GRASS, STONE};
 use voxel_lab::eval::raymarch_check;
+use voxel_lab::raymarch::{RayMarcher, Shading};
 use voxel_lab::scene::{Scene, scene_files};
-use voxel_render::{Camera, RendererConfig, Technique};
+use voxel_render::{Camera, Lighting, RendererConfig, Technique};
 
 /// Small enough for CI, large enough that the terrain scenes hold steps, water and glass.
 const SIZE: (u32, u32) = (192, 108);
@@ -52,6 +53,68 @@ fn the_ray_march_agrees_with_the_reference_on_the_suite() {
             c.pixels
         );
     }
+}
+
+/// The renderer's settings with the lighting of `hour` (flat textures, as the ray march
+/// draws them).
+fn at_hour(hour: f32, technique: Technique) -> RendererConfig {
+    let l = Lighting::daytime(hour);
+    RendererConfig {
+        flat_textures: true,
+        sun_dir: l.sun_dir,
+        ambient: l.ambient,
+        brightness: l.brightness,
+        sky: l.sky,
+        ..tests::technique_config(technique, SIZE.0, SIZE.1)
+    }
+}
+
+#[test]
+fn at_night_the_world_is_moonlit_and_the_ray_march_agrees() {
+    let Some(ctx) = tests::gpu() else { return };
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/water_through_glass.toml");
+    let scene = Scene::load(&file).unwrap();
+    let camera = scene.cameras[0];
+    let mean = |img: &voxel_render::Image| {
+        let rgb = img.rgba.chunks_exact(4).flat_map(|p| &p[..3]);
+        let sum: u64 = rgb.map(|&c| u64::from(c)).sum();
+        sum as f64 / (img.rgba.len() / 4 * 3) as f64
+    };
+    let noon = tests::render_with(&ctx, &scene, at_hour(12.0, Technique::Reference));
+    let night_config = at_hour(0.0, Technique::Reference);
+    let mut r = voxel_lab::headless::renderer_for(&ctx, &scene, night_config.clone()).unwrap();
+    let night = tests::frame(&ctx, &mut r, &camera);
+    // Moonlight is an eighth of daylight in linear light: after the sRGB curve the picture
+    // is well under half as bright, but not black.
+    let (day, dark) = (mean(&noon), mean(&night));
+    assert!(
+        dark < 0.45 * day && dark > 4.0,
+        "night mean {dark:.1} against noon {day:.1}"
+    );
+    // The CPU ray march, lit by the same moon, draws the same picture.
+    let drawn = r.drawn_camera(&camera);
+    let shading = Shading::of(&night_config);
+    let marcher = RayMarcher::with_content(&scene.world, &scene.content);
+    let ray = marcher.render(&drawn, SIZE.0, SIZE.1, &shading);
+    let c = marcher.compare(&ray, &drawn, &shading, &night, None);
+    assert_eq!(
+        (c.differing, c.cracks),
+        (0, 0),
+        "{} pixels off edges differ (max {}/255): {:?}",
+        c.differing,
+        c.max_abs_err_off_edges,
+        c.worst
+    );
+    // The real-time default draws the night as faithfully as the day.
+    let off = |hour: f32, reference: &voxel_render::Image| {
+        let quads = tests::render_with(&ctx, &scene, at_hour(hour, Technique::SortedQuads));
+        tests::diff(&quads, reference)
+    };
+    let (by_day, by_night) = (off(12.0, &noon), off(0.0, &night));
+    assert!(
+        by_night.over_one <= by_day.over_one && by_night.max <= by_day.max.max(1),
+        "sorted-quads against the reference: night {by_night:?}, day {by_day:?}"
+    );
 }
 
 /// A floor of grass with a one-block step of stone-capped grass on its -x half, seen from

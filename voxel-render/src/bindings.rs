@@ -122,8 +122,10 @@ pub(crate) struct FrameUniforms {
     /// 1 when a volume (a translucent block with absorption) is in view and group 0's
     /// volume depth holds this frame's opaque depth; else 0.
     pub volumes: u32,
-    /// Padding to 16 bytes.
-    pub _pad2: f32,
+    /// How bright the light of the sun (or moon) and the ambient light are: 1 by day,
+    /// [`Lighting::MOONLIGHT`](crate::Lighting::MOONLIGHT) at night. Scales every lit
+    /// colour; the sky is cleared to its own colour.
+    pub brightness: f32,
     /// The look of the medium the eye is in: linear colour and absorption, zero for none.
     pub medium_look: [f32; 4],
 }
@@ -255,6 +257,7 @@ mod tests {
                 field!(FrameUniforms, ao_strength),
                 field!(FrameUniforms, tan_half),
                 field!(FrameUniforms, volumes),
+                field!(FrameUniforms, brightness),
                 field!(FrameUniforms, medium_look),
             ],
         );

@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use voxel_render::{BayerSize, GpuContext, Lighting, Technique, WeightFunction};
+use voxel_render::{BayerSize, GpuContext, Technique, WeightFunction};
 use winit::window::Window;
 
 use super::post::FRAME_FORMAT;
@@ -209,10 +209,10 @@ impl Gfx {
             egui::Slider::new(&mut s.view_distance, 1..=super::MAX_VIEW_DISTANCE)
                 .text("view distance (chunks)"),
         );
-        // The default lighting until the slider is moved; then the sun of that hour.
+        // The default lighting until the slider is moved; then the sun (or, at night, the
+        // moon) of that hour.
         let mut hour = s.hour.unwrap_or(DEFAULT_HOUR);
-        let slider = egui::Slider::new(&mut hour, Lighting::SUNRISE..=Lighting::SUNSET)
-            .text("time of day (h)");
+        let slider = egui::Slider::new(&mut hour, 0.0..=24.0).text("time of day (h)");
         if ui.add(slider).changed() {
             s.hour = Some(hour);
         }

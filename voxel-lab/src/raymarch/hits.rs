@@ -40,7 +40,7 @@ impl RayMarcher {
             if q.dot(right).abs() > s || q.dot(up).abs() > s {
                 continue;
             }
-            let l = particle_light(light.sun, light.ambient);
+            let l = light.brightness * particle_light(light.sun, light.ambient);
             hits.push(ContentHit {
                 t,
                 color: p.color.map(|c| srgb_to_linear(c) * l),
@@ -99,7 +99,7 @@ impl RayMarcher {
                     && t <= far
                 {
                     let normal = box_normal(e.rotation, a, sign);
-                    let l = face_light(normal, light.sun, light.ambient);
+                    let l = light.brightness * face_light(normal, light.sun, light.ambient);
                     hits.push(ContentHit {
                         t,
                         color: e.color.map(|c| srgb_to_linear(c) * l),
@@ -114,7 +114,7 @@ impl RayMarcher {
                 continue;
             }
             let normal = box_normal(e.rotation, face.0, face.1);
-            let l = face_light(normal, light.sun, light.ambient);
+            let l = light.brightness * face_light(normal, light.sun, light.ambient);
             hits.push(ContentHit {
                 t: t_in,
                 color: e.color.map(|c| srgb_to_linear(c) * l),

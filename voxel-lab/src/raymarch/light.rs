@@ -36,7 +36,7 @@ impl RayMarcher {
             (f64::from(n[0]) * sun[0] + f64::from(n[1]) * sun[1] + f64::from(n[2]) * sun[2])
                 .max(0.0);
         let ambient = f64::from(w.shading.ambient);
-        let light = ambient + (1.0 - ambient) * n_dot_l;
+        let light = w.light.brightness * (ambient + (1.0 - ambient) * n_dot_l);
         let translucent = self.class(surface.id) == RenderClass::Translucent;
         let shade = if translucent {
             1.0
@@ -59,6 +59,8 @@ impl RayMarcher {
 pub(super) struct Light {
     pub(super) sun: DVec3,
     pub(super) ambient: f64,
+    /// Scales every lit colour (the sky is not lit).
+    pub(super) brightness: f64,
     pub(super) sky: [f64; 3],
     pub(super) fog: Option<Fog>,
     /// What a medium's colour is lit by: a face turned to the sky.
@@ -77,7 +79,8 @@ impl Light {
         let s = shading.sun_dir.map(f64::from);
         let sun = DVec3::from(s).try_normalize().unwrap_or(DVec3::Y);
         let ambient = f64::from(shading.ambient);
-        let medium_light = ambient + (1.0 - ambient) * sun.y.max(0.0);
+        let brightness = f64::from(shading.brightness);
+        let medium_light = brightness * (ambient + (1.0 - ambient) * sun.y.max(0.0));
         let fog = camera
             .medium
             .and_then(|id| m.media.get(id.index()).copied().flatten())
@@ -95,6 +98,7 @@ impl Light {
         Self {
             sun,
             ambient,
+            brightness,
             sky: shading.sky.map(f64::from),
             fog,
             medium_light,

@@ -59,6 +59,8 @@ pub struct Shading {
     pub sun_dir: [f32; 3],
     /// Ambient share.
     pub ambient: f32,
+    /// Brightness of the light (scales every lit colour, not the sky).
+    pub brightness: f32,
     /// Sky colour, linear.
     pub sky: [f32; 3],
     /// Ambient-occlusion strength (0 to 1).
@@ -73,6 +75,7 @@ impl Shading {
         Self {
             sun_dir: config.sun_dir,
             ambient: config.ambient,
+            brightness: config.brightness,
             sky: config.sky,
             ao_strength: config.ao_strength,
             texturing: if config.flat_textures {

@@ -40,6 +40,10 @@ pub struct RendererConfig {
     /// Ambient share of the lighting, 0 to 1 (outside, NaN or infinite: an error at
     /// [`Renderer::new`]). Default 0.45: faces away from the sun stay readable.
     pub ambient: f32,
+    /// How bright the sun's (or the moon's) and the ambient light are, finite and at
+    /// least 0 (else an error at [`Renderer::new`]): every lit colour is scaled by it, the
+    /// sky is not. Default 1, daylight; [`Lighting::daytime`] lowers it at night.
+    pub brightness: f32,
     /// Sky colour (linear), each channel finite and at least 0 (else an error at
     /// [`Renderer::new`]). Default a light blue.
     pub sky: [f32; 3],
@@ -76,6 +80,7 @@ impl Default for RendererConfig {
             oit: OitConfig::default(),
             sun_dir: [0.35, 0.85, 0.4],
             ambient: 0.45,
+            brightness: 1.0,
             sky: [0.45, 0.65, 0.9],
             draw: DrawMode::Indirect,
             fade_in_frames: 0,
@@ -121,15 +126,19 @@ pub struct Lighting {
     pub sun_dir: [f32; 3],
     /// Ambient share of the lighting, 0 to 1.
     pub ambient: f32,
+    /// How bright the light is (1 by day, [`Lighting::MOONLIGHT`] at night), at least 0.
+    pub brightness: f32,
     /// Sky colour (linear), what the background is cleared to.
     pub sky: [f32; 3],
 }
 
 impl Lighting {
-    /// The first hour [`Lighting::daytime`] draws: sunrise.
+    /// The hour the sun rises in [`Lighting::daytime`].
     pub const SUNRISE: f32 = 6.0;
-    /// The last hour [`Lighting::daytime`] draws: sunset.
+    /// The hour the sun sets in [`Lighting::daytime`].
     pub const SUNSET: f32 = 18.0;
+    /// The brightness of moonlight (night in [`Lighting::daytime`]), a share of daylight.
+    pub const MOONLIGHT: f32 = 0.12;
 
     /// The lighting of [`RendererConfig::default`].
     pub fn default_day() -> Self {
@@ -137,37 +146,102 @@ impl Lighting {
         Self {
             sun_dir: c.sun_dir,
             ambient: c.ambient,
+            brightness: c.brightness,
             sky: c.sky,
         }
     }
 
-    /// Daylight at `hour` (clamped to [`Lighting::SUNRISE`]..=[`Lighting::SUNSET`]): the
-    /// sun rises in the east (+x), stands highest in the south (+z) at noon and sets in
-    /// the west; the ambient share falls from 0.45 at noon to 0.2 at the horizon, and the
-    /// sky turns from light blue to a dusk orange. A model for a time-of-day control, not
+    /// The lighting at `hour` of a 24-hour day (any finite hour, taken modulo 24; NaN or
+    /// infinite: noon). Day, [`Lighting::SUNRISE`] to [`Lighting::SUNSET`]: the sun rises
+    /// in the east (+x), stands highest in the south (+z) at noon and sets in the west;
+    /// the ambient share falls from 0.45 at noon to 0.2 at the horizon, and the sky turns
+    /// from light blue to a dusk orange. Night, from an hour after sunset to an hour before
+    /// sunrise: the moon crosses the sky on the sun's path, its light
+    /// [`Lighting::MOONLIGHT`] bright, more of it ambient (0.5), under a dark blue sky.
+    /// Twilight, the hour between: day and night blended, so that a clock running
+    /// through the day changes the light smoothly. A model for a time-of-day control, not
     /// an atmosphere.
     pub fn daytime(hour: f32) -> Self {
-        let hour = if hour.is_finite() { hour } else { 12.0 };
-        let h = hour.clamp(Self::SUNRISE, Self::SUNSET);
-        // 0 at sunrise, pi at sunset.
-        let a = (h - Self::SUNRISE) / (Self::SUNSET - Self::SUNRISE) * std::f32::consts::PI;
-        // A path leaning toward the south (z = 0.47 y: at 10:30 this is the default
-        // lighting's sun within a few degrees), a few degrees above the horizon at either
-        // end so that the sides facing the sun keep some light.
+        let hour = if hour.is_finite() {
+            hour.rem_euclid(24.0)
+        } else {
+            12.0
+        };
+        let (rise, set) = (Self::SUNRISE, Self::SUNSET);
+        if (rise..=set).contains(&hour) {
+            return Self::sun(hour);
+        }
+        // Hours since sunset, 0 to 12: twilight in the first and the last hour.
+        let since = (hour - set).rem_euclid(24.0);
+        let night_len = 24.0 - (set - rise);
+        if since < 1.0 {
+            Self::blend(Self::sun(set), Self::moon(1.0 / night_len), since)
+        } else if since > night_len - 1.0 {
+            let t = since - (night_len - 1.0);
+            Self::blend(
+                Self::moon((night_len - 1.0) / night_len),
+                Self::sun(rise),
+                t,
+            )
+        } else {
+            Self::moon(since / night_len)
+        }
+    }
+
+    /// A body on the daily path at `a` (0 rising in the east, pi setting in the west): a
+    /// path leaning toward the south (z = 0.47 y: at 10:30 this is the default lighting's
+    /// sun within a few degrees), a few degrees above the horizon at either end so that
+    /// the sides facing it keep some light.
+    fn path(a: f32) -> glam::Vec3 {
         let elevation = 0.08 + 0.92 * a.sin();
-        let sun = glam::Vec3::new(a.cos(), elevation, 0.47 * elevation).normalize_or(glam::Vec3::Y);
+        glam::Vec3::new(a.cos(), elevation, 0.47 * elevation).normalize_or(glam::Vec3::Y)
+    }
+
+    /// Daylight at `hour`, from sunrise to sunset.
+    fn sun(hour: f32) -> Self {
+        let a = (hour - Self::SUNRISE) / (Self::SUNSET - Self::SUNRISE) * std::f32::consts::PI;
         let day = glam::Vec3::from([0.45, 0.65, 0.9]);
         let dusk = glam::Vec3::from([0.85, 0.45, 0.25]);
         let t = a.sin().clamp(0.0, 1.0).sqrt();
         Self {
-            sun_dir: sun.to_array(),
+            sun_dir: Self::path(a).to_array(),
             ambient: 0.2 + 0.25 * t,
+            brightness: 1.0,
             sky: dusk.lerp(day, t).to_array(),
         }
     }
 
-    /// Checks the values: a finite non-zero sun direction, an ambient share from 0 to 1,
-    /// a finite sky colour of non-negative channels.
+    /// Moonlight with the moon `share` (0 to 1) of the way across the sky.
+    fn moon(share: f32) -> Self {
+        Self {
+            sun_dir: Self::path(share * std::f32::consts::PI).to_array(),
+            ambient: 0.5,
+            brightness: Self::MOONLIGHT,
+            sky: [0.012, 0.018, 0.045],
+        }
+    }
+
+    /// `a` turning into `b` as `t` goes from 0 to 1 (smoothly at both ends). The light
+    /// turns all ambient halfway, where the direction changes from `a`'s to `b`'s, so that
+    /// no face's light jumps.
+    fn blend(a: Self, b: Self, t: f32) -> Self {
+        let s = t * t * (3.0 - 2.0 * t);
+        let mix = |x: f32, y: f32| x + (y - x) * s;
+        let (body, half) = if s < 0.5 {
+            (a, s * 2.0)
+        } else {
+            (b, 2.0 - s * 2.0)
+        };
+        Self {
+            sun_dir: body.sun_dir,
+            ambient: body.ambient + (1.0 - body.ambient) * half,
+            brightness: mix(a.brightness, b.brightness),
+            sky: std::array::from_fn(|i| mix(a.sky[i], b.sky[i])),
+        }
+    }
+
+    /// Checks the values: a finite non-zero sun direction, an ambient share from 0 to 1, a
+    /// finite brightness of at least 0, a finite sky colour of non-negative channels.
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(Error::InvalidSetting(what));
         if let Err(why) = voxel_core::unit_direction(self.sun_dir.map(f64::from)) {
@@ -175,6 +249,12 @@ impl Lighting {
         }
         if !(0.0..=1.0).contains(&self.ambient) {
             return bad(format!("ambient {}: it must be from 0 to 1", self.ambient));
+        }
+        if !(self.brightness.is_finite() && self.brightness >= 0.0) {
+            return bad(format!(
+                "brightness {}: it must be finite and not negative",
+                self.brightness
+            ));
         }
         if !self.sky.iter().all(|c| c.is_finite() && *c >= 0.0) {
             return bad(format!(
@@ -229,6 +309,12 @@ pub(super) fn check_lighting(config: &RendererConfig) -> Result<()> {
         return bad(format!(
             "ambient {}: it must be a share from 0 to 1",
             config.ambient
+        ));
+    }
+    if !(config.brightness.is_finite() && config.brightness >= 0.0) {
+        return bad(format!(
+            "brightness {}: it must be finite and at least 0",
+            config.brightness
         ));
     }
     if !config.sky.iter().all(|v| v.is_finite() && *v >= 0.0) {

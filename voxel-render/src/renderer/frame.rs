@@ -323,7 +323,8 @@ impl Renderer {
         }
         if let Some((_, look)) = &medium {
             let sun = sun_unit(self.config.sun_dir);
-            let light = self.config.ambient + (1.0 - self.config.ambient) * sun.y.max(0.0);
+            let light = self.config.brightness
+                * (self.config.ambient + (1.0 - self.config.ambient) * sun.y.max(0.0));
             let params = medium::fog_params(look, camera, aspect, [w as f32, h as f32], light);
             self.ctx
                 .queue
@@ -516,6 +517,7 @@ impl Renderer {
             far: camera.far as f32,
             sun_dir: sun.to_array(),
             ambient: self.config.ambient,
+            brightness: self.config.brightness,
             sky: self.config.sky,
             viewport: [w as f32, h as f32],
             medium: medium.map_or(NO_MEDIUM, |(b, _)| u32::from(b.0)),

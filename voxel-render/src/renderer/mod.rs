@@ -430,22 +430,24 @@ impl Renderer {
         Ok(())
     }
 
-    /// The sun direction, ambient share and sky in force.
+    /// The sun direction, ambient share, brightness and sky in force.
     pub fn lighting(&self) -> Lighting {
         Lighting {
             sun_dir: self.config.sun_dir,
             ambient: self.config.ambient,
+            brightness: self.config.brightness,
             sky: self.config.sky,
         }
     }
 
-    /// Changes the sun direction, ambient share and sky from the next frame on: they are
+    /// Changes the sun direction, ambient share, brightness and sky from the next frame on: they are
     /// frame uniforms and the clear colour, so nothing is rebuilt and no chunk is uploaded
     /// again. Invalid values ([`Lighting::validate`]) are an error and change nothing.
     pub fn set_lighting(&mut self, lighting: Lighting) -> Result<()> {
         lighting.validate()?;
         self.config.sun_dir = lighting.sun_dir;
         self.config.ambient = lighting.ambient;
+        self.config.brightness = lighting.brightness;
         self.config.sky = lighting.sky;
         Ok(())
     }

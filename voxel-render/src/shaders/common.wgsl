@@ -260,10 +260,10 @@ fn albedo(in: VsOut) -> vec4<f32> {
     return textureSample(block_textures, block_sampler, image_uv(in.uv, in.face), in.layer);
 }
 
-// Lambert with the sun plus ambient, times the ambient occlusion.
+// Lambert with the sun plus ambient, at the light's brightness, times the ambient occlusion.
 fn light(rgb: vec3<f32>, in: VsOut) -> vec3<f32> {
     let n_dot_l = max(dot(NORMALS[in.face], frame.sun_dir), 0.0);
-    return rgb * (frame.ambient + (1.0 - frame.ambient) * n_dot_l) * in.shade;
+    return rgb * frame.brightness * (frame.ambient + (1.0 - frame.ambient) * n_dot_l) * in.shade;
 }
 
 // Whether a translucent fragment counts (the model in `medium.rs`): every front face

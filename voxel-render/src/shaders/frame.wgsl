@@ -23,6 +23,8 @@ struct Frame {
     // `entry_look` hold the nearest entry into a volume, and fragments inside a volume are
     // composed as the sorted techniques need (`inside_volume`).
     volumes: u32,
+    // How bright sun (or moon) and ambient light are: 1 by day, less at night.
+    brightness: f32,
     // The look of the medium the eye is in (linear colour, absorption), or zero.
     medium_look: vec4<f32>,
 };
