@@ -109,7 +109,7 @@ fn draw_or_refuse(
 fn vulkan_config(ctx: &GpuContext, technique: Technique) -> RendererConfig {
     let mut config = technique_config(technique, W, H);
     config.oit.mboit.half_precision =
-        !voxel_render::low_level::moments::single_precision(&ctx.caps, &config.oit.mboit);
+        !voxel_render::low_level::single_precision(&ctx.caps, &config.oit.mboit);
     config
 }
 

@@ -124,7 +124,7 @@ fn peel_layers_beyond_the_limit_are_an_error_not_a_hang() {
     }
     assert_eq!(r.config().oit.peeling.layers, 8, "nothing changed");
     let mut c = r.config().oit.clone();
-    c.peeling.layers = voxel_render::low_level::peeling::MAX_PEEL_LAYERS;
+    c.peeling.layers = voxel_render::low_level::MAX_PEEL_LAYERS;
     r.set_oit_config(c).unwrap();
     frame(&ctx, &mut r, &scene.cameras[0]);
 }

@@ -182,7 +182,7 @@ fn sorted_quads_is_exact_without_cycles() {
         .collect();
     assert_eq!(runs.len(), COUNT);
     // A game's particles and entities are ordered by their centres, which is not exact
-    // (`voxel_render::low_level::sorted`): only scenes of blocks count here.
+    // (the sorted techniques): only scenes of blocks count here.
     let blocks_only = |scene: &str| {
         summary.features.iter().any(|f| {
             f.scene == scene

@@ -6,7 +6,7 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use voxel_core::blocks::*;
-use voxel_render::low_level::wboit::{self, HEADROOM_SCALE};
+use voxel_render::low_level::{HEADROOM_SCALE, RGBA8_SCALE};
 use voxel_render::{GpuPass, Renderer, RendererConfig, Technique, WeightFunction};
 
 use tests::*;
@@ -321,7 +321,7 @@ fn shader_weights_match_the_rust_formulas() {
             "{weight:?}: shader {got}, rust {want}"
         );
     }
-    assert_eq!(wboit::RGBA8_SCALE, 1.0 / 24000.0);
+    assert_eq!(RGBA8_SCALE, 1.0 / 24000.0);
 }
 
 /// A small pane of red glass in the middle of the view, in front of a stone wall: its

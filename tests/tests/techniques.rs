@@ -4,7 +4,7 @@
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use voxel_core::blocks::*;
-use voxel_render::low_level::stipple::bayer::bayer;
+use voxel_render::low_level::bayer;
 use voxel_render::{BayerSize, Renderer, RendererConfig, Technique};
 
 use tests::*;

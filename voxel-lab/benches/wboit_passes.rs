@@ -14,7 +14,7 @@ use std::path::Path;
 use voxel_lab::eval::oit_config;
 use voxel_lab::headless::{self, Offscreen, SceneRenderer};
 use voxel_lab::scene::{Scene, scene_files};
-use voxel_render::low_level::wboit;
+use voxel_render::low_level::REVEALAGE_FORMAT;
 use voxel_render::{GpuContext, GpuPass, OitConfig, RendererConfig, Technique, WeightFunction};
 
 const WARMUP: usize = 3;
@@ -90,7 +90,7 @@ fn clear_ms(ctx: &GpuContext, (w, h): (u32, u32)) -> Result<f64, String> {
             .create_view(&wgpu::TextureViewDescriptor::default())
     };
     let accum = target(wgpu::TextureFormat::Rgba16Float);
-    let reveal = target(wboit::REVEALAGE_FORMAT);
+    let reveal = target(REVEALAGE_FORMAT);
     let queries = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
         label: Some("bench_clear"),
         ty: wgpu::QueryType::Timestamp,
@@ -255,7 +255,7 @@ fn main() -> Result<(), String> {
     }
     println!(
         "\nclearing the accumulation (RGBA16F) and revealage ({:?}) in an empty pass: {:.3} ms",
-        wboit::REVEALAGE_FORMAT,
+        REVEALAGE_FORMAT,
         clear_ms(&ctx, size)?
     );
     Ok(())

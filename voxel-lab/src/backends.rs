@@ -122,7 +122,7 @@ pub struct Row {
 fn config_like(ctx: &GpuContext, technique: Technique, (w, h): (u32, u32)) -> RendererConfig {
     let mut oit = OitConfig::with(technique);
     oit.mboit.half_precision =
-        !voxel_render::low_level::moments::single_precision(&ctx.caps, &oit.mboit);
+        !voxel_render::low_level::single_precision(&ctx.caps, &oit.mboit);
     RendererConfig {
         width: w,
         height: h,

@@ -11,9 +11,13 @@ pub use crate::chunks::{ChunkStore, GpuChunk, MeshKind};
 pub use crate::context::WANTED_FEATURES;
 pub use crate::gpu::{Pass, clear, pipelines_built};
 pub use crate::ladder::{Limit, Need, check};
+pub use crate::oit::moments::single_precision;
+pub use crate::oit::peeling::MAX_PEEL_LAYERS;
+pub use crate::oit::stipple::bayer::bayer;
+pub use crate::oit::wboit::{HEADROOM_SCALE, REVEALAGE_FORMAT, RGBA8_SCALE};
 pub use crate::oit::{
-    MboitReport, OitManager, PeelReport, ReferenceReport, SortReport, TechniqueReport, WboitReport,
-    WeightFit, moments, peeling, sorted, stipple, wboit,
+    MboitReport, OitManager, PeelReport, ReferenceReport, SortReport, TechniqueReport,
+    WboitReport, WeightFit,
 };
 pub use crate::renderer::ChunkMemory;
 pub use crate::stream::{EDIT_BYTES, EDITED_CHUNK_BYTES, MAX_VIEW_DISTANCE};

@@ -20,7 +20,7 @@ macro_rules! field {
 pub(crate) use field;
 
 /// Parses WGSL source (panics with naga's message on a syntax error).
-pub fn parse(source: &str) -> naga::Module {
+pub(crate) fn parse(source: &str) -> naga::Module {
     naga::front::wgsl::parse_str(source)
         .unwrap_or_else(|e| panic!("WGSL does not parse: {}", e.emit_to_string(source)))
 }

@@ -8,13 +8,13 @@
 //! is its folder plus one line in the list below (and, if it has settings of its own, their
 //! struct as a field of [`OitConfig`]).
 
-pub mod moments;
+pub(crate) mod moments;
 pub(crate) mod opaque_only;
-pub mod peeling;
+pub(crate) mod peeling;
 pub(crate) mod reference;
-pub mod sorted;
-pub mod stipple;
-pub mod wboit;
+pub(crate) mod sorted;
+pub(crate) mod stipple;
+pub(crate) mod wboit;
 
 use std::fmt;
 use std::sync::Arc;

@@ -103,7 +103,7 @@ pub struct MboitReport {
 /// The technique's uniform (`MboitParams` in `moments.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct MboitParams {
+pub(crate) struct MboitParams {
     /// ln of the nearest view depth of the warp.
     pub ln_near: f32,
     /// 1 / (ln far − ln near).
@@ -312,7 +312,7 @@ struct Targets {
 
 /// Moment-based OIT's pipelines, targets and uniform.
 #[derive(Debug)]
-pub struct Mboit {
+pub(crate) struct Mboit {
     moments: SidedPipeline,
     resolve: SidedPipeline,
     composite: wgpu::RenderPipeline,

@@ -83,7 +83,7 @@ pub struct PeelReport {
 
 /// Which peeling.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PeelMode {
+pub(crate) enum PeelMode {
     /// Dual depth peeling of `layers` layers (even).
     Dual {
         /// Layers captured at most: front and back, two per iteration.
@@ -154,7 +154,7 @@ fn peel_own_wgsl() -> String {
 
 /// Depth peeling resources.
 #[derive(Debug)]
-pub struct Peeling {
+pub(crate) struct Peeling {
     device: wgpu::Device,
     mode: PeelMode,
     peel_front: SidedPipeline,

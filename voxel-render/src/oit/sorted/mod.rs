@@ -74,7 +74,7 @@ struct ChunkOrder {
 
 /// The blending pipeline, and for `sorted-quads` each chunk's exact order.
 #[derive(Debug)]
-pub struct Sorted {
+pub(crate) struct Sorted {
     pipeline: SidedPipeline,
     /// The group games bind (frame and boundary only: the pass has no group of its own).
     game_layout: wgpu::BindGroupLayout,

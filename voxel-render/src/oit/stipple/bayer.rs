@@ -95,7 +95,7 @@ pub(crate) const STIPPLE_MODE: u32 = 1;
 /// The 32-bit shading state: bits 0–7 uniform alpha (0–255), bits 8–9 transparency
 /// mode (always `STIPPLE_MODE` here), bits 10–11 dither pattern; bits 12–31 are left zero.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct ShadingState {
+pub(crate) struct ShadingState {
     /// Whole-draw opacity, 255 = 1.0.
     pub alpha: u8,
     /// Which Bayer matrix.

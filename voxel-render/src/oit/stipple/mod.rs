@@ -10,7 +10,7 @@
 //! Its uniform (a packed 32-bit shading state) and the Bayer tables are its own group 2.
 //! The shimmer when the camera moves is the technique's nature, kept as it is.
 
-pub mod bayer;
+pub(crate) mod bayer;
 
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -24,7 +24,8 @@ use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{Error, GpuContext, Result};
 
-pub use bayer::{BayerSize, ShadingState};
+pub use bayer::BayerSize;
+pub(crate) use bayer::ShadingState;
 
 /// Settings of stipple. Every field has a reasoned default.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -117,7 +118,7 @@ fn group_entries() -> [wgpu::BindGroupLayoutEntry; 2] {
 
 /// The stipple pipeline and its uniform.
 #[derive(Debug)]
-pub struct Stipple {
+pub(crate) struct Stipple {
     pipeline: SidedPipeline,
     depth_write: bool,
     params: wgpu::Buffer,

@@ -33,8 +33,8 @@
 //! translucent planes ([`WboitSettings::composite_scissor`]); the accumulation targets are
 //! cleared by the accumulation pass's load ops (no clear pass).
 
-pub mod fit;
-pub mod weights;
+pub(crate) mod fit;
+pub(crate) mod weights;
 
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;

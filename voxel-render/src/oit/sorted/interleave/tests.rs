@@ -5,7 +5,7 @@ use super::*;
 
 /// How a point stands against a chunk's translucent quads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Side {
+pub(crate) enum Side {
     /// Drawn before the chunk.
     Behind,
     /// Drawn after it.
