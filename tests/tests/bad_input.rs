@@ -139,7 +139,9 @@ fn config_tells_the_truth_after_every_setter() {
         Technique::Stipple
     );
     assert_eq!(r.config().oit.technique, Technique::Stipple);
-    r.set_weight(voxel_render::WeightFunction::McGuire8);
+    let mut oit = r.config().oit.clone();
+    oit.wboit.weight = voxel_render::WeightFunction::McGuire8;
+    r.set_oit_config(oit).unwrap();
     assert_eq!(
         r.config().oit.wboit.weight,
         voxel_render::WeightFunction::McGuire8

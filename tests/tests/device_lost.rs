@@ -61,7 +61,6 @@ fn a_lost_device_gives_errors_and_a_new_device_works() {
     // The calls without a result do nothing harmful.
     r.remove_chunk(pos);
     r.clear_chunks();
-    r.set_weight(voxel_render::WeightFunction::McGuire8);
     r.set_fade_in_frames(4);
     assert!(r.gpu_times_blocking().is_empty());
     let _ = r.gpu_times();

@@ -121,8 +121,7 @@ pub struct Row {
 /// moments in 16 bits where `ctx` cannot blend 32-bit floats.
 fn config_like(ctx: &GpuContext, technique: Technique, (w, h): (u32, u32)) -> RendererConfig {
     let mut oit = OitConfig::with(technique);
-    oit.mboit.half_precision =
-        !voxel_render::low_level::single_precision(&ctx.caps, &oit.mboit);
+    oit.mboit.half_precision = !voxel_render::low_level::single_precision(&ctx.caps, &oit.mboit);
     RendererConfig {
         width: w,
         height: h,

@@ -16,8 +16,8 @@ pub use crate::oit::peeling::MAX_PEEL_LAYERS;
 pub use crate::oit::stipple::bayer::bayer;
 pub use crate::oit::wboit::{HEADROOM_SCALE, REVEALAGE_FORMAT, RGBA8_SCALE};
 pub use crate::oit::{
-    MboitReport, OitManager, PeelReport, ReferenceReport, SortReport, TechniqueReport,
-    WboitReport, WeightFit,
+    MboitReport, OitManager, PeelReport, ReferenceReport, SortReport, TechniqueReport, WboitReport,
+    WeightFit,
 };
 pub use crate::renderer::ChunkMemory;
 pub use crate::stream::{EDIT_BYTES, EDITED_CHUNK_BYTES, MAX_VIEW_DISTANCE};

@@ -23,7 +23,7 @@ use crate::gpu::{self, ChunkPipeline, DepthMode};
 use crate::ladder;
 use crate::medium::{self, MediumLook, MediumPass};
 use crate::oit::sorted::interleave::Interleaver;
-use crate::oit::{OitConfig, OitManager, Setup, Technique, TechniqueReport, WeightFunction};
+use crate::oit::{OitConfig, OitManager, Setup, Technique, TechniqueReport};
 use crate::submission::{Outcome, Submissions};
 use crate::textures::BlockTextures;
 use crate::timing::{GpuTimes, Timer};
@@ -385,14 +385,6 @@ impl Renderer {
     /// drawing.
     pub fn release_technique(&mut self, technique: Technique) {
         self.oit.release(technique);
-    }
-
-    /// Changes the WBOIT weight function (a uniform: no pipeline is rebuilt).
-    pub fn set_weight(&mut self, weight: WeightFunction) {
-        let mut config = self.oit.config().clone();
-        config.wboit.weight = weight;
-        // Only the weight changed: the configuration stays valid.
-        let _ = self.set_oit_config(config);
     }
 
     /// Changes how chunk meshes are drawn; indirect draws stay off on an adapter without
