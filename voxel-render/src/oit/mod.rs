@@ -99,6 +99,12 @@ macro_rules! techniques {
                 match self { $( Technique::$variant => <$kind as TechniqueKind>::SORTS, )* }
             }
 
+            /// Whether the technique composes fragments inside a volume against the volume's
+            /// entry ([`TechniqueKind::composes_inside_volumes`]).
+            pub(crate) fn composes_inside_volumes(self) -> bool {
+                match self { $( Technique::$variant => <$kind as TechniqueKind>::composes_inside_volumes(self), )* }
+            }
+
             /// Whether the technique with `config` reads [`FrameView::layers`].
             fn reads_layers(self, config: &OitConfig) -> bool {
                 match self { $( Technique::$variant => <$kind as TechniqueKind>::reads_layers(config), )* }
@@ -292,6 +298,13 @@ pub(crate) trait TechniqueKind: TranslucentTechnique + Sized + 'static {
 
     /// Whether `technique` (one this type draws) computes the exact blend.
     fn is_exact(_technique: Technique) -> bool {
+        false
+    }
+
+    /// Whether `technique` draws translucent fragments in order, one blend each, so that a
+    /// fragment inside a volume is composed against the volume's entry
+    /// (`inside_volume.wgsl`, frame uniforms' `volumes` mode 2).
+    fn composes_inside_volumes(_technique: Technique) -> bool {
         false
     }
 

@@ -202,12 +202,9 @@ impl Renderer {
         } else {
             game.translucent_objects().len()
         };
-        // The sorted techniques (drawn in order, one blend per fragment) compose a fragment
-        // inside a volume against the volume's entry (`inside_volume.wgsl`).
-        let ordered = matches!(
-            self.oit.technique(),
-            Technique::Sorted | Technique::SortedQuads | Technique::DepthPeeling
-        );
+        // The techniques drawn in order, one blend per fragment, compose a fragment inside
+        // a volume against the volume's entry (`inside_volume.wgsl`).
+        let ordered = self.oit.technique().composes_inside_volumes();
         let volume_mode = match (volumes, ordered) {
             (false, _) => 0,
             (true, false) => 1,

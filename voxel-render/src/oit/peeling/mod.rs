@@ -198,6 +198,12 @@ impl TechniqueKind for Peeling {
         technique == Technique::PeelReference
     }
 
+    /// Depth peeling blends its layers front to back, one per fragment; the peel
+    /// reference carries the medium from layer to layer itself.
+    fn composes_inside_volumes(technique: Technique) -> bool {
+        technique == Technique::DepthPeeling
+    }
+
     fn key(technique: Technique, config: &OitConfig, _: &Capabilities) -> PeelMode {
         match technique {
             Technique::PeelReference => PeelMode::Converge,

@@ -89,6 +89,10 @@ impl TechniqueKind for Sorted {
 
     const SORTS: bool = true;
 
+    fn composes_inside_volumes(_: Technique) -> bool {
+        true
+    }
+
     fn key(_: Technique, _: &OitConfig, _: &Capabilities) {}
 
     fn create(setup: &Setup, technique: Technique, _: &OitConfig) -> Result<Self> {
