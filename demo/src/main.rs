@@ -241,7 +241,7 @@ struct WindowArgs {
     technique: Technique,
     /// Chunks of terrain loaded around the eye, each way (1 to 32); they stream in as
     /// the camera flies.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(demo::app::MAX_VIEW_DISTANCE)), default_value_t = 8)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(demo::app::MAX_DEMO_VIEW_DISTANCE)), default_value_t = 8)]
     view_distance: u32,
     /// Start with the error map against the reference on.
     #[arg(long)]

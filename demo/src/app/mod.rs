@@ -48,7 +48,7 @@ pub struct DemoOptions {
     pub size: (u32, u32),
     /// Initial technique.
     pub technique: Technique,
-    /// Chunks of terrain loaded around the eye, each way (1 to [`MAX_VIEW_DISTANCE`]).
+    /// Chunks of terrain loaded around the eye, each way (1 to [`MAX_DEMO_VIEW_DISTANCE`]).
     pub view_distance: u32,
     /// Scripted: quit after this many frames (per technique with `cycle`).
     pub frames: Option<u64>,
@@ -93,7 +93,7 @@ impl Default for DemoOptions {
 }
 
 /// The demo's largest view distance, in chunks (the streamer's own limit is higher).
-pub const MAX_VIEW_DISTANCE: u32 = 32;
+pub const MAX_DEMO_VIEW_DISTANCE: u32 = 32;
 
 /// Whether a window can be opened: an X11 or Wayland display is named in the environment.
 pub fn have_display() -> bool {
@@ -397,7 +397,7 @@ impl Gfx {
                 None,
             ),
         };
-        let view_distance = opts.view_distance.clamp(1, MAX_VIEW_DISTANCE);
+        let view_distance = opts.view_distance.clamp(1, MAX_DEMO_VIEW_DISTANCE);
         let (yaw, pitch) = cam.yaw_pitch();
         let settings = Settings {
             oit: OitConfig::with(opts.technique),

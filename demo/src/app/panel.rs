@@ -206,7 +206,7 @@ impl Gfx {
             }
         }
         ui.add(
-            egui::Slider::new(&mut s.view_distance, 1..=super::MAX_VIEW_DISTANCE)
+            egui::Slider::new(&mut s.view_distance, 1..=super::MAX_DEMO_VIEW_DISTANCE)
                 .text("view distance (chunks)"),
         );
         // The default lighting until the slider is moved; then the sun (or, at night, the
