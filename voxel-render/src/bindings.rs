@@ -123,7 +123,7 @@ pub(crate) struct FrameUniforms {
     /// volume depth holds this frame's opaque depth; else 0.
     pub volumes: u32,
     /// How bright the light of the sun (or moon) and the ambient light are: 1 by day,
-    /// [`Lighting::MOONLIGHT`](crate::Lighting::MOONLIGHT) at night. Scales every lit
+    /// `Lighting::MOONLIGHT` at night. Scales every lit
     /// colour; the sky is cleared to its own colour.
     pub brightness: f32,
     /// The look of the medium the eye is in: linear colour and absorption, zero for none.
