@@ -188,7 +188,7 @@ impl QuadArena {
     }
 
     /// The most quads one mesh may have: a page as large as the adapter's storage binding.
-    pub fn max_mesh_quads(&self) -> u32 {
+    pub(crate) fn max_mesh_quads(&self) -> u32 {
         self.max_page_quads
     }
 
@@ -280,7 +280,7 @@ impl QuadArena {
 
     /// Gives back page `page` if it holds no quads; returns whether it did. Its index
     /// stays free for the next new page.
-    pub fn drop_page(&mut self, page: u32) -> bool {
+    pub(crate) fn drop_page(&mut self, page: u32) -> bool {
         let Some(slot) = self.pages.get_mut(page as usize) else {
             return false;
         };
@@ -351,7 +351,7 @@ impl QuadArena {
     /// (nothing changed) when the other pages lack room. The copies read the page as the
     /// queue holds it when `encoder` runs: submit `encoder` before writing to the new
     /// places, or the copies overwrite what was written.
-    pub fn compact(
+    pub(crate) fn compact(
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         page: u32,

@@ -136,7 +136,7 @@ pub(crate) const NO_MEDIUM: u32 = u32::MAX;
 
 /// Quad flag (bit 16 of word 1 of a [`voxel_mesh::PackedQuad`]): a translucent face toward
 /// another translucent type (`FLAG_INTERFACE` in WGSL).
-pub const FLAG_INTERFACE: u32 = 1;
+pub(crate) const FLAG_INTERFACE: u32 = 1;
 
 /// A chunk's record in the records array, by slot (`ChunkInfo` in WGSL).
 #[repr(C)]

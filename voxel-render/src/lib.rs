@@ -6,18 +6,21 @@
 //! - [`Image`] and [`readback`]: pictures back to the CPU, PNG files.
 //! - [`ChunkStreamer`]: the chunks around a moving eye, generated, meshed and uploaded on
 //!   rayon's workers.
+//! - [`content`]: a game's particles and boxes, opaque or translucent, drawn through the
+//!   frame's [`stages`] by every technique without WGSL of its own.
 //!
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `ladder`
 //! (what each pass needs of a device), `camera`, `readback`, `submission`, `timing`, `fetch`
 //! (how quads reach the vertex shader) → `gpu` (pass and pipeline plumbing) → `bindings` (what every chunk
 //! pipeline binds), `textures`, `arena` (the quad arena), `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
-//! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` → `stream` (chunks loaded around a moving eye). A test
+//! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` → `content` (ready-made game content) → `stream` (chunks loaded around a moving eye). A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
 pub mod arena;
 mod bindings;
 mod camera;
 mod chunks;
+pub mod content;
 mod context;
 mod error;
 mod fetch;

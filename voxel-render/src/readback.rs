@@ -68,7 +68,7 @@ impl Image {
     /// larger one is an [`Error::Image`] naming its size, found from the header before
     /// anything is allocated, so a small file claiming a huge image costs nothing. The
     /// decoder's own allocation limit is set to what such an image needs.
-    pub fn load_png_within(path: &Path, max_side: u32) -> Result<Self> {
+    pub(crate) fn load_png_within(path: &Path, max_side: u32) -> Result<Self> {
         let file = std::fs::File::open(path).map_err(|error| Error::Io {
             path: path.to_owned(),
             error,

@@ -269,7 +269,7 @@ impl Culled {
 
     /// The planes of the visible translucent meshes ([`crate::layers`]; in no particular
     /// order), when [`ChunkStore::cull`] was asked for them (else empty).
-    pub fn translucent_layers(&self) -> VisibleLayers<'_> {
+    pub(crate) fn translucent_layers(&self) -> VisibleLayers<'_> {
         self.layers.view()
     }
 }
@@ -309,7 +309,7 @@ impl Frustum {
 
     /// Distance from the eye to the chunk's centre, or `None` when the chunk's box lies
     /// wholly outside one plane.
-    pub fn chunk_distance(&self, pos: ChunkPos) -> Option<f64> {
+    pub(crate) fn chunk_distance(&self, pos: ChunkPos) -> Option<f64> {
         let s = CHUNK_SIZE as f64;
         let min = self.relative(pos);
         let lo = min.as_vec3();

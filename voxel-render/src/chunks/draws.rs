@@ -164,14 +164,14 @@ impl FrameDraws<'_> {
 /// Builds a frame's draw lists: commands appended per list, runs split where the page
 /// changes.
 #[derive(Debug, Default)]
-pub struct DrawBuilder {
+pub(crate) struct DrawBuilder {
     commands: Vec<DrawCommand>,
 }
 
 impl DrawBuilder {
     /// A list drawing `meshes` (slot and place of each, as [`Culled::meshes`] gives them),
     /// in order.
-    pub fn list(&mut self, meshes: impl IntoIterator<Item = (u32, Alloc)>) -> DrawList {
+    pub(crate) fn list(&mut self, meshes: impl IntoIterator<Item = (u32, Alloc)>) -> DrawList {
         let mut list = DrawList::default();
         for (slot, mesh) in meshes {
             let index = self.commands.len() as u32;
@@ -196,12 +196,12 @@ impl DrawBuilder {
     }
 
     /// Forgets the commands (keeping their room), for the next frame.
-    pub fn clear(&mut self) {
+    pub(crate) fn clear(&mut self) {
         self.commands.clear();
     }
 
     /// The commands of every list, to be uploaded with [`ChunkStore::upload_draws`].
-    pub fn commands(&self) -> &[DrawCommand] {
+    pub(crate) fn commands(&self) -> &[DrawCommand] {
         &self.commands
     }
 }

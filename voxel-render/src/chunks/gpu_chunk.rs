@@ -83,7 +83,7 @@ impl GpuChunk {
 
 /// A chunk's translucent quads seen from afar: their box and their planes.
 #[derive(Clone, Copy, Debug)]
-pub struct Surfaces<'a> {
+pub(crate) struct Surfaces<'a> {
     /// The box's lowest corner, world blocks.
     pub lo: DVec3,
     /// The box's highest corner, world blocks.
@@ -98,7 +98,7 @@ pub struct Surfaces<'a> {
 
 impl Surfaces<'_> {
     /// Distances from `eye` to the box: its nearest point, its centre, its farthest corner.
-    pub fn distances(&self, eye: DVec3) -> [f64; 3] {
+    pub(crate) fn distances(&self, eye: DVec3) -> [f64; 3] {
         let near = eye.clamp(self.lo, self.hi).distance(eye);
         let mid = ((self.lo + self.hi) * 0.5).distance(eye);
         let far = (eye - self.lo).abs().max((eye - self.hi).abs()).length();

@@ -29,8 +29,10 @@ use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
 pub use cull::{Culled, Frustum, REGION_CHUNKS};
-pub use draws::{DrawBuilder, DrawCommand, DrawList, FrameDraws};
-pub use gpu_chunk::{GpuChunk, Surfaces};
+pub(crate) use draws::DrawBuilder;
+pub use draws::{DrawCommand, DrawList, FrameDraws};
+pub use gpu_chunk::GpuChunk;
+pub(crate) use gpu_chunk::Surfaces;
 pub use store::ChunkStore;
 
 /// A fast hasher for small keys of integers (chunk positions): a multiply-rotate per word

@@ -175,7 +175,7 @@ impl ChunkStore {
     /// Call once the frame whose lists were built is submitted (or before the next
     /// frame's lists are built, which implies it): the places and slots freed meanwhile
     /// become free, and pages left empty are given back.
-    pub fn frame_submitted(&mut self, ctx: &GpuContext) {
+    pub(crate) fn frame_submitted(&mut self, ctx: &GpuContext) {
         self.in_flight = false;
         let mut dropped = false;
         for a in std::mem::take(&mut self.retired) {
@@ -448,7 +448,7 @@ impl ChunkStore {
     /// chunk whose box [`Frustum::chunk_distance`] does not put outside the frustum. With
     /// `layers`, it also copies the visible translucent meshes' planes
     /// ([`Culled::translucent_layers`]).
-    pub fn cull(&self, frustum: &Frustum, layers: bool, out: &mut Culled) {
+    pub(crate) fn cull(&self, frustum: &Frustum, layers: bool, out: &mut Culled) {
         for list in &mut out.near {
             list.clear();
         }
@@ -510,7 +510,7 @@ impl ChunkStore {
     /// The copies are submitted at once, on an encoder of their own: a write to a moved
     /// mesh's new place made after this (a technique re-sorting its quads this frame, an
     /// upload before the frame's submit) lands after the copy, never under it.
-    pub fn compact(&mut self, ctx: &GpuContext) -> bool {
+    pub(crate) fn compact(&mut self, ctx: &GpuContext) -> bool {
         if self.in_flight {
             return false;
         }

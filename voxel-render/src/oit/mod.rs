@@ -582,7 +582,7 @@ impl OitManager {
     /// Whether the technique in force reads the planes of the visible translucent meshes
     /// ([`FrameView::layers`]; WBOIT with the fitted weight, MBOIT). The renderer's culling copies
     /// them only then.
-    pub fn wants_layers(&self) -> bool {
+    pub(crate) fn wants_layers(&self) -> bool {
         self.config.technique.reads_layers(&self.config)
     }
 
@@ -602,7 +602,7 @@ impl OitManager {
     /// its pipelines and targets are built from) changes; other settings apply from the
     /// next frame. An invalid setting, or a technique the adapter cannot run
     /// ([`Error::Unsupported`]), is an error and changes nothing.
-    pub fn set_config(&mut self, config: OitConfig) -> Result<()> {
+    pub(crate) fn set_config(&mut self, config: OitConfig) -> Result<()> {
         config.validate()?;
         let technique = Self::resolve_with(&self.setup, &config, config.technique)?;
         self.config = config;

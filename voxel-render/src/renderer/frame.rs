@@ -100,7 +100,11 @@ impl Renderer {
         self.check_output(output, format)?;
         let stages = game.stages();
         if stages.translucent {
-            let current = self.oit.contract()?.id;
+            let contract = self.oit.contract()?;
+            game.follow_contract(&self.ctx, &contract);
+            // A device lost in the game's code makes nothing valid.
+            self.ctx.check_device()?;
+            let current = contract.id;
             let built_for = game.translucent_contract_id();
             if built_for != Some(current) {
                 return Err(Error::StaleContract {

@@ -170,7 +170,7 @@ fn separate(b: Ball, eye: DVec3, s: &Surfaces<'_>) -> bool {
 
 // `Split` lives with the stages that carry it to the techniques (`GameDraw::splits`), so
 // that `stages` does not reach up into `oit`.
-pub use crate::stages::Split;
+pub(crate) use crate::stages::Split;
 
 /// How strongly a place for an object is ruled out: a chunk-wide sound test against a
 /// single quad's plane.

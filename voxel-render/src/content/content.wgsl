@@ -1,4 +1,4 @@
-// A game's content drawn through the renderer's stages (content.rs): boxes turned any way
+// A game's content drawn through the renderer's stages (draw.rs): boxes turned any way
 // and camera-facing particles, pulled from a storage buffer, 36 vertices each (a particle
 // uses the first 6). Lit like the world's faces: Lambert with the sun plus ambient, a
 // particle as a face turned to the sky.

@@ -1,4 +1,4 @@
-// The entities example's shaders: boxes and camera-facing particles from one instance
+// The custom_stage example's shaders: boxes and camera-facing particles from one instance
 // layout. Opaque boxes write the scene colour; translucent ones and the particles end in
 // `oit_output`, which the renderer's prelude for each pass of the technique declares.
 
