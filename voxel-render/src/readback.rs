@@ -59,7 +59,7 @@ impl Image {
     pub const MAX_PNG_SIDE: u32 = 16_384;
 
     /// Reads an 8-bit PNG (grey, RGB or RGBA; palettes expanded) of at most
-    /// [`Image::MAX_PNG_SIDE`] a side (see [`Image::load_png_within`]).
+    /// [`Image::MAX_PNG_SIDE`] a side (see `Image::load_png_within`).
     pub fn load_png(path: &Path) -> Result<Self> {
         Self::load_png_within(path, Self::MAX_PNG_SIDE)
     }

@@ -411,7 +411,7 @@ pub struct FrameView<'a> {
     pub view_proj: Mat4,
     /// The visible chunks with translucent meshes, farthest first.
     pub translucent: &'a [ChunkPos],
-    /// Their planes, when the technique asked for them ([`OitManager::wants_layers`];
+    /// Their planes, when the technique asked for them (`OitManager::wants_layers`;
     /// else empty).
     pub layers: VisibleLayers<'a>,
     /// The game's translucent objects when it draws translucent geometry this frame
