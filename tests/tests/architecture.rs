@@ -27,6 +27,7 @@ const RENDER: &[&str] = &[
     "stages",
     "oit",
     "renderer",
+    "content",
     "stream",
     "low_level",
 ];

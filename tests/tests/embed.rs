@@ -647,9 +647,9 @@ fn a_game_registry_generates_the_default_terrain_through_a_mapping() {
 fn switching_to_prebuilt_techniques_builds_no_pipeline() {
     let Some(ctx) = gpu() else { return };
     let s = tests::Scene {
-        content: voxel_lab::content::Content {
+        content: voxel_render::content::Content {
             particles: (0..40)
-                .map(|i| voxel_lab::content::Particle {
+                .map(|i| voxel_render::content::Particle {
                     center: DVec3::new(
                         -6.0 + f64::from(i) * 0.3,
                         1.5 + f64::from(i % 5) * 0.4,

@@ -1,5 +1,6 @@
-//! The entities example (`voxel-render/examples/entities.rs`): a game's own shaders and
-//! stages, run headless as a user would. Every technique draws its crate, glass cube and
+//! The entities example (`voxel-render/examples/entities.rs`): a game's things drawn by the
+//! ready-made helper (`voxel_render::content`), run headless as a user would; and the
+//! custom_stage example, the same things with the game's own shaders. Every technique draws its crate, glass cube and
 //! bubbles. Depth peeling and sorted-quads differ from the A-buffer reference where the
 //! bubbles and the crate lie inside the water: they put the whole path through the water
 //! in front of them (a volume is composed at its entry face), where the reference splits it
@@ -14,9 +15,13 @@ use tests::{diff, distinct_colours, example_binary, gpu, out_dir};
 use voxel_render::Image;
 
 fn run(technique: &str) -> Image {
-    let out = out_dir("entities_example").join(format!("{technique}.png"));
+    run_example("entities", technique)
+}
+
+fn run_example(example: &str, technique: &str) -> Image {
+    let out = out_dir("entities_example").join(format!("{example}_{technique}.png"));
     let _ = std::fs::remove_file(&out);
-    let result = Command::new(example_binary("entities"))
+    let result = Command::new(example_binary(example))
         .args(["--frames", "3", "--technique", technique, "--out"])
         .arg(&out)
         .output()
@@ -52,6 +57,17 @@ fn the_entities_example_composes_its_things_with_every_technique() {
     );
     for t in ["wboit-mrt", "stipple"] {
         let img = run(t);
+        assert!(distinct_colours(&img) > 200, "{t}: a flat picture");
+    }
+}
+
+/// The custom path draws its things with the game's own shaders, whatever the technique
+/// (its translucent pipelines rebuilt for each technique's contract).
+#[test]
+fn the_custom_stage_example_draws_with_its_own_shaders() {
+    let Some(_ctx) = gpu() else { return };
+    for t in ["sorted-quads", "wboit-mrt"] {
+        let img = run_example("custom_stage", t);
         assert!(distinct_colours(&img) > 200, "{t}: a flat picture");
     }
 }

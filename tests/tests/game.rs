@@ -7,7 +7,7 @@
 use glam::{DQuat, DVec3};
 use tests::{Scene, diff, gpu, out_dir, technique_config, thin_water_world};
 use voxel_core::blocks::{GLASS, SAND, WATER};
-use voxel_lab::content::{Content, Entity, Particle};
+use voxel_render::content::{Content, ContentStages, Entity, Particle};
 use voxel_render::{Image, RendererConfig, Technique};
 
 const W: u32 = 160;
@@ -416,6 +416,51 @@ fn stale_game_pipelines_are_refused_before_recording() {
         matches!(e, voxel_render::Error::StaleContract { .. }),
         "{e:?}"
     );
+}
+
+/// `ContentStages` follows what the game switches by itself (`GameStages::follow_contract`
+/// and the frame's sample count): no call between frames, each picture equals a fresh
+/// renderer's, and a switch back to a technique it has drawn with builds nothing.
+#[test]
+fn content_stages_follow_switches_and_msaa_by_themselves() {
+    let Some(ctx) = gpu() else { return };
+    let scene = with(
+        &pool(),
+        Content {
+            particles: vec![quad([5.5, 3.5, 3.0])],
+            entities: vec![plate([12.5, 1.0, 3.0], 0.5), plate([8.5, -3.0, 3.0], 1.0)],
+        },
+    );
+    let camera = scene.cameras[0];
+    let mut r =
+        tests::renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, W, H)).unwrap();
+    let mut game = ContentStages::new(&r.renderer, scene.content.clone());
+    let target = tests::Offscreen::new(&ctx, W, H);
+    let shot = |r: &mut voxel_render::Renderer, game: &mut ContentStages| {
+        r.render_and_submit(&target.view, &camera, game).unwrap();
+        target.read(&ctx).unwrap()
+    };
+    let _ = shot(&mut r.renderer, &mut game);
+    for t in [Technique::SortedQuads, Technique::DepthPeeling] {
+        r.set_technique(t).unwrap();
+        let got = shot(&mut r.renderer, &mut game);
+        let d = diff(&got, &render(&scene, technique_config(t, W, H)));
+        assert!(d.max <= 1, "after switching to {}: {d:?}", t.name());
+    }
+    let built = game.pipelines_built();
+    r.set_technique(Technique::WboitMrt).unwrap();
+    let _ = shot(&mut r.renderer, &mut game);
+    assert_eq!(
+        game.pipelines_built(),
+        built,
+        "a switch back built a pipeline"
+    );
+    r.set_msaa(true).unwrap();
+    let got = shot(&mut r.renderer, &mut game);
+    let mut config = technique_config(Technique::WboitMrt, W, H);
+    config.msaa = true;
+    let d = diff(&got, &render(&scene, config));
+    assert!(d.max <= 1, "after MSAA on: {d:?}");
 }
 
 /// A flat translucent slab wholly above the water surface seen from under water, and its

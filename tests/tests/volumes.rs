@@ -273,7 +273,7 @@ fn the_holes_of_a_cutout_block_in_water_show_the_water_as_the_ray_march_computes
 /// each; the weighted ones put the whole path in front of them and are measured only.
 #[test]
 fn things_inside_water_are_composed_with_the_path_split_at_them() {
-    use voxel_lab::content::{Content, Entity, Particle};
+    use voxel_render::content::{Content, Entity, Particle};
     let Some(ctx) = gpu() else { return };
     let lake = load("lake_depths.toml");
     let content = Content {

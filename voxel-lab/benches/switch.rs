@@ -5,8 +5,8 @@
 //!
 //! The world is the record bench's generated terrain at view distance `SWITCH_VD` (default
 //! 16), seen from 40 blocks above the ground at 640×360; the game draws 2 000 bubbles
-//! over the water ahead and a translucent crate through the lab's content stages
-//! (`voxel_lab::content`). At loading time every real-time technique is built
+//! over the water ahead and a translucent crate through the renderer's content stages
+//! (`voxel_render::content`). At loading time every real-time technique is built
 //! (`prebuild_technique`) and the game's pipelines for its contract
 //! (`translucent_contract_for`, through `ContentStages::prebuild`). Then the game switches
 //! through every real-time technique in turn. Each frame is waited for before the next.
@@ -19,8 +19,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use glam::{DQuat, DVec3};
-use voxel_lab::content::{Content, ContentStages, Entity, Particle};
 use voxel_lab::headless::Offscreen;
+use voxel_render::content::{Content, ContentStages, Entity, Particle};
 use voxel_render::{Camera, GpuContext, Renderer, Technique, low_level};
 
 #[path = "common/record_world.rs"]
@@ -36,7 +36,6 @@ fn frame(
     cam: &Camera,
 ) -> Result<(f64, u64), String> {
     let chain = |e: voxel_render::Error| voxel_lab::chain(&e);
-    game.update_pipelines(r).map_err(chain)?;
     let before = low_level::pipelines_built();
     let stats = r
         .render_and_submit(&target.view, cam, game)

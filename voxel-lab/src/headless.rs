@@ -6,7 +6,7 @@ use voxel_render::{
     Camera, FrameStats, GpuContext, Image, LimitsPreset, NoGame, Renderer, RendererConfig, readback,
 };
 
-use crate::content::ContentStages;
+use voxel_render::content::ContentStages;
 
 use crate::scene::Scene;
 
@@ -110,13 +110,14 @@ impl Offscreen {
 }
 
 /// A renderer with a scene's chunks uploaded, and the scene's game content (particles,
-/// entities: [`crate::content`]) drawn through its stages in every frame. Derefs to the
+/// entities: [`voxel_render::content`]) drawn through its stages in every frame. Derefs to the
 /// [`Renderer`].
 #[derive(Debug)]
 pub struct SceneRenderer {
     /// The renderer.
     pub renderer: Renderer,
-    /// The scene's content, when it has any.
+    /// The scene's content, when it has any: it does not follow a technique switch by
+    /// itself (`set_follow_contract(false)`), `render_and_submit` rebuilds its pipelines.
     pub content: Option<ContentStages>,
 }
 
@@ -180,8 +181,13 @@ pub fn renderer_for(
             .upload_chunk(pos, &meshes)
             .map_err(|e| crate::chain(&e))?;
     }
-    let content =
-        (!scene.content.is_empty()).then(|| ContentStages::new(&renderer, scene.content.clone()));
+    // The lab builds its content's pipelines when it renders (`render_and_submit`), so that
+    // its tests see the renderer refuse pipelines built for another contract.
+    let content = (!scene.content.is_empty()).then(|| {
+        let mut stages = ContentStages::new(&renderer, scene.content.clone());
+        stages.set_follow_contract(false);
+        stages
+    });
     Ok(SceneRenderer { renderer, content })
 }
 

@@ -6,7 +6,7 @@
 //! - the model: [`files`] (result files written in one checked call), [`limits`] (the
 //!   documented caps on a run), [`progress`], [`random`]
 //!   (random scenes as scene-file text), [`edges`] (which pixels lie on quad edges),
-//!   [`content`] (a game's particles and entities),
+//!   [`content`] (what the ray march needs of a game's particles and entities),
 //!   [`raymarch`] (the CPU ray-march reference),
 //!   [`summary`], [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the

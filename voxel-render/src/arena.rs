@@ -12,7 +12,7 @@
 //! unit test's measure). Whole pages stay bounded two ways: a page whose last mesh is
 //! freed is given back ([`QuadArena::free`] says so, and the chunk store drops it once
 //! no frame in flight draws from it), so an arena holding no chunk holds no page; and
-//! [`QuadArena::compact`] moves the meshes of the emptiest page into the others (a GPU
+//! `QuadArena::compact` moves the meshes of the emptiest page into the others (a GPU
 //! copy) and frees it, which the chunk store runs when more than half of the arena's
 //! bytes are free and a page would be freed. A page keeps its index for its whole life
 //! (a freed page leaves a hole that the next new page fills), so that a place handed out
@@ -203,7 +203,7 @@ impl QuadArena {
 
     /// Room for `quads` quads; adds a page when none has room. The page list changed when
     /// the returned flag is true (bind groups over the pages must be remade). `Ok(None)`
-    /// for 0 quads or more than [`QuadArena::max_mesh_quads`]; an error (and no new page)
+    /// for 0 quads or more than `QuadArena::max_mesh_quads`; an error (and no new page)
     /// when the device cannot make the page.
     pub(crate) fn alloc(
         &mut self,
@@ -273,7 +273,7 @@ impl QuadArena {
     }
 
     /// Gives back a mesh's quads; returns whether its page now holds none (see
-    /// [`QuadArena::drop_page`]).
+    /// `QuadArena::drop_page`).
     pub(crate) fn free(&mut self, a: Alloc) -> bool {
         match self.pages.get_mut(a.page as usize) {
             Some(Some(p)) => {
@@ -403,7 +403,7 @@ impl QuadArena {
     }
 }
 
-/// What [`QuadArena::compact`] did.
+/// What `QuadArena::compact` did.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub(crate) struct Compacted {
     /// The new place of each mesh moved, in the order given.

@@ -12,6 +12,8 @@
 //!   rayon's workers.
 //! - [`stages`]: the game's own geometry in the frame ([`GameStages`]), composed by every
 //!   technique, and the helpers its pipelines and overlays are built with.
+//! - [`content`]: a game's particles and boxes, opaque or translucent, drawn through the
+//!   frame's stages by every technique without WGSL of its own.
 //! - [`Image`] and [`readback`]: pictures back to the CPU, PNG files; [`textures`]: a
 //!   game's block textures.
 //!
@@ -25,13 +27,15 @@
 //! `bindings` (what every chunk pipeline binds), `textures`, `arena` (the quad arena),
 //! `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
 //! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` →
-//! `stream` (chunks loaded around a moving eye) → `low_level`. A test
+//! `content` (ready-made game content) → `stream` (chunks loaded around a moving eye) →
+//! `low_level`. A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
 mod arena;
 mod bindings;
 mod camera;
 mod chunks;
+pub mod content;
 mod context;
 mod error;
 mod fetch;

@@ -15,9 +15,10 @@
 //! [`TranslucentVariant`] with its own prelude, colour targets, depth state and bind group
 //! layout at [`OIT_GROUP`]; the game builds one pipeline per variant of the
 //! [`TranslucentContract`] in force and rebuilds them when its `id` changes (a technique
-//! switch, or settings its pipelines depend on). The renderer binds its group at
-//! [`OIT_GROUP`] before calling [`GameStages::translucent`]; the game sets its pipeline and
-//! its own groups (0 to `OIT_GROUP - 1`).
+//! switch, or settings its pipelines depend on), before the frame or in
+//! [`GameStages::follow_contract`] (the `content` module is such a game, ready-made). The
+//! renderer binds its group at [`OIT_GROUP`] before calling [`GameStages::translucent`];
+//! the game sets its pipeline and its own groups (0 to `OIT_GROUP - 1`).
 
 use std::ops::Range;
 
@@ -125,6 +126,15 @@ pub struct GameFrame<'a> {
     pub opaque_samples: u32,
     /// Format of the output (the overlay stage's target).
     pub output_format: wgpu::TextureFormat,
+    /// The lighting in force, to light the game's things as the world is lit: the unit
+    /// direction towards the sun (or moon), the ambient share, and the brightness every
+    /// lit colour is scaled by (`Lighting`): a face of normal `n` and colour `c` is
+    /// `c * brightness * (ambient + (1 - ambient) * max(dot(n, sun_dir), 0))`.
+    pub sun_dir: Vec3,
+    /// The ambient share, 0 to 1 (see `sun_dir`).
+    pub ambient: f32,
+    /// The light's brightness, 1 by day (see `sun_dir`).
+    pub brightness: f32,
     /// Sorted techniques: the game's translucent objects back to front (indices into
     /// [`GameStages::translucent_objects`]); `None` when the technique does not sort. A
     /// game drawing instances uploads them in this order in `prepare`.
@@ -209,6 +219,13 @@ pub trait GameStages {
     fn translucent_contract_id(&self) -> Option<u64> {
         None
     }
+
+    /// Called at the start of every frame that declares the translucent stage, with the
+    /// contract in force, before [`GameStages::translucent_contract_id`] is checked: a game
+    /// that builds its translucent pipelines by itself builds them here when it has none
+    /// for `contract.id` (`content::ContentStages` does). The default does nothing: the
+    /// game built them before the frame.
+    fn follow_contract(&mut self, _ctx: &GpuContext, _contract: &TranslucentContract) {}
 
     /// Before any pass is recorded: write uniforms and instance buffers (`frame.order`
     /// gives the sorted order when the technique sorts).

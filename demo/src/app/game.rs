@@ -1,11 +1,11 @@
 //! The demo's own game content, drawn through the renderer's frame stages like a game's
-//! (`voxel_lab::content`): bubbles rising through the water to its surface, a glass cube
+//! (`voxel_render::content`): bubbles rising through the water to its surface, a glass cube
 //! turning as it bobs through the surface, and an opaque boat rocking on it. They are
 //! placed where the first camera's view meets the water level and animated each frame.
 
 use glam::{DQuat, DVec3};
 use voxel_core::TerrainConfig;
-use voxel_lab::content::{Content, ContentStages, Entity, Particle};
+use voxel_render::content::{Content, ContentStages, Entity, Particle};
 use voxel_render::{Camera, GpuContext, Renderer, Technique};
 
 /// Which content is shown (the panel's toggles).
@@ -179,10 +179,10 @@ impl Game {
     }
 }
 
-/// Makes or refreshes `stages` for `renderer` with `content`, its pipelines matching the
-/// renderer's technique; made new, with `ahead` its pipelines for every real-time
-/// technique the device runs are built at once, as the renderer built the techniques
-/// (switching then compiles nothing).
+/// Makes or refreshes `stages` for `renderer` with `content` (its pipelines follow the
+/// renderer's technique by themselves); made new, with `ahead` its pipelines for every
+/// real-time technique the device runs are built at once, as the renderer built the
+/// techniques (switching then compiles nothing).
 fn prepare(
     stages: &mut Option<ContentStages>,
     ctx: &GpuContext,
@@ -190,11 +190,8 @@ fn prepare(
     content: &Content,
     ahead: bool,
 ) -> voxel_render::Result<()> {
-    let s = match stages {
-        Some(s) => {
-            s.set_content(ctx, content.clone());
-            s
-        }
+    match stages {
+        Some(s) => s.set_content(ctx, content.clone()),
         None => {
             let s = stages.insert(ContentStages::new(renderer, content.clone()));
             if ahead {
@@ -204,8 +201,7 @@ fn prepare(
                     }
                 }
             }
-            s
         }
-    };
-    s.update_pipelines(renderer)
+    }
+    Ok(())
 }

@@ -10,7 +10,8 @@ use super::blocks::srgb_to_linear;
 use super::light::Light;
 use super::walk::Walker;
 use super::{Projection, RayMarcher};
-use crate::content::{Content, box_normal, face_light, particle_light};
+use crate::content::{box_normal, face_light, particle_light};
+use voxel_render::content::Content;
 
 impl RayMarcher {
     /// The game surfaces the ray from `eye` along `dir` meets between `near` and `far`, by

@@ -33,7 +33,7 @@ use rayon::prelude::*;
 use voxel_core::{BlockId, CHUNK_SIZE, ChunkPos, Face, RenderClass, World};
 use voxel_render::{Camera, Image, RendererConfig};
 
-use crate::content::Content;
+use voxel_render::content::Content;
 
 use blocks::srgb_to_linear;
 pub use compare::{Comparison, DifferingPixel, EDGE_RADIUS_PX};
@@ -165,7 +165,7 @@ pub struct RayMarcher {
     media: Vec<Option<Medium>>,
     /// Per block: the medium a cutout block stands in.
     medium_of: Vec<Option<BlockId>>,
-    /// A game's particles and entities ([`crate::content`]).
+    /// A game's particles and entities ([`voxel_render::content`]).
     content: Content,
 }
 

@@ -5,7 +5,8 @@ use voxel_render::low_level::WORLD_EXTENT;
 
 use super::format::SceneFile;
 use super::parse::at_line;
-use crate::content::{Content, Entity, rotation};
+use crate::content::rotation;
+use voxel_render::content::{Content, Entity};
 
 /// Most particles a scene file may ask for, in all: a frame draws each one (36 vertices),
 /// and the ray march bins them per picture.

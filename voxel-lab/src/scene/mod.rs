@@ -86,7 +86,7 @@ use voxel_core::{
 };
 use voxel_render::Camera;
 
-use crate::content::Content;
+use voxel_render::content::Content;
 
 pub use content::MAX_PARTICLES;
 pub use parse::{parse, parse_in};
@@ -106,7 +106,7 @@ pub struct Scene {
     pub paths: Vec<Option<DVec3>>,
     /// Output size the scene asks for.
     pub size: Option<(u32, u32)>,
-    /// A game's particles and entities ([`crate::content`]), drawn through the renderer's
+    /// A game's particles and entities ([`voxel_render::content`]), drawn through the renderer's
     /// stages.
     pub content: Content,
 }

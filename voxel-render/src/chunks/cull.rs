@@ -222,7 +222,7 @@ pub(super) struct FarEntry {
     pub(super) mesh: Alloc,
 }
 
-/// One frame's visible meshes of every kind, from [`ChunkStore::cull`], in draw order:
+/// One frame's visible meshes of every kind, from `ChunkStore::cull`, in draw order:
 /// opaque and cutout meshes by page, then front to back (early depth rejection; equal
 /// distances by slot), translucent ones farthest first by
 /// [`voxel_mesh::order::chunk_order_key`] (equal keys by position). Keep one between

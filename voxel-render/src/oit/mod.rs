@@ -424,7 +424,7 @@ pub(crate) struct FrameView<'a> {
     pub view_proj: Mat4,
     /// The visible chunks with translucent meshes, farthest first.
     pub translucent: &'a [ChunkPos],
-    /// Their planes, when the technique asked for them ([`OitManager::wants_layers`];
+    /// Their planes, when the technique asked for them (`OitManager::wants_layers`;
     /// else empty).
     pub layers: VisibleLayers<'a>,
     /// The game's translucent objects when it draws translucent geometry this frame

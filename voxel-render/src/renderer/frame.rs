@@ -92,7 +92,11 @@ impl Renderer {
         self.check_output(output, format)?;
         let stages = game.stages();
         if stages.translucent {
-            let current = self.oit.contract()?.id;
+            let contract = self.oit.contract()?;
+            game.follow_contract(&self.ctx, &contract);
+            // A device lost in the game's code makes nothing valid.
+            self.ctx.check_device()?;
+            let current = contract.id;
             let built_for = game.translucent_contract_id();
             if built_for != Some(current) {
                 return Err(Error::StaleContract {
@@ -225,6 +229,9 @@ impl Renderer {
             size: (w, h),
             opaque_samples: if self.config.msaa { MSAA_SAMPLES } else { 1 },
             output_format: self.config.output_format,
+            sun_dir: sun_unit(self.config.sun_dir),
+            ambient: self.config.ambient,
+            brightness: self.config.brightness,
             order: sorts.then_some(order),
         };
         if stages != crate::stages::Stages::default() {

@@ -1,13 +1,15 @@
-// The entities example's shaders: boxes and camera-facing particles from one instance
+// The custom_stage example's shaders: boxes and camera-facing particles from one instance
 // layout. Opaque boxes write the scene colour; translucent ones and the particles end in
 // `oit_output`, which the renderer's prelude for each pass of the technique declares.
 
 struct GameView {
     view_proj: mat4x4<f32>,
-    // The camera's right and up (particles face it); the sun; w of sun: ambient.
+    // The camera's right and up (particles face it); the sun, w: ambient; x of light:
+    // brightness (the frame's lighting, `GameFrame::sun_dir`, `ambient`, `brightness`).
     right: vec4<f32>,
     up: vec4<f32>,
     sun: vec4<f32>,
+    light: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> game_view: GameView;
@@ -70,7 +72,8 @@ fn vs_game(@builtin(vertex_index) vi: u32, inst: Instance) -> GameOut {
         normal = normalize(n);
     }
     out.position = game_view.view_proj * vec4<f32>(p, 1.0);
-    let light = game_view.sun.w + (1.0 - game_view.sun.w) * max(dot(normal, game_view.sun.xyz), 0.0);
+    let lambert = max(dot(normal, game_view.sun.xyz), 0.0);
+    let light = game_view.light.x * (game_view.sun.w + (1.0 - game_view.sun.w) * lambert);
     out.color = vec4<f32>(inst.color.rgb * light, inst.color.a);
     return out;
 }

@@ -1,7 +1,7 @@
-// A game's content drawn through the renderer's stages (content.rs): boxes turned any way
+// A game's content drawn through the renderer's stages (draw.rs): boxes turned any way
 // and camera-facing particles, pulled from a storage buffer, 36 vertices each (a particle
-// uses the first 6). Lit like the world's faces: Lambert with the sun plus ambient, a
-// particle as a face turned to the sky.
+// uses the first 6). Lit like the world's faces: Lambert with the sun plus ambient at the light's
+// brightness, a particle as a face turned to the sky.
 
 struct View {
     view_proj: mat4x4<f32>,
@@ -9,6 +9,7 @@ struct View {
     up: vec4<f32>,
     sun: vec3<f32>,
     ambient: f32,
+    brightness: f32,
 };
 
 struct Prim {
@@ -53,7 +54,7 @@ fn vs_content(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) 
         }
         let world = p.center + (view.right.xyz * c.x + view.up.xyz * c.y) * p.axis_x.x;
         out.position = view.view_proj * vec4<f32>(world, 1.0);
-        let light = view.ambient + (1.0 - view.ambient) * max(view.sun.y, 0.0);
+        let light = view.brightness * (view.ambient + (1.0 - view.ambient) * max(view.sun.y, 0.0));
         out.color = vec4<f32>(p.color.rgb * light, p.color.a);
         return out;
     }
@@ -69,7 +70,7 @@ fn vs_content(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) 
     let k = select(vec2<f32>(c.y, c.x), c, sign > 0.0);
     let world = p.center + n + u * k.x + v * k.y;
     out.position = view.view_proj * vec4<f32>(world, 1.0);
-    let light = view.ambient + (1.0 - view.ambient) * max(dot(normalize(n), view.sun), 0.0);
+    let light = view.brightness * (view.ambient + (1.0 - view.ambient) * max(dot(normalize(n), view.sun), 0.0));
     out.color = vec4<f32>(p.color.rgb * light, p.color.a);
     return out;
 }
