@@ -31,6 +31,8 @@
 //! `low_level`. A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
+#![warn(missing_docs)]
+
 mod arena;
 mod bindings;
 mod camera;
