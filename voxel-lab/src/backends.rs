@@ -137,19 +137,13 @@ fn config_like(ctx: &GpuContext, technique: Technique, (w, h): (u32, u32)) -> Re
 type Drawn = (Technique, Image, &'static str, Option<f64>);
 
 /// Draws `scene` with `config` on `ctx` ([`Drawn`]).
-fn draw(
-    ctx: &GpuContext,
-    scene: &Scene,
-    config: RendererConfig,
-    frames: u32,
-) -> Result<Drawn> {
+fn draw(ctx: &GpuContext, scene: &Scene, config: RendererConfig, frames: u32) -> Result<Drawn> {
     let (w, h) = (config.width, config.height);
     let mut r = renderer_for(ctx, scene, config)?;
     let target = Offscreen::new(ctx, w, h);
     let mut ms = Vec::new();
     for i in 0..=frames {
-        r.render_and_submit(&target.view, &scene.cameras[0])
-            ?;
+        r.render_and_submit(&target.view, &scene.cameras[0])?;
         let t = r.gpu_times_blocking();
         if i > 0 && !t.is_empty() {
             ms.push(t.iter().map(|(_, ms)| ms).sum::<f64>());

@@ -233,13 +233,7 @@ where
 }
 
 /// Error against a swept parameter, one line per technique. Writes `path.png` and `.svg`.
-pub fn sweep(
-    path: &Path,
-    title: &str,
-    x_desc: &str,
-    log_x: bool,
-    series: &[Series],
-) -> Result<()> {
+pub fn sweep(path: &Path, title: &str, x_desc: &str, log_x: bool, series: &[Series]) -> Result<()> {
     line_chart(
         path,
         title,
@@ -344,12 +338,7 @@ where
 }
 
 /// One bar per name. Writes `path.png` and `path.svg`.
-pub fn bars(
-    path: &Path,
-    title: &str,
-    y_desc: &str,
-    values: &[(String, f64)],
-) -> Result<()> {
+pub fn bars(path: &Path, title: &str, y_desc: &str, values: &[(String, f64)]) -> Result<()> {
     fonts();
     draw_png(&path.with_extension("png"), (900, 520), |root| {
         bar_body(root, title, y_desc, values)
@@ -416,11 +405,7 @@ pub struct Spread {
 /// Speed against accuracy over a distribution of scenes: per technique a marker at the
 /// medians and bars (whiskers) from p10 to p90 of each. Log axes; FLIP below
 /// [`FLIP_FLOOR`] is drawn there. Writes `path.png` and `path.svg`.
-pub fn speed_vs_accuracy_spread(
-    path: &Path,
-    title: &str,
-    spreads: &[Spread],
-) -> Result<()> {
+pub fn speed_vs_accuracy_spread(path: &Path, title: &str, spreads: &[Spread]) -> Result<()> {
     fonts();
     draw_png(&path.with_extension("png"), (1000, 640), |root| {
         spread_body(root, title, spreads)
@@ -645,7 +630,9 @@ mod tests {
         for blocked in ["sva.png", "sva.svg"] {
             let _ = std::fs::remove_dir_all(&dir);
             std::fs::create_dir_all(dir.join(blocked)).unwrap();
-            let e = speed_vs_accuracy(&dir.join("sva"), "t", &s, &s).unwrap_err();
+            let e = speed_vs_accuracy(&dir.join("sva"), "t", &s, &s)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(blocked), "{blocked}: {e}");
         }
         let _ = std::fs::remove_dir_all(dir);

@@ -238,10 +238,7 @@ impl fmt::Display for Error {
             } => write!(f, "{device}, {technique}: {}", crate::chain(source)),
             Self::NoAdapter { backends, source } => write!(f, "no {backends:?} adapter: {source}"),
             Self::NoWebGl2Device(e) => write!(f, "no device with WebGL2's limits: {e}"),
-            Self::Size {
-                what,
-                size: (w, h),
-            } => {
+            Self::Size { what, size: (w, h) } => {
                 if !(1..=MAX_SIDE).contains(w) || !(1..=MAX_SIDE).contains(h) {
                     write!(
                         f,

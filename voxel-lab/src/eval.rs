@@ -20,11 +20,7 @@ use crate::summary::{
 };
 
 /// A renderer for measurements, sized `size`.
-pub fn make_renderer(
-    ctx: &GpuContext,
-    scene: &Scene,
-    size: (u32, u32),
-) -> Result<SceneRenderer> {
+pub fn make_renderer(ctx: &GpuContext, scene: &Scene, size: (u32, u32)) -> Result<SceneRenderer> {
     let config = RendererConfig {
         width: size.0,
         height: size.1,
@@ -69,17 +65,13 @@ pub fn measure(
     warmup: usize,
     frames: usize,
 ) -> Result<Measured> {
-    renderer
-        .set_oit_config(config.clone())
-        ?;
+    renderer.set_oit_config(config.clone())?;
     let mut gpu = Vec::new();
     let mut cpu = Vec::new();
     let mut sort = Vec::new();
     let mut stats = FrameStats::default();
     for i in 0..warmup + frames.max(1) {
-        stats = renderer
-            .render_and_submit(&target.view, camera)
-            ?;
+        stats = renderer.render_and_submit(&target.view, camera)?;
         let times = renderer.gpu_times_blocking();
         if i >= warmup {
             cpu.push(stats.cpu_ms);
@@ -103,8 +95,7 @@ pub fn measure(
 
 /// The HDR scene colour as f32 RGBA.
 pub fn read_hdr(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>> {
-    let bytes =
-        voxel_render::readback::read_texture(ctx, texture, 8)?;
+    let bytes = voxel_render::readback::read_texture(ctx, texture, 8)?;
     Ok(bytes
         .chunks_exact(8)
         .map(|p| {
@@ -241,12 +232,9 @@ pub fn raymarch_check(
     let shading = raymarch::Shading::of(&config);
     let mut renderer = renderer_for(ctx, scene, config)?;
     let target = Offscreen::new(ctx, size.0, size.1);
-    renderer
-        .render_and_submit(&target.view, camera)
-        ?;
+    renderer.render_and_submit(&target.view, camera)?;
     let gpu = target.read(ctx)?;
-    let depth: Vec<f32> = voxel_render::readback::read_texture(ctx, renderer.scene_depth(), 4)
-        ?
+    let depth: Vec<f32> = voxel_render::readback::read_texture(ctx, renderer.scene_depth(), 4)?
         .chunks_exact(4)
         .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
         .collect();
@@ -455,8 +443,8 @@ pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary> {
             Some(set) => {
                 // Parsed from its text like a scene file, so that the text replays it.
                 let generated = set.scene(i, opts.size.unwrap_or(DEFAULT_SIZE));
-                let scene = crate::scene::parse(&generated.text)
-                    .map_err(|e| e.in_file(&generated.name))?;
+                let scene =
+                    crate::scene::parse(&generated.text).map_err(|e| e.in_file(&generated.name))?;
                 features.push(SceneFeatures {
                     scene: generated.name.clone(),
                     features: generated.features,

@@ -39,9 +39,7 @@ pub fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32)) -> Result<Vec<E
     let target = Offscreen::new(ctx, size.0, size.1);
     let camera = &scene.cameras[0];
     let mut draw = |t: Technique| -> Result<Image> {
-        renderer
-            .set_oit_config(oit_config(t, default_weight()))
-            ?;
+        renderer.set_oit_config(oit_config(t, default_weight()))?;
         render_image(ctx, &mut renderer, &target, camera)?;
         render_image(ctx, &mut renderer, &target, camera)
     };
@@ -68,12 +66,9 @@ pub fn write(out: &Path, entries: &[Entry], columns: usize) -> Result<()> {
     std::fs::create_dir_all(out).map_err(Error::io(out))?;
     for e in entries {
         let name = e.technique.name();
-        e.image
-            .save_png(&out.join(format!("{name}.png")))
-            ?;
+        e.image.save_png(&out.join(format!("{name}.png")))?;
         e.error_map
-            .save_png(&out.join(format!("{name}_flip.png")))
-            ?;
+            .save_png(&out.join(format!("{name}_flip.png")))?;
     }
     let Some(first) = entries.first() else {
         return Ok(());
@@ -124,9 +119,9 @@ pub fn write(out: &Path, entries: &[Entry], columns: usize) -> Result<()> {
                 })?;
         }
         root.present().map_err(|e| Error::Chart {
-                    what: "gallery",
-                    detail: format!("{e:?}"),
-                })?;
+            what: "gallery",
+            detail: format!("{e:?}"),
+        })?;
     }
     let rgba = rgb
         .chunks_exact(3)

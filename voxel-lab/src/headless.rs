@@ -171,16 +171,12 @@ pub fn renderer_for(
 ) -> Result<SceneRenderer> {
     if !scene.content.is_empty() {
         let what = format!("{}: the lab's game content", scene.name);
-        voxel_render::ladder::check(&what, &content_needs(), &ctx.caps)
-            ?;
+        voxel_render::ladder::check(&what, &content_needs(), &ctx.caps)?;
     }
-    let mut renderer =
-        Renderer::new(ctx, scene.world.registry(), config)?;
+    let mut renderer = Renderer::new(ctx, scene.world.registry(), config)?;
     let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
     for (pos, meshes) in mesh_chunks(&scene.world, &positions)? {
-        renderer
-            .upload_chunk(pos, &meshes)
-            ?;
+        renderer.upload_chunk(pos, &meshes)?;
     }
     let content =
         (!scene.content.is_empty()).then(|| ContentStages::new(&renderer, scene.content.clone()));
@@ -194,8 +190,6 @@ pub fn render_image(
     target: &Offscreen,
     camera: &Camera,
 ) -> Result<Image> {
-    renderer
-        .render_and_submit(&target.view, camera)
-        ?;
+    renderer.render_and_submit(&target.view, camera)?;
     target.read(ctx)
 }

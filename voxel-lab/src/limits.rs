@@ -74,7 +74,7 @@ mod tests {
             ((8192, 8192), "33177600"),
             ((8193, 1), "8192"),
         ] {
-            let e = check_size("--size", bad).unwrap_err();
+            let e = check_size("--size", bad).unwrap_err().to_string();
             assert!(e.contains("--size") && e.contains(word), "{bad:?}: {e}");
         }
         assert!(check_range("--frames", 0, 1, 1000).is_err());
@@ -82,6 +82,7 @@ mod tests {
         assert!(
             check_range("--warmup", u64::from(u32::MAX), 0, 100)
                 .unwrap_err()
+                .to_string()
                 .contains("4294967295")
         );
     }

@@ -125,8 +125,7 @@ fn sheets(
         60.0,
         0.1,
         4000.0,
-    )
-    ?;
+    )?;
     Ok(Scene::new("sweep", world, camera))
 }
 
@@ -325,9 +324,7 @@ fn flicker_path(
             0,
         )?;
         for (i, c) in cameras.iter().enumerate() {
-            renderer
-                .render_and_submit(&target.view, c)
-                ?;
+            renderer.render_and_submit(&target.view, c)?;
             visit(i, target.read(ctx)?);
         }
         Ok(())

@@ -252,11 +252,7 @@ pub fn rss_bytes() -> Option<u64> {
 }
 
 /// The eye at `frame`: 40 blocks above the ground at the origin, flying along +x.
-fn camera_at(
-    generator: &TerrainGenerator,
-    opts: &StreamOptions,
-    frame: usize,
-) -> Result<Camera> {
+fn camera_at(generator: &TerrainGenerator, opts: &StreamOptions, frame: usize) -> Result<Camera> {
     let y = generator.height_at(0, 0) as f64 + 40.0;
     let z = match opts.teleport_at {
         Some(t) if frame >= t => TELEPORT_CHUNKS * 32.0,
@@ -283,8 +279,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
         vertical_distance: opts.vertical_distance,
         ..StreamConfig::default()
     };
-    let mut streamer = ChunkStreamer::new(registry.clone(), generator.clone(), config)
-        ?;
+    let mut streamer = ChunkStreamer::new(registry.clone(), generator.clone(), config)?;
     let (w, h) = opts.size;
     let mut renderer = Renderer::new(
         ctx,
@@ -295,8 +290,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
             draw: opts.draw,
             ..RendererConfig::default()
         },
-    )
-    ?;
+    )?;
     let target = Offscreen::new(ctx, w, h);
     let mut failed = 0;
 
@@ -304,9 +298,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
     let start = Instant::now();
     let first = camera_at(&generator, opts, 0)?;
     while !streamer.is_idle() {
-        let f = streamer
-            .update(first.eye, &mut renderer)
-            ?;
+        let f = streamer.update(first.eye, &mut renderer)?;
         failed += f.failed.len();
         std::thread::sleep(std::time::Duration::from_micros(500));
     }
@@ -317,9 +309,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
     for i in 0..opts.frames {
         let camera = camera_at(&generator, opts, i)?;
         let t0 = Instant::now();
-        let f = streamer
-            .update(camera.eye, &mut renderer)
-            ?;
+        let f = streamer.update(camera.eye, &mut renderer)?;
         let stream_ms = t0.elapsed().as_secs_f64() * 1e3;
         failed += f.failed.len();
         let mut encoder = ctx
@@ -327,9 +317,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("stream_frame"),
             });
-        let stats = renderer
-            .render(&mut encoder, &target.view, &camera)
-            ?;
+        let stats = renderer.render(&mut encoder, &target.view, &camera)?;
         let t1 = Instant::now();
         ctx.queue.submit([encoder.finish()]);
         let submit_ms = t1.elapsed().as_secs_f64() * 1e3;

@@ -281,12 +281,11 @@ pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene> {
     let c = site.center;
     let cx = c[0].div_euclid(32) as i32;
     let cz = c[2].div_euclid(32) as i32;
-    let world = generator
-        .generate_world(
-            Arc::new(BlockRegistry::default()),
-            ChunkPos::new(cx - radius, 0, cz - radius),
-            ChunkPos::new(cx + radius, 1, cz + radius),
-        )?;
+    let world = generator.generate_world(
+        Arc::new(BlockRegistry::default()),
+        ChunkPos::new(cx - radius, 0, cz - radius),
+        ChunkPos::new(cx + radius, 1, cz + radius),
+    )?;
     let dir = DVec3::new(
         f64::from(site.water_dir[0]),
         0.0,
@@ -299,7 +298,8 @@ pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene> {
     let ground = generator.height_at(eye.x.floor() as i64, eye.z.floor() as i64) as f64;
     eye.y = eye.y.max(ground + 3.5);
     let target = center + dir * 12.0 + DVec3::Y * (sea - center.y + 1.0);
-    let camera = Camera::look_at(eye, target, 70.0, 0.1, 600.0)?.in_medium(world.medium_at(eye.to_array()));
+    let camera =
+        Camera::look_at(eye, target, 70.0, 0.1, 600.0)?.in_medium(world.medium_at(eye.to_array()));
     // The flicker path slides sideways, keeping the greenhouse in view.
     let side = DVec3::new(-dir.z, 0.0, dir.x);
     Ok(Scene {

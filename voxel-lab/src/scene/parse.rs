@@ -308,13 +308,12 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene> {
     let mut cameras = Vec::new();
     let mut paths = Vec::new();
     if file.cameras.is_empty() {
-        let (lo, hi) = model_bounds
-            .ok_or_else(|| {
-                Error::scene(
-                    Some(1),
-                    "cameras: a scene needs at least one [[cameras]] entry (or a model)",
-                )
-            })?;
+        let (lo, hi) = model_bounds.ok_or_else(|| {
+            Error::scene(
+                Some(1),
+                "cameras: a scene needs at least one [[cameras]] entry (or a model)",
+            )
+        })?;
         let (camera, path_to) = framing_camera(lo, hi)?;
         cameras.push(camera.in_medium(world.medium_at(camera.eye.to_array())));
         paths.push(Some(path_to));
