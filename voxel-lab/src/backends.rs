@@ -181,7 +181,7 @@ pub fn run(opts: &Options) -> Result<Vec<Row>> {
                     return Err(Error::Technique {
                         device: d.name.clone(),
                         technique: t,
-                        source,
+                        source: Box::new(source),
                     });
                 }
                 Ok(_) => {

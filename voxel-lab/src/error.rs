@@ -47,6 +47,14 @@ pub enum Error {
         /// What is wrong: the field (`table.key`) and why.
         message: String,
     },
+    /// Another error (the renderer refusing the camera that frames a scene's models) while
+    /// building the scene of a file or a generated scene; reads `FILE:error`.
+    InScene {
+        /// The file, or a generated scene's name.
+        file: String,
+        /// What went wrong.
+        error: Box<Error>,
+    },
     /// No scene files to evaluate: none given, or a folder holding none.
     NoScenes {
         /// The folder searched, if one was.
@@ -82,8 +90,8 @@ pub enum Error {
         device: String,
         /// The technique.
         technique: Technique,
-        /// What the renderer said.
-        source: voxel_render::Error,
+        /// What the renderer said (boxed: it is the largest of the lab's errors).
+        source: Box<voxel_render::Error>,
     },
     /// No adapter of the given backends (`demo backends`).
     NoAdapter {
@@ -172,8 +180,9 @@ impl Error {
         }
     }
 
-    /// This error, when it is a scene's, as read from `file` (a path or a generated
-    /// scene's name); other errors as they are.
+    /// This error as one of the scene read from `file` (a path or a generated scene's
+    /// name): an [`Error::Scene`] names the file, another error is wrapped in an
+    /// [`Error::InScene`].
     pub fn in_file(self, file: impl fmt::Display) -> Self {
         match self {
             Self::Scene {
@@ -185,7 +194,11 @@ impl Error {
                 line,
                 message,
             },
-            other => other,
+            Self::Scene { .. } | Self::InScene { .. } => self,
+            other => Self::InScene {
+                file: file.to_string(),
+                error: Box::new(other),
+            },
         }
     }
 }
@@ -216,6 +229,7 @@ impl fmt::Display for Error {
                     None => write!(f, "?: {message}"),
                 }
             }
+            Self::InScene { file, error } => write!(f, "{file}:{error}"),
             Self::NoScenes { dir: None } => f.write_str("no scene files to evaluate"),
             Self::NoScenes { dir: Some(dir) } => {
                 write!(f, "{}: no .toml or .vox scene files", dir.display())
