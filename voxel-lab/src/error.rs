@@ -23,7 +23,7 @@ pub enum Error {
         source: std::io::Error,
     },
     /// A scene file longer than the most one may hold
-    /// ([`crate::limits::MAX_SCENE_FILE_BYTES`]).
+    /// (`limits::MAX_SCENE_FILE_BYTES`).
     FileTooLarge {
         /// The file.
         path: PathBuf,
@@ -102,12 +102,16 @@ pub enum Error {
     },
     /// The adapter refused a device with WebGL2's limits (`demo backends`).
     NoWebGl2Device(wgpu::RequestDeviceError),
-    /// A picture size past the caps of [`crate::limits`].
+    /// A picture size past the caps of `limits`.
     Size {
         /// The option or field that gave it.
         what: String,
         /// The size, width × height.
         size: (u32, u32),
+        /// The widest and tallest allowed (`limits::MAX_SIDE`).
+        max_side: u32,
+        /// The most pixels allowed (`limits::MAX_PIXELS`).
+        max_pixels: u64,
     },
     /// A number outside the range an option allows.
     OutOfRange {
@@ -129,15 +133,19 @@ pub enum Error {
     },
     /// A random scene set of no scenes.
     NoRandomScenes,
-    /// A random scene set of more than [`crate::random::MAX_SCENES`] scenes.
+    /// A random scene set of more than `random::MAX_SCENES` scenes.
     TooManyRandomScenes {
         /// The count as given (it may be too large for a number).
         count: String,
+        /// The most allowed (`random::MAX_SCENES`).
+        max: usize,
     },
-    /// A backend name that is none of [`crate::headless::BACKENDS`].
+    /// A backend name that is none of `headless::BACKENDS`.
     UnknownBackend {
         /// The name given.
         name: String,
+        /// The names there are, comma-separated.
+        known: String,
     },
     /// A chart (or the gallery's sheet) that plotters could not draw.
     Chart {
@@ -205,7 +213,6 @@ impl Error {
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        use crate::limits::{MAX_PIXELS, MAX_SIDE};
         match self {
             Self::Io { path, source } => write!(f, "{}: {source}", path.display()),
             Self::FileTooLarge { path, limit } => write!(
@@ -252,16 +259,21 @@ impl fmt::Display for Error {
             } => write!(f, "{device}, {technique}: {}", crate::chain(source)),
             Self::NoAdapter { backends, source } => write!(f, "no {backends:?} adapter: {source}"),
             Self::NoWebGl2Device(e) => write!(f, "no device with WebGL2's limits: {e}"),
-            Self::Size { what, size: (w, h) } => {
-                if !(1..=MAX_SIDE).contains(w) || !(1..=MAX_SIDE).contains(h) {
+            Self::Size {
+                what,
+                size: (w, h),
+                max_side,
+                max_pixels,
+            } => {
+                if !(1..=*max_side).contains(w) || !(1..=*max_side).contains(h) {
                     write!(
                         f,
-                        "{what} {w}x{h}: each side must be from 1 to {MAX_SIDE} pixels"
+                        "{what} {w}x{h}: each side must be from 1 to {max_side} pixels"
                     )
                 } else {
                     write!(
                         f,
-                        "{what} {w}x{h}: at most {MAX_PIXELS} pixels (7680x4320) in all"
+                        "{what} {w}x{h}: at most {max_pixels} pixels (7680x4320) in all"
                     )
                 }
             }
@@ -273,15 +285,11 @@ impl fmt::Display for Error {
             } => write!(f, "{what} {value}: it must be from {min} to {max}"),
             Self::InvalidOption { option, message } => write!(f, "{option} {message}"),
             Self::NoRandomScenes => f.write_str("a random set needs at least 1 scene"),
-            Self::TooManyRandomScenes { count } => write!(
+            Self::TooManyRandomScenes { count, max } => write!(
                 f,
-                "{count} random scenes: at most {} (at about a second per scene that is already more than a day, and every record stays in memory)",
-                crate::random::MAX_SCENES
+                "{count} random scenes: at most {max} (at about a second per scene that is already more than a day, and every record stays in memory)"
             ),
-            Self::UnknownBackend { name } => {
-                let names: Vec<&str> = crate::headless::BACKENDS.iter().map(|(n, _)| *n).collect();
-                write!(f, "{name:?}: expected one of {}", names.join(", "))
-            }
+            Self::UnknownBackend { name, known } => write!(f, "{name:?}: expected one of {known}"),
             Self::Chart { what, detail } => write!(f, "{what}: {detail}"),
             Self::Json(e) => e.fmt(f),
         }

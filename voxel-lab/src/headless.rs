@@ -68,8 +68,12 @@ pub fn backend(name: &str) -> Result<wgpu::Backends> {
         .iter()
         .find(|(n, _)| *n == name)
         .map(|(_, b)| *b)
-        .ok_or_else(|| Error::UnknownBackend {
-            name: name.to_owned(),
+        .ok_or_else(|| {
+            let names: Vec<&str> = BACKENDS.iter().map(|(n, _)| *n).collect();
+            Error::UnknownBackend {
+                name: name.to_owned(),
+                known: names.join(", "),
+            }
         })
 }
 

@@ -3,7 +3,7 @@
 //! It has no window: the demo's window and the integration tests both build on it.
 //!
 //! Modules depend on each other one way:
-//! - the model: [`files`] (result files written in one checked call), [`limits`] (the
+//! - the model: [`error`] (what can go wrong, [`Error`]), [`files`] (result files written in one checked call), [`limits`] (the
 //!   documented caps on a run), [`progress`], [`random`]
 //!   (random scenes as scene-file text), [`edges`] (which pixels lie on quad edges),
 //!   [`content`] (a game's particles and entities),

@@ -40,6 +40,8 @@ pub fn check_size(what: &str, (w, h): (u32, u32)) -> Result<()> {
         return Err(Error::Size {
             what: what.to_owned(),
             size: (w, h),
+            max_side: MAX_SIDE,
+            max_pixels: MAX_PIXELS,
         });
     }
     Ok(())

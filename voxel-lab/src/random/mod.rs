@@ -153,6 +153,7 @@ impl RandomSet {
 pub fn too_many(count: &str) -> Error {
     Error::TooManyRandomScenes {
         count: count.to_owned(),
+        max: MAX_SCENES,
     }
 }
 
