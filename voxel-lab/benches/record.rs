@@ -165,7 +165,7 @@ fn main() -> Result<()> {
         return Ok(());
     }
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/record-bench.txt");
-    std::fs::write(&path, out).map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::write(&path, out).map_err(voxel_lab::Error::io(&path))?;
     println!("written to {}", path.display());
     Ok(())
 }
