@@ -2,3 +2,6 @@
 //! lab live in `voxel-lab`, which has no window.
 
 pub mod app;
+pub mod error;
+
+pub use error::{Error, Result};

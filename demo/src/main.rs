@@ -6,6 +6,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use clap::{Args, Parser, Subcommand};
+use demo::{Error, Result};
 use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator};
 use voxel_lab::{EvalOptions, chain, headless, scene};
 use voxel_render::{BayerSize, RendererConfig, Technique, WeightFunction};
@@ -49,20 +50,24 @@ impl DeviceArgs {
     }
 }
 
-fn quad_fetch(s: &str) -> Result<voxel_render::QuadFetch, String> {
-    voxel_render::QuadFetch::from_name(s).map_err(|e| e.to_string())
+fn quad_fetch(s: &str) -> Result<voxel_render::QuadFetch> {
+    Ok(voxel_render::QuadFetch::from_name(s)?)
 }
 
 /// An hour of the day, 0 to 24.
-fn hour(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(h) if (0.0..=24.0).contains(&h) => Ok(h),
-        _ => Err(format!("{s:?}: an hour from 0 to 24 (e.g. 12 or 22.5)")),
-    }
+fn hour(s: &str) -> Result<f32> {
+    s.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|h| (0.0..=24.0).contains(h))
+        .ok_or_else(|| Error::NotA {
+            value: s.to_owned(),
+            what: "an hour from 0 to 24 (e.g. 12 or 22.5)".to_owned(),
+        })
 }
 
-fn limits_preset(s: &str) -> Result<voxel_render::LimitsPreset, String> {
-    voxel_render::LimitsPreset::from_name(s).map_err(|e| e.to_string())
+fn limits_preset(s: &str) -> Result<voxel_render::LimitsPreset> {
+    Ok(voxel_render::LimitsPreset::from_name(s)?)
 }
 
 #[derive(Subcommand, Debug)]
@@ -122,12 +127,15 @@ struct GalleryArgs {
 }
 
 /// How chunk meshes are drawn: `indirect` or `per-chunk`.
-fn draw_mode(s: &str) -> Result<voxel_render::DrawMode, String> {
+fn draw_mode(s: &str) -> Result<voxel_render::DrawMode> {
     use voxel_render::DrawMode;
     [DrawMode::Indirect, DrawMode::PerChunk]
         .into_iter()
         .find(|m| m.name() == s)
-        .ok_or_else(|| format!("{s:?}: expected indirect or per-chunk"))
+        .ok_or_else(|| Error::Expected {
+            value: s.to_owned(),
+            expected: "indirect or per-chunk",
+        })
 }
 
 #[derive(Args, Debug)]
@@ -173,17 +181,21 @@ fn names_help() -> String {
 
 /// `WxH`, each side 1 to [`voxel_lab::limits::MAX_SIDE`], at most
 /// [`voxel_lab::limits::MAX_PIXELS`] in all.
-fn size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("{s:?} is not WxH (e.g. 1280x720)"))?;
+fn size(s: &str) -> Result<(u32, u32)> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| Error::NotA {
+        value: s.to_owned(),
+        what: "WxH (e.g. 1280x720)".to_owned(),
+    })?;
     let max = voxel_lab::limits::MAX_SIDE;
     let side = |v: &str| {
         v.trim()
             .parse::<u32>()
             .ok()
             .filter(|n| (1..=max).contains(n))
-            .ok_or_else(|| format!("{v:?} is not a whole number from 1 to {max}"))
+            .ok_or_else(|| Error::NotA {
+                value: v.to_owned(),
+                what: format!("a whole number from 1 to {max}"),
+            })
     };
     let size = (side(w)?, side(h)?);
     voxel_lab::limits::check_size("size", size)?;
@@ -191,41 +203,44 @@ fn size(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// A number of random scenes: 1 to [`voxel_lab::random::MAX_SCENES`].
-fn random_count(s: &str) -> Result<usize, String> {
+fn random_count(s: &str) -> Result<usize> {
     let max = voxel_lab::random::MAX_SCENES;
     let t = s.trim();
     if !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit()) {
         // Too many digits for a usize is still "too many", not "not a number".
         return match t.parse::<usize>() {
-            Ok(n) => voxel_lab::random::RandomSet::new(n, 0).map(|r| r.count),
-            Err(_) => Err(voxel_lab::random::too_many(t)),
+            Ok(n) => Ok(voxel_lab::random::RandomSet::new(n, 0)?.count),
+            Err(_) => Err(voxel_lab::random::too_many(t).into()),
         };
     }
-    Err(format!(
-        "{s:?} is not a number of scenes: a whole number from 1 to {max}"
-    ))
+    Err(Error::NotA {
+        value: s.to_owned(),
+        what: format!("a number of scenes: a whole number from 1 to {max}"),
+    })
 }
 
 /// A seed: any whole number from 0 to 2^64 - 1.
-fn random_seed(s: &str) -> Result<u64, String> {
-    s.trim()
-        .parse()
-        .map_err(|_| format!("{s:?} is not a seed: a whole number from 0 to {}", u64::MAX))
+fn random_seed(s: &str) -> Result<u64> {
+    s.trim().parse().map_err(|_| Error::NotA {
+        value: s.to_owned(),
+        what: format!("a seed: a whole number from 0 to {}", u64::MAX),
+    })
 }
 
-fn technique(s: &str) -> Result<Technique, String> {
-    Technique::from_name(s).map_err(|e| e.to_string())
+fn technique(s: &str) -> Result<Technique> {
+    Ok(Technique::from_name(s)?)
 }
 
-fn weight(s: &str) -> Result<WeightFunction, String> {
-    WeightFunction::from_name(s).map_err(|e| e.to_string())
+fn weight(s: &str) -> Result<WeightFunction> {
+    Ok(WeightFunction::from_name(s)?)
 }
 
-fn bayer(s: &str) -> Result<BayerSize, String> {
-    let side = s
-        .parse()
-        .map_err(|_| format!("{s:?}: expected 2, 4, 8 or 16"))?;
-    BayerSize::from_side(side).map_err(|e| e.to_string())
+fn bayer(s: &str) -> Result<BayerSize> {
+    let side = s.parse().map_err(|_| Error::Expected {
+        value: s.to_owned(),
+        expected: "2, 4, 8 or 16",
+    })?;
+    Ok(BayerSize::from_side(side)?)
 }
 
 #[derive(Args, Debug, Clone)]
@@ -420,27 +435,29 @@ fn main() {
 }
 
 /// Fails early, before any rendering, when `dir` cannot be created or written to.
-fn writable_dir(dir: &Path) -> Result<(), String> {
+fn writable_dir(dir: &Path) -> Result<()> {
     if let Some(file) = dir.ancestors().find(|a| a.is_file()) {
-        return Err(format!(
-            "{}: cannot write into {} because {} is a file, not a folder",
-            dir.display(),
-            dir.display(),
-            file.display()
-        ));
+        return Err(Error::NotAFolder {
+            dir: dir.to_owned(),
+            file: file.to_owned(),
+        });
     }
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(voxel_lab::Error::io(dir))?;
     let probe = dir.join(format!(".write-test-{}", std::process::id()));
-    std::fs::write(&probe, b"")
-        .map_err(|e| format!("{}: cannot write here: {e}", dir.display()))?;
+    std::fs::write(&probe, b"").map_err(|error| Error::NotWritable {
+        dir: dir.to_owned(),
+        error,
+    })?;
     let _ = std::fs::remove_file(probe);
     Ok(())
 }
 
 /// [`writable_dir`] for the folder of an output file, which must not be a folder itself.
-fn writable_file(path: &Path) -> Result<(), String> {
+fn writable_file(path: &Path) -> Result<()> {
     if path.is_dir() {
-        return Err(format!("{}: is a folder, not a file", path.display()));
+        return Err(Error::IsAFolder {
+            path: path.to_owned(),
+        });
     }
     match path.parent().filter(|p| !p.as_os_str().is_empty()) {
         Some(dir) => writable_dir(dir),
@@ -449,7 +466,7 @@ fn writable_file(path: &Path) -> Result<(), String> {
 }
 
 /// Generates and meshes a world, then prints what it holds and how long it took.
-fn stats(a: StatsArgs) -> Result<(), String> {
+fn stats(a: StatsArgs) -> Result<()> {
     let (seed, n) = (a.seed, a.chunks);
     let registry = Arc::new(BlockRegistry::default());
     let generator = TerrainGenerator::new(TerrainConfig {
@@ -458,16 +475,14 @@ fn stats(a: StatsArgs) -> Result<(), String> {
     });
     let half = n / 2;
     let t = Instant::now();
-    let mut world = generator
-        .generate_world(
-            registry.clone(),
-            ChunkPos::new(-half, 0, -half),
-            ChunkPos::new(n - half - 1, 1, n - half - 1),
-        )
-        .map_err(|e| e.to_string())?;
+    let mut world = generator.generate_world(
+        registry.clone(),
+        ChunkPos::new(-half, 0, -half),
+        ChunkPos::new(n - half - 1, 1, n - half - 1),
+    )?;
     let gen_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let meshes = voxel_mesh::mesh_dirty(&mut world).map_err(|e| e.to_string())?;
+    let meshes = voxel_mesh::mesh_dirty(&mut world)?;
     let mesh_s = t.elapsed().as_secs_f64();
 
     let uniform = world
@@ -511,7 +526,7 @@ fn stats(a: StatsArgs) -> Result<(), String> {
 
 /// Renders the default scene (or a scene file) headlessly to a PNG and prints GPU times
 /// per pass.
-fn render(a: RenderArgs, device: &headless::Device) -> Result<(), String> {
+fn render(a: RenderArgs, device: &headless::Device) -> Result<()> {
     writable_file(&a.out)?;
     let (width, height) = a.size;
     let mut config = RendererConfig {
@@ -541,7 +556,7 @@ fn render(a: RenderArgs, device: &headless::Device) -> Result<(), String> {
     config
         .oit
         .validate()
-        .map_err(|e| format!("--layers: {e}"))?;
+        .map_err(|e| Error::from(e).in_option("--layers"))?;
 
     let t = Instant::now();
     let scene = match &a.scene {
@@ -575,9 +590,7 @@ fn render(a: RenderArgs, device: &headless::Device) -> Result<(), String> {
     let mut first_sort = None;
     // The first frame warms up (pipeline and target creation); it is not timed.
     for i in 0..=frames {
-        let s = renderer
-            .render_and_submit(&target.view, &camera)
-            .map_err(|e| chain(&e))?;
+        let s = renderer.render_and_submit(&target.view, &camera)?;
         if i == 0 {
             first_sort = s.technique.sort;
         } else {
@@ -595,8 +608,8 @@ fn render(a: RenderArgs, device: &headless::Device) -> Result<(), String> {
         }
     }
     let image = target.read(&ctx)?;
-    image.save_png(&a.out).map_err(|e| chain(&e))?;
-    let stats = stats.ok_or("no frame rendered")?;
+    image.save_png(&a.out)?;
+    let stats = stats.ok_or(Error::NoFrame)?;
     println!(
         "technique {}: drew {} opaque, {} cutout, {} translucent chunk meshes ({} translucent quads)",
         renderer.config().oit.technique,
@@ -645,7 +658,7 @@ fn render(a: RenderArgs, device: &headless::Device) -> Result<(), String> {
 }
 
 /// The scene files named on the command line (files or folders), or the `scenes/` folder.
-fn scene_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
+fn scene_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let given: Vec<PathBuf> = if given.is_empty() {
         let local = PathBuf::from("scenes");
         let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
@@ -660,7 +673,7 @@ fn scene_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>, String> {
         } else if p.is_file() {
             out.push(p);
         } else {
-            return Err(format!("{}: no such scene file or folder", p.display()));
+            return Err(Error::NoSuchScene { path: p });
         }
     }
     Ok(out)
@@ -671,8 +684,8 @@ fn names<T: Copy>(
     given: &[String],
     all: &[T],
     none_ok: bool,
-    parse: impl Fn(&str) -> Result<T, String>,
-) -> Result<Vec<T>, String> {
+    parse: impl Fn(&str) -> Result<T>,
+) -> Result<Vec<T>> {
     let given: Vec<&str> = given
         .iter()
         .map(|s| s.trim())
@@ -687,7 +700,7 @@ fn names<T: Copy>(
 
 /// Renders every scene with every technique and the exact reference; writes the summary,
 /// charts, heat maps, stability sweeps and report.
-fn eval(a: EvalArgs, device: &headless::Device) -> Result<(), String> {
+fn eval(a: EvalArgs, device: &headless::Device) -> Result<()> {
     writable_dir(&a.out)?;
     let random = a
         .random
@@ -700,9 +713,9 @@ fn eval(a: EvalArgs, device: &headless::Device) -> Result<(), String> {
             scene_paths(&a.scenes)?
         },
         techniques: names(&a.techniques, &Technique::ALL, false, technique)
-            .map_err(|e| format!("--techniques: {e}"))?,
+            .map_err(|e| e.in_option("--techniques"))?,
         weights: names(&a.weights, &WeightFunction::ALL, true, weight)
-            .map_err(|e| format!("--weights: {e}"))?,
+            .map_err(|e| e.in_option("--weights"))?,
         size: a.size,
         frames: a.frames as usize,
         warmup: a.warmup as usize,
@@ -740,7 +753,7 @@ fn eval(a: EvalArgs, device: &headless::Device) -> Result<(), String> {
 }
 
 /// Flies over streamed terrain and writes what it measured.
-fn stream(a: StreamArgs, device: &headless::Device) -> Result<(), String> {
+fn stream(a: StreamArgs, device: &headless::Device) -> Result<()> {
     let opts = voxel_lab::stream::StreamOptions {
         view_distance: a.view_distance,
         vertical_distance: a.vertical_distance,
@@ -803,7 +816,7 @@ fn stream(a: StreamArgs, device: &headless::Device) -> Result<(), String> {
 }
 
 /// Renders one scene with every technique and writes the pictures, error maps and sheet.
-fn gallery(a: GalleryArgs, device: &headless::Device) -> Result<(), String> {
+fn gallery(a: GalleryArgs, device: &headless::Device) -> Result<()> {
     writable_dir(&a.out)?;
     let scene = scene::Scene::load(&a.scene)?;
     let ctx = device.context()?;
@@ -823,7 +836,7 @@ fn gallery(a: GalleryArgs, device: &headless::Device) -> Result<(), String> {
 }
 
 /// The backend × technique table.
-fn backends(a: BackendsArgs) -> Result<(), String> {
+fn backends(a: BackendsArgs) -> Result<()> {
     writable_dir(&a.out)?;
     let opts = voxel_lab::backends::Options {
         size: a.size,
@@ -836,7 +849,7 @@ fn backends(a: BackendsArgs) -> Result<(), String> {
 }
 
 /// Opens the interactive demo.
-fn window(a: WindowArgs, device: DeviceArgs) -> Result<(), String> {
+fn window(a: WindowArgs, device: DeviceArgs) -> Result<()> {
     demo::app::run(demo::app::DemoOptions {
         backends: device.backend,
         limits: device.limits,
@@ -858,7 +871,7 @@ fn window(a: WindowArgs, device: DeviceArgs) -> Result<(), String> {
 
 /// Without a display: every technique's picture of the default scene, and a quick
 /// evaluation of the suite with its speed/accuracy chart.
-fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<(), String> {
+fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()> {
     writable_dir(&a.out)?;
     let (w, h) = a.size;
     let ctx = device.context()?;
@@ -877,12 +890,10 @@ fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<(), String> {
             continue;
         }
         // One frame to settle (adaptive peeling), one to keep.
-        renderer
-            .render_and_submit(&target.view, &scene.cameras[0])
-            .map_err(|e| chain(&e))?;
+        renderer.render_and_submit(&target.view, &scene.cameras[0])?;
         let img = headless::render_image(&ctx, &mut renderer, &target, &scene.cameras[0])?;
         let path = a.out.join(format!("{}.png", t.name()));
-        img.save_png(&path).map_err(|e| chain(&e))?;
+        img.save_png(&path)?;
         println!("wrote {}", path.display());
     }
     let eval_out = a.out.join("eval");

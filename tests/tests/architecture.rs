@@ -34,6 +34,7 @@ const RENDER: &[&str] = &[
 
 /// voxel-lab, bottom up: the model, then the runs, then the report (its lib.rs docs).
 const LAB: &[&str] = &[
+    "error",
     "files",
     "limits",
     "progress",

@@ -492,7 +492,9 @@ fn game_content_under_webgl2_limits_is_refused_naming_the_capability() {
     let Some(w2) = tests::webgl2() else { return };
     let scene = scenes(true).pop().unwrap();
     assert!(!scene.content.is_empty(), "{}", scene.name);
-    let e = renderer_for(&w2, &scene, technique_config(Technique::Stipple, W, H)).unwrap_err();
+    let e = renderer_for(&w2, &scene, technique_config(Technique::Stipple, W, H))
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("max_storage_buffers_per_shader_stage of at least 1 (this device: 0)"),
         "{e}"

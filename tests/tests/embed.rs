@@ -287,7 +287,7 @@ fn png_header_bombs_are_refused_before_decoding() {
          [[cameras]]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\n",
     )
     .unwrap();
-    let e = Scene::load(&scene).unwrap_err();
+    let e = Scene::load(&scene).unwrap_err().to_string();
     assert!(
         e.contains("blocks.texture") && e.contains("100000x100000 pixels"),
         "{e}"

@@ -338,7 +338,7 @@ fn every_broken_file_is_an_error_naming_the_file_and_the_fault() {
     for (name, bytes, want) in cases {
         let path = dir.join(format!("{name}.vox"));
         std::fs::write(&path, &bytes).unwrap();
-        let e = Scene::load(&path).unwrap_err();
+        let e = Scene::load(&path).unwrap_err().to_string();
         assert!(
             e.contains(&path.display().to_string()) && e.contains(want),
             "{name}: {e}"
@@ -351,14 +351,16 @@ fn every_broken_file_is_an_error_naming_the_file_and_the_fault() {
         "name = \"bad\"\n\n[[models]]\nfile = \"cycle.vox\"\n",
     )
     .unwrap();
-    let e = Scene::load(&scene).unwrap_err();
+    let e = Scene::load(&scene).unwrap_err().to_string();
     assert!(
         e.starts_with(&format!("{}:4: models.file: ", scene.display()))
             && e.contains("cycle.vox")
             && e.contains("cycle"),
         "{e}"
     );
-    let e = Scene::load(&dir.join("no_such.vox")).unwrap_err();
+    let e = Scene::load(&dir.join("no_such.vox"))
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("no_such.vox") && e.contains("cannot read"),
         "{e}"
@@ -443,7 +445,8 @@ max = [0, 0, 0]
             &text.replace(&bad.replace("WATER", &c.water.to_string()), want),
             &dir,
         )
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
         let expect = match want {
             "index = 0" | "index = 256" => "models.palette.index",
             "class = \"glass\"" => "models.palette.class",

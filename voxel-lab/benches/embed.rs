@@ -19,6 +19,7 @@
 
 use std::sync::Arc;
 use std::time::Instant;
+use voxel_lab::Result;
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -33,7 +34,7 @@ const W: u32 = 640;
 const H: u32 = 360;
 
 /// The terrain of the disc of radius `vd` chunks.
-fn world(vd: i32) -> Result<(World, Vec<ChunkPos>), String> {
+fn world(vd: i32) -> Result<(World, Vec<ChunkPos>)> {
     let generator = TerrainGenerator::new(TerrainConfig::default());
     let mut positions = Vec::new();
     for dx in -vd..=vd {
@@ -49,7 +50,7 @@ fn world(vd: i32) -> Result<(World, Vec<ChunkPos>), String> {
         .collect();
     let mut world = World::new(Arc::new(BlockRegistry::default()));
     for (p, c) in chunks {
-        world.insert_chunk(p, c).map_err(|e| e.to_string())?;
+        world.insert_chunk(p, c)?;
     }
     Ok((world, positions))
 }
@@ -60,21 +61,20 @@ fn renderer(
     world: &World,
     positions: &[ChunkPos],
     config: RendererConfig,
-) -> Result<Renderer, String> {
-    let chain = |e: voxel_render::Error| voxel_lab::chain(&e);
-    let mut r = Renderer::new(ctx, world.registry(), config).map_err(chain)?;
-    for (pos, meshes) in mesh_chunks(world, positions).map_err(|e| e.to_string())? {
-        r.upload_chunk(pos, &meshes).map_err(chain)?;
+) -> Result<Renderer> {
+    let mut r = Renderer::new(ctx, world.registry(), config)?;
+    for (pos, meshes) in mesh_chunks(world, positions)? {
+        r.upload_chunk(pos, &meshes)?;
     }
     Ok(r)
 }
 
-fn camera(vd: i32) -> Result<Camera, String> {
+fn camera(vd: i32) -> Result<Camera> {
     let g = TerrainGenerator::new(TerrainConfig::default());
     let eye = DVec3::new(0.5, g.height_at(0, 0) as f64 + 40.0, 0.5);
     let far = f64::from(vd) * 32.0 * 1.5;
     Camera::from_yaw_pitch(eye, std::f64::consts::FRAC_PI_2, -0.25, 70.0, 0.1, far)
-        .map_err(|e| e.to_string())
+        .map_err(voxel_lab::Error::Render)
 }
 
 /// One frame into `target`, waited for; its CPU milliseconds (`FrameStats::cpu_ms`, the
@@ -106,8 +106,8 @@ fn config(technique: Technique) -> RendererConfig {
     c
 }
 
-fn main() -> Result<(), String> {
-    let ctx = GpuContext::headless(wgpu::Backends::VULKAN).map_err(|e| e.to_string())?;
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let ctx = GpuContext::headless(wgpu::Backends::VULKAN)?;
     let target = Offscreen::new(&ctx, W, H);
     let dusk = Lighting::daytime(17.5);
     println!("adapter: {}\n", ctx.caps.adapter_name);
@@ -120,7 +120,7 @@ fn main() -> Result<(), String> {
         let mut r = renderer(&ctx, &world, &positions, config(Technique::WboitMrt))?;
         rows[0][k] = steady(&ctx, &mut r, &target.view, &cam);
         let start = Instant::now();
-        r.set_lighting(dusk).map_err(|e| e.to_string())?;
+        r.set_lighting(dusk)?;
         let set = start.elapsed().as_secs_f64() * 1e3;
         rows[1][k] = set + frame(&ctx, &mut r, &target.view, &cam);
         // Without a setter: a renderer built with the lighting, every chunk again.
@@ -156,14 +156,14 @@ fn main() -> Result<(), String> {
         // Cold: the technique is built in the first frame after the switch.
         let mut r = renderer(&ctx, &world, &positions, config(Technique::OpaqueOnly))?;
         steady(&ctx, &mut r, &target.view, &cam);
-        r.set_technique(t).map_err(|e| e.to_string())?;
+        r.set_technique(t)?;
         let cold = frame(&ctx, &mut r, &target.view, &cam);
         let settled = steady(&ctx, &mut r, &target.view, &cam);
         // Built ahead at load time.
         let mut r = renderer(&ctx, &world, &positions, config(Technique::OpaqueOnly))?;
-        r.prebuild_technique(t).map_err(|e| e.to_string())?;
+        r.prebuild_technique(t)?;
         steady(&ctx, &mut r, &target.view, &cam);
-        r.set_technique(t).map_err(|e| e.to_string())?;
+        r.set_technique(t)?;
         let ahead = frame(&ctx, &mut r, &target.view, &cam);
         println!("| `{t}` | {cold:.2} | {ahead:.2} | {settled:.2} |");
     }
@@ -180,7 +180,7 @@ fn main() -> Result<(), String> {
     );
     let first = frame(&ctx, &mut r, &bgra.view, &cam);
     let again = steady(&ctx, &mut r, &bgra.view, &cam);
-    let img = readback::read_image(&ctx, &bgra.texture).map_err(|e| e.to_string())?;
+    let img = readback::read_image(&ctx, &bgra.texture)?;
     println!(
         "\n| output format (VD 8, sorted-quads) | ms |\n|---|---:|\n| steady frame into Rgba8UnormSrgb | {rgba:.2} |\n| first frame into Bgra8UnormSrgb | {first:.2} |\n| steady frame into Bgra8UnormSrgb | {again:.2} |"
     );

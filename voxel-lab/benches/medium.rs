@@ -13,6 +13,9 @@ use voxel_lab::headless::{self, Offscreen};
 use voxel_lab::scene::Scene;
 use voxel_render::{Camera, GpuPass, NoGame, RendererConfig, Technique};
 
+/// A bench's errors: the lab's, wgpu's, and its own messages.
+type Result<T, E = Box<dyn std::error::Error>> = std::result::Result<T, E>;
+
 const FRAMES: usize = 15;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -31,12 +34,10 @@ fn times(
     renderer: &mut voxel_render::Renderer,
     target: &Offscreen,
     camera: &Camera,
-) -> Result<[f64; 3], String> {
+) -> Result<[f64; 3]> {
     let (mut work, mut medium, mut total) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..FRAMES + 2 {
-        renderer
-            .render_and_submit(&target.view, camera, &mut NoGame)
-            .map_err(|e| voxel_lab::chain(&e))?;
+        renderer.render_and_submit(&target.view, camera, &mut NoGame)?;
         let t = renderer.gpu_times_blocking();
         if i >= 2 {
             work.push(t.translucent_work());
@@ -57,7 +58,7 @@ fn config(technique: Technique, (width, height): (u32, u32)) -> RendererConfig {
     config
 }
 
-fn main() -> Result<(), String> {
+fn main() -> Result<()> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
     let ctx = headless::context()?;
     let (w, h) = (640, 360);
@@ -66,17 +67,11 @@ fn main() -> Result<(), String> {
 }
 
 /// The deep and shallow lake seen from above, its water a volume and a thin surface.
-fn from_above(
-    ctx: &voxel_render::GpuContext,
-    dir: &Path,
-    (w, h): (u32, u32),
-) -> Result<(), String> {
-    let text = std::fs::read_to_string(dir.join("lake_depths.toml")).map_err(|e| e.to_string())?;
+fn from_above(ctx: &voxel_render::GpuContext, dir: &Path, (w, h): (u32, u32)) -> Result<()> {
+    let text = std::fs::read_to_string(dir.join("lake_depths.toml"))?;
     let volume = voxel_lab::scene::parse(&text)?;
     let registry = volume.world.registry();
-    let water = registry
-        .get(voxel_core::blocks::WATER)
-        .map_err(|e| e.to_string())?;
+    let water = registry.get(voxel_core::blocks::WATER)?;
     let [r, g, b] = water.color;
     let thin = format!(
         "{}\n[[blocks]]\nname = \"thin_water\"\ncolor = [{r}, {g}, {b}]\nopacity = {}\nclass = \"translucent\"\n",
@@ -102,11 +97,7 @@ fn from_above(
 }
 
 /// The eye under water, and the same camera treated as if it were in air.
-fn under_water(
-    ctx: &voxel_render::GpuContext,
-    dir: &Path,
-    (w, h): (u32, u32),
-) -> Result<(), String> {
+fn under_water(ctx: &voxel_render::GpuContext, dir: &Path, (w, h): (u32, u32)) -> Result<()> {
     let scene = Scene::load(&dir.join("under_water.toml"))?;
     println!(
         "under_water scene, {w}x{h}, {}, median of {FRAMES} frames (inside = the eye in the water; air = the same camera with no medium)",

@@ -19,6 +19,7 @@ use std::ops::Range;
 use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
+use voxel_lab::Result;
 
 use glam::DVec3;
 use voxel_core::{BlockId, BlockRegistry, Chunk, ChunkPos, World, blocks};
@@ -54,7 +55,7 @@ fn dome(cx: i32, cz: i32) -> bool {
 }
 
 /// The sea of radius `vd` chunks, meshed and uploaded into a renderer of `technique`.
-fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Renderer, String> {
+fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Renderer> {
     let registry = Arc::new(BlockRegistry::default());
     let mut sea = Chunk::default();
     let mut domed = Chunk::default();
@@ -82,15 +83,13 @@ fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Renderer,
             }
             let floor = ChunkPos::new(cx, -1, cz);
             let water = ChunkPos::new(cx, 0, cz);
-            world
-                .insert_chunk(floor, Chunk::uniform(blocks::SAND))
-                .map_err(|e| e.to_string())?;
+            world.insert_chunk(floor, Chunk::uniform(blocks::SAND))?;
             let c = if dome(cx, cz) {
                 domed.clone()
             } else {
                 sea.clone()
             };
-            world.insert_chunk(water, c).map_err(|e| e.to_string())?;
+            world.insert_chunk(water, c)?;
             positions.extend([floor, water]);
         }
     }
@@ -100,21 +99,19 @@ fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Renderer,
         ..RendererConfig::default()
     };
     config.oit.technique = technique;
-    let mut renderer = Renderer::new(ctx, &registry, config).map_err(|e| voxel_lab::chain(&e))?;
-    for (pos, meshes) in mesh_chunks(&world, &positions).map_err(|e| e.to_string())? {
-        renderer
-            .upload_chunk(pos, &meshes)
-            .map_err(|e| voxel_lab::chain(&e))?;
+    let mut renderer = Renderer::new(ctx, &registry, config)?;
+    for (pos, meshes) in mesh_chunks(&world, &positions)? {
+        renderer.upload_chunk(pos, &meshes)?;
     }
     Ok(renderer)
 }
 
-fn camera(vd: i32) -> Result<Camera, String> {
+fn camera(vd: i32) -> Result<Camera> {
     let eye = DVec3::new(0.5, f64::from(SURFACE) + 6.0, 0.5);
     let pitch: f64 = -0.3;
     let dir = DVec3::new(pitch.cos(), pitch.sin(), 0.0);
     Camera::look_at(eye, eye + dir, 70.0, 0.1, f64::from(vd) * 32.0 * 1.5)
-        .map_err(|e| voxel_lab::chain(&e))
+        .map_err(voxel_lab::Error::Render)
 }
 
 /// `n` objects in the water in front of the camera, within the view distance.
@@ -186,20 +183,13 @@ fn measure(
     renderer: &mut Renderer,
     game: &mut Orderer,
     camera: &Camera,
-) -> Result<(f64, f64), String> {
+) -> Result<(f64, f64)> {
     let target = Offscreen::new(ctx, W, H);
-    game.contract = Some(
-        renderer
-            .translucent_contract()
-            .map_err(|e| voxel_lab::chain(&e))?
-            .id,
-    );
+    game.contract = Some(renderer.translucent_contract()?.id);
     let (mut order, mut cpu) = (Vec::new(), Vec::new());
     for i in 0..WARMUP + FRAMES {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let stats = renderer
-            .render(&mut encoder, &target.view, camera, game)
-            .map_err(|e| voxel_lab::chain(&e))?;
+        let stats = renderer.render(&mut encoder, &target.view, camera, game)?;
         ctx.queue.submit([encoder.finish()]);
         let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
         if i >= WARMUP {
@@ -229,7 +219,7 @@ fn plain_sort(objects: &[TranslucentObject], camera: &Camera) -> f64 {
     median(&mut ms[WARMUP..])
 }
 
-fn main() -> Result<(), String> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let ctx = headless::context()?;
     let vds = list("ORDER_VD", &[8, 16, 32]);
     let counts = list("ORDER_OBJECTS", &[1_000, 2_000, 10_000, 100_000]);
@@ -266,9 +256,7 @@ fn main() -> Result<(), String> {
             let plain = plain_sort(&game.objects, &camera);
             let visible = {
                 let target = Offscreen::new(&ctx, W, H);
-                let stats = quads
-                    .render_and_submit(&target.view, &camera, &mut NoGame)
-                    .map_err(|e| voxel_lab::chain(&e))?;
+                let stats = quads.render_and_submit(&target.view, &camera, &mut NoGame)?;
                 stats.meshes_drawn[2]
             };
             let row = format!(
@@ -281,7 +269,7 @@ fn main() -> Result<(), String> {
         }
     }
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/object-order.md");
-    voxel_render::readback::write_file(&path, out.as_bytes()).map_err(|e| e.to_string())?;
+    voxel_render::readback::write_file(&path, out.as_bytes())?;
     println!("wrote {}", path.display());
     Ok(())
 }

@@ -10,6 +10,9 @@
 use voxel_lab::headless::{self, Offscreen, SceneRenderer};
 use voxel_render::{DrawMode, GpuPass, GpuTimes, QuadFetch, RendererConfig, Technique};
 
+/// A bench's errors: the lab's, wgpu's, and its own messages.
+type Result<T, E = Box<dyn std::error::Error>> = std::result::Result<T, E>;
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -33,7 +36,7 @@ fn arg(name: &str) -> Option<String> {
         .and_then(|i| args.get(i + 1).cloned())
 }
 
-fn main() -> Result<(), String> {
+fn main() -> Result<()> {
     let (w, h) = arg("--size")
         .and_then(|s| {
             let (a, b) = s.split_once('x')?;
@@ -44,10 +47,7 @@ fn main() -> Result<(), String> {
     let scene = voxel_lab::scene::default_scene(1)?;
     let ctx = headless::context()?;
     if !ctx.caps.timestamps() {
-        return Err(format!(
-            "{} has no timestamp queries",
-            ctx.caps.adapter_name
-        ));
+        return Err(format!("{} has no timestamp queries", ctx.caps.adapter_name).into());
     }
     println!(
         "default scene (seed 1), {w}x{h}, {}, {frames} frames each after 2 untimed, the ways in turn",
@@ -67,7 +67,7 @@ fn main() -> Result<(), String> {
         Technique::SortedQuads,
         Technique::WboitMrt,
     ] {
-        let make = |fetch, draw| -> Result<SceneRenderer, String> {
+        let make = |fetch, draw| -> voxel_lab::Result<SceneRenderer> {
             let mut config = RendererConfig {
                 width: w,
                 height: h,
@@ -95,8 +95,7 @@ fn main() -> Result<(), String> {
             for j in 0..ways.len() {
                 let k = (i + j) % ways.len();
                 let r = &mut renderers[k];
-                r.render_and_submit(&target.view, &camera)
-                    .map_err(|e| voxel_lab::chain(&e))?;
+                r.render_and_submit(&target.view, &camera)?;
                 let g = r.gpu_times_blocking();
                 if i >= 2 {
                     times[k].push(split(&g));

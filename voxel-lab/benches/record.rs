@@ -21,6 +21,9 @@ use std::time::Instant;
 use voxel_lab::headless::{self, Offscreen};
 use voxel_render::{DrawMode, FrameStats, GpuContext, NoGame, Technique};
 
+/// A bench's errors: the lab's, wgpu's, and its own messages.
+type Result<T, E = Box<dyn std::error::Error>> = std::result::Result<T, E>;
+
 #[path = "common/record_world.rs"]
 mod record_world;
 use record_world::{H, LAYERS, SEED, W, camera, renderer};
@@ -51,7 +54,7 @@ struct Row {
 
 const MODES: [DrawMode; 2] = [DrawMode::Indirect, DrawMode::PerChunk];
 
-fn measure(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Row, String> {
+fn measure(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Row> {
     let mut renderer = renderer(ctx, vd, technique)?;
     let target = Offscreen::new(ctx, W, H);
     let camera = camera(vd)?;
@@ -74,16 +77,12 @@ fn measure(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Row, Strin
             let mut encoder = ctx
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-            let s = renderer
-                .render(&mut encoder, &target.view, &camera, &mut NoGame)
-                .map_err(|e| voxel_lab::chain(&e))?;
+            let s = renderer.render(&mut encoder, &target.view, &camera, &mut NoGame)?;
             let t = Instant::now();
             let commands = encoder.finish();
             let finish = t.elapsed().as_secs_f64() * 1e3;
             ctx.queue.submit([commands]);
-            ctx.device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| e.to_string())?;
+            ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
             if i >= WARMUP {
                 ms[m].push(s.cpu_ms);
                 finish_ms[m].push(s.cpu_ms + finish);
@@ -100,7 +99,7 @@ fn measure(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Row, Strin
     })
 }
 
-fn main() -> Result<(), String> {
+fn main() -> Result<()> {
     let ctx = headless::context()?;
     let mut out = String::new();
     writeln!(
@@ -115,13 +114,11 @@ fn main() -> Result<(), String> {
         LAYERS.start(),
         LAYERS.end(),
         frames()
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     writeln!(
         out,
         "| VD technique | chunks | meshes | calls indirect | calls per-chunk | CPU ms indirect | CPU ms per-chunk | indirect / per-chunk | +finish indirect | +finish per-chunk | ratio +finish |\n|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     print!("{out}");
     // RECORD_VD=32 (a comma list) runs only those view distances (for profiling).
     let only: Option<Vec<i32>> = std::env::var("RECORD_VD")
@@ -162,13 +159,13 @@ fn main() -> Result<(), String> {
             percentile(fi, 0.5) / percentile(fp, 0.5),
         );
         println!("{line}");
-        writeln!(out, "{line}").map_err(|e| e.to_string())?;
+        writeln!(out, "{line}")?;
     }
     if only.is_some() {
         return Ok(());
     }
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/record-bench.txt");
-    std::fs::write(&path, out).map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::write(&path, out).map_err(voxel_lab::Error::io(&path))?;
     println!("written to {}", path.display());
     Ok(())
 }

@@ -11,6 +11,9 @@ use voxel_lab::headless::{self, Offscreen};
 use voxel_lab::scene::{Scene, default_scene};
 use voxel_render::{Camera, RendererConfig, Technique};
 
+/// A bench's errors: the lab's, wgpu's, and its own messages.
+type Result<T, E = Box<dyn std::error::Error>> = std::result::Result<T, E>;
+
 const FRAMES: usize = 120;
 
 fn percentile(v: &[f64], p: f64) -> f64 {
@@ -19,7 +22,7 @@ fn percentile(v: &[f64], p: f64) -> f64 {
     v[((v.len() - 1) as f64 * p).round() as usize]
 }
 
-fn walk(name: &str, scene: &Scene, to: DVec3) -> Result<(), String> {
+fn walk(name: &str, scene: &Scene, to: DVec3) -> Result<()> {
     let ctx = headless::context()?;
     let (w, h) = (640, 360);
     let mut config = RendererConfig {
@@ -40,9 +43,7 @@ fn walk(name: &str, scene: &Scene, to: DVec3) -> Result<(), String> {
             eye: start.eye.lerp(to, i as f64 / (FRAMES - 1) as f64),
             ..start
         };
-        let stats = renderer
-            .render_and_submit(&target.view, &camera)
-            .map_err(|e| voxel_lab::chain(&e))?;
+        let stats = renderer.render_and_submit(&target.view, &camera)?;
         let sort = stats.technique.sort.ok_or("no sort report")?;
         cycles = cycles.max(sort.cycles);
         if i == 0 {
@@ -69,9 +70,7 @@ fn walk(name: &str, scene: &Scene, to: DVec3) -> Result<(), String> {
         ms.len()
     );
     // A still camera sorts nothing.
-    let again = renderer
-        .render_and_submit(&target.view, &Camera { eye: to, ..start })
-        .map_err(|e| voxel_lab::chain(&e))?;
+    let again = renderer.render_and_submit(&target.view, &Camera { eye: to, ..start })?;
     println!(
         "  still camera: {} chunks re-sorted",
         again.technique.sort.map_or(0, |s| s.chunks_resorted)
@@ -79,7 +78,7 @@ fn walk(name: &str, scene: &Scene, to: DVec3) -> Result<(), String> {
     Ok(())
 }
 
-fn main() -> Result<(), String> {
+fn main() -> Result<()> {
     let default = default_scene(1)?;
     let cam = default.cameras[0];
     let side = default.paths[0].unwrap_or(cam.eye) - cam.eye;

@@ -9,12 +9,13 @@
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
+use voxel_lab::Result;
 
 use voxel_lab::headless;
 use voxel_lab::stream::{StreamOptions, StreamReport, run};
 use voxel_render::DrawMode;
 
-fn main() -> Result<(), String> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames: usize = std::env::var("STREAM_FRAMES")
         .ok()
         .and_then(|v| v.parse().ok())
@@ -102,7 +103,7 @@ fn main() -> Result<(), String> {
         );
     }
     println!("{table}");
-    std::fs::create_dir_all(&out).map_err(|e| e.to_string())?;
-    std::fs::write(out.join("stream-bench.md"), &table).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(&out)?;
+    std::fs::write(out.join("stream-bench.md"), &table)?;
     Ok(())
 }

@@ -17,6 +17,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
+use voxel_lab::Result;
 
 use glam::{DQuat, DVec3};
 use voxel_lab::headless::Offscreen;
@@ -34,12 +35,9 @@ fn frame(
     game: &mut ContentStages,
     target: &Offscreen,
     cam: &Camera,
-) -> Result<(f64, u64), String> {
-    let chain = |e: voxel_render::Error| voxel_lab::chain(&e);
+) -> Result<(f64, u64)> {
     let before = low_level::pipelines_built();
-    let stats = r
-        .render_and_submit(&target.view, cam, game)
-        .map_err(chain)?;
+    let stats = r.render_and_submit(&target.view, cam, game)?;
     let _ = ctx.device.poll(wgpu::PollType::wait_indefinitely());
     Ok((stats.cpu_ms, low_level::pipelines_built() - before))
 }
@@ -75,8 +73,7 @@ fn content(cam: &Camera) -> Content {
     }
 }
 
-fn main() -> Result<(), String> {
-    let chain = |e: voxel_render::Error| voxel_lab::chain(&e);
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let vd: i32 = std::env::var("SWITCH_VD")
         .ok()
         .and_then(|v| v.parse().ok())
@@ -89,8 +86,8 @@ fn main() -> Result<(), String> {
     let mut game = ContentStages::new(&r, content(&cam));
     let start = Instant::now();
     for t in Technique::REAL_TIME {
-        r.prebuild_technique(t).map_err(chain)?;
-        game.prebuild(&mut r, t).map_err(chain)?;
+        r.prebuild_technique(t)?;
+        game.prebuild(&mut r, t)?;
     }
     let loading = start.elapsed().as_secs_f64() * 1e3;
     for _ in 0..3 {
@@ -119,7 +116,7 @@ fn main() -> Result<(), String> {
     );
     print!("{out}");
     for t in Technique::REAL_TIME.into_iter().skip(1).chain([first]) {
-        r.set_technique(t).map_err(chain)?;
+        r.set_technique(t)?;
         let (ms, built) = frame(&ctx, &mut r, &mut game, &target, &cam)?;
         let mut steady: Vec<f64> = (0..10)
             .map(|_| frame(&ctx, &mut r, &mut game, &target, &cam).map(|f| f.0))
@@ -135,7 +132,7 @@ fn main() -> Result<(), String> {
         out += "\n";
     }
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/switch-bench.md");
-    voxel_render::readback::write_file(&path, out.as_bytes()).map_err(|e| e.to_string())?;
+    voxel_render::readback::write_file(&path, out.as_bytes())?;
     println!("wrote {}", path.display());
     Ok(())
 }

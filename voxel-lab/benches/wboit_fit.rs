@@ -6,6 +6,7 @@
 //! ms. Prints figures; asserts nothing about time.
 //! `cargo bench -p voxel-lab --bench wboit_fit` (FIT_VD=8,32 picks view distances).
 
+use voxel_lab::Result;
 use voxel_lab::eval::oit_config;
 use voxel_lab::headless::{self, Offscreen};
 use voxel_render::{NoGame, Technique, WeightFunction};
@@ -22,7 +23,7 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
-fn main() -> Result<(), String> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let ctx = headless::context()?;
     let vds: Vec<i32> = std::env::var("FIT_VD")
         .ok()
@@ -53,19 +54,13 @@ fn main() -> Result<(), String> {
         for i in 0..WARMUP + FRAMES {
             let order = if i % 2 == 0 { [0, 1] } else { [1, 0] };
             for m in order {
-                renderer
-                    .set_oit_config(oit_config(Technique::WboitMrt, weights[m]))
-                    .map_err(|e| voxel_lab::chain(&e))?;
+                renderer.set_oit_config(oit_config(Technique::WboitMrt, weights[m]))?;
                 let mut encoder = ctx
                     .device
                     .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-                let s = renderer
-                    .render(&mut encoder, &target.view, &camera, &mut NoGame)
-                    .map_err(|e| voxel_lab::chain(&e))?;
+                let s = renderer.render(&mut encoder, &target.view, &camera, &mut NoGame)?;
                 ctx.queue.submit([encoder.finish()]);
-                ctx.device
-                    .poll(wgpu::PollType::wait_indefinitely())
-                    .map_err(|e| e.to_string())?;
+                ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
                 if i >= WARMUP {
                     prepare[m].push(s.technique.prepare_ms);
                     render[m].push(s.cpu_ms);

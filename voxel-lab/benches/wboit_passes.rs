@@ -17,6 +17,9 @@ use voxel_lab::scene::{Scene, scene_files};
 use voxel_render::low_level::REVEALAGE_FORMAT;
 use voxel_render::{GpuContext, GpuPass, OitConfig, RendererConfig, Technique, WeightFunction};
 
+/// A bench's errors: the lab's, wgpu's, and its own messages.
+type Result<T, E = Box<dyn std::error::Error>> = std::result::Result<T, E>;
+
 const WARMUP: usize = 3;
 
 fn frames() -> usize {
@@ -68,7 +71,7 @@ fn modes() -> Vec<(&'static str, OitConfig)> {
 
 /// Median GPU ms of an empty render pass that clears WBOIT's accumulation (RGBA16F) and
 /// revealage targets, as the accumulation pass's load ops do.
-fn clear_ms(ctx: &GpuContext, (w, h): (u32, u32)) -> Result<f64, String> {
+fn clear_ms(ctx: &GpuContext, (w, h): (u32, u32)) -> Result<f64> {
     use wgpu::TextureUsages as U;
     let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING;
     let target = |format| {
@@ -144,14 +147,9 @@ fn clear_ms(ctx: &GpuContext, (w, h): (u32, u32)) -> Result<f64, String> {
         encoder.copy_buffer_to_buffer(&resolve, 0, &read, 0, 16);
         ctx.queue.submit([encoder.finish()]);
         read.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-        ctx.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| e.to_string())?;
+        ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
         let t: [u64; 2] = {
-            let view = read
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| e.to_string())?;
+            let view = read.slice(..).get_mapped_range()?;
             bytemuck::pod_read_unaligned(&view)
         };
         read.unmap();
@@ -162,7 +160,7 @@ fn clear_ms(ctx: &GpuContext, (w, h): (u32, u32)) -> Result<f64, String> {
     Ok(median(&mut ms))
 }
 
-fn main() -> Result<(), String> {
+fn main() -> Result<()> {
     let ctx = headless::context()?;
     if !ctx.caps.timestamps() {
         return Err("this adapter has no timestamp queries: nothing to measure".into());
@@ -219,8 +217,7 @@ fn main() -> Result<(), String> {
             for k in 0..modes.len() {
                 let m = (i + k) % modes.len();
                 let r = &mut renderers[m];
-                r.render_and_submit(&target.view, &camera)
-                    .map_err(|e| voxel_lab::chain(&e))?;
+                r.render_and_submit(&target.view, &camera)?;
                 let t = r.gpu_times_blocking();
                 if i >= WARMUP {
                     times[m][0].push(t.get(GpuPass::Translucent).unwrap_or(0.0));

@@ -3,6 +3,8 @@
 //! itself or as its replacement) or which capability it lacks, its error against the
 //! Vulkan picture, its GPU time.
 
+use crate::{Error, Result};
+
 use std::path::{Path, PathBuf};
 
 use voxel_render::{GpuContext, Image, OitConfig, Renderer, RendererConfig, Technique};
@@ -33,7 +35,7 @@ pub struct Device {
 
 /// The four devices: Vulkan, GL, and both with WebGL2's limits and no optional feature but
 /// timestamp queries (which WebGL2 lacks; asked for here only to time the passes).
-pub fn devices() -> Result<Vec<Device>, String> {
+pub fn devices() -> Result<Vec<Device>> {
     let vulkan = headless::Device {
         backends: wgpu::Backends::VULKAN,
         limits: voxel_render::LimitsPreset::Adapter,
@@ -64,7 +66,7 @@ pub fn devices() -> Result<Vec<Device>, String> {
 
 /// A device of `backends` with WebGL2's limits and timestamp queries (when the adapter has
 /// them).
-fn webgl2_timed(backends: wgpu::Backends) -> Result<GpuContext, String> {
+fn webgl2_timed(backends: wgpu::Backends) -> Result<GpuContext> {
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
     desc.backends = backends;
     let instance = wgpu::Instance::new(desc);
@@ -72,7 +74,7 @@ fn webgl2_timed(backends: wgpu::Backends) -> Result<GpuContext, String> {
         let adapter = instance
             .request_adapter(&Default::default())
             .await
-            .map_err(|e| format!("no {backends:?} adapter: {e}"))?;
+            .map_err(|source| Error::NoAdapter { backends, source })?;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("webgl2_limits_timed"),
@@ -81,7 +83,7 @@ fn webgl2_timed(backends: wgpu::Backends) -> Result<GpuContext, String> {
                 ..Default::default()
             })
             .await
-            .map_err(|e| format!("no device with WebGL2's limits: {e}"))?;
+            .map_err(Error::NoWebGl2Device)?;
         Ok(GpuContext::from_device(&adapter, device, queue))
     })
 }
@@ -135,19 +137,13 @@ fn config_like(ctx: &GpuContext, technique: Technique, (w, h): (u32, u32)) -> Re
 type Drawn = (Technique, Image, &'static str, Option<f64>);
 
 /// Draws `scene` with `config` on `ctx` ([`Drawn`]).
-fn draw(
-    ctx: &GpuContext,
-    scene: &Scene,
-    config: RendererConfig,
-    frames: u32,
-) -> Result<Drawn, String> {
+fn draw(ctx: &GpuContext, scene: &Scene, config: RendererConfig, frames: u32) -> Result<Drawn> {
     let (w, h) = (config.width, config.height);
     let mut r = renderer_for(ctx, scene, config)?;
     let target = Offscreen::new(ctx, w, h);
     let mut ms = Vec::new();
     for i in 0..=frames {
-        r.render_and_submit(&target.view, &scene.cameras[0])
-            .map_err(|e| crate::chain(&e))?;
+        r.render_and_submit(&target.view, &scene.cameras[0])?;
         let t = r.gpu_times_blocking();
         if i > 0 && !t.is_empty() {
             ms.push(t.iter().map(|(_, ms)| ms).sum::<f64>());
@@ -166,7 +162,7 @@ fn draw(
 
 /// Runs every technique on every device of [`devices`] and writes `report.md` and the
 /// pictures into `opts.out`; returns the rows.
-pub fn run(opts: &Options) -> Result<Vec<Row>, String> {
+pub fn run(opts: &Options) -> Result<Vec<Row>> {
     let scene = scene::default_scene(1)?;
     let devices = devices()?;
     let vulkan = &devices[0].ctx;
@@ -175,13 +171,19 @@ pub fn run(opts: &Options) -> Result<Vec<Row>, String> {
         let dir = opts
             .out
             .join(d.name.replace([',', ' '], "_").replace("__", "_"));
-        std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        std::fs::create_dir_all(&dir).map_err(Error::io(&dir))?;
         for t in Technique::ALL {
             let config = config_like(&d.ctx, t, opts.size);
             // Refused before anything is made when the device cannot run it.
             let outcome = match Renderer::new(&d.ctx, scene.world.registry(), config.clone()) {
                 Err(e @ voxel_render::Error::Unsupported(_)) => Outcome::Unsupported(e.to_string()),
-                Err(e) => return Err(format!("{}, {t}: {}", d.name, crate::chain(&e))),
+                Err(source) => {
+                    return Err(Error::Technique {
+                        device: d.name.clone(),
+                        technique: t,
+                        source: Box::new(source),
+                    });
+                }
                 Ok(_) => {
                     let (drew, image, fetch, gpu_ms) = draw(&d.ctx, &scene, config, opts.frames)?;
                     save(&image, &dir.join(format!("{t}.png")))?;
@@ -215,12 +217,12 @@ pub fn run(opts: &Options) -> Result<Vec<Row>, String> {
     }
     let report = markdown(&rows, &devices, opts);
     let path = opts.out.join("report.md");
-    std::fs::write(&path, report).map_err(|e| format!("{}: {e}", path.display()))?;
+    std::fs::write(&path, report).map_err(Error::io(&path))?;
     Ok(rows)
 }
 
-fn save(image: &Image, path: &Path) -> Result<(), String> {
-    image.save_png(path).map_err(|e| crate::chain(&e))
+fn save(image: &Image, path: &Path) -> Result<()> {
+    image.save_png(path).map_err(Error::Render)
 }
 
 /// The table as Markdown, with the devices it was made on.

@@ -2,6 +2,8 @@
 //! against a swept parameter, and bars. PNG (bitmap) and SVG from the same drawing code.
 //! Text uses the Ubuntu font that egui ships, so no system font is needed.
 
+use crate::{Error, Result};
+
 use std::path::Path;
 use std::sync::Once;
 
@@ -46,8 +48,11 @@ pub(crate) fn fonts() {
     });
 }
 
-fn err(e: impl std::fmt::Debug) -> String {
-    format!("chart: {e:?}")
+fn err(e: impl std::fmt::Debug) -> Error {
+    Error::Chart {
+        what: "chart",
+        detail: format!("{e:?}"),
+    }
 }
 
 /// Axis range covering `values` with a margin; on a log axis the range stays positive.
@@ -105,7 +110,7 @@ pub fn speed_vs_accuracy(
     title: &str,
     per_scene: &[Series],
     means: &[Series],
-) -> Result<(), String> {
+) -> Result<()> {
     fonts();
     draw_png(&path.with_extension("png"), (1000, 640), |root| {
         scatter(root, title, per_scene, means)
@@ -121,8 +126,8 @@ pub fn speed_vs_accuracy(
 fn draw_png(
     path: &Path,
     size: (u32, u32),
-    f: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), String>,
-) -> Result<(), String> {
+    f: impl FnOnce(DrawingArea<BitMapBackend<'_>, Shift>) -> Result<()>,
+) -> Result<()> {
     let (w, h) = size;
     let mut rgb = vec![255u8; w as usize * h as usize * 3];
     f(BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area())?;
@@ -136,15 +141,15 @@ fn draw_png(
         rgba,
     }
     .save_png(path)
-    .map_err(|e| crate::chain(&e))
+    .map_err(Error::Render)
 }
 
 /// Draws with `f` into an SVG text in memory and writes it to `path` in one checked write.
 fn draw_svg(
     path: &Path,
     size: (u32, u32),
-    f: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<(), String>,
-) -> Result<(), String> {
+    f: impl FnOnce(DrawingArea<SVGBackend<'_>, Shift>) -> Result<()>,
+) -> Result<()> {
     let mut text = String::new();
     f(SVGBackend::with_string(&mut text, size).into_drawing_area())?;
     crate::files::write_file(path, text.as_bytes())
@@ -155,7 +160,7 @@ fn scatter<DB: DrawingBackend>(
     title: &str,
     per_scene: &[Series],
     means: &[Series],
-) -> Result<(), String>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -228,13 +233,7 @@ where
 }
 
 /// Error against a swept parameter, one line per technique. Writes `path.png` and `.svg`.
-pub fn sweep(
-    path: &Path,
-    title: &str,
-    x_desc: &str,
-    log_x: bool,
-    series: &[Series],
-) -> Result<(), String> {
+pub fn sweep(path: &Path, title: &str, x_desc: &str, log_x: bool, series: &[Series]) -> Result<()> {
     line_chart(
         path,
         title,
@@ -252,7 +251,7 @@ pub fn line_chart(
     (x_desc, y_desc): (&str, &str),
     log_x: bool,
     series: &[Series],
-) -> Result<(), String> {
+) -> Result<()> {
     fonts();
     let axes = (x_desc, y_desc);
     draw_png(&path.with_extension("png"), (900, 560), |root| {
@@ -269,7 +268,7 @@ fn lines<DB: DrawingBackend>(
     (x_desc, y_desc): (&str, &str),
     log_x: bool,
     series: &[Series],
-) -> Result<(), String>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -339,12 +338,7 @@ where
 }
 
 /// One bar per name. Writes `path.png` and `path.svg`.
-pub fn bars(
-    path: &Path,
-    title: &str,
-    y_desc: &str,
-    values: &[(String, f64)],
-) -> Result<(), String> {
+pub fn bars(path: &Path, title: &str, y_desc: &str, values: &[(String, f64)]) -> Result<()> {
     fonts();
     draw_png(&path.with_extension("png"), (900, 520), |root| {
         bar_body(root, title, y_desc, values)
@@ -359,7 +353,7 @@ fn bar_body<DB: DrawingBackend>(
     title: &str,
     y_desc: &str,
     values: &[(String, f64)],
-) -> Result<(), String>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -411,11 +405,7 @@ pub struct Spread {
 /// Speed against accuracy over a distribution of scenes: per technique a marker at the
 /// medians and bars (whiskers) from p10 to p90 of each. Log axes; FLIP below
 /// [`FLIP_FLOOR`] is drawn there. Writes `path.png` and `path.svg`.
-pub fn speed_vs_accuracy_spread(
-    path: &Path,
-    title: &str,
-    spreads: &[Spread],
-) -> Result<(), String> {
+pub fn speed_vs_accuracy_spread(path: &Path, title: &str, spreads: &[Spread]) -> Result<()> {
     fonts();
     draw_png(&path.with_extension("png"), (1000, 640), |root| {
         spread_body(root, title, spreads)
@@ -429,7 +419,7 @@ fn spread_body<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
     spreads: &[Spread],
-) -> Result<(), String>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -485,7 +475,7 @@ pub fn histograms(
     title: &str,
     bins: &[String],
     series: &[(String, Vec<usize>)],
-) -> Result<(), String> {
+) -> Result<()> {
     fonts();
     let cols = 3usize;
     let rows = series.len().div_ceil(cols).max(1);
@@ -504,7 +494,7 @@ fn histogram_body<DB: DrawingBackend>(
     bins: &[String],
     series: &[(String, Vec<usize>)],
     (rows, cols): (usize, usize),
-) -> Result<(), String>
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -640,7 +630,9 @@ mod tests {
         for blocked in ["sva.png", "sva.svg"] {
             let _ = std::fs::remove_dir_all(&dir);
             std::fs::create_dir_all(dir.join(blocked)).unwrap();
-            let e = speed_vs_accuracy(&dir.join("sva"), "t", &s, &s).unwrap_err();
+            let e = speed_vs_accuracy(&dir.join("sva"), "t", &s, &s)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(blocked), "{blocked}: {e}");
         }
         let _ = std::fs::remove_dir_all(dir);

@@ -8,6 +8,8 @@
 //! scenes do not exceed. A technique's worst scene is the one with the highest mean FLIP,
 //! ties broken by the largest channel error.
 
+use crate::{Error, Result};
+
 use serde::Serialize;
 
 use crate::random::{Features, RandomSet};
@@ -496,13 +498,13 @@ pub fn write_worst(
     set: RandomSet,
     d: &Distribution,
     opts: &EvalOptions,
-) -> Result<(), String> {
+) -> Result<()> {
     let size = (d.width, d.height);
     let index = |name: &str| d.scenes.iter().position(|s| s.scene == name);
-    let write = |rel: &str, index: usize, comment: &str| -> Result<(), String> {
+    let write = |rel: &str, index: usize, comment: &str| -> Result<()> {
         let path = out.join(rel);
         if let Some(dir) = path.parent() {
-            std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+            std::fs::create_dir_all(dir).map_err(Error::io(dir))?;
         }
         let text = format!(
             "# {comment}\n# Replay: demo eval --scenes {rel} --frames {} --warmup {}\n{}",

@@ -1,6 +1,8 @@
 //! Runs of the lab: every scene of a suite rendered with every technique and with both
 //! exact methods; error and cost per picture, as [`Record`]s.
 
+use crate::{Error, Result};
+
 use std::path::Path;
 
 use voxel_render::{
@@ -18,11 +20,7 @@ use crate::summary::{
 };
 
 /// A renderer for measurements, sized `size`.
-pub fn make_renderer(
-    ctx: &GpuContext,
-    scene: &Scene,
-    size: (u32, u32),
-) -> Result<SceneRenderer, String> {
+pub fn make_renderer(ctx: &GpuContext, scene: &Scene, size: (u32, u32)) -> Result<SceneRenderer> {
     let config = RendererConfig {
         width: size.0,
         height: size.1,
@@ -66,18 +64,14 @@ pub fn measure(
     config: &OitConfig,
     warmup: usize,
     frames: usize,
-) -> Result<Measured, String> {
-    renderer
-        .set_oit_config(config.clone())
-        .map_err(|e| crate::chain(&e))?;
+) -> Result<Measured> {
+    renderer.set_oit_config(config.clone())?;
     let mut gpu = Vec::new();
     let mut cpu = Vec::new();
     let mut sort = Vec::new();
     let mut stats = FrameStats::default();
     for i in 0..warmup + frames.max(1) {
-        stats = renderer
-            .render_and_submit(&target.view, camera)
-            .map_err(|e| crate::chain(&e))?;
+        stats = renderer.render_and_submit(&target.view, camera)?;
         let times = renderer.gpu_times_blocking();
         if i >= warmup {
             cpu.push(stats.cpu_ms);
@@ -100,9 +94,8 @@ pub fn measure(
 }
 
 /// The HDR scene colour as f32 RGBA.
-pub fn read_hdr(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>, String> {
-    let bytes =
-        voxel_render::readback::read_texture(ctx, texture, 8).map_err(|e| crate::chain(&e))?;
+pub fn read_hdr(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<[f32; 4]>> {
+    let bytes = voxel_render::readback::read_texture(ctx, texture, 8)?;
     Ok(bytes
         .chunks_exact(8)
         .map(|p| {
@@ -143,7 +136,7 @@ pub fn reference(
     camera: &Camera,
     scene: &Scene,
     name: &str,
-) -> Result<(Reference, RayMarchCheck), String> {
+) -> Result<(Reference, RayMarchCheck)> {
     let weight = default_weight();
     let abuffer = measure(
         ctx,
@@ -228,7 +221,7 @@ pub fn raymarch_check(
     scene: &Scene,
     camera: &Camera,
     size: (u32, u32),
-) -> Result<RayMarchCheck, String> {
+) -> Result<RayMarchCheck> {
     let config = RendererConfig {
         width: size.0,
         height: size.1,
@@ -239,12 +232,9 @@ pub fn raymarch_check(
     let shading = raymarch::Shading::of(&config);
     let mut renderer = renderer_for(ctx, scene, config)?;
     let target = Offscreen::new(ctx, size.0, size.1);
-    renderer
-        .render_and_submit(&target.view, camera)
-        .map_err(|e| crate::chain(&e))?;
+    renderer.render_and_submit(&target.view, camera)?;
     let gpu = target.read(ctx)?;
-    let depth: Vec<f32> = voxel_render::readback::read_texture(ctx, renderer.scene_depth(), 4)
-        .map_err(|e| crate::chain(&e))?
+    let depth: Vec<f32> = voxel_render::readback::read_texture(ctx, renderer.scene_depth(), 4)?
         .chunks_exact(4)
         .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
         .collect();
@@ -286,7 +276,7 @@ impl EvalOptions {
     /// reads every scene file (parsing it and checking the size it asks for), so that
     /// nothing is rendered or written when any of it is wrong. The error names the option
     /// or the file.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         use crate::limits::{self, check_range};
         if let Some(size) = self.size {
             limits::check_size("--size", size)?;
@@ -317,7 +307,7 @@ impl EvalOptions {
         }
         if self.random.is_none() {
             if self.scenes.is_empty() {
-                return Err("no scene files to evaluate".into());
+                return Err(Error::NoScenes { dir: None });
             }
             for path in &self.scenes {
                 // Parsing checks a scene's own size against the same caps.
@@ -341,7 +331,7 @@ fn scene_records(
     scene: &Scene,
     heatmaps: bool,
     progress: &mut Progress,
-) -> Result<(Vec<Record>, ReferenceCheck), String> {
+) -> Result<(Vec<Record>, ReferenceCheck)> {
     let stem = stem.to_owned();
     let size = opts.size.or(scene.size).unwrap_or(DEFAULT_SIZE);
     let mut renderer = make_renderer(ctx, scene, size)?;
@@ -431,18 +421,18 @@ fn scene_records(
     Ok((records, reference.check))
 }
 
-fn save(image: &Image, path: &Path) -> Result<(), String> {
-    image.save_png(path).map_err(|e| crate::chain(&e))
+fn save(image: &Image, path: &Path) -> Result<()> {
+    image.save_png(path).map_err(Error::Render)
 }
 
 /// Measures every scene of `opts` with every technique against its reference.
-pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary, String> {
+pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary> {
     let dir = if opts.random.is_some() {
         opts.out.clone()
     } else {
         opts.out.join("heatmaps")
     };
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(Error::io(&dir))?;
     let count = opts.random.map_or(opts.scenes.len(), |r| r.count);
     let mut progress = Progress::new(count * (runs(opts).len() + 1));
     let mut records = Vec::new();
@@ -453,8 +443,8 @@ pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary, String
             Some(set) => {
                 // Parsed from its text like a scene file, so that the text replays it.
                 let generated = set.scene(i, opts.size.unwrap_or(DEFAULT_SIZE));
-                let scene = crate::scene::parse(&generated.text)
-                    .map_err(|e| format!("{}:{e}", generated.name))?;
+                let scene =
+                    crate::scene::parse(&generated.text).map_err(|e| e.in_file(&generated.name))?;
                 features.push(SceneFeatures {
                     scene: generated.name.clone(),
                     features: generated.features,

@@ -1,6 +1,8 @@
 //! One scene under every technique: each picture with its FLIP error map against the exact
 //! reference (the A-buffer), side by side in one labelled sheet (`demo gallery`).
 
+use crate::{Error, Result};
+
 use std::path::Path;
 
 use plotters::prelude::*;
@@ -27,7 +29,7 @@ pub struct Entry {
 /// Renders `scene`'s first camera at `size` with the reference and every technique
 /// (default settings; two frames each, so that adaptive peeling settles), and compares
 /// each with the reference.
-pub fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32)) -> Result<Vec<Entry>, String> {
+pub fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32)) -> Result<Vec<Entry>> {
     let config = voxel_render::RendererConfig {
         width: size.0,
         height: size.1,
@@ -36,10 +38,8 @@ pub fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32)) -> Result<Vec<E
     let mut renderer = renderer_for(ctx, scene, config)?;
     let target = Offscreen::new(ctx, size.0, size.1);
     let camera = &scene.cameras[0];
-    let mut draw = |t: Technique| -> Result<Image, String> {
-        renderer
-            .set_oit_config(oit_config(t, default_weight()))
-            .map_err(|e| crate::chain(&e))?;
+    let mut draw = |t: Technique| -> Result<Image> {
+        renderer.set_oit_config(oit_config(t, default_weight()))?;
         render_image(ctx, &mut renderer, &target, camera)?;
         render_image(ctx, &mut renderer, &target, camera)
     };
@@ -62,16 +62,13 @@ pub fn render(ctx: &GpuContext, scene: &Scene, size: (u32, u32)) -> Result<Vec<E
 /// Writes `<technique>.png` and `<technique>_flip.png` per entry into `out`, and
 /// `gallery.png`: a sheet of `columns` tiles, each the picture over its error map under a
 /// line naming the technique, its mean FLIP and its largest channel error.
-pub fn write(out: &Path, entries: &[Entry], columns: usize) -> Result<(), String> {
-    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+pub fn write(out: &Path, entries: &[Entry], columns: usize) -> Result<()> {
+    std::fs::create_dir_all(out).map_err(Error::io(out))?;
     for e in entries {
         let name = e.technique.name();
-        e.image
-            .save_png(&out.join(format!("{name}.png")))
-            .map_err(|e| crate::chain(&e))?;
+        e.image.save_png(&out.join(format!("{name}.png")))?;
         e.error_map
-            .save_png(&out.join(format!("{name}_flip.png")))
-            .map_err(|e| crate::chain(&e))?;
+            .save_png(&out.join(format!("{name}_flip.png")))?;
     }
     let Some(first) = entries.first() else {
         return Ok(());
@@ -116,9 +113,15 @@ pub fn write(out: &Path, entries: &[Entry], columns: usize) -> Result<(), String
                 e.metrics.max_abs_err
             );
             root.draw(&Text::new(text, (x0 as i32, y0 as i32), style.clone()))
-                .map_err(|e| format!("gallery: {e:?}"))?;
+                .map_err(|e| Error::Chart {
+                    what: "gallery",
+                    detail: format!("{e:?}"),
+                })?;
         }
-        root.present().map_err(|e| format!("gallery: {e:?}"))?;
+        root.present().map_err(|e| Error::Chart {
+            what: "gallery",
+            detail: format!("{e:?}"),
+        })?;
     }
     let rgba = rgb
         .chunks_exact(3)
@@ -130,5 +133,5 @@ pub fn write(out: &Path, entries: &[Entry], columns: usize) -> Result<(), String
         rgba,
     }
     .save_png(&out.join("gallery.png"))
-    .map_err(|e| crate::chain(&e))
+    .map_err(Error::Render)
 }

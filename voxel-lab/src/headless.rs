@@ -1,5 +1,7 @@
 //! Rendering without a window: a headless GPU, an offscreen target, PNG output.
 
+use crate::{Error, Result};
+
 use voxel_mesh::mesh_chunks;
 use voxel_render::low_level::{Limit, Need};
 use voxel_render::{
@@ -12,7 +14,7 @@ use crate::scene::Scene;
 
 /// A headless context on Vulkan (lavapipe on a machine without a GPU), or the backends
 /// named by `WGPU_BACKEND`, with the adapter's limits.
-pub fn context() -> Result<GpuContext, String> {
+pub fn context() -> Result<GpuContext> {
     Device::from_env().context()
 }
 
@@ -35,8 +37,8 @@ impl Device {
     }
 
     /// A headless context on it.
-    pub fn context(&self) -> Result<GpuContext, String> {
-        GpuContext::headless_with(self.backends, self.limits).map_err(|e| crate::chain(&e))
+    pub fn context(&self) -> Result<GpuContext> {
+        GpuContext::headless_with(self.backends, self.limits).map_err(Error::Render)
     }
 
     /// Its name in reports: the backends and, unless the adapter's, the limits.
@@ -61,14 +63,17 @@ pub const BACKENDS: [(&str, wgpu::Backends); 4] = [
 ];
 
 /// Parses a backend's name ([`BACKENDS`]); the error lists the names.
-pub fn backend(name: &str) -> Result<wgpu::Backends, String> {
+pub fn backend(name: &str) -> Result<wgpu::Backends> {
     BACKENDS
         .iter()
         .find(|(n, _)| *n == name)
         .map(|(_, b)| *b)
         .ok_or_else(|| {
             let names: Vec<&str> = BACKENDS.iter().map(|(n, _)| *n).collect();
-            format!("{name:?}: expected one of {}", names.join(", "))
+            Error::UnknownBackend {
+                name: name.to_owned(),
+                known: names.join(", "),
+            }
         })
 }
 
@@ -99,8 +104,8 @@ impl Offscreen {
     }
 
     /// Reads the target back.
-    pub fn read(&self, ctx: &GpuContext) -> Result<Image, String> {
-        let rgba = readback::read_texture(ctx, &self.texture, 4).map_err(|e| crate::chain(&e))?;
+    pub fn read(&self, ctx: &GpuContext) -> Result<Image> {
+        let rgba = readback::read_texture(ctx, &self.texture, 4)?;
         Ok(Image {
             width: self.texture.width(),
             height: self.texture.height(),
@@ -167,19 +172,15 @@ pub fn renderer_for(
     ctx: &GpuContext,
     scene: &Scene,
     config: RendererConfig,
-) -> Result<SceneRenderer, String> {
+) -> Result<SceneRenderer> {
     if !scene.content.is_empty() {
         let what = format!("{}: the lab's game content", scene.name);
-        voxel_render::low_level::check(&what, &content_needs(), &ctx.caps)
-            .map_err(|e| crate::chain(&e))?;
+        voxel_render::low_level::check(&what, &content_needs(), &ctx.caps)?;
     }
-    let mut renderer =
-        Renderer::new(ctx, scene.world.registry(), config).map_err(|e| crate::chain(&e))?;
+    let mut renderer = Renderer::new(ctx, scene.world.registry(), config)?;
     let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
-    for (pos, meshes) in mesh_chunks(&scene.world, &positions).map_err(|e| e.to_string())? {
-        renderer
-            .upload_chunk(pos, &meshes)
-            .map_err(|e| crate::chain(&e))?;
+    for (pos, meshes) in mesh_chunks(&scene.world, &positions)? {
+        renderer.upload_chunk(pos, &meshes)?;
     }
     // The lab builds its content's pipelines when it renders (`render_and_submit`), so that
     // its tests see the renderer refuse pipelines built for another contract.
@@ -197,9 +198,7 @@ pub fn render_image(
     renderer: &mut SceneRenderer,
     target: &Offscreen,
     camera: &Camera,
-) -> Result<Image, String> {
-    renderer
-        .render_and_submit(&target.view, camera)
-        .map_err(|e| crate::chain(&e))?;
+) -> Result<Image> {
+    renderer.render_and_submit(&target.view, camera)?;
     target.read(ctx)
 }

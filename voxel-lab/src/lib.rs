@@ -3,7 +3,7 @@
 //! It has no window: the demo's window and the integration tests both build on it.
 //!
 //! Modules depend on each other one way:
-//! - the model: [`files`] (result files written in one checked call), [`limits`] (the
+//! - the model: [`error`] (what can go wrong, [`Error`]), [`files`] (result files written in one checked call), [`limits`] (the
 //!   documented caps on a run), [`progress`], [`random`]
 //!   (random scenes as scene-file text), [`edges`] (which pixels lie on quad edges),
 //!   [`content`] (what the ray march needs of a game's particles and entities),
@@ -23,6 +23,7 @@ pub mod charts;
 pub mod content;
 pub mod distribution;
 pub mod edges;
+pub mod error;
 pub mod eval;
 pub mod files;
 pub mod gallery;
@@ -38,6 +39,7 @@ pub mod stability;
 pub mod stream;
 pub mod summary;
 
+pub use error::{Error, Result};
 pub use summary::{EvalOptions, Summary};
 
 /// `e` and its sources, joined by ": " (what a user needs to see of a renderer error).
@@ -59,7 +61,7 @@ pub fn chain(e: &dyn std::error::Error) -> String {
 ///
 /// Fails before rendering anything when `opts` asks for more than [`limits`] allows, a
 /// scene file is broken or asks for a size past the caps ([`EvalOptions::validate`]).
-pub fn evaluate(ctx: &voxel_render::GpuContext, opts: &EvalOptions) -> Result<Summary, String> {
+pub fn evaluate(ctx: &voxel_render::GpuContext, opts: &EvalOptions) -> Result<Summary> {
     opts.validate()?;
     let out = &opts.out;
     let summary = eval::run_suite(ctx, opts)?;

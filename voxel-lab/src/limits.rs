@@ -3,6 +3,8 @@
 //! written: by the command line's parsers, by scene parsing, and by
 //! `EvalOptions::validate`, which `evaluate` runs first.
 
+use crate::{Error, Result};
+
 /// Widest and tallest picture, in pixels: twice a 4K display's width.
 pub const MAX_SIDE: u32 = 8192;
 /// Most pixels in a picture: an 8K UHD display (7680 × 4320), 33.2 M. The exact
@@ -32,26 +34,30 @@ pub const MAX_SCENE_FILE_BYTES: u64 = 1 << 20;
 
 /// Checks a picture size against [`MAX_SIDE`] and [`MAX_PIXELS`]; the error names `what`
 /// (a flag or a field) and the limits.
-pub fn check_size(what: &str, (w, h): (u32, u32)) -> Result<(), String> {
-    if !(1..=MAX_SIDE).contains(&w) || !(1..=MAX_SIDE).contains(&h) {
-        return Err(format!(
-            "{what} {w}x{h}: each side must be from 1 to {MAX_SIDE} pixels"
-        ));
-    }
-    if u64::from(w) * u64::from(h) > MAX_PIXELS {
-        return Err(format!(
-            "{what} {w}x{h}: at most {MAX_PIXELS} pixels (7680x4320) in all"
-        ));
+pub fn check_size(what: &str, (w, h): (u32, u32)) -> Result<()> {
+    let sides = (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h);
+    if !sides || u64::from(w) * u64::from(h) > MAX_PIXELS {
+        return Err(Error::Size {
+            what: what.to_owned(),
+            size: (w, h),
+            max_side: MAX_SIDE,
+            max_pixels: MAX_PIXELS,
+        });
     }
     Ok(())
 }
 
 /// Checks that `value` of `what` lies in `min..=max`.
-pub fn check_range(what: &str, value: u64, min: u64, max: u64) -> Result<(), String> {
+pub fn check_range(what: &str, value: u64, min: u64, max: u64) -> Result<()> {
     if (min..=max).contains(&value) {
         Ok(())
     } else {
-        Err(format!("{what} {value}: it must be from {min} to {max}"))
+        Err(Error::OutOfRange {
+            what: what.to_owned(),
+            value,
+            min,
+            max,
+        })
     }
 }
 
@@ -70,7 +76,7 @@ mod tests {
             ((8192, 8192), "33177600"),
             ((8193, 1), "8192"),
         ] {
-            let e = check_size("--size", bad).unwrap_err();
+            let e = check_size("--size", bad).unwrap_err().to_string();
             assert!(e.contains("--size") && e.contains(word), "{bad:?}: {e}");
         }
         assert!(check_range("--frames", 0, 1, 1000).is_err());
@@ -78,6 +84,7 @@ mod tests {
         assert!(
             check_range("--warmup", u64::from(u32::MAX), 0, 100)
                 .unwrap_err()
+                .to_string()
                 .contains("4294967295")
         );
     }

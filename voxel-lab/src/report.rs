@@ -1,5 +1,7 @@
 //! `report.md`: every figure of an evaluation in tables, with the charts and heat maps.
 
+use crate::Result;
+
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -46,11 +48,11 @@ fn ranking<'a>(summary: &'a Summary, scene: &str) -> Vec<&'a Record> {
 
 /// The speed-against-accuracy chart. `opaque-only` (draws no translucency, costs nothing)
 /// stays out of it.
-pub fn chart(out: &Path, summary: &Summary, opts: &EvalOptions) -> Result<(), String> {
+pub fn chart(out: &Path, summary: &Summary, opts: &EvalOptions) -> Result<()> {
     chart_to(&out.join("speed_vs_accuracy"), summary, opts)
 }
 
-fn chart_to(path: &Path, summary: &Summary, opts: &EvalOptions) -> Result<(), String> {
+fn chart_to(path: &Path, summary: &Summary, opts: &EvalOptions) -> Result<()> {
     let names: Vec<String> = summary
         .main_techniques()
         .into_iter()
@@ -103,7 +105,7 @@ pub fn random_charts(
     summary: &Summary,
     dist: &Distribution,
     opts: &EvalOptions,
-) -> Result<(), String> {
+) -> Result<()> {
     let main = summary.main_techniques();
     let spreads: Vec<Spread> = dist
         .techniques
@@ -146,7 +148,7 @@ pub fn random_charts(
 }
 
 /// Draws the stability charts into `out/stability/`: one per sweep, one per flicker path.
-pub fn stability_charts(out: &Path, st: &Stability) -> Result<(), String> {
+pub fn stability_charts(out: &Path, st: &Stability) -> Result<()> {
     let dir = out.join("stability");
     for sw in &st.sweeps {
         let series: Vec<Series> = sw
@@ -187,7 +189,7 @@ pub fn write(
     distribution: Option<&Distribution>,
     stability: Option<&Stability>,
     opts: &EvalOptions,
-) -> Result<(), String> {
+) -> Result<()> {
     let mut s = String::new();
     if let Some(d) = distribution {
         random_report(&mut s, summary, d, opts);
@@ -209,7 +211,7 @@ pub fn write(
 }
 
 /// Writes `out/report.md`; an error names that file.
-fn write_report(out: &Path, text: String) -> Result<(), String> {
+fn write_report(out: &Path, text: String) -> Result<()> {
     let path = out.join("report.md");
     crate::files::write_file(&path, text.as_bytes())
 }

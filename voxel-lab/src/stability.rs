@@ -2,6 +2,8 @@
 //! distance of the stack) and chart each technique's error against it, and a camera path
 //! that measures temporal flicker beyond the reference's own change.
 
+use crate::{Error, Result};
+
 use std::sync::Arc;
 
 use glam::DVec3;
@@ -92,7 +94,7 @@ fn sheets(
     zs: &[i32],
     half: i32,
     eye_z: f64,
-) -> Result<Scene, String> {
+) -> Result<Scene> {
     let mut world = World::new(registry);
     let back = zs.iter().min().copied().unwrap_or(0) - 4;
     let fill =
@@ -123,8 +125,7 @@ fn sheets(
         60.0,
         0.1,
         4000.0,
-    )
-    .map_err(|e| crate::chain(&e))?;
+    )?;
     Ok(Scene::new("sweep", world, camera))
 }
 
@@ -135,7 +136,7 @@ fn errors(
     opts: &EvalOptions,
     size: (u32, u32),
     techniques: &[Technique],
-) -> Result<Vec<f64>, String> {
+) -> Result<Vec<f64>> {
     let mut renderer = make_renderer(ctx, scene, size)?;
     let target = Offscreen::new(ctx, size.0, size.1);
     let cam = scene.cameras[0];
@@ -169,9 +170,9 @@ fn errors(
 const COLORS: [[u8; 3]; 4] = [[210, 60, 40], [40, 90, 210], [60, 180, 70], [230, 200, 60]];
 
 /// Runs the sweeps and the flicker paths, writes `stability/stability.json`.
-pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability, String> {
+pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability> {
     let dir = opts.out.join("stability");
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(Error::io(&dir))?;
     let techniques = swept(opts);
     let size = opts
         .size
@@ -190,8 +191,8 @@ pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability, String> {
                      parameter: &str,
                      log: bool,
                      values: &[f64],
-                     build: &dyn Fn(f64) -> Result<Scene, String>|
-     -> Result<Sweep, String> {
+                     build: &dyn Fn(f64) -> Result<Scene>|
+     -> Result<Sweep> {
         let mut flip = vec![Vec::new(); techniques.len()];
         for &v in values {
             progress.step(&format!("stability: {name} {v}"));
@@ -262,7 +263,7 @@ pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability, String> {
 
 /// The scenes whose camera paths measure flicker: the greenhouse and the corridor when in
 /// the suite, else the first scene with a path.
-fn flicker_scenes(opts: &EvalOptions) -> Result<Vec<(String, Scene)>, String> {
+fn flicker_scenes(opts: &EvalOptions) -> Result<Vec<(String, Scene)>> {
     let mut out = Vec::new();
     let stem = |p: &std::path::PathBuf| {
         p.file_stem()
@@ -292,7 +293,7 @@ fn flicker_path(
     opts: &EvalOptions,
     size: (u32, u32),
     techniques: &[Technique],
-) -> Result<Flicker, String> {
+) -> Result<Flicker> {
     let start = scene.cameras[0];
     let end = scene.paths[0].unwrap_or(start.eye + DVec3::X * 2.0);
     let frames = opts.flicker_frames.max(2);
@@ -311,7 +312,7 @@ fn flicker_path(
     let path = |renderer: &mut crate::headless::SceneRenderer,
                 t: Technique,
                 visit: &mut dyn FnMut(usize, voxel_render::Image)|
-     -> Result<(), String> {
+     -> Result<()> {
         // Settle at the start (pipelines, adaptive peeling), then walk the path.
         measure(
             ctx,
@@ -323,9 +324,7 @@ fn flicker_path(
             0,
         )?;
         for (i, c) in cameras.iter().enumerate() {
-            renderer
-                .render_and_submit(&target.view, c)
-                .map_err(|e| crate::chain(&e))?;
+            renderer.render_and_submit(&target.view, c)?;
             visit(i, target.read(ctx)?);
         }
         Ok(())

@@ -7,6 +7,8 @@
 //! distance is loaded until the streamer is idle (`prefill_ms`), so that the frames measure
 //! the steady streaming of a flight, not the first load.
 
+use crate::{Error, Result};
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -68,34 +70,43 @@ impl Default for StreamOptions {
 
 impl StreamOptions {
     /// Checks the options a user gives (the streamer checks its own configuration too).
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<()> {
         if !(1..=MAX_VIEW_DISTANCE).contains(&self.view_distance) {
-            return Err(format!(
-                "--view-distance {}: it must be from 1 to {MAX_VIEW_DISTANCE}",
-                self.view_distance
+            return Err(Error::option(
+                "--view-distance",
+                format!(
+                    "{}: it must be from 1 to {MAX_VIEW_DISTANCE}",
+                    self.view_distance
+                ),
             ));
         }
         if self.vertical_distance > MAX_VIEW_DISTANCE {
-            return Err(format!(
-                "vertical distance {}: it must be from 0 to {MAX_VIEW_DISTANCE}",
-                self.vertical_distance
+            return Err(Error::option(
+                "vertical distance",
+                format!(
+                    "{}: it must be from 0 to {MAX_VIEW_DISTANCE}",
+                    self.vertical_distance
+                ),
             ));
         }
         if self.frames == 0 {
-            return Err("--frames must be at least 1".into());
+            return Err(Error::option("--frames", "must be at least 1"));
         }
         if let Some(t) = self.teleport_at
             && t >= self.frames
         {
-            return Err(format!(
-                "--teleport-at {t}: it must be a frame of the flight (0 to {})",
-                self.frames - 1
+            return Err(Error::option(
+                "--teleport-at",
+                format!(
+                    "{t}: it must be a frame of the flight (0 to {})",
+                    self.frames - 1
+                ),
             ));
         }
         if !(self.speed.is_finite() && (0.0..=1024.0).contains(&self.speed)) {
-            return Err(format!(
-                "--speed {}: it must be from 0 to 1024 blocks per frame",
-                self.speed
+            return Err(Error::option(
+                "--speed",
+                format!("{}: it must be from 0 to 1024 blocks per frame", self.speed),
             ));
         }
         Ok(())
@@ -241,11 +252,7 @@ pub fn rss_bytes() -> Option<u64> {
 }
 
 /// The eye at `frame`: 40 blocks above the ground at the origin, flying along +x.
-fn camera_at(
-    generator: &TerrainGenerator,
-    opts: &StreamOptions,
-    frame: usize,
-) -> Result<Camera, String> {
+fn camera_at(generator: &TerrainGenerator, opts: &StreamOptions, frame: usize) -> Result<Camera> {
     let y = generator.height_at(0, 0) as f64 + 40.0;
     let z = match opts.teleport_at {
         Some(t) if frame >= t => TELEPORT_CHUNKS * 32.0,
@@ -254,14 +261,14 @@ fn camera_at(
     let eye = DVec3::new(0.5 + opts.speed * frame as f64, y, 0.5 + z);
     let far = (f64::from(opts.view_distance) * 32.0 * 1.5).max(200.0);
     Camera::from_yaw_pitch(eye, std::f64::consts::FRAC_PI_2, -0.25, 70.0, 0.1, far)
-        .map_err(|e| crate::chain(&e))
+        .map_err(Error::Render)
 }
 
 /// Flies `opts` and writes `stream.json`, `frames.json` and the `cpu_ms` chart into
 /// `opts.out`.
-pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, String> {
+pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
     opts.validate()?;
-    std::fs::create_dir_all(&opts.out).map_err(|e| format!("{}: {e}", opts.out.display()))?;
+    std::fs::create_dir_all(&opts.out).map_err(Error::io(&opts.out))?;
     let registry = Arc::new(BlockRegistry::default());
     let generator = TerrainGenerator::new(TerrainConfig {
         seed: opts.seed,
@@ -272,8 +279,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
         vertical_distance: opts.vertical_distance,
         ..StreamConfig::default()
     };
-    let mut streamer = ChunkStreamer::new(registry.clone(), generator.clone(), config)
-        .map_err(|e| crate::chain(&e))?;
+    let mut streamer = ChunkStreamer::new(registry.clone(), generator.clone(), config)?;
     let (w, h) = opts.size;
     let mut renderer = Renderer::new(
         ctx,
@@ -284,8 +290,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
             draw: opts.draw,
             ..RendererConfig::default()
         },
-    )
-    .map_err(|e| crate::chain(&e))?;
+    )?;
     let target = Offscreen::new(ctx, w, h);
     let mut failed = 0;
 
@@ -293,9 +298,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
     let start = Instant::now();
     let first = camera_at(&generator, opts, 0)?;
     while !streamer.is_idle() {
-        let f = streamer
-            .update(first.eye, &mut renderer)
-            .map_err(|e| crate::chain(&e))?;
+        let f = streamer.update(first.eye, &mut renderer)?;
         failed += f.failed.len();
         std::thread::sleep(std::time::Duration::from_micros(500));
     }
@@ -306,9 +309,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
     for i in 0..opts.frames {
         let camera = camera_at(&generator, opts, i)?;
         let t0 = Instant::now();
-        let f = streamer
-            .update(camera.eye, &mut renderer)
-            .map_err(|e| crate::chain(&e))?;
+        let f = streamer.update(camera.eye, &mut renderer)?;
         let stream_ms = t0.elapsed().as_secs_f64() * 1e3;
         failed += f.failed.len();
         let mut encoder = ctx
@@ -316,9 +317,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("stream_frame"),
             });
-        let stats = renderer
-            .render(&mut encoder, &target.view, &camera, &mut NoGame)
-            .map_err(|e| crate::chain(&e))?;
+        let stats = renderer.render(&mut encoder, &target.view, &camera, &mut NoGame)?;
         let t1 = Instant::now();
         ctx.queue.submit([encoder.finish()]);
         let submit_ms = t1.elapsed().as_secs_f64() * 1e3;
@@ -394,7 +393,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport, Strin
 }
 
 /// CPU ms per frame over the flight: the whole frame, the streamer and the recording.
-fn chart(path: &Path, report: &StreamReport, records: &[StreamFrameRecord]) -> Result<(), String> {
+fn chart(path: &Path, report: &StreamReport, records: &[StreamFrameRecord]) -> Result<()> {
     let line = |name: &str, f: fn(&StreamFrameRecord) -> f64| Series {
         name: name.to_owned(),
         points: records

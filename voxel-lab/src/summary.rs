@@ -2,6 +2,8 @@
 //! technique, the exact methods' agreement per scene ([`ReferenceCheck`]), and the
 //! questions the charts and the report ask of them.
 
+use crate::Result;
+
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -250,7 +252,7 @@ pub fn is_real_time(run: &str) -> bool {
 }
 
 /// Writes `value` as pretty JSON.
-pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), String> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
+pub fn write_json(path: &Path, value: &impl Serialize) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)?;
     crate::files::write_file(path, (text + "\n").as_bytes())
 }

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use voxel_lab::chain;
+use crate::{Error, Result};
 use voxel_render::GpuContext;
 use winit::window::Window;
 
@@ -22,7 +22,7 @@ impl Display {
         window: Arc<Window>,
         backends: Option<wgpu::Backends>,
         limits: voxel_render::LimitsPreset,
-    ) -> Result<(Self, GpuContext), String> {
+    ) -> Result<(Self, GpuContext)> {
         // The window's display: wgpu's GL backend makes its EGL display from it.
         let mut desc = wgpu::InstanceDescriptor::new_with_display_handle(Box::new(window.clone()));
         desc.backends = backends
@@ -31,18 +31,15 @@ impl Display {
         let instance = wgpu::Instance::new(desc);
         let surface = instance
             .create_surface(window.clone())
-            .map_err(|e| format!("cannot create a surface for the window: {e}"))?;
+            .map_err(Error::CreateSurface)?;
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             compatible_surface: Some(&surface),
             ..Default::default()
         }))
-        .map_err(|e| {
-            format!("no GPU adapter can draw to this window: {e} (install mesa-vulkan-drivers)")
-        })?;
+        .map_err(Error::NoWindowAdapter)?;
         let (device, queue) =
-            pollster::block_on(voxel_render::request_device_with(&adapter, limits))
-                .map_err(|e| chain(&e))?;
+            pollster::block_on(voxel_render::request_device_with(&adapter, limits))?;
         let ctx = GpuContext::from_device(&adapter, device, queue);
         let caps = surface.get_capabilities(&adapter);
         let format = caps
@@ -51,7 +48,7 @@ impl Display {
             .copied()
             .find(|f| f.is_srgb())
             .or_else(|| caps.formats.first().copied())
-            .ok_or("the surface offers no format")?;
+            .ok_or(Error::NoSurfaceFormat)?;
         let size = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -95,7 +92,7 @@ impl Display {
     /// This frame's surface texture, or `None` when there is none to draw to this time
     /// (the surface was outdated or lost and is being reconfigured, or the window is
     /// minimised or hidden): try again next frame.
-    pub fn acquire(&mut self, ctx: &GpuContext) -> Result<Option<wgpu::SurfaceTexture>, String> {
+    pub fn acquire(&mut self, ctx: &GpuContext) -> Result<Option<wgpu::SurfaceTexture>> {
         match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t) => Ok(Some(t)),
             wgpu::CurrentSurfaceTexture::Suboptimal(t) => {
@@ -111,7 +108,7 @@ impl Display {
                 self.surface = self
                     .instance
                     .create_surface(self.window.clone())
-                    .map_err(|e| format!("surface lost and not recreated: {e}"))?;
+                    .map_err(Error::SurfaceLost)?;
                 self.surface.configure(&ctx.device, &self.config);
                 Ok(None)
             }

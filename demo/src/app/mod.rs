@@ -20,6 +20,8 @@ use std::time::{Duration, Instant};
 use glam::DVec3;
 use voxel_core::{BlockId, BlockRegistry, ChunkPos, RenderClass, TerrainConfig, TerrainGenerator};
 use voxel_lab::{chain, scene};
+
+use crate::{Error, Result};
 use voxel_mesh::ChunkMeshes;
 use voxel_render::{
     Camera, ChunkSink, ChunkStreamer, FrameStats, GpuContext, GpuTimes, Image, Lighting, OitConfig,
@@ -103,23 +105,21 @@ pub fn have_display() -> bool {
 }
 
 /// Opens the window and runs until it is closed (or the script ends).
-pub fn run(opts: DemoOptions) -> Result<(), String> {
-    let event_loop = EventLoop::new().map_err(|e| format!("cannot open a window: {e}"))?;
+pub fn run(opts: DemoOptions) -> Result<()> {
+    let event_loop = EventLoop::new().map_err(Error::NoEventLoop)?;
     let mut app = App {
         opts,
         gfx: None,
         error: None,
     };
-    event_loop
-        .run_app(&mut app)
-        .map_err(|e| format!("event loop: {e}"))?;
+    event_loop.run_app(&mut app).map_err(Error::EventLoop)?;
     app.error.map_or(Ok(()), Err)
 }
 
 struct App {
     opts: DemoOptions,
     gfx: Option<Gfx>,
-    error: Option<String>,
+    error: Option<Error>,
 }
 
 impl ApplicationHandler for App {
@@ -135,7 +135,7 @@ impl ApplicationHandler for App {
             ));
         let result = event_loop
             .create_window(attrs)
-            .map_err(|e| format!("cannot create the window: {e}"))
+            .map_err(Error::CreateWindow)
             .and_then(|w| Gfx::new(Arc::new(w), self.opts.clone()));
         match result {
             Ok(g) => {
@@ -299,11 +299,7 @@ impl ChunkSink for Sinks<'_> {
 
 /// A streamer of `seed`'s terrain (or of the opened scene's world) with `view_distance`
 /// chunks each way (4 up and down).
-fn streamer(
-    seed: u32,
-    view_distance: u32,
-    scene: Option<&OpenScene>,
-) -> Result<ChunkStreamer, String> {
+fn streamer(seed: u32, view_distance: u32, scene: Option<&OpenScene>) -> Result<ChunkStreamer> {
     let config = StreamConfig {
         view_distance,
         vertical_distance: 4,
@@ -319,7 +315,7 @@ fn streamer(
             ChunkStreamer::new(Arc::new(BlockRegistry::default()), generator, config)
         }
     }
-    .map_err(|e| chain(&e))
+    .map_err(Error::from)
 }
 
 /// A scene opened with `--scene`: its name and world (streamed like terrain).
@@ -379,7 +375,7 @@ struct Gfx {
 }
 
 impl Gfx {
-    fn new(window: Arc<Window>, opts: DemoOptions) -> Result<Self, String> {
+    fn new(window: Arc<Window>, opts: DemoOptions) -> Result<Self> {
         let (display, ctx) = Display::new(window, opts.backends, opts.limits)?;
         // The scene's first camera, or the default view of the seed (its world is only the
         // few chunks around it).
@@ -424,12 +420,12 @@ impl Gfx {
         let registry = open
             .as_ref()
             .map_or_else(BlockRegistry::default, |s| (**s.world.registry()).clone());
-        let mut renderer = Renderer::new(&ctx, &registry, config).map_err(|e| chain(&e))?;
+        let mut renderer = Renderer::new(&ctx, &registry, config)?;
         // Every real-time technique the device runs, built now: the number keys and the
         // panel switch without a hitch (the game's pipelines follow with its content).
         for t in Technique::supported(&ctx.caps) {
             if !t.stalls() {
-                renderer.prebuild_technique(t).map_err(|e| chain(&e))?;
+                renderer.prebuild_technique(t)?;
             }
         }
         let post = Post::new(&ctx.device, display.config.format);
@@ -501,17 +497,13 @@ impl Gfx {
     }
 
     /// Streams one frame's worth around the eye into the renderer (and the reference).
-    fn stream(&mut self) -> Result<(), String> {
+    fn stream(&mut self) -> Result<()> {
         let eye = self.input.fly.eye;
         let mut sinks = Sinks {
             renderer: &mut self.renderer,
             reference: self.reference.as_mut(),
         };
-        let frame = self
-            .streaming
-            .streamer
-            .update(eye, &mut sinks)
-            .map_err(|e| chain(&e))?;
+        let frame = self.streaming.streamer.update(eye, &mut sinks)?;
         if let Some((pos, why)) = frame.failed.first() {
             self.status.message = format!("chunk {pos:?}: {why}");
         }
@@ -520,7 +512,7 @@ impl Gfx {
     }
 
     /// Streams until everything within the view distance is drawn (or `limit` passes).
-    fn load_all(&mut self, limit: Duration) -> Result<(), String> {
+    fn load_all(&mut self, limit: Duration) -> Result<()> {
         let start = Instant::now();
         loop {
             self.stream()?;
@@ -528,25 +520,24 @@ impl Gfx {
                 return Ok(());
             }
             if start.elapsed() > limit {
-                return Err(format!(
-                    "the view distance did not load in {} s",
-                    limit.as_secs()
-                ));
+                return Err(Error::LoadTimeout {
+                    seconds: limit.as_secs(),
+                });
             }
             std::thread::sleep(Duration::from_millis(1));
         }
     }
 
     /// The fly camera, immersed in whatever translucent block holds the eye.
-    fn camera(&self) -> Result<Camera, String> {
+    fn camera(&self) -> Result<Camera> {
         let f = &self.input.fly;
         let medium = self.streaming.streamer.world().medium_at(f.eye.to_array());
         Camera::from_yaw_pitch(f.eye, f.yaw, f.pitch, 70.0, 0.1, self.far)
             .map(|c| c.in_medium(medium))
-            .map_err(|e| chain(&e))
+            .map_err(Error::from)
     }
 
-    fn resize(&mut self, w: u32, h: u32) -> Result<(), String> {
+    fn resize(&mut self, w: u32, h: u32) -> Result<()> {
         // Minimised: keep everything as it is until a real size comes back.
         if w == 0 || h == 0 {
             return Ok(());
@@ -558,7 +549,7 @@ impl Gfx {
     /// Sizes the frame targets to the window and the 3D view to the room right of the
     /// panel (`view_x` pixels wide); renderers follow the view. Nothing happens when
     /// nothing changed.
-    fn layout(&mut self, view_x: u32) -> Result<(), String> {
+    fn layout(&mut self, view_x: u32) -> Result<()> {
         let (w, h) = self.display.size();
         let view_x = view_x.min(w.saturating_sub(16));
         let frame = &self.frames.frame.texture;
@@ -568,7 +559,7 @@ impl Gfx {
         self.frames = Frames::new(&self.ctx.device, &self.post, w, h, view_x);
         let (vw, vh) = self.frames.view_size();
         for r in std::iter::once(&mut self.renderer).chain(self.reference.as_mut()) {
-            r.resize(vw, vh).map_err(|e| chain(&e))?;
+            r.resize(vw, vh)?;
         }
         Ok(())
     }
@@ -699,7 +690,7 @@ impl Gfx {
     }
 
     /// Applies what the panel changed.
-    fn apply_settings(&mut self) -> Result<(), String> {
+    fn apply_settings(&mut self) -> Result<()> {
         let mut s = self.settings.clone();
         let a = self.applied.clone();
         if s.seed != a.seed && self.scene.is_none() {
@@ -715,10 +706,7 @@ impl Gfx {
                 r.clear_chunks();
             }
         } else if s.view_distance != a.view_distance {
-            self.streaming
-                .streamer
-                .set_view_distance(s.view_distance)
-                .map_err(|e| chain(&e))?;
+            self.streaming.streamer.set_view_distance(s.view_distance)?;
         }
         self.far = far_plane(s.view_distance).max(self.scene.as_ref().map_or(0.0, |s| s.far));
         if s.oit != a.oit {
@@ -729,11 +717,11 @@ impl Gfx {
                     s.oit = a.oit.clone();
                     self.settings.oit = a.oit.clone();
                 }
-                other => other.map_err(|e| chain(&e))?,
+                other => other?,
             }
         }
         if s.msaa != a.msaa {
-            self.renderer.set_msaa(s.msaa).map_err(|e| chain(&e))?;
+            self.renderer.set_msaa(s.msaa)?;
         }
         if s.fade_in_frames != a.fade_in_frames {
             self.renderer.set_fade_in_frames(s.fade_in_frames);
@@ -742,7 +730,7 @@ impl Gfx {
             // Uniforms only: applied at the next frame, no chunk uploaded again.
             let lighting = s.hour.map_or_else(Lighting::default_day, Lighting::daytime);
             for r in std::iter::once(&mut self.renderer).chain(self.reference.as_mut()) {
-                r.set_lighting(lighting).map_err(|e| chain(&e))?;
+                r.set_lighting(lighting)?;
             }
         }
         if s.heatmap && self.reference.is_none() {
@@ -755,7 +743,7 @@ impl Gfx {
     }
 
     /// A renderer drawing the exact reference of the same world and view.
-    fn reference_renderer(&self) -> Result<Renderer, String> {
+    fn reference_renderer(&self) -> Result<Renderer> {
         let (w, h) = self.renderer.size();
         let config = RendererConfig {
             width: w,
@@ -766,11 +754,11 @@ impl Gfx {
         };
         let streamer = &self.streaming.streamer;
         let world = streamer.world();
-        let mut r = Renderer::new(&self.ctx, world.registry(), config).map_err(|e| chain(&e))?;
+        let mut r = Renderer::new(&self.ctx, world.registry(), config)?;
         // What the renderer draws, meshed at once (the same meshes the streamer made).
         let positions: Vec<ChunkPos> = streamer.uploaded().collect();
-        for (pos, m) in voxel_mesh::mesh_chunks(world, &positions).map_err(|e| e.to_string())? {
-            r.upload_chunk(pos, &m).map_err(|e| chain(&e))?;
+        for (pos, m) in voxel_mesh::mesh_chunks(world, &positions)? {
+            r.upload_chunk(pos, &m)?;
         }
         Ok(r)
     }
@@ -792,7 +780,7 @@ impl Gfx {
     }
 
     /// The scripted edit and resizes of the window test.
-    fn scripted_events(&mut self) -> Result<(), String> {
+    fn scripted_events(&mut self) -> Result<()> {
         let n = self.status.frame_index;
         if self.script.opts.edit && n == 1 {
             self.edit(true);
@@ -814,7 +802,7 @@ impl Gfx {
         Ok(())
     }
 
-    fn frame(&mut self) -> Result<Flow, String> {
+    fn frame(&mut self) -> Result<Flow> {
         let dt = self.tick();
         self.game_time += if self.script.opts.frames.is_some() {
             1.0 / 60.0
@@ -871,18 +859,16 @@ impl Gfx {
 
     /// The 3D view (and the error map against the reference when on), copied right of
     /// the panel.
-    fn draw_scene(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<(), String> {
+    fn draw_scene(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<()> {
         let camera = self.camera()?;
         let toggles = self.settings.game;
-        self.game
-            .update(
-                &self.ctx,
-                &mut self.renderer,
-                self.reference.as_mut(),
-                toggles,
-                self.game_time,
-            )
-            .map_err(|e| chain(&e))?;
+        self.game.update(
+            &self.ctx,
+            &mut self.renderer,
+            self.reference.as_mut(),
+            toggles,
+            self.game_time,
+        )?;
         let (stages, reference_stages) = self.game.stages(toggles);
         let mut no_game = voxel_render::NoGame;
         let stages: &mut dyn voxel_render::GameStages = match stages {
@@ -892,18 +878,15 @@ impl Gfx {
         let frames = &self.frames;
         match &mut self.reference {
             Some(reference) => {
-                self.status.stats = self
-                    .renderer
-                    .render(encoder, &frames.technique.view, &camera, stages)
-                    .map_err(|e| chain(&e))?;
+                self.status.stats =
+                    self.renderer
+                        .render(encoder, &frames.technique.view, &camera, stages)?;
                 let mut no_game = voxel_render::NoGame;
                 let reference_stages: &mut dyn voxel_render::GameStages = match reference_stages {
                     Some(s) => s,
                     None => &mut no_game,
                 };
-                reference
-                    .render(encoder, &frames.reference.view, &camera, reference_stages)
-                    .map_err(|e| chain(&e))?;
+                reference.render(encoder, &frames.reference.view, &camera, reference_stages)?;
                 Post::draw(
                     encoder,
                     &self.post.diff,
@@ -912,10 +895,9 @@ impl Gfx {
                 );
             }
             None => {
-                self.status.stats = self
-                    .renderer
-                    .render(encoder, &frames.view.view, &camera, stages)
-                    .map_err(|e| chain(&e))?;
+                self.status.stats =
+                    self.renderer
+                        .render(encoder, &frames.view.view, &camera, stages)?;
             }
         }
         encoder.copy_texture_to_texture(
@@ -936,7 +918,7 @@ impl Gfx {
     }
 
     /// The scripted run: screenshots, technique cycling, quitting.
-    fn script(&mut self) -> Result<Flow, String> {
+    fn script(&mut self) -> Result<Flow> {
         let Some(frames) = self.script.opts.frames else {
             return Ok(Flow::Continue);
         };
@@ -968,16 +950,15 @@ impl Gfx {
         Ok(Flow::Quit)
     }
 
-    fn save_screenshot(&mut self, path: &std::path::Path) -> Result<(), String> {
+    fn save_screenshot(&mut self, path: &std::path::Path) -> Result<()> {
         let texture = &self.frames.frame.texture;
-        let rgba = readback::read_texture(&self.ctx, texture, 4).map_err(|e| chain(&e))?;
+        let rgba = readback::read_texture(&self.ctx, texture, 4)?;
         Image {
             width: texture.width(),
             height: texture.height(),
             rgba,
         }
-        .save_png(path)
-        .map_err(|e| chain(&e))?;
+        .save_png(path)?;
         self.status.message = format!("saved {}", path.display());
         Ok(())
     }

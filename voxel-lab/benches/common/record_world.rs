@@ -5,6 +5,7 @@
 //! pitched down 0.25 rad, far plane VD × 32 × 1.5 blocks.
 
 use std::sync::Arc;
+use voxel_lab::Result;
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -28,7 +29,7 @@ fn generator() -> TerrainGenerator {
 
 /// The terrain of the disc of radius `vd` chunks, meshed and uploaded into a new `W`×`H`
 /// renderer drawing with `technique`.
-pub fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Renderer, String> {
+pub fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Renderer> {
     let registry = Arc::new(BlockRegistry::default());
     let generator = generator();
     let mut positions = Vec::new();
@@ -45,7 +46,7 @@ pub fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Rende
         .collect();
     let mut world = World::new(registry.clone());
     for (p, c) in chunks {
-        world.insert_chunk(p, c).map_err(|e| e.to_string())?;
+        world.insert_chunk(p, c)?;
     }
     let mut config = RendererConfig {
         width: W,
@@ -53,20 +54,18 @@ pub fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Rende
         ..RendererConfig::default()
     };
     config.oit.technique = technique;
-    let mut renderer = Renderer::new(ctx, &registry, config).map_err(|e| voxel_lab::chain(&e))?;
-    for (pos, meshes) in mesh_chunks(&world, &positions).map_err(|e| e.to_string())? {
-        renderer
-            .upload_chunk(pos, &meshes)
-            .map_err(|e| voxel_lab::chain(&e))?;
+    let mut renderer = Renderer::new(ctx, &registry, config)?;
+    for (pos, meshes) in mesh_chunks(&world, &positions)? {
+        renderer.upload_chunk(pos, &meshes)?;
     }
     Ok(renderer)
 }
 
 /// The camera of view distance `vd`.
-pub fn camera(vd: i32) -> Result<Camera, String> {
+pub fn camera(vd: i32) -> Result<Camera> {
     let eye = DVec3::new(0.5, generator().height_at(0, 0) as f64 + 40.0, 0.5);
     let pitch: f64 = -0.25;
     let dir = DVec3::new(pitch.cos(), pitch.sin(), 0.0);
     Camera::look_at(eye, eye + dir, 70.0, 0.1, f64::from(vd) * 32.0 * 1.5)
-        .map_err(|e| voxel_lab::chain(&e))
+        .map_err(voxel_lab::Error::Render)
 }

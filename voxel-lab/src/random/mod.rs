@@ -92,6 +92,8 @@
 //! - `content`: a game's particles and entities.
 //! - here: the set of scenes, the [`Features`] and [`generate`], which writes the text.
 
+use crate::{Error, Result};
+
 mod boxes;
 mod camera;
 mod content;
@@ -126,9 +128,9 @@ pub struct RandomSet {
 
 impl RandomSet {
     /// `count` scenes from `seed`; `count` must be 1 to [`MAX_SCENES`].
-    pub fn new(count: usize, seed: u64) -> Result<Self, String> {
+    pub fn new(count: usize, seed: u64) -> Result<Self> {
         if count == 0 {
-            return Err("a random set needs at least 1 scene".into());
+            return Err(Error::NoRandomScenes);
         }
         if count > MAX_SCENES {
             return Err(too_many(&count.to_string()));
@@ -148,10 +150,11 @@ impl RandomSet {
 }
 
 /// The error for a count above [`MAX_SCENES`], written as the user wrote it.
-pub fn too_many(count: &str) -> String {
-    format!(
-        "{count} random scenes: at most {MAX_SCENES} (at about a second per scene that is already more than a day, and every record stays in memory)"
-    )
+pub fn too_many(count: &str) -> Error {
+    Error::TooManyRandomScenes {
+        count: count.to_owned(),
+        max: MAX_SCENES,
+    }
 }
 
 /// Name of scene `index` of `seed`.

@@ -1,5 +1,7 @@
 //! Block types a scene file declares: their class, pattern, textures and medium.
 
+use crate::Result;
+
 use std::path::Path;
 
 use serde::Deserialize;
@@ -53,7 +55,7 @@ pub(super) fn block_def(
     dir: &Path,
     b: &Spanned<BlockDefFile>,
     registry: &BlockRegistry,
-) -> Result<BlockDef, String> {
+) -> Result<BlockDef> {
     let d = b.get_ref();
     let mut def = BlockDef::new(d.name.clone(), d.color, d.opacity);
     if let Some(a) = &d.absorption {
@@ -113,7 +115,7 @@ pub(super) fn block_def(
             }
         };
     }
-    let image = |key: &str, file: &Option<Spanned<String>>| -> Result<Option<BlockImage>, String> {
+    let image = |key: &str, file: &Option<Spanned<String>>| -> Result<Option<BlockImage>> {
         let Some(file) = file else { return Ok(None) };
         voxel_render::textures::load_block_image(&dir.join(file.get_ref()))
             .map(Some)

@@ -1,5 +1,7 @@
 //! A scene file's particles and entities, checked, as a game's content.
 
+use crate::Result;
+
 use glam::DVec3;
 use voxel_render::low_level::WORLD_EXTENT;
 
@@ -13,7 +15,7 @@ use voxel_render::content::{Content, Entity};
 pub const MAX_PARTICLES: usize = 1_000_000;
 
 /// The particles and entities of a scene file, checked.
-pub(super) fn content_of(text: &str, file: &SceneFile) -> Result<Content, String> {
+pub(super) fn content_of(text: &str, file: &SceneFile) -> Result<Content> {
     let mut content = Content::default();
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite() && x.abs() < WORLD_EXTENT);
     for p in &file.particles {

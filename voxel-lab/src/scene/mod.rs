@@ -69,6 +69,8 @@
 //! A bare `.vox` file is a scene too ([`Scene::load`]): its model with the lowest corner at
 //! the origin, seen by [`framing_camera`].
 
+use crate::{Error, Result};
+
 mod blocks;
 mod content;
 mod format;
@@ -131,30 +133,38 @@ impl Scene {
     /// file, or an endless one like `/dev/zero`, is an error after that many bytes), or a
     /// bare `.vox` model ([`Scene::from_vox`]). Errors name the file, the line and the
     /// field.
-    pub fn load(path: &Path) -> Result<Self, String> {
+    pub fn load(path: &Path) -> Result<Self> {
         if is_vox(path) {
             return Self::from_vox(path);
         }
         let text = read_limited(path, crate::limits::MAX_SCENE_FILE_BYTES)?;
         let dir = path.parent().unwrap_or(Path::new(""));
-        parse_in(&text, dir).map_err(|e| format!("{}:{}", path.display(), e))
+        parse_in(&text, dir).map_err(|e| e.in_file(path.display()))
     }
 
     /// A MagicaVoxel model as a scene: its blocks with the lowest corner at the origin
     /// (palette entries as its materials say), seen by [`framing_camera`]. Named after the
     /// file. Errors name the file and what is wrong with it.
-    pub fn from_vox(path: &Path) -> Result<Self, String> {
-        let file = VoxFile::load(path).map_err(|e| e.to_string())?;
+    pub fn from_vox(path: &Path) -> Result<Self> {
+        let file = VoxFile::load(path)?;
         let name = model_name(path);
         let mut registry = BlockRegistry::default();
         let blocks = file
             .register_blocks(&name, &[], &mut registry)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+            .map_err(|source| Error::Model {
+                path: path.to_owned(),
+                source,
+            })?;
         let mut world = World::new(Arc::new(registry));
         let placed = file
             .place(&name, &blocks, VoxPlacement::default(), &mut world)
-            .map_err(|e| format!("{}: {e}", path.display()))?
-            .ok_or_else(|| format!("{}: the file places no voxels", path.display()))?;
+            .map_err(|source| Error::Model {
+                path: path.to_owned(),
+                source,
+            })?
+            .ok_or_else(|| Error::EmptyModel {
+                path: path.to_owned(),
+            })?;
         let (camera, path_to) = framing_camera(placed.0, placed.1)?;
         let mut scene = Scene::new(&name, world, camera);
         scene.description = format!(
@@ -185,7 +195,7 @@ fn model_name(path: &Path) -> String {
 /// whole box lies within 92 % of a 60° field of view both ways (so any picture at least as
 /// wide as high shows all of it). Also returns where the flicker test moves the eye: 10°
 /// further round the box.
-pub fn framing_camera(min: WorldPos, max: WorldPos) -> Result<(Camera, DVec3), String> {
+pub fn framing_camera(min: WorldPos, max: WorldPos) -> Result<(Camera, DVec3)> {
     let lo = DVec3::new(f64::from(min.x), f64::from(min.y), f64::from(min.z));
     let hi = DVec3::new(f64::from(max.x), f64::from(max.y), f64::from(max.z)) + DVec3::ONE;
     let centre = (lo + hi) * 0.5;
@@ -216,28 +226,30 @@ pub fn framing_camera(min: WorldPos, max: WorldPos) -> Result<(Camera, DVec3), S
     }
     let radius = (hi - lo).length() * 0.5;
     let eye = centre + d * distance;
-    let camera = Camera::look_at(eye, centre, fov, 0.1, distance + 2.0 * radius + 16.0)
-        .map_err(|e| e.to_string())?;
+    let camera = Camera::look_at(eye, centre, fov, 0.1, distance + 2.0 * radius + 16.0)?;
     let path_to = centre + direction(55.0f64.to_radians()) * distance;
     Ok((camera, path_to))
 }
 
 /// The text of `path`, reading at most `limit` bytes: more is an error naming the file
 /// and the limit, as is text that is not UTF-8.
-pub fn read_limited(path: &Path, limit: u64) -> Result<String, String> {
+pub fn read_limited(path: &Path, limit: u64) -> Result<String> {
     use std::io::Read as _;
-    let file = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let file = std::fs::File::open(path).map_err(Error::io(path))?;
     let mut bytes = Vec::new();
     file.take(limit + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+        .map_err(Error::io(path))?;
     if bytes.len() as u64 > limit {
-        return Err(format!(
-            "{}: larger than {limit} bytes, the most a scene file may hold",
-            path.display()
-        ));
+        return Err(Error::FileTooLarge {
+            path: path.to_owned(),
+            limit,
+        });
     }
-    String::from_utf8(bytes).map_err(|e| format!("{}: not UTF-8 text ({e})", path.display()))
+    String::from_utf8(bytes).map_err(|source| Error::NotUtf8 {
+        path: path.to_owned(),
+        source,
+    })
 }
 
 /// Chunks generated around the default scene's structure, in each horizontal direction.
@@ -245,12 +257,12 @@ pub const DEFAULT_RADIUS: i32 = 6;
 
 /// The default scene for `seed`: terrain `DEFAULT_RADIUS` chunks around the greenhouse
 /// nearest the origin, the camera on the land side looking through it at the sea.
-pub fn default_scene(seed: u32) -> Result<Scene, String> {
+pub fn default_scene(seed: u32) -> Result<Scene> {
     default_scene_with_radius(seed, DEFAULT_RADIUS)
 }
 
 /// [`default_scene`] with `radius` chunks of terrain each way (1 to 16).
-pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene, String> {
+pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene> {
     let radius = radius.clamp(1, 16);
     let config = TerrainConfig {
         seed,
@@ -265,19 +277,15 @@ pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene, String
         .min_by_key(|s| s.center[0].pow(2) + s.center[2].pow(2))
         .or_else(|| sites.first())
         .copied()
-        .ok_or_else(|| {
-            format!("seed {seed}: no glass structure within 768 blocks of the origin")
-        })?;
+        .ok_or(Error::NoGlassStructure { seed })?;
     let c = site.center;
     let cx = c[0].div_euclid(32) as i32;
     let cz = c[2].div_euclid(32) as i32;
-    let world = generator
-        .generate_world(
-            Arc::new(BlockRegistry::default()),
-            ChunkPos::new(cx - radius, 0, cz - radius),
-            ChunkPos::new(cx + radius, 1, cz + radius),
-        )
-        .map_err(|e| e.to_string())?;
+    let world = generator.generate_world(
+        Arc::new(BlockRegistry::default()),
+        ChunkPos::new(cx - radius, 0, cz - radius),
+        ChunkPos::new(cx + radius, 1, cz + radius),
+    )?;
     let dir = DVec3::new(
         f64::from(site.water_dir[0]),
         0.0,
@@ -290,9 +298,8 @@ pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene, String
     let ground = generator.height_at(eye.x.floor() as i64, eye.z.floor() as i64) as f64;
     eye.y = eye.y.max(ground + 3.5);
     let target = center + dir * 12.0 + DVec3::Y * (sea - center.y + 1.0);
-    let camera = Camera::look_at(eye, target, 70.0, 0.1, 600.0)
-        .map_err(|e| e.to_string())?
-        .in_medium(world.medium_at(eye.to_array()));
+    let camera =
+        Camera::look_at(eye, target, 70.0, 0.1, 600.0)?.in_medium(world.medium_at(eye.to_array()));
     // The flicker path slides sideways, keeping the greenhouse in view.
     let side = DVec3::new(-dir.z, 0.0, dir.x);
     Ok(Scene {
@@ -313,26 +320,28 @@ pub fn fill_box(
     min: [i32; 3],
     max: [i32; 3],
     id: voxel_core::BlockId,
-) -> Result<(), String> {
+) -> Result<()> {
     world
         .fill_box(
             WorldPos::new(min[0], min[1], min[2]),
             WorldPos::new(max[0], max[1], max[2]),
             id,
         )
-        .map_err(|e| e.to_string())
+        .map_err(Error::Core)
 }
 
 /// The scene files of a folder (`.toml` scenes and bare `.vox` models), sorted.
-pub fn scene_files(dir: &Path) -> Result<Vec<PathBuf>, String> {
+pub fn scene_files(dir: &Path) -> Result<Vec<PathBuf>> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .map_err(Error::io(dir))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "toml") || is_vox(p))
         .collect();
     v.sort();
     if v.is_empty() {
-        return Err(format!("{}: no .toml or .vox scene files", dir.display()));
+        return Err(Error::NoScenes {
+            dir: Some(dir.to_owned()),
+        });
     }
     Ok(v)
 }

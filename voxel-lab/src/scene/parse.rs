@@ -1,6 +1,8 @@
 //! Reading a scene file: its limits, errors with line numbers, palettes, and building the
 //! world and cameras it describes.
 
+use crate::{Error, Result};
+
 use std::path::Path;
 use std::sync::Arc;
 
@@ -28,10 +30,11 @@ const MAX_BOX_BLOCKS: i128 = 20_000_000;
 /// GiB. 16 384 chunks hold a 4096 × 4096 floor.
 const MAX_BOX_CHUNKS: i128 = 16_384;
 
-/// `line N: message` for the byte offset `at` of `text`.
-pub(super) fn at_line(text: &str, at: usize, message: impl std::fmt::Display) -> String {
+/// The scene error `message` at the line of the byte offset `at` of `text` (it reads
+/// `LINE: message`).
+pub(super) fn at_line(text: &str, at: usize, message: impl std::fmt::Display) -> Error {
     let line = text[..at.min(text.len())].matches('\n').count() + 1;
-    format!("{line}: {message}")
+    Error::scene(Some(line), message)
 }
 
 /// The `table.key` written on the line holding byte `at` (the key before `=`, the table
@@ -62,12 +65,12 @@ fn field_at(text: &str, at: usize) -> String {
 
 /// Parses the text of a scene file; errors read `LINE: field: message`. Model files are
 /// found relative to the working folder; [`parse_in`] names another.
-pub fn parse(text: &str) -> Result<Scene, String> {
+pub fn parse(text: &str) -> Result<Scene> {
     parse_in(text, Path::new(""))
 }
 
 /// What a `[[models.palette]]` entry asks for, checked.
-fn palette_override(text: &str, p: &Spanned<PaletteDef>) -> Result<PaletteOverride, String> {
+fn palette_override(text: &str, p: &Spanned<PaletteDef>) -> Result<PaletteOverride> {
     let d = p.get_ref();
     let index = u8::try_from(*d.index.get_ref())
         .ok()
@@ -119,7 +122,7 @@ fn palette_override(text: &str, p: &Spanned<PaletteDef>) -> Result<PaletteOverri
 }
 
 /// [`parse`], with model files found relative to `dir` (the scene file's folder).
-pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
+pub fn parse_in(text: &str, dir: &Path) -> Result<Scene> {
     let file: SceneFile = toml::from_str(text).map_err(|e| match e.span() {
         Some(s) => {
             let field = field_at(text, s.start);
@@ -130,7 +133,7 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
                 at_line(text, s.start, format!("{field}: {message}"))
             }
         }
-        None => format!("?: {}", e.message().trim()),
+        None => Error::scene(None, e.message().trim()),
     })?;
 
     let mut registry = BlockRegistry::default();
@@ -305,8 +308,12 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene, String> {
     let mut cameras = Vec::new();
     let mut paths = Vec::new();
     if file.cameras.is_empty() {
-        let (lo, hi) = model_bounds
-            .ok_or("1: cameras: a scene needs at least one [[cameras]] entry (or a model)")?;
+        let (lo, hi) = model_bounds.ok_or_else(|| {
+            Error::scene(
+                Some(1),
+                "cameras: a scene needs at least one [[cameras]] entry (or a model)",
+            )
+        })?;
         let (camera, path_to) = framing_camera(lo, hi)?;
         cameras.push(camera.in_medium(world.medium_at(camera.eye.to_array())));
         paths.push(Some(path_to));

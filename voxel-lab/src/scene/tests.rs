@@ -74,7 +74,7 @@ fn blocks_take_textures_patterns_and_classes_from_the_file() {
     let g = block("pattern = \"grass\"\nsoil = [9, 8, 7]");
     assert_eq!(g.pattern, Pattern::Grass { soil: [9, 8, 7] });
     assert!(g.images.is_empty());
-    let err = |extra: &str| parse_in(&text(extra), &dir).unwrap_err();
+    let err = |extra: &str| parse_in(&text(extra), &dir).unwrap_err().to_string();
     let e = err("side = \"wide.png\"");
     assert!(
         e.starts_with("6: blocks.side: ") && e.contains("wide.png") && e.contains("square"),
@@ -139,7 +139,7 @@ fn the_framing_camera_shows_the_whole_box_tightly() {
 #[test]
 fn an_unknown_block_names_the_line_and_lists_the_known_ones() {
     let bad = GOOD.replace("block = \"smoky_glass\"", "block = \"lava\"");
-    let e = parse(&bad).unwrap_err();
+    let e = parse(&bad).unwrap_err().to_string();
     assert!(
         e.starts_with("11: boxes.block: unknown block name \"lava\""),
         "{e}"
@@ -150,17 +150,25 @@ fn an_unknown_block_names_the_line_and_lists_the_known_ones() {
 
 #[test]
 fn syntax_and_type_errors_name_line_and_field() {
-    let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [3, 2]")).unwrap_err();
+    let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [3, 2]"))
+        .unwrap_err()
+        .to_string();
     assert!(
         e.starts_with("13: boxes.max:") && e.contains("length 3"),
         "{e}"
     );
 
-    let e = parse(&GOOD.replace("fov", "x").replace("path_to", "pathto")).unwrap_err();
+    let e = parse(&GOOD.replace("fov", "x").replace("path_to", "pathto"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("pathto"), "unknown keys are named: {e}");
-    let e = parse("name = \"x\"\n[[cameras]]\neye = [0, 0, 0]\n").unwrap_err();
+    let e = parse("name = \"x\"\n[[cameras]]\neye = [0, 0, 0]\n")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("target"), "missing keys are named: {e}");
-    let e = parse("name = \"x\"\nsize = [64, 32\n").unwrap_err();
+    let e = parse("name = \"x\"\nsize = [64, 32\n")
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("2:") || e.starts_with("3:"), "{e}");
 }
 
@@ -183,7 +191,7 @@ fn arrays_of_the_wrong_length_and_missing_fields_name_their_table() {
         ),
     ] {
         assert!(GOOD.contains(from), "{from}");
-        let e = parse(&GOOD.replace(from, to)).unwrap_err();
+        let e = parse(&GOOD.replace(from, to)).unwrap_err().to_string();
         assert!(
             e.contains(field) && (e.contains('3') || e.contains('2')),
             "{to}: {e}"
@@ -196,11 +204,12 @@ fn arrays_of_the_wrong_length_and_missing_fields_name_their_table() {
         )
     };
     parse(&particles("count = 3")).unwrap();
-    let e = parse(&particles("")).unwrap_err();
+    let e = parse(&particles("")).unwrap_err().to_string();
     assert!(e.contains("particles") && e.contains("count"), "{e}");
     assert!(!e.contains("boxes") && !e.contains("cameras"), "{e}");
     let e = parse(&particles("count = 3").replace("color = [1, 2, 3]", "color = [1, 2, 3, 4]"))
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("particles.color") && e.contains("length 3"),
         "{e}"
@@ -208,27 +217,38 @@ fn arrays_of_the_wrong_length_and_missing_fields_name_their_table() {
     let e = parse(&format!(
         "{GOOD}\n[[entities]]\ncenter = [0.0, 0.0, 0.0]\nsize = [1.0, 1.0]\ncolor = [1, 2, 3]\n"
     ))
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("entities.size") && e.contains("length 3"), "{e}");
 }
 
 #[test]
 fn bad_values_are_errors_not_panics() {
-    let e =
-        parse(&GOOD.replace("target = [0.5, 1.0, 0.0]", "target = [0.5, 1.0, 10.0]")).unwrap_err();
+    let e = parse(&GOOD.replace("target = [0.5, 1.0, 0.0]", "target = [0.5, 1.0, 10.0]"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("cameras") && e.contains("zero"), "{e}");
-    let e = parse(&GOOD.replace("opacity = 0.5", "opacity = 1.5")).unwrap_err();
+    let e = parse(&GOOD.replace("opacity = 0.5", "opacity = 1.5"))
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("5: blocks:"), "{e}");
-    let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [-3, 2, 0]")).unwrap_err();
+    let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [-3, 2, 0]"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("min must not exceed max"), "{e}");
-    let e = parse(&GOOD.replace("size = [64, 32]", "size = [0, 32]")).unwrap_err();
+    let e = parse(&GOOD.replace("size = [64, 32]", "size = [0, 32]"))
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("3: size"), "{e}");
     let e = parse(&format!(
         "{GOOD}\n[terrain]\nmin_chunk = [0, 0, 0]\nmax_chunk = [100, 8, 100]\n"
     ))
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("at most 4096 chunks"), "{e}");
-    let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [3000, 3000, 3000]")).unwrap_err();
+    let e = parse(&GOOD.replace("max = [3, 2, 0]", "max = [3000, 3000, 3000]"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("blocks in all"), "{e}");
     // Volumes whose i64 product wraps: the whole i32 range on two or three axes.
     for (min, max) in [
@@ -244,13 +264,13 @@ fn bad_values_are_errors_not_panics() {
         let text = GOOD
             .replace("min = [0, 0, 0]", &format!("min = {min}"))
             .replace("max = [3, 2, 0]", &format!("max = {max}"));
-        let e = parse(&text).unwrap_err();
+        let e = parse(&text).unwrap_err().to_string();
         assert!(e.contains("20000000 blocks in all"), "{e}");
     }
     let e = parse(&format!(
         "{GOOD}\n[terrain]\nmin_chunk = [-2147483648, -2147483648, -2147483648]\nmax_chunk = [2147483647, 2147483647, 2147483647]\n"
     ))
-    .unwrap_err();
+    .unwrap_err().to_string();
     assert!(e.contains("at most 4096 chunks"), "{e}");
 }
 
@@ -259,13 +279,13 @@ fn bad_values_are_errors_not_panics() {
 #[test]
 fn the_box_check_bounds_chunks_too() {
     let row = GOOD.replace("max = [3, 2, 0]", "max = [19999999, 0, 0]");
-    let e = parse(&row).unwrap_err();
+    let e = parse(&row).unwrap_err().to_string();
     assert!(e.contains("16384 chunks"), "{e}");
     let floor = GOOD.replace("max = [3, 2, 0]", "max = [4095, 0, 4095]");
     let s = parse(&floor).unwrap();
     assert_eq!(s.world.len(), 16_384);
     let beyond = GOOD.replace("max = [3, 2, 0]", "max = [4096, 0, 4095]");
-    assert!(parse(&beyond).unwrap_err().contains("chunks"));
+    assert!(parse(&beyond).unwrap_err().to_string().contains("chunks"));
 }
 
 /// A `path_to` where no camera can be (NaN, infinite, on the target, outside
@@ -279,7 +299,8 @@ fn a_bad_path_to_is_an_error() {
         "[3e10, 1.0, 0.0]",
     ] {
         let e = parse(&GOOD.replace("path_to = [3.0, 1.0, 10.0]", &format!("path_to = {bad}")))
-            .unwrap_err();
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("cameras.path_to"), "{bad}: {e}");
     }
 }
@@ -288,7 +309,9 @@ fn a_bad_path_to_is_an_error() {
 #[test]
 fn sizes_past_the_caps_are_errors() {
     for (size, word) in [("[16384, 16384]", "8192"), ("[8192, 8192]", "pixels")] {
-        let e = parse(&GOOD.replace("size = [64, 32]", &format!("size = {size}"))).unwrap_err();
+        let e = parse(&GOOD.replace("size = [64, 32]", &format!("size = {size}")))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("3: size") && e.contains(word), "{e}");
     }
 }
@@ -300,7 +323,7 @@ fn scene_files_are_read_with_a_size_limit() {
     let limit = crate::limits::MAX_SCENE_FILE_BYTES;
     for endless in ["/dev/zero", "/dev/urandom"] {
         if Path::new(endless).exists() {
-            let e = Scene::load(Path::new(endless)).unwrap_err();
+            let e = Scene::load(Path::new(endless)).unwrap_err().to_string();
             assert!(e.contains(endless) && e.contains(&limit.to_string()), "{e}");
         }
     }
@@ -310,12 +333,17 @@ fn scene_files_are_read_with_a_size_limit() {
     let mut text = GOOD.to_owned();
     text.push_str(&"# padding\n".repeat(limit as usize / 10 + 1));
     std::fs::write(&big, &text).unwrap();
-    assert!(Scene::load(&big).unwrap_err().contains("larger than"));
+    assert!(
+        Scene::load(&big)
+            .unwrap_err()
+            .to_string()
+            .contains("larger than")
+    );
     let ok = dir.join("ok.toml");
     std::fs::write(&ok, GOOD).unwrap();
     Scene::load(&ok).unwrap();
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, [0xffu8, 0xfe, 0x00]).unwrap();
-    assert!(Scene::load(&bad).unwrap_err().contains("UTF-8"));
+    assert!(Scene::load(&bad).unwrap_err().to_string().contains("UTF-8"));
     let _ = std::fs::remove_dir_all(dir);
 }
