@@ -18,6 +18,8 @@
 //! - [`gallery`]: one scene under every technique with its error maps (`demo gallery`);
 //! - [`backends`]: every technique on Vulkan, GL and WebGL2's limits (`demo backends`).
 
+#![warn(missing_docs)]
+
 pub mod backends;
 pub mod charts;
 pub mod content;
