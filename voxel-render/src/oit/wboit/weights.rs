@@ -33,7 +33,7 @@ pub enum WeightFunction {
     McGuire10 = 5,
     /// Ours: `3000 · e^−τ`, where `τ` is the optical depth expected in front of the
     /// fragment, estimated each frame from the visible translucent meshes for the
-    /// fragment's screen tile and interpolated in log depth ([`super::fit`]). The ideal
+    /// fragment's screen tile and interpolated in log depth (`super::fit`). The ideal
     /// weight of a layer is the transmittance in front of it (with it the weighted average
     /// is exact), so this weight falls where translucent layers are and stays flat where
     /// there are none: steep through a stack of dense sheets, flat between clear glass at
