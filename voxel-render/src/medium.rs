@@ -95,24 +95,6 @@ pub(crate) fn looks(registry: &BlockRegistry) -> Vec<Option<MediumLook>> {
         .collect()
 }
 
-/// The fog pass's uniform (`FogParams` in `medium.wgsl`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct FogParams {
-    /// Lit fog colour, linear.
-    pub color: [f32; 3],
-    /// Optical depth per block: the medium's absorption.
-    pub density: f32,
-    /// `tan` of half the horizontal and vertical field of view.
-    pub tan_half: [f32; 2],
-    /// Near and far plane distances.
-    pub near_far: [f32; 2],
-    /// Render target size in pixels.
-    pub viewport: [f32; 2],
-    /// Padding.
-    pub _pad: [f32; 2],
-}
-
 /// The medium shaders: the boundary pass (after the shared chunk code) and the fog.
 pub(crate) fn boundary_wgsl() -> String {
     crate::bindings::common_wgsl() + include_str!("shaders/medium_boundary.wgsl")
@@ -125,7 +107,9 @@ pub(crate) fn volume_exit_wgsl() -> String {
 
 /// The fog pass's shader (after `fullscreen.wgsl`).
 pub(crate) fn fog_wgsl() -> String {
-    gpu::DEPTH_UV_WGSL.to_owned() + include_str!("shaders/medium_fog.wgsl")
+    gpu::DEPTH_UV_WGSL.to_owned()
+        + crate::bindings::FRAME_WGSL
+        + include_str!("shaders/medium_fog.wgsl")
 }
 
 /// The format of the nearest volume entry's look (linear colour, absorption).
@@ -140,10 +124,8 @@ pub(crate) struct MediumPass {
     /// The nearest front face of a volume and its look (`volume_exit.wgsl`).
     volume_entry: wgpu::RenderPipeline,
     fog: wgpu::RenderPipeline,
-    /// Group 0 of the fog: the boundary depth and the parameters.
+    /// Group 0 of the fog: the boundary depth and the frame's uniforms.
     pub fog_layout: wgpu::BindGroupLayout,
-    /// The fog's parameters, written each frame inside a medium.
-    pub fog_params: wgpu::Buffer,
     /// The nearest sampler the fog reads the boundary depth with.
     depth_sampler: wgpu::Sampler,
     /// Copies the opaque depth into the boundary.
@@ -215,33 +197,31 @@ impl MediumPass {
             constants: &[],
         }
         .build(device);
-        let fog_params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("medium_fog_params"),
-            size: std::mem::size_of::<FogParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         Self {
             boundary,
             volume_exit,
             volume_entry,
             fog,
             fog_layout,
-            fog_params,
             depth_sampler: gpu::depth_sampler(device),
             depth_copy: gpu::DepthCopy::new(ctx),
         }
     }
 
-    /// The fog's bind group over `boundary` (per render size).
-    pub(crate) fn fog_group(&self, device: &wgpu::Device, boundary: &Target) -> wgpu::BindGroup {
+    /// The fog's bind group over `boundary` (per render size) and the frame's uniforms.
+    pub(crate) fn fog_group(
+        &self,
+        device: &wgpu::Device,
+        boundary: &Target,
+        frame: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
         gpu::bind_group(
             device,
             "medium_fog",
             &self.fog_layout,
             &[
                 wgpu::BindingResource::TextureView(&boundary.view),
-                self.fog_params.as_entire_binding(),
+                frame.as_entire_binding(),
                 wgpu::BindingResource::Sampler(&self.depth_sampler),
             ],
         )
@@ -368,26 +348,6 @@ fn nearest_faces(
             pass.set_bind_group(0, scene, &[]);
             draws.draw(chunks, pass);
         });
-}
-
-/// The fog of `look` seen with `camera` (already guarded) at `aspect`, lit by `sun` and
-/// `ambient` like a face turned to the sky.
-pub(crate) fn fog_params(
-    look: &MediumLook,
-    camera: &Camera,
-    aspect: f64,
-    viewport: [f32; 2],
-    light: f32,
-) -> FogParams {
-    let tan_y = (camera.fov_y_deg.to_radians() / 2.0).tan();
-    FogParams {
-        color: look.color.map(|c| c * light),
-        density: look.absorption,
-        tan_half: [(tan_y * aspect) as f32, tan_y as f32],
-        near_far: [camera.near as f32, camera.far as f32],
-        viewport,
-        _pad: [0.0; 2],
-    }
 }
 
 /// How far the corners of the near plane are from the eye, per unit of near distance.

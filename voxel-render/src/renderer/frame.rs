@@ -325,14 +325,8 @@ impl Renderer {
         if stages.translucent {
             self.ctx.check_device()?;
         }
-        if let Some((_, look)) = &medium {
-            let sun = sun_unit(self.config.sun_dir);
-            let light = self.config.brightness
-                * (self.config.ambient + (1.0 - self.config.ambient) * sun.y.max(0.0));
-            let params = medium::fog_params(look, camera, aspect, [w as f32, h as f32], light);
-            self.ctx
-                .queue
-                .write_buffer(&self.medium.fog_params, 0, bytemuck::bytes_of(&params));
+        if medium.is_some() {
+            // The eye's medium, its light and the camera are in the frame's uniforms.
             self.medium.fog_pass(encoder, &t.color, &t.fog_group, timer);
         }
         if stages.hdr_overlay {

@@ -267,7 +267,7 @@ impl SceneTargets {
             &volume_depth,
             (&depth, &scene.media.view),
         );
-        let fog_group = medium.fog_group(device, &boundary);
+        let fog_group = medium.fog_group(device, &boundary, &scene.frame_buffer);
         let tonemap_group =
             gpu::texture_group(device, "tonemap", &post.tonemap_layout, &[&color.view]);
         let depth_resolve_group = msaa.as_ref().map(|(_, d)| {

@@ -28,3 +28,9 @@ struct Frame {
     // The look of the medium the eye is in (linear colour, absorption), or zero.
     medium_look: vec4<f32>,
 };
+
+// The light a medium's colour is lit by, the same for the fog around the eye and for a
+// path through a volume: that of a face turned to the sky, at the light's brightness.
+fn frame_sky_light(f: Frame) -> f32 {
+    return f.brightness * (f.ambient + (1.0 - f.ambient) * max(f.sun_dir.y, 0.0));
+}

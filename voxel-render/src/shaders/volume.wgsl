@@ -31,7 +31,7 @@ fn medium_segment(m: vec4<f32>, d: f32) -> vec4<f32> {
     if m.a <= 0.0 || d <= 0.0 {
         return vec4<f32>(0.0);
     }
-    let light = frame.brightness * (frame.ambient + (1.0 - frame.ambient) * max(frame.sun_dir.y, 0.0));
+    let light = frame_sky_light(frame);
     let t = exp(-m.a * d);
     return vec4<f32>(m.rgb * light * (1.0 - t), 1.0 - t);
 }
