@@ -67,7 +67,7 @@ pub use oit::{
     WboitSettings, WeightFunction,
 };
 pub use readback::Image;
-pub use renderer::{FrameStats, Lighting, Renderer, RendererConfig};
+pub use renderer::{FrameStats, Lighting, OUTPUT_FORMATS, Renderer, RendererConfig};
 pub use stages::{GameFrame, GameStages, NoGame, Stages, TranslucentContract, TranslucentObject};
 pub use stream::{ChunkSink, ChunkSource, ChunkStreamer, StreamConfig, StreamFrame};
 pub use timing::{GpuPass, GpuTimes};

@@ -18,7 +18,7 @@ pub struct RendererConfig {
     pub height: u32,
     /// Format of the textures `render` draws into first (its tonemap pipeline is built
     /// with the renderer). Default `Rgba8UnormSrgb`, what offscreen readback and PNG files
-    /// want. Any of `OUTPUT_FORMATS` works without changing this: an output of another
+    /// want. Any of [`OUTPUT_FORMATS`] works without changing this: an output of another
     /// format gets its tonemap pipeline at its first frame (once per format, about a
     /// millisecond), and this field follows the format drawn last.
     pub output_format: wgpu::TextureFormat,
@@ -96,7 +96,7 @@ impl Default for RendererConfig {
 /// not; 10-bit; half float, written linear) and what offscreen targets use. An sRGB format
 /// is encoded by the GPU, the 8- and 10-bit linear ones by the tonemap shader, so every
 /// one shows the same picture.
-pub(crate) const OUTPUT_FORMATS: [wgpu::TextureFormat; 6] = [
+pub const OUTPUT_FORMATS: [wgpu::TextureFormat; 6] = [
     wgpu::TextureFormat::Rgba8UnormSrgb,
     wgpu::TextureFormat::Rgba8Unorm,
     wgpu::TextureFormat::Bgra8UnormSrgb,

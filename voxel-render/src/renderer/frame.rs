@@ -50,7 +50,7 @@ impl Renderer {
 
     /// Records a frame into `encoder`, ending with the tonemap into `output`: a view of
     /// mip level 0 of a single-layer, single-sample 2D texture of the renderer's size,
-    /// of one of `OUTPUT_FORMATS`, with `RENDER_ATTACHMENT` usage. The view has its
+    /// of one of [`OUTPUT_FORMATS`], with `RENDER_ATTACHMENT` usage. The view has its
     /// texture's format, or [`RendererConfig::output_view_format`] when that is the
     /// texture's twin. Anything else is an [`Error::Output`] before anything is recorded.
     ///

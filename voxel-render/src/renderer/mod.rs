@@ -29,8 +29,7 @@ use crate::textures::BlockTextures;
 use crate::timing::{GpuTimes, Timer};
 use crate::{Error, GpuContext, Result};
 
-pub(crate) use config::OUTPUT_FORMATS;
-pub use config::{Lighting, RendererConfig};
+pub use config::{Lighting, OUTPUT_FORMATS, RendererConfig};
 use config::{check_ao_strength, check_lighting, check_output_format, check_size};
 use targets::{MSAA_SAMPLES, Post, SceneResources, SceneTargets};
 
