@@ -72,7 +72,7 @@ fn a_short_stream_writes_its_report() {
     assert!(0.0 < p50 && p50 <= p95 && p95 <= max, "{text}");
     // Flying at 4 blocks a frame, 60 frames cross 7 chunks: new ones stream in.
     assert!(n("upload_bytes_per_frame_p95") > 0.0, "{text}");
-    // Blocks resident within 2x a packed-index palette (the bound).
+    // Blocks resident within 2x a packed-index palette (the bound the streamer keeps).
     assert!(
         n("chunk_storage_bytes") <= 2.0 * n("packed_index_bytes"),
         "{text}"

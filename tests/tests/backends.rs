@@ -244,7 +244,7 @@ fn under_webgl2_limits_the_world_is_drawn_without_storage_buffers_and_matches_vu
         QuadFetch::choose(&w2.caps, None).unwrap(),
         QuadFetch::Instanced
     );
-    // The floor: these draw the world under WebGL2's limits, as themselves.
+    // The floor: these draw the world under WebGL2's limits, as themselves.
     let supported = Technique::supported(&w2.caps);
     for t in [
         Technique::OpaqueOnly,

@@ -283,7 +283,7 @@ fn failing_class_scenes() -> Vec<(Scene, bool)> {
     vec![
         // A chunk-wide water surface with small glass objects just above it (touching, they
         // would cut the surface into several quads), seen from above the water in the same
-        // chunk (the example).
+        // chunk (the classic example).
         (
             scene(
                 "water_and_pillar",
