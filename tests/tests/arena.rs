@@ -95,7 +95,12 @@ fn about_to_compact(
     for (pos, m) in &fillers {
         r.upload_chunk(*pos, m).unwrap();
     }
-    let page = |r: &Renderer, pos| r.chunks().get(pos).unwrap().mesh(MeshKind::Opaque);
+    let page = |r: &Renderer, pos| {
+        voxel_render::low_level::chunks(r)
+            .get(pos)
+            .unwrap()
+            .mesh(MeshKind::Opaque)
+    };
     let mut left = Vec::new();
     for (pos, m) in fillers {
         if page(&r, pos).unwrap().page == 0 {
@@ -107,7 +112,7 @@ fn about_to_compact(
     let memory = r.chunk_memory();
     assert_eq!(memory.pages, 3, "{memory:?}");
     for (pos, _) in kept {
-        let c = r.chunks().get(*pos).unwrap();
+        let c = voxel_render::low_level::chunks(&r).get(*pos).unwrap();
         for kind in [MeshKind::Opaque, MeshKind::Translucent] {
             assert!(c.mesh(kind).is_none_or(|a| a.page == 0), "{pos:?} {kind:?}");
         }
@@ -147,7 +152,7 @@ fn compaction_in_a_first_frame_keeps_every_technique_exact() {
             let first = frame(&ctx, &mut r, &cam);
             let memory = r.chunk_memory();
             assert_eq!(memory.pages, 2, "page 0 compacted away: {memory:?}");
-            let moved = r.chunks().get(kept[0].0).unwrap();
+            let moved = voxel_render::low_level::chunks(&r).get(kept[0].0).unwrap();
             assert!(
                 moved
                     .mesh(MeshKind::Translucent)
@@ -253,7 +258,7 @@ fn a_mesh_over_the_storage_binding_is_an_error() {
             msg.contains(&(PAGE_QUADS + 1).to_string()) && msg.contains(&PAGE_QUADS.to_string()),
             "{msg}"
         );
-        let c = r.chunks().get(pos).unwrap();
+        let c = voxel_render::low_level::chunks(&r).get(pos).unwrap();
         assert_eq!(c.mesh(MeshKind::Opaque).map(|a| a.quads), Some(10));
     }
     let full = ChunkMeshes {

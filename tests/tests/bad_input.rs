@@ -146,7 +146,7 @@ fn config_tells_the_truth_after_every_setter() {
         r.config().oit.wboit.weight,
         voxel_render::WeightFunction::McGuire8
     );
-    assert_eq!(r.oit().config(), &r.config().oit);
+    assert_eq!(voxel_render::low_level::oit(&r).config(), &r.config().oit);
 }
 
 #[test]

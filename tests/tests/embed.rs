@@ -318,7 +318,10 @@ fn lighting_changed_at_run_time_equals_a_renderer_built_with_it() {
     let mut live = renderer_for(&ctx, &s, config.clone()).unwrap();
     let noon = frame(&ctx, &mut live, &cam);
     let generations = |r: &voxel_render::Renderer| -> Vec<u64> {
-        let mut g: Vec<u64> = r.chunks().iter().map(|c| c.generation()).collect();
+        let mut g: Vec<u64> = voxel_render::low_level::chunks(r)
+            .iter()
+            .map(|c| c.generation())
+            .collect();
         g.sort_unstable();
         g
     };
@@ -412,7 +415,7 @@ fn a_technique_built_ahead_switches_without_building() {
     let config = technique_config(Technique::WboitMrt, 96, 72);
     let mut r = renderer_for(&ctx, &s, config.clone()).unwrap();
     frame(&ctx, &mut r, &cam);
-    let builds = |r: &voxel_render::Renderer| r.oit().builds();
+    let builds = |r: &voxel_render::Renderer| voxel_render::low_level::oit(r).builds();
     assert_eq!(builds(&r), 1, "WBOIT built at its first frame");
     assert_eq!(
         r.prebuild_technique(Technique::SortedQuads).unwrap(),

@@ -150,7 +150,12 @@ fn fp16_overflow_never_reaches_the_picture() {
     // saturates at 65504), and the composite's guard keeps the scene finite.
     let mut r = overflow_renderer(&ctx, &scene, false);
     let img = frame(&ctx, &mut r, &scene.cameras[0]);
-    let accum = read_hdr(&ctx, r.oit().accumulation_target().unwrap());
+    let accum = read_hdr(
+        &ctx,
+        voxel_render::low_level::oit(&r)
+            .accumulation_target()
+            .unwrap(),
+    );
     assert!(
         accum.iter().any(|p| p[3] >= 65504.0),
         "the test scene must overflow fp16"
@@ -167,7 +172,12 @@ fn fp16_overflow_never_reaches_the_picture() {
     // parallel sheets, one per chunk layer, drawn back to front).
     let mut r = overflow_renderer(&ctx, &scene, true);
     let img = frame(&ctx, &mut r, &scene.cameras[0]);
-    let accum = read_hdr(&ctx, r.oit().accumulation_target().unwrap());
+    let accum = read_hdr(
+        &ctx,
+        voxel_render::low_level::oit(&r)
+            .accumulation_target()
+            .unwrap(),
+    );
     assert!(finite(&accum), "headroom keeps the sums finite");
     assert!(finite(&read_hdr(&ctx, r.scene_color())));
     img.save_png(&out_dir("fp16_overflow").join("headroom.png"))
@@ -235,7 +245,7 @@ fn techniques_create_resources_only_when_translucency_is_on_screen() {
     .unwrap();
     frame(&ctx, &mut r, &away);
     assert!(
-        !r.oit().has_resources(),
+        !voxel_render::low_level::oit(&r).has_resources(),
         "no translucent chunk visible: no WBOIT targets"
     );
     let times = r.gpu_times_blocking();
@@ -244,7 +254,7 @@ fn techniques_create_resources_only_when_translucency_is_on_screen() {
         "{times:?}"
     );
     frame(&ctx, &mut r, &scene.cameras[0]);
-    assert!(r.oit().has_resources());
+    assert!(voxel_render::low_level::oit(&r).has_resources());
     let times = r.gpu_times_blocking();
     assert!(times.get(GpuPass::Translucent).is_some(), "{times:?}");
     assert!(times.iter().all(|(_, ms)| ms.is_finite() && ms >= 0.0));
@@ -288,7 +298,12 @@ fn shader_weights_match_the_rust_formulas() {
         let stats = r
             .render_and_submit(&Offscreen::new(&ctx, 33, 33).view, &cam)
             .unwrap();
-        let accum = read_hdr(&ctx, r.oit().accumulation_target().unwrap());
+        let accum = read_hdr(
+            &ctx,
+            voxel_render::low_level::oit(&r)
+                .accumulation_target()
+                .unwrap(),
+        );
 
         let got = accum[16 * 33 + 16][3];
         let fit = stats

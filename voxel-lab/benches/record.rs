@@ -92,7 +92,7 @@ fn measure(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Row> {
     }
     Ok(Row {
         label: format!("{vd} {technique}"),
-        chunks: renderer.chunks().len(),
+        chunks: voxel_render::low_level::chunks(&renderer).len(),
         stats,
         ms,
         finish_ms,

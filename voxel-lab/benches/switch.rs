@@ -104,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .split_whitespace()
             .next()
             .unwrap_or("?"),
-        r.chunks().len(),
+        voxel_render::low_level::chunks(&r).len(),
     );
     let _ = writeln!(
         out,

@@ -358,7 +358,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
         size: opts.size,
         prefill_ms,
         chunks_resident: world.len(),
-        chunks_on_gpu: renderer.chunks().len(),
+        chunks_on_gpu: voxel_render::low_level::chunks(&renderer).len(),
         chunks_drawn_p50: Spread::of(&col(|r| r.chunks_drawn as f64)).p50,
         draw_calls_p50: Spread::of(&col(|r| r.draw_calls as f64)).p50,
         cpu_frame_ms: cpu_spread,

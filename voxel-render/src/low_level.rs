@@ -21,3 +21,15 @@ pub use crate::oit::{
 };
 pub use crate::renderer::ChunkMemory;
 pub use crate::stream::{EDIT_BYTES, EDITED_CHUNK_BYTES, MAX_VIEW_DISTANCE};
+
+/// The chunks `renderer` holds on the GPU (the store's meshes, their places in the arena and
+/// their generations).
+pub fn chunks(renderer: &crate::Renderer) -> &ChunkStore {
+    renderer.chunks()
+}
+
+/// The transparency manager of `renderer`: the technique's configuration, how many times
+/// techniques were built, and WBOIT's accumulation target.
+pub fn oit(renderer: &crate::Renderer) -> &OitManager {
+    renderer.oit()
+}

@@ -250,7 +250,7 @@ impl Gfx {
             "streaming: {} chunks held ({:.1} MiB), {} on the GPU ({:.1} MiB of quads), {} jobs, {} uploads",
             streamer.world().len(),
             streamer.memory_bytes() as f64 / f64::from(1 << 20),
-            self.renderer.chunks().len(),
+            voxel_render::low_level::chunks(&self.renderer).len(),
             memory.quad_bytes as f64 / f64::from(1 << 20),
             last.jobs,
             last.uploads

@@ -453,13 +453,13 @@ impl Renderer {
         }
     }
 
-    /// The chunks on the GPU.
-    pub fn chunks(&self) -> &ChunkStore {
+    /// The chunks on the GPU ([`crate::low_level::chunks`]).
+    pub(crate) fn chunks(&self) -> &ChunkStore {
         &self.chunks
     }
 
-    /// The transparency manager.
-    pub fn oit(&self) -> &OitManager {
+    /// The transparency manager ([`crate::low_level::oit`]).
+    pub(crate) fn oit(&self) -> &OitManager {
         &self.oit
     }
 
