@@ -10,7 +10,7 @@ use super::blocks::srgb_to_linear;
 use super::light::Light;
 use super::walk::Walker;
 use super::{Projection, RayMarcher};
-use crate::content::{box_normal, face_light, particle_light};
+use crate::content::box_normal;
 use voxel_render::content::Content;
 
 impl RayMarcher {
@@ -41,7 +41,7 @@ impl RayMarcher {
             if q.dot(right).abs() > s || q.dot(up).abs() > s {
                 continue;
             }
-            let l = light.brightness * particle_light(light.sun, light.ambient);
+            let l = light.sky();
             hits.push(ContentHit {
                 t,
                 color: p.color.map(|c| srgb_to_linear(c) * l),
@@ -100,7 +100,7 @@ impl RayMarcher {
                     && t <= far
                 {
                     let normal = box_normal(e.rotation, a, sign);
-                    let l = light.brightness * face_light(normal, light.sun, light.ambient);
+                    let l = light.on(normal);
                     hits.push(ContentHit {
                         t,
                         color: e.color.map(|c| srgb_to_linear(c) * l),
@@ -115,7 +115,7 @@ impl RayMarcher {
                 continue;
             }
             let normal = box_normal(e.rotation, face.0, face.1);
-            let l = light.brightness * face_light(normal, light.sun, light.ambient);
+            let l = light.on(normal);
             hits.push(ContentHit {
                 t: t_in,
                 color: e.color.map(|c| srgb_to_linear(c) * l),

@@ -7,6 +7,7 @@ use voxel_render::Camera;
 
 use super::walk::Walker;
 use super::{RayMarcher, Shading, Surface};
+use crate::content::{face_light, particle_light};
 
 /// The tonemap of `shaders/tonemap.wgsl` (values up to the shoulder unchanged, then a
 /// smooth roll-off towards 1), then sRGB encoding and 8-bit rounding.
@@ -31,12 +32,7 @@ impl RayMarcher {
     pub(super) fn lit(&self, surface: Surface, p: DVec3, a: [f64; 4], w: &Walker<'_>) -> [f64; 3] {
         let face = surface.face;
         let n = face.normal();
-        let sun = w.light.sun;
-        let n_dot_l =
-            (f64::from(n[0]) * sun[0] + f64::from(n[1]) * sun[1] + f64::from(n[2]) * sun[2])
-                .max(0.0);
-        let ambient = f64::from(w.shading.ambient);
-        let light = w.light.brightness * (ambient + (1.0 - ambient) * n_dot_l);
+        let light = w.light.on(DVec3::from(n.map(f64::from)));
         let translucent = self.class(surface.id) == RenderClass::Translucent;
         let shade = if translucent {
             1.0
@@ -75,12 +71,24 @@ pub(super) struct Fog {
 }
 
 impl Light {
+    /// The light on a surface of unit normal `normal`: Lambert with the sun plus ambient,
+    /// at the light's brightness (`light` in the renderer's `common.wgsl`).
+    pub(super) fn on(&self, normal: DVec3) -> f64 {
+        self.brightness * face_light(normal, self.sun, self.ambient)
+    }
+
+    /// The light of a face turned to the sky: a particle's (a medium's colour is lit so
+    /// too, `medium_light`).
+    pub(super) fn sky(&self) -> f64 {
+        self.brightness * particle_light(self.sun, self.ambient)
+    }
+
     pub(super) fn new(m: &RayMarcher, camera: &Camera, shading: &Shading) -> Self {
         let s = shading.sun_dir.map(f64::from);
         let sun = DVec3::from(s).try_normalize().unwrap_or(DVec3::Y);
         let ambient = f64::from(shading.ambient);
         let brightness = f64::from(shading.brightness);
-        let medium_light = brightness * (ambient + (1.0 - ambient) * sun.y.max(0.0));
+        let medium_light = brightness * particle_light(sun, ambient);
         let fog = camera
             .medium
             .and_then(|id| m.media.get(id.index()).copied().flatten())
