@@ -155,16 +155,30 @@ impl Camera {
     /// (depth 1 at the near plane, 0 at the far plane) for `aspect` = width / height.
     pub fn view_proj(&self, aspect: f64) -> Mat4 {
         let f = self.unit_forward();
-        // Looking straight up or down: pick another up vector so the basis stays defined.
-        let up = if f.y.abs() > 0.999 {
-            DVec3::Z
-        } else {
-            DVec3::Y
-        };
-        let view = DMat4::look_to_rh(DVec3::ZERO, f, up);
+        let view = DMat4::look_to_rh(DVec3::ZERO, f, up_hint(f));
         // Reverse-Z: a standard projection with near and far swapped.
         let proj = DMat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, self.far, self.near);
         (proj * view).as_mat4()
+    }
+}
+
+/// The up vector a view looking along the unit `forward` is built with: world up, or +z
+/// looking straight up or down, so that the basis stays defined.
+fn up_hint(forward: DVec3) -> DVec3 {
+    if forward.y.abs() > 0.999 {
+        DVec3::Z
+    } else {
+        DVec3::Y
+    }
+}
+
+impl Camera {
+    /// The unit right and up vectors of the view [`Camera::view_proj`] builds (what faces
+    /// the camera, a game's particles, is drawn in).
+    pub(crate) fn right_up(&self) -> (DVec3, DVec3) {
+        let f = self.unit_forward();
+        let right = f.cross(up_hint(f)).normalize();
+        (right, right.cross(f))
     }
 }
 

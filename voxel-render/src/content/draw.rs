@@ -453,14 +453,7 @@ impl GameStages for ContentStages {
             self.opaque_pipeline_for(&ctx.device, frame.opaque_samples);
         }
         // The camera's right and up, for particles: the basis of `Camera::view_proj`.
-        let f = frame.camera.unit_forward();
-        let up = if f.y.abs() > 0.999 {
-            DVec3::Z
-        } else {
-            DVec3::Y
-        };
-        let right = f.cross(up).normalize();
-        let true_up = right.cross(f);
+        let (right, true_up) = frame.camera.right_up();
         let v = |d: DVec3| [d.x as f32, d.y as f32, d.z as f32, 0.0];
         let view = View {
             view_proj: frame.view_proj.to_cols_array_2d(),
