@@ -19,15 +19,16 @@ pub(crate) fn common_wgsl() -> String {
         .f32("MAX_GROWTH", MAX_GROWTH)
         .u32("TABLE_WIDTH", crate::fetch::TABLE_WIDTH)
         .finish()
-        + FRAME_WGSL
+        + &frame_wgsl()
         + gpu::DEPTH_UV_WGSL
         + include_str!("shaders/common.wgsl")
         + VOLUME_WGSL
-        + INSIDE_VOLUME_WGSL
+        + PATH_WGSL
 }
 
-/// Fragments inside a volume in the sorted techniques (`shaders/inside_volume.wgsl`).
-pub(crate) const INSIDE_VOLUME_WGSL: &str = include_str!("shaders/inside_volume.wgsl");
+/// The media between the eye and a fragment for the real-time techniques
+/// (`shaders/path.wgsl`).
+pub(crate) const PATH_WGSL: &str = include_str!("shaders/path.wgsl");
 
 /// The volume functions (`shaders/volume.wgsl`): they read `frame`, `block_media` and
 /// `TABLE_WIDTH`, `FLAG_INTERFACE`, which the including shader declares.
@@ -39,10 +40,11 @@ pub(crate) const VOLUME_WGSL: &str = include_str!("shaders/volume.wgsl");
 /// functions.
 pub(crate) fn scene_volume_wgsl(group: u32) -> String {
     gpu::WgslConsts::default()
+        .u32("NO_MEDIUM", NO_MEDIUM)
         .u32("FLAG_INTERFACE", FLAG_INTERFACE)
         .u32("TABLE_WIDTH", crate::fetch::TABLE_WIDTH)
         .finish()
-        + FRAME_WGSL
+        + &frame_wgsl()
         + gpu::DEPTH_UV_WGSL
         + &format!(
             "@group({group}) @binding(0) var<uniform> frame: Frame;\n\
@@ -53,7 +55,7 @@ pub(crate) fn scene_volume_wgsl(group: u32) -> String {
              fn medium_look(block: u32) -> vec4<f32> {{\n    \
              if block == OBJECT_BLOCK {{\n        return vec4<f32>(0.0);\n    }}\n    \
              return textureLoad(block_media, vec2<i32>(i32(block % TABLE_WIDTH), i32(block / TABLE_WIDTH)), 0);\n}}\n\n\
-             // The opaque depth at pixel `xy` (valid when frame.volumes is 1).\n\
+             // The opaque depth at pixel `xy` (the exact references' volume depth).\n\
              fn opaque_depth_at(xy: vec2<f32>) -> f32 {{\n    \
              let uv = depth_uv(xy, textureDimensions(volume_depth));\n    \
              return textureSampleLevel(volume_depth, depth_sampler, uv, 0.0).x;\n}}\n\n"
@@ -61,8 +63,17 @@ pub(crate) fn scene_volume_wgsl(group: u32) -> String {
         + VOLUME_WGSL
 }
 
-/// The `Frame` struct (what [`FrameUniforms`] is in WGSL).
-pub(crate) const FRAME_WGSL: &str = include_str!("shaders/frame.wgsl");
+/// The `Frame` struct (what [`FrameUniforms`] is in WGSL), after the values of its
+/// `volumes` field.
+pub(crate) fn frame_wgsl() -> String {
+    gpu::WgslConsts::default()
+        .u32("MEDIA_NONE", MEDIA_NONE)
+        .u32("MEDIA_EYE", MEDIA_EYE)
+        .u32("MEDIA_VOLUMES", MEDIA_VOLUMES)
+        .u32("MEDIA_WALK", MEDIA_WALK)
+        .finish()
+        + include_str!("shaders/frame.wgsl")
+}
 
 /// How much ambient occlusion darkens at full strength: a vertex of AO value `v` (0 to 3,
 /// `voxel_mesh::ao`) gets brightness `1 − strength · AO_DEPTH · (3 − v) / 3`, so an inner
@@ -119,8 +130,8 @@ pub(crate) struct FrameUniforms {
     /// `tan` of half the horizontal and vertical field of view: a pixel's ray length per
     /// unit of view depth.
     pub tan_half: [f32; 2],
-    /// 1 when a volume (a translucent block with absorption) is in view and group 0's
-    /// volume depth holds this frame's opaque depth; else 0.
+    /// Which media the frame's fragments are seen through ([`MEDIA_NONE`],
+    /// [`MEDIA_EYE`], [`MEDIA_VOLUMES`], [`MEDIA_WALK`]).
     pub volumes: u32,
     /// How bright the light of the sun (or moon) and the ambient light are: 1 by day,
     /// `Lighting::MOONLIGHT` at night. Scales every lit
@@ -132,6 +143,20 @@ pub(crate) struct FrameUniforms {
 
 // A record is one texel of the records' table texture (`fetch.rs`).
 const _: () = assert!(std::mem::size_of::<ChunkUniforms>() == crate::fetch::RECORD_BYTES);
+
+/// [`FrameUniforms::volumes`]: no volume in view and the eye in no absorbing medium.
+pub(crate) const MEDIA_NONE: u32 = 0;
+/// [`FrameUniforms::volumes`], real-time techniques: the eye in an absorbing medium, no
+/// volume to compose besides (or a technique that draws no translucency): fragments are
+/// seen through the eye's medium up to its boundary (`path.wgsl`).
+pub(crate) const MEDIA_EYE: u32 = 1;
+/// [`FrameUniforms::volumes`], real-time techniques: a volume in view too; `volume_depth`
+/// holds where volumes end, `volume_entry` and `entry_look` the nearest entry into one,
+/// `opaque_copy` the opaque depth.
+pub(crate) const MEDIA_VOLUMES: u32 = 2;
+/// [`FrameUniforms::volumes`], exact references: they walk the media from the eye along
+/// their sorted fragments; `volume_depth` holds the opaque depth.
+pub(crate) const MEDIA_WALK: u32 = 3;
 
 /// [`FrameUniforms::medium`] when the eye is in no translucent volume.
 pub(crate) const NO_MEDIUM: u32 = u32::MAX;
@@ -191,9 +216,11 @@ impl SharedLayouts {
             // The opaque depth as volumes read it, and each block's look as a medium.
             gpu::texture_entry(7, gpu::DEPTH_READ),
             gpu::texture_entry(8, wgpu::TextureSampleType::Float { filterable: false }),
-            // The nearest entry into a volume and its medium's look.
+            // The nearest entry into a volume and its medium's look, and a copy of the
+            // opaque depth.
             gpu::texture_entry(9, gpu::DEPTH_READ),
             gpu::texture_entry(10, wgpu::TextureSampleType::Float { filterable: false }),
+            gpu::texture_entry(11, gpu::DEPTH_READ),
         ];
         // Group 0's block layers (read where the quad is expanded) and group 1, as
         // `common.wgsl` declares them for each way of fetching quads.

@@ -105,11 +105,27 @@ pub(crate) fn volume_exit_wgsl() -> String {
     crate::bindings::common_wgsl() + include_str!("shaders/volume_exit.wgsl")
 }
 
-/// The fog pass's shader (after `fullscreen.wgsl`).
-pub(crate) fn fog_wgsl() -> String {
-    gpu::DEPTH_UV_WGSL.to_owned()
-        + crate::bindings::FRAME_WGSL
-        + include_str!("shaders/medium_fog.wgsl")
+/// The media pass's shader (after `fullscreen.wgsl`): the scene group as group 0, the
+/// volume and path functions.
+pub(crate) fn media_wgsl() -> String {
+    gpu::WgslConsts::default()
+        .u32("NO_MEDIUM", crate::bindings::NO_MEDIUM)
+        .u32("FLAG_INTERFACE", crate::bindings::FLAG_INTERFACE)
+        .finish()
+        + &crate::bindings::frame_wgsl()
+        + gpu::DEPTH_UV_WGSL
+        + "@group(0) @binding(0) var<uniform> frame: Frame;\n\
+           @group(0) @binding(3) var medium_boundary: texture_2d<f32>;\n\
+           @group(0) @binding(6) var depth_sampler: sampler;\n\
+           @group(0) @binding(7) var volume_depth: texture_2d<f32>;\n\
+           @group(0) @binding(9) var volume_entry: texture_2d<f32>;\n\
+           @group(0) @binding(10) var entry_look: texture_2d<f32>;\n\
+           @group(0) @binding(11) var opaque_copy: texture_2d<f32>;\n\n\
+           fn boundary_depth(xy: vec2<f32>) -> f32 {\n    \
+           return depth_at(medium_boundary, xy);\n}\n\n"
+        + crate::bindings::VOLUME_WGSL
+        + crate::bindings::PATH_WGSL
+        + include_str!("shaders/media.wgsl")
 }
 
 /// The format of the nearest volume entry's look (linear colour, absorption).
@@ -123,12 +139,9 @@ pub(crate) struct MediumPass {
     volume_exit: wgpu::RenderPipeline,
     /// The nearest front face of a volume and its look (`volume_exit.wgsl`).
     volume_entry: wgpu::RenderPipeline,
-    fog: wgpu::RenderPipeline,
-    /// Group 0 of the fog: the boundary depth and the frame's uniforms.
-    pub fog_layout: wgpu::BindGroupLayout,
-    /// The nearest sampler the fog reads the boundary depth with.
-    depth_sampler: wgpu::Sampler,
-    /// Copies the opaque depth into the boundary.
+    /// The media over the opaque picture (`media.wgsl`), with the scene group.
+    media: wgpu::RenderPipeline,
+    /// Copies the opaque depth into the boundary and the volume depths.
     depth_copy: gpu::DepthCopy,
 }
 
@@ -174,25 +187,14 @@ impl MediumPass {
             samples: 1,
         }
         .build_two_sided(device);
-        let fog_layout = gpu::layout(
-            device,
-            "medium_fog_layout",
-            &[
-                gpu::texture_entry(0, gpu::DEPTH_READ),
-                gpu::buffer_entry(
-                    1,
-                    wgpu::ShaderStages::FRAGMENT,
-                    wgpu::BufferBindingType::Uniform,
-                ),
-                gpu::depth_sampler_entry(2),
-            ],
-        );
-        let fog = FullscreenPipeline {
-            label: "medium_fog",
-            source: &fog_wgsl(),
-            fragment_entry: "fs_fog",
-            groups: &[Some(&fog_layout)],
-            targets: &[gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
+        let media = FullscreenPipeline {
+            label: "media",
+            source: &media_wgsl(),
+            fragment_entry: "fs_media",
+            groups: &[Some(&layouts.scene)],
+            targets: &[gpu::scene_target(Some(
+                wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING,
+            ))],
             writes_depth: false,
             constants: &[],
         }
@@ -201,30 +203,9 @@ impl MediumPass {
             boundary,
             volume_exit,
             volume_entry,
-            fog,
-            fog_layout,
-            depth_sampler: gpu::depth_sampler(device),
+            media,
             depth_copy: gpu::DepthCopy::new(ctx),
         }
-    }
-
-    /// The fog's bind group over `boundary` (per render size) and the frame's uniforms.
-    pub(crate) fn fog_group(
-        &self,
-        device: &wgpu::Device,
-        boundary: &Target,
-        frame: &wgpu::Buffer,
-    ) -> wgpu::BindGroup {
-        gpu::bind_group(
-            device,
-            "medium_fog",
-            &self.fog_layout,
-            &[
-                wgpu::BindingResource::TextureView(&boundary.view),
-                frame.as_entire_binding(),
-                wgpu::BindingResource::Sampler(&self.depth_sampler),
-            ],
-        )
     }
 
     /// Writes into `boundary` the depth of the first surface of the medium (the frame's
@@ -285,18 +266,21 @@ impl MediumPass {
 
     /// Writes into `entry_depth` and `entry_look` the nearest front face of a volume in
     /// front of `opaque_depth` and its medium's look (`scene`: group 0 with the opaque depth
-    /// in `volume_entry`'s place). After [`Self::volume_depth_pass`].
+    /// in `volume_entry`'s place), and a copy of the opaque depth into `opaque_copy`. After
+    /// [`Self::volume_depth_pass`].
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn volume_entry_pass(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         opaque_depth: &Target,
-        (entry_depth, entry_look): (&Target, &Target),
+        (entry_depth, entry_look, opaque_copy): (&Target, &Target, &Target),
         scene: &wgpu::BindGroup,
         draws: &FrameDraws<'_>,
         chunks: &DrawList,
         timer: Option<&Timer>,
     ) {
+        self.depth_copy
+            .record(encoder, opaque_depth, opaque_copy, GpuPass::Medium, timer);
         self.depth_copy
             .record(encoder, opaque_depth, entry_depth, GpuPass::Medium, timer);
         let colors = [gpu::clear(&entry_look.view, wgpu::Color::TRANSPARENT)];
@@ -312,18 +296,20 @@ impl MediumPass {
         );
     }
 
-    /// Blends the fog over `target` along the way to the boundary.
-    pub(crate) fn fog_pass(
+    /// Blends over `target` (the opaque picture) the media in front of it: the eye's
+    /// medium up to its boundary and the nearest volume (`scene`: the scene group, after
+    /// the boundary and volume passes).
+    pub(crate) fn media_pass(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         target: &Target,
-        fog_group: &wgpu::BindGroup,
+        scene: &wgpu::BindGroup,
         timer: Option<&Timer>,
     ) {
         let colors = [gpu::load(&target.view)];
-        Pass::new("medium_fog", GpuPass::Medium, &colors).record(encoder, timer, |pass| {
-            pass.set_pipeline(&self.fog);
-            pass.set_bind_group(0, fog_group, &[]);
+        Pass::new("media", GpuPass::Medium, &colors).record(encoder, timer, |pass| {
+            pass.set_pipeline(&self.media);
+            pass.set_bind_group(0, scene, &[]);
             pass.draw(0..3, 0..1);
         });
     }

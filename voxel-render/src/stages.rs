@@ -153,13 +153,17 @@ impl GameFrame<'_> {
     }
 }
 
-/// The rule for equal depths between a game's translucent object and a block's face (a
-/// plate lying in a water surface, a decal on a pane): the block's face is in front. The
-/// exact methods compare an object's fragment at its depth times `1 - OBJECT_DEPTH_BIAS`
-/// (reverse-Z: a little farther, 32 steps of a 32-bit float) and the lab's ray march an
-/// object's hit at its distance times `1 + OBJECT_DEPTH_BIAS`, so they agree on which is
-/// in front instead of each breaking the tie its own way. Surfaces farther apart than
-/// that (about 4e-4 blocks at a distance of 100) are ordered by where they are.
+/// The rule for equal depths between a game's translucent object and a block's face (foam
+/// lying in a water surface, a decal on a pane): the object is on the eye's side of the
+/// face, in front of it, seen from either side. The exact methods compare an object's
+/// fragment at its depth times `1 + OBJECT_DEPTH_BIAS` (reverse-Z: a little nearer, 32
+/// steps of a 32-bit float) and the lab's ray march an object's hit at its distance times
+/// `1 - OBJECT_DEPTH_BIAS`, so they agree on which is in front instead of each breaking the
+/// tie its own way; the sorted techniques draw such an object after the face (the order of
+/// `interleave`), and the weighted ones do not order. Surfaces farther apart than that
+/// (about 4e-4 blocks at a distance of 100) are ordered by where they are. An object lying
+/// in an *opaque* face's plane z-fights with it in every real-time technique (its
+/// fragments and the face's are depth-tested): offset such decals.
 pub const OBJECT_DEPTH_BIAS: f32 = 1.0 / 262_144.0;
 
 /// Depth convention of every stage: 32-bit float, reverse-Z (1 at the near plane, 0 far),
@@ -286,7 +290,7 @@ pub struct GameDraw<'a> {
     /// The nearest sampler depth textures are read with (`gpu::DEPTH_READ`).
     pub depth_sampler: &'a wgpu::Sampler,
     /// Where volumes end, the nearest entry into a volume and its medium's look
-    /// (`shaders/inside_volume.wgsl`).
+    /// (`shaders/path.wgsl`).
     pub volume_depth: &'a wgpu::TextureView,
     /// See `volume_depth`.
     pub volume_entry: &'a wgpu::TextureView,
@@ -399,7 +403,7 @@ pub(crate) fn game_prelude(own: &str, output: &str) -> String {
         .u32("FLAG_INTERFACE", voxel_mesh::FLAG_INTERFACE)
         .f32("OIT_OBJECT_DEPTH_BIAS", OBJECT_DEPTH_BIAS)
         .finish()
-        + crate::bindings::FRAME_WGSL
+        + &crate::bindings::frame_wgsl()
         + crate::gpu::DEPTH_UV_WGSL
         + &format!(
             "@group({OIT_GROUP}) @binding(0) var<uniform> frame: Frame;\n\
@@ -416,13 +420,13 @@ pub(crate) fn game_prelude(own: &str, output: &str) -> String {
              fn oit_view_depth(position: vec4<f32>) -> f32 {{\n    \
              return frame.near * frame.far / (position.z * (frame.far - frame.near) + frame.near);\n}}\n\n\
              // The fragment's position with its depth as the exact methods compare an\n\
-             // object's (OBJECT_DEPTH_BIAS: at equal depth a block's face is in front).\n\
+             // object's (OBJECT_DEPTH_BIAS: at equal depth the object is in front).\n\
              fn oit_object_position(position: vec4<f32>) -> vec4<f32> {{\n    \
-             return vec4<f32>(position.xy, position.z * (1.0 - OIT_OBJECT_DEPTH_BIAS), position.w);\n}}\n\n"
+             return vec4<f32>(position.xy, min(position.z * (1.0 + OIT_OBJECT_DEPTH_BIAS), 1.0), position.w);\n}}\n\n"
         );
     header
         + crate::bindings::VOLUME_WGSL
-        + crate::bindings::INSIDE_VOLUME_WGSL
+        + crate::bindings::PATH_WGSL
         + &regroup(own, 2, OIT_GROUP, OWN_SHIFT)
         + "\n"
         + output

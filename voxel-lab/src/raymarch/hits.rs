@@ -136,9 +136,10 @@ impl RayMarcher {
         t: f64,
         w: &mut Walker<'_>,
     ) -> bool {
-        // At equal depth a block's face is in front of an object's: the object's hit
-        // counts OBJECT_DEPTH_BIAS farther, as the GPU's exact methods count it.
-        let bias = 1.0 + f64::from(voxel_render::stages::OBJECT_DEPTH_BIAS);
+        // At equal depth an object is in front of a block's face (on the eye's side of it):
+        // the object's hit counts OBJECT_DEPTH_BIAS nearer, as the GPU's exact methods
+        // count it.
+        let bias = 1.0 - f64::from(voxel_render::stages::OBJECT_DEPTH_BIAS);
         while let Some(h) = hits.get(*next) {
             if h.t * bias >= t {
                 break;

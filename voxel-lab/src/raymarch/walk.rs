@@ -37,15 +37,26 @@ impl RayMarcher {
         let mut layers: Vec<[f64; 4]> = Vec::new();
         let mut end: Option<(Surface, [f64; 3])> = None;
         let mut boundary: Option<f64> = None;
-        let mut end_t = far;
 
+        // In the eye's medium the ray starts inside a volume, at the eye: what it meets on the
+        // way to the medium's first surface is seen through the part of the way in front of
+        // it, as everything inside a volume is.
+        let eye_volume = light
+            .fog
+            .as_ref()
+            .filter(|f| f.density > 0.0)
+            .map(|f| Volume {
+                start: 0.0,
+                color: f.color,
+                absorption: f.density,
+            });
         let mut walker = Walker {
             eye,
             dir,
             near,
             far,
             medium,
-            volume: None,
+            volume: eye_volume,
             shading,
             light,
             want_color,
@@ -107,10 +118,9 @@ impl RayMarcher {
             let mut prev = self.get(cell);
             if Self::content_until(&hits, &mut next_hit, t0, &mut walker) {
                 content_end = true;
-                end_t = hits[next_hit - 1].t;
             } else if let Some(axis) = entry_axis {
                 // The ray enters the box from air through a face along `axis`.
-                let ended = self.crossing(
+                self.crossing(
                     &CrossingCtx {
                         from: BlockId::AIR,
                         to: prev,
@@ -121,9 +131,6 @@ impl RayMarcher {
                     },
                     &mut walker,
                 );
-                if ended {
-                    end_t = t0;
-                }
             }
             let s = CHUNK_SIZE as i64;
             let chunk_of = |cell: &[i64; 3]| cell.map(|v| v.div_euclid(s));
@@ -175,7 +182,6 @@ impl RayMarcher {
                 let t = t_max[axis];
                 if Self::content_until(&hits, &mut next_hit, t.min(t1), &mut walker) {
                     content_end = true;
-                    end_t = hits[next_hit - 1].t;
                     break;
                 }
                 if t > t1 {
@@ -200,9 +206,7 @@ impl RayMarcher {
                     step: step[axis],
                     t,
                 };
-                if self.crossing(&ctx, &mut walker) {
-                    end_t = t;
-                }
+                self.crossing(&ctx, &mut walker);
                 prev = b;
             }
         }
@@ -211,11 +215,13 @@ impl RayMarcher {
             && Self::content_until(&hits, &mut next_hit, far, &mut walker)
         {
             content_end = true;
-            end_t = hits[next_hit - 1].t;
         }
         if !content_end && walker.end.is_none() {
-            // Into the sky: a volume the ray is still in ends where the loaded blocks do.
-            walker.absorb_to(t1.min(far));
+            // Into the sky: a volume the ray is still in ends where the loaded blocks do; the
+            // eye's own passage, which no surface ended, at the far plane (where the
+            // renderer's boundary lies when nothing is drawn).
+            let own_passage = medium.is_some() && walker.boundary.is_none();
+            walker.absorb_to(if own_passage { far } else { t1.min(far) });
         }
         let end_surface = end.map(|(s, _)| s);
         end_surface.map(|s| s.plane()).hash(&mut hasher);
@@ -240,16 +246,7 @@ impl RayMarcher {
             }
             acc[3] += k * l[3];
         }
-        let mut color: [f64; 3] = std::array::from_fn(|c| acc[c] + (1.0 - acc[3]) * background[c]);
-        // Fog of the medium over the way to its first surface (or the end).
-        if let Some(fog) = &light.fog {
-            let depth = boundary.unwrap_or(end_t).min(end_t);
-            let transmittance = (-fog.density * depth * dir.length()).exp();
-            for (c, f) in color.iter_mut().zip(fog.color) {
-                *c = f * (1.0 - transmittance) + *c * transmittance;
-            }
-        }
-        result.color = color;
+        result.color = std::array::from_fn(|c| acc[c] + (1.0 - acc[3]) * background[c]);
         result
     }
 
@@ -326,20 +323,22 @@ impl RayMarcher {
                 w.layer(self, back, p, a);
             }
         }
-        // The volume of the block entered, unless the eye's own passage goes on (the
-        // medium's fog stands for it).
+        // The volume of the block entered, unless the eye's own passage goes on (the eye's
+        // medium, from the eye).
         let own_passage = w.medium.is_some() && w.boundary.is_none();
-        w.volume = self
-            .media
-            .get(x.to.index())
-            .copied()
-            .flatten()
-            .filter(|m| m.absorption > 0.0 && !own_passage)
-            .map(|m| Volume {
-                start: x.t,
-                color: m.color.map(|c| c * w.light.medium_light),
-                absorption: m.absorption,
-            });
+        if !own_passage {
+            w.volume = self
+                .media
+                .get(x.to.index())
+                .copied()
+                .flatten()
+                .filter(|m| m.absorption > 0.0)
+                .map(|m| Volume {
+                    start: x.t,
+                    color: m.color.map(|c| c * w.light.medium_light),
+                    absorption: m.absorption,
+                });
+        }
         ended
     }
 }
@@ -416,8 +415,8 @@ impl Walker<'_> {
         }
     }
 
-    /// The medium's first surface (it ends the fog; the signature notes it, since the fog
-    /// changes where it does).
+    /// The medium's first surface (it ends the eye's passage through the medium; the
+    /// signature notes it, since the path changes where it does).
     fn set_boundary(&mut self, t: f64, s: Surface) {
         *self.boundary = Some(t);
         (1u8, s.plane()).hash(self.hasher);

@@ -99,12 +99,6 @@ macro_rules! techniques {
                 match self { $( Technique::$variant => <$kind as TechniqueKind>::SORTS, )* }
             }
 
-            /// Whether the technique composes fragments inside a volume against the volume's
-            /// entry ([`TechniqueKind::composes_inside_volumes`]).
-            pub(crate) fn composes_inside_volumes(self) -> bool {
-                match self { $( Technique::$variant => <$kind as TechniqueKind>::composes_inside_volumes(self), )* }
-            }
-
             /// Whether the technique with `config` reads [`FrameView::layers`].
             fn reads_layers(self, config: &OitConfig) -> bool {
                 match self { $( Technique::$variant => <$kind as TechniqueKind>::reads_layers(config), )* }
@@ -301,13 +295,6 @@ pub(crate) trait TechniqueKind: TranslucentTechnique + Sized + 'static {
         false
     }
 
-    /// Whether `technique` draws translucent fragments in order, one blend each, so that a
-    /// fragment inside a volume is composed against the volume's entry
-    /// (`inside_volume.wgsl`, frame uniforms' `volumes` mode 2).
-    fn composes_inside_volumes(_technique: Technique) -> bool {
-        false
-    }
-
     /// Whether it reads the visible translucent meshes' planes ([`FrameView::layers`])
     /// with `config`: the culling copies them only then.
     fn reads_layers(_config: &OitConfig) -> bool {
@@ -450,9 +437,9 @@ pub(crate) struct TranslucentFrame<'a> {
     /// The eye is inside a translucent volume: draw both sides of translucent faces
     /// (the `two_sided` variant of each [`crate::gpu::SidedPipeline`]).
     pub two_sided: bool,
-    /// A volume (a translucent block with absorption) is in view: group 0's volume depth
-    /// holds the opaque depth, and the exact references draw both sides (where a ray
-    /// leaves a volume).
+    /// The exact references walk media along their fragments (a volume in view, or the
+    /// eye in one): group 0's volume depth holds the opaque depth, and they draw both
+    /// sides (where a ray leaves a volume).
     pub volumes: bool,
     /// The game's translucent geometry, drawn in every pass of the technique.
     pub game: Option<&'a GameDraw<'a>>,

@@ -12,7 +12,7 @@ use super::RendererConfig;
 use super::config::{OUTPUT_FORMATS, output_format, sun_unit};
 use super::targets::MSAA_SAMPLES;
 use super::{FrameStats, Renderer};
-use crate::bindings::{FrameUniforms, NO_MEDIUM};
+use crate::bindings::{FrameUniforms, MEDIA_EYE, MEDIA_NONE, MEDIA_VOLUMES, MEDIA_WALK, NO_MEDIUM};
 use crate::chunks::{DrawList, DrawMode, FrameDraws, Frustum, GpuChunk, MeshKind};
 use crate::error::scoped;
 use crate::gpu::{self, Depth, Pass};
@@ -143,13 +143,26 @@ impl Renderer {
         let layers = self.oit.wants_layers();
         self.chunks.cull(&frustum, layers, &mut self.culled);
         self.chunks.lists_built();
-        // A volume in view: its faces read the opaque depth (a copy, made below), whose
-        // target is made the first time.
-        let volumes = self
-            .culled
-            .translucent_slots()
-            .any(|slot| self.chunks.by_slot(slot).is_some_and(GpuChunk::has_volume));
-        if volumes && !self.targets.volumes {
+        // The media fragments are seen through (`bindings::MEDIA_*`): a volume in view (a
+        // translucent block with absorption; a technique that draws no translucency sees none)
+        // or the eye inside an absorbing medium. Their passes read depths whose targets are
+        // made the first time.
+        let technique = self.oit.technique();
+        let exact = technique.is_exact();
+        let volumes = technique != Technique::OpaqueOnly
+            && self
+                .culled
+                .translucent_slots()
+                .any(|slot| self.chunks.by_slot(slot).is_some_and(GpuChunk::has_volume));
+        let eye_absorbs = medium.is_some_and(|(_, look)| look.absorption > 0.0);
+        let media = match (exact, volumes, eye_absorbs) {
+            (_, false, false) => MEDIA_NONE,
+            (true, _, _) => MEDIA_WALK,
+            (false, true, _) => MEDIA_VOLUMES,
+            (false, false, true) => MEDIA_EYE,
+        };
+        let volume_targets = media == MEDIA_VOLUMES || media == MEDIA_WALK;
+        if volume_targets && !self.targets.volumes {
             let (size, msaa) = (self.size(), self.config.msaa);
             let targets = scoped(&self.ctx.device, "making the volume depth", || {
                 self.targets_for(size, msaa, true)
@@ -206,19 +219,11 @@ impl Renderer {
         } else {
             game.translucent_objects().len()
         };
-        // The techniques drawn in order, one blend per fragment, compose a fragment inside
-        // a volume against the volume's entry (`inside_volume.wgsl`).
-        let ordered = self.oit.technique().composes_inside_volumes();
-        let volume_mode = match (volumes, ordered) {
-            (false, _) => 0,
-            (true, false) => 1,
-            (true, true) => 2,
-        };
         self.write_frame_uniforms(
             camera,
             view_proj,
             medium.as_ref().map(|(b, look)| (*b, look)),
-            volume_mode,
+            media,
         );
         let (eye_int, eye_frac) = camera.eye_split();
         let game_frame = GameFrame {
@@ -276,25 +281,27 @@ impl Renderer {
                 timer,
             );
         }
-        if volumes {
-            let exits = (!self.oit.technique().is_exact()).then_some((
-                &t.exit_scene_group,
-                &draws,
-                translucent,
-            ));
+        if volume_targets {
+            let exits = (!exact).then_some((&t.exit_scene_group, &draws, translucent));
             self.medium
                 .volume_depth_pass(encoder, &t.depth, &t.volume_depth, exits, timer);
-            if volume_mode == 2 {
-                self.medium.volume_entry_pass(
-                    encoder,
-                    &t.depth,
-                    (&t.volume_entry, &t.entry_look),
-                    &t.entry_scene_group,
-                    &draws,
-                    translucent,
-                    timer,
-                );
-            }
+        }
+        if media == MEDIA_VOLUMES {
+            self.medium.volume_entry_pass(
+                encoder,
+                &t.depth,
+                (&t.volume_entry, &t.entry_look, &t.opaque_copy),
+                &t.entry_scene_group,
+                &draws,
+                translucent,
+                timer,
+            );
+        }
+        if media == MEDIA_EYE || media == MEDIA_VOLUMES {
+            // The opaque picture seen through the media; each translucent fragment is seen
+            // through its own part of the path (`shaders/path.wgsl`).
+            self.medium
+                .media_pass(encoder, &t.color, &t.scene_group, timer);
         }
         let game_draw = stages.translucent.then_some(GameDraw {
             stages: game,
@@ -318,16 +325,12 @@ impl Renderer {
                 chunks: translucent,
                 timer,
                 two_sided: medium.is_some(),
-                volumes,
+                volumes: media == MEDIA_WALK,
                 game: game_draw.as_ref(),
             },
         )?;
         if stages.translucent {
             self.ctx.check_device()?;
-        }
-        if medium.is_some() {
-            // The eye's medium, its light and the camera are in the frame's uniforms.
-            self.medium.fog_pass(encoder, &t.color, &t.fog_group, timer);
         }
         if stages.hdr_overlay {
             let colors = [gpu::load(&t.color.view)];
@@ -500,7 +503,7 @@ impl Renderer {
         camera: &Camera,
         view_proj: Mat4,
         medium: Option<(BlockId, &MediumLook)>,
-        volumes: u32,
+        media: u32,
     ) {
         let (eye_int, eye_frac) = camera.eye_split();
         let sun = sun_unit(self.config.sun_dir);
@@ -521,7 +524,7 @@ impl Renderer {
             medium: medium.map_or(NO_MEDIUM, |(b, _)| u32::from(b.0)),
             ao_strength: self.config.ao_strength,
             tan_half: [tan_x as f32, tan_y as f32],
-            volumes,
+            volumes: media,
             medium_look: medium.map_or([0.0; 4], |(_, look)| {
                 let [r, g, b] = look.color;
                 [r, g, b, look.absorption]

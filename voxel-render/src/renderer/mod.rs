@@ -205,15 +205,7 @@ impl Renderer {
         post.make_tonemap(ctx, config.output_format);
         let medium = MediumPass::new(ctx, &layouts);
         let size = (config.width, config.height);
-        let targets = SceneTargets::new(
-            ctx,
-            &post,
-            &layouts,
-            &scene,
-            &medium,
-            size,
-            (config.msaa, false),
-        );
+        let targets = SceneTargets::new(ctx, &post, &layouts, &scene, size, (config.msaa, false));
         let block_opacity = registry
             .iter()
             .map(|(_, def)| def.opacity)

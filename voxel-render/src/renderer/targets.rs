@@ -9,7 +9,7 @@ use crate::QuadFetch;
 use crate::bindings::SharedLayouts;
 use crate::fetch::TableTexture;
 use crate::gpu::{self, FullscreenPipeline, Target};
-use crate::medium::{self, MediumPass};
+use crate::medium;
 use crate::textures::BlockTextures;
 use crate::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
 
@@ -48,11 +48,12 @@ pub(super) struct SceneTargets {
     pub(super) exit_scene_group: wgpu::BindGroup,
     /// The scene group of the pass writing `volume_entry` and `entry_look`.
     pub(super) entry_scene_group: wgpu::BindGroup,
-    /// The nearest front face of a volume (`shaders/inside_volume.wgsl`).
+    /// The nearest front face of a volume (`shaders/path.wgsl`).
     pub(super) volume_entry: Target,
     /// Its medium's look.
     pub(super) entry_look: Target,
-    pub(super) fog_group: wgpu::BindGroup,
+    /// A copy of the opaque depth the chunk passes read (`opaque_copy` in `common.wgsl`).
+    pub(super) opaque_copy: Target,
     /// MSAA colour and depth, resolved into `color` and `depth`.
     pub(super) msaa: Option<(Target, Target)>,
     pub(super) tonemap_group: wgpu::BindGroup,
@@ -82,7 +83,6 @@ impl Renderer {
             &self.post,
             &self.layouts,
             &self.scene,
-            &self.medium,
             size,
             (msaa, volumes),
         )
@@ -160,7 +160,6 @@ impl SceneTargets {
         post: &Post,
         layouts: &SharedLayouts,
         scene: &SceneResources,
-        medium: &MediumPass,
         size: (u32, u32),
         (msaa, volumes): (bool, bool),
     ) -> Self {
@@ -224,6 +223,7 @@ impl SceneTargets {
         let volume_depth = volume_target("volume_depth", DEPTH_FORMAT);
         let volume_entry = volume_target("volume_entry", DEPTH_FORMAT);
         let entry_look = volume_target("entry_look", medium::ENTRY_LOOK_FORMAT);
+        let opaque_copy = volume_target("opaque_copy", DEPTH_FORMAT);
         // The block layers: binding 4 (a storage buffer) or 5 (a table texture),
         // `shaders/common.wgsl`.
         let layers = match &scene.layer_table {
@@ -245,6 +245,7 @@ impl SceneTargets {
                 (8, wgpu::BindingResource::TextureView(&scene.media.view)),
                 (9, wgpu::BindingResource::TextureView(&entry.0.view)),
                 (10, wgpu::BindingResource::TextureView(entry.1)),
+                (11, wgpu::BindingResource::TextureView(&opaque_copy.view)),
             ];
             let entries =
                 resources.map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
@@ -267,7 +268,6 @@ impl SceneTargets {
             &volume_depth,
             (&depth, &scene.media.view),
         );
-        let fog_group = medium.fog_group(device, &boundary, &scene.frame_buffer);
         let tonemap_group =
             gpu::texture_group(device, "tonemap", &post.tonemap_layout, &[&color.view]);
         let depth_resolve_group = msaa.as_ref().map(|(_, d)| {
@@ -291,7 +291,7 @@ impl SceneTargets {
             entry_scene_group,
             volume_entry,
             entry_look,
-            fog_group,
+            opaque_copy,
             msaa,
             tonemap_group,
             depth_resolve_group,

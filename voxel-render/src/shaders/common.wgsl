@@ -26,15 +26,16 @@ struct ChunkInfo {
 @group(0) @binding(3) var medium_boundary: texture_2d<f32>;
 // The sampler depth textures are read with (every chunk pass's own too).
 @group(0) @binding(6) var depth_sampler: sampler;
-// Volumes (`medium.rs`): the opaque depth behind the translucent passes (a copy, valid
-// when frame.volumes is 1), and per block id its look as a medium, TABLE_WIDTH entries a
+// Volumes (`medium.rs`): where volumes end (`volume_exit.wgsl`; the exact references: the
+// opaque depth), and per block id its look as a medium, TABLE_WIDTH entries a
 // row: linear colour and absorption per block (0: a thin surface).
 @group(0) @binding(7) var volume_depth: texture_2d<f32>;
 @group(0) @binding(8) var block_media: texture_2d<f32>;
 // The nearest entry into a volume (a depth texture, read as a float one) and its medium's
-// look, when `frame.volumes` is 2 (`inside_volume.wgsl`).
+// look, and a copy of the opaque depth, when `frame.volumes` is MEDIA_VOLUMES (`path.wgsl`).
 @group(0) @binding(9) var volume_entry: texture_2d<f32>;
 @group(0) @binding(10) var entry_look: texture_2d<f32>;
+@group(0) @binding(11) var opaque_copy: texture_2d<f32>;
 
 // How quads and their tables reach the vertex stage (`fetch.rs`); a pipeline uses one of
 // the two, and binds only that one's resources.
@@ -303,29 +304,25 @@ fn medium_look(block: u32) -> vec4<f32> {
     return textureLoad(block_media, table_texel(block), 0);
 }
 
-// What every technique composes for a translucent fragment: its face, and where it is
-// the entry face of a volume (a front face of a block with absorption), the volume behind
-// it down to where it ends (`volume_depth`: the first back face of a volume, or the
-// opaque surface; `volume_exit.wgsl`): what lies behind keeps exp(−absorption · d) of its
-// light over the d blocks the ray travels inside, and takes the medium's lit colour for
-// the rest. Exact for one volume along the ray with nothing translucent inside it (water
-// over the ground, or left through its far side); translucent things inside it get the
-// whole path in front of them, and a second volume behind the first ends at the first's
-// exit (the exact references split the path at every face).
+// What every real-time technique composes for a translucent fragment: its face, seen
+// through the media in front of it (`fogged`, `path.wgsl`). The path through the nearest
+// volume behind it is the media pass's, which lies it over the opaque picture; the entry
+// face of a volume beyond where that one ends (the sea behind a glass pillar standing in
+// it, water under ice) composes its own volume behind it down to the opaque surface: exact
+// where the volume ends there with nothing translucent inside it. The exact references walk
+// the media along their sorted fragments themselves and take `surface_color`.
 fn translucent_color(in: VsOut, front: bool) -> vec4<f32> {
     let c = surface_color(in, front);
-    if frame.volumes == 0u || c.a <= 0.0 {
+    if (frame.volumes != MEDIA_EYE && frame.volumes != MEDIA_VOLUMES) || c.a <= 0.0 {
         return c;
     }
     let m = medium_look(in.block);
-    if !front || m.a <= 0.0 {
-        return inside_volume(in.clip.xy, in.clip.z, c);
+    if frame.volumes == MEDIA_VOLUMES && front && m.a > 0.0 && in.clip.z < depth_at(volume_entry, in.clip.xy) {
+        let v = medium_segment(m, ray_length(in.clip.xy, in.clip.z, depth_at(opaque_copy, in.clip.xy)));
+        let all = in_front_of(vec4<f32>(0.0), c) + (1.0 - c.a) * v;
+        return fogged(in.clip.xy, in.clip.z, vec4<f32>(all.rgb / all.a, all.a));
     }
-    let z = depth_at(volume_depth, in.clip.xy);
-    let p = in_front_of(vec4<f32>(0.0), c);
-    let v = medium_segment(m, ray_length(in.clip.xy, in.clip.z, z));
-    let all = p + (1.0 - p.a) * v;
-    return vec4<f32>(all.rgb / all.a, all.a);
+    return fogged(in.clip.xy, in.clip.z, c);
 }
 
 // Level of the n×n Bayer matrix (n a power of two) at a pixel, over n²: the matrix

@@ -18,10 +18,10 @@ struct Frame {
     ao_strength: f32,
     // tan of half the horizontal and vertical field of view.
     tan_half: vec2<f32>,
-    // 0: no volume in view. 1: a volume is in view and `volume_depth` holds where volumes
-    // end (the exact references: the opaque depth). 2: besides, `volume_entry` and
-    // `entry_look` hold the nearest entry into a volume, and fragments inside a volume are
-    // composed as the sorted techniques need (`inside_volume`).
+    // Which media the fragments are seen through (MEDIA_*, `bindings.rs`): none; the eye's
+    // medium (real-time techniques, `path.wgsl`); besides, the nearest volume in view
+    // (`volume_depth`, `volume_entry`, `entry_look`, `opaque_copy` hold it); or every
+    // medium, walked by the exact references along their sorted fragments.
     volumes: u32,
     // How bright sun (or moon) and ambient light are: 1 by day, less at night.
     brightness: f32,

@@ -13,8 +13,16 @@ fn fragment_info(block: u32, front: bool, flags: u32) -> u32 {
         | select(0u, INFO_INTERFACE, (flags & FLAG_INTERFACE) != 0u);
 }
 
-// View depth of reverse-Z window depth `z` (the far plane where nothing was drawn).
+// A window depth that stands for the eye itself (view depth 0): a path from the eye starts
+// there. Every drawn depth is at most 1 (the near plane).
+const EYE_Z: f32 = 2.0;
+
+// View depth of reverse-Z window depth `z` (the far plane where nothing was drawn; 0 at
+// EYE_Z).
 fn view_depth_of(z: f32) -> f32 {
+    if z >= EYE_Z {
+        return 0.0;
+    }
     return frame.near * frame.far / (z * (frame.far - frame.near) + frame.near);
 }
 
@@ -44,7 +52,7 @@ fn medium_segment(m: vec4<f32>, d: f32) -> vec4<f32> {
 fn medium_after(current: vec4<f32>, look: vec4<f32>, info: u32) -> vec4<f32> {
     let front = (info & INFO_FRONT) != 0u;
     let at_interface = (info & INFO_INTERFACE) != 0u;
-    if (info & 0xffffu) == OBJECT_BLOCK || frame.volumes == 0u {
+    if (info & 0xffffu) == OBJECT_BLOCK || frame.volumes != MEDIA_WALK {
         return current;
     }
     if look.a > 0.0 && front {
@@ -56,12 +64,20 @@ fn medium_after(current: vec4<f32>, look: vec4<f32>, info: u32) -> vec4<f32> {
     return current;
 }
 
+// The medium a walk from the eye starts in (the exact references): the eye's, or none.
+fn eye_medium() -> vec4<f32> {
+    if frame.volumes == MEDIA_WALK && frame.medium != NO_MEDIUM {
+        return frame.medium_look;
+    }
+    return vec4<f32>(0.0);
+}
+
 // Whether a fragment changes the medium (the exact references keep it even where it has
 // no colour).
 fn changes_medium(look: vec4<f32>, info: u32) -> bool {
     let front = (info & INFO_FRONT) != 0u;
     let at_interface = (info & INFO_INTERFACE) != 0u;
-    return frame.volumes != 0u && (info & 0xffffu) != OBJECT_BLOCK
+    return frame.volumes == MEDIA_WALK && (info & 0xffffu) != OBJECT_BLOCK
         && ((look.a > 0.0 && (front || !at_interface)) || (front && at_interface));
 }
 

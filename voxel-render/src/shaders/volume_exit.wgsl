@@ -1,5 +1,5 @@
 // Where the volumes end along each pixel's ray (appended to common.wgsl), for the
-// techniques that compose a volume at its entry face (`translucent_color`): the back faces
+// real-time techniques' path through the nearest volume (`path.wgsl`): the back faces
 // of every volume type in front of the opaque surface, nearest kept in the depth
 // attachment, which starts as a copy of the opaque depth. A volume entered at a front face
 // then ends at the first of them, or at the opaque surface. With the eye inside a medium
@@ -18,13 +18,14 @@ fn fs_volume_exit(in: VsOut, @builtin(front_facing) front: bool) {
 }
 
 // The nearest entry into a volume in front of the opaque surface (a front face of a
-// volume), its medium's look in the colour target, for the sorted techniques' fragments
-// inside a volume (`inside_volume.wgsl`). In this pass group 0's `volume_entry` binding
-// holds the opaque depth itself.
+// volume), its medium's look in the colour target: the volume the real-time techniques
+// see fragments and the opaque picture through (`path.wgsl`). A chunk still dissolving in
+// enters nothing where its face is dissolved. In this pass group 0's `volume_entry`
+// binding holds the opaque depth itself.
 @fragment
 fn fs_volume_entry(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let m = medium_look(in.block);
-    if !front || m.a <= 0.0 {
+    if !front || m.a <= 0.0 || faded_out(in) {
         discard;
     }
     return m;

@@ -485,7 +485,7 @@ impl Mboit {
             "struct OitOutput {\n    @location(0) accumulation: vec4<f32>,\n};\n\n\
              // accumulation += (C·α, α)·T, T the transmittance in front from the moments.\n\
              fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
-             return OitOutput(mboit_resolve(position, oit_view_depth(position), color));\n}\n"
+             return OitOutput(mboit_resolve(position, oit_view_depth(position), fogged(position.xy, position.z, color)));\n}\n"
         } else {
             "struct OitOutput {\n    @location(0) b0: vec4<f32>,\n    @location(1) moments: vec4<f32>,\n};\n\n\
              // b0 += −ln(1 − α), moments += that times (z, z², z³, z⁴) of the warped depth.\n\

@@ -7,9 +7,15 @@
 @fragment
 fn fs_last_volume(in: FullscreenOut) -> @location(0) vec4<f32> {
     let s = textureLoad(final_state, vec2<i32>(in.clip.xy), 0);
-    let medium = vec4<f32>(unpack2x16float(s.x), unpack2x16float(s.y));
+    // Before any layer the ray is still in the eye's medium, from the eye.
+    var medium = eye_medium();
+    var start = EYE_Z;
+    if s.w != 0u {
+        medium = vec4<f32>(unpack2x16float(s.x), unpack2x16float(s.y));
+        start = bitcast<f32>(s.z);
+    }
     if medium.a <= 0.0 {
         discard;
     }
-    return medium_segment(medium, ray_length(in.clip.xy, bitcast<f32>(s.z), opaque_depth_at(in.clip.xy)));
+    return medium_segment(medium, ray_length(in.clip.xy, start, opaque_depth_at(in.clip.xy)));
 }

@@ -14,6 +14,25 @@ fn peel_candidate(position: vec4<f32>) -> bool {
 }
 
 // Peeling to convergence: per pixel, the medium the ray is in after the layers peeled so
-// far (a look as halves: colour r, g in x; b and absorption in y) and the last layer's
-// depth (z, the bits of an f32). Unused (1×1) in dual peeling.
+// far (a look as halves: colour r, g in x; b and absorption in y), the last layer's depth
+// (z, the bits of an f32) and whether a layer was peeled (w: 0 before the first, when the
+// ray is still in the eye's medium, from the eye). Unused (1×1) in dual peeling.
 @group(2) @binding(2) var peel_state: texture_2d<u32>;
+
+// Where the ray stands at pixel `xy` after the layers peeled so far: its medium, and the
+// depth it is in it since.
+struct PeelFrom {
+    medium: vec4<f32>,
+    depth: f32,
+};
+
+fn peel_from_state(s: vec4<u32>) -> PeelFrom {
+    if s.w == 0u {
+        return PeelFrom(eye_medium(), EYE_Z);
+    }
+    return PeelFrom(vec4<f32>(unpack2x16float(s.x), unpack2x16float(s.y)), bitcast<f32>(s.z));
+}
+
+fn peel_from(xy: vec2<f32>) -> PeelFrom {
+    return peel_from_state(textureLoad(peel_state, vec2<i32>(xy), 0));
+}

@@ -198,12 +198,6 @@ impl TechniqueKind for Peeling {
         technique == Technique::PeelReference
     }
 
-    /// Depth peeling blends its layers front to back, one per fragment; the peel
-    /// reference carries the medium from layer to layer itself.
-    fn composes_inside_volumes(technique: Technique) -> bool {
-        technique == Technique::DepthPeeling
-    }
-
     fn key(technique: Technique, config: &OitConfig, _: &Capabilities) -> PeelMode {
         match technique {
             Technique::PeelReference => PeelMode::Converge,
@@ -662,7 +656,7 @@ impl TranslucentTechnique for Peeling {
             fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
             let p = oit_object_position(position);\n    \
             if !peel_candidate(p) || color.a <= 0.0 {\n        discard;\n    }\n    \
-            return OitOutput(inside_volume(p.xy, p.z, color), p.z);\n}\n";
+            return OitOutput(fogged(p.xy, p.z, color), p.z);\n}\n";
         let variant = |name, depth| TranslucentVariant {
             name,
             wgsl: game_prelude(&peel_own_wgsl(), output),

@@ -12,13 +12,13 @@ struct PeelLayer {
 // The layer of a fragment at `position` of straight colour `c`, whose part in the medium
 // is `info` with block look `look` (`fragment_info`, `medium_look`).
 fn peel_layer(position: vec4<f32>, c: vec4<f32>, look: vec4<f32>, info: u32) -> PeelLayer {
-    let s = textureLoad(peel_state, vec2<i32>(position.xy), 0);
-    let medium = vec4<f32>(unpack2x16float(s.x), unpack2x16float(s.y));
-    let segment = medium_segment(medium, ray_length(position.xy, bitcast<f32>(s.z), position.z));
+    let start = peel_from(position.xy);
+    let medium = start.medium;
+    let segment = medium_segment(medium, ray_length(position.xy, start.depth, position.z));
     let p = in_front_of(segment, c);
     let next = medium_after(medium, look, info);
     var out: PeelLayer;
     out.color = select(vec4<f32>(0.0), vec4<f32>(p.rgb / p.a, p.a), p.a > 0.0);
-    out.state = vec4<u32>(pack2x16float(next.rg), pack2x16float(next.ba), bitcast<u32>(position.z), 0u);
+    out.state = vec4<u32>(pack2x16float(next.rg), pack2x16float(next.ba), bitcast<u32>(position.z), 1u);
     return out;
 }

@@ -1,7 +1,8 @@
 // Exact reference, pass 2 (appended to fullscreen.wgsl, the scene group as group 1 with
 // the volume functions, and types.wgsl): sort each pixel's fragments by depth and blend
 // them front to back, with the volumes between them (the path inside each medium, from
-// the face where the ray enters it to the one where it leaves or to the opaque surface);
+// the eye in the eye's medium or from the face where the ray enters it, to the one where
+// it leaves or to the opaque surface);
 // the result goes over the opaque image with (One, OneMinusSrcAlpha):
 // out = Σ layers (exact "over" order) + Π(1 − α) · opaque.
 
@@ -39,7 +40,11 @@ fn in_front(a: Node, b: Node) -> bool {
 fn fs_resolve(in: FullscreenOut) -> @location(0) vec4<f32> {
     let p = vec2<u32>(in.clip.xy);
     var next = heads[head_index(p)];
-    if next == 0u {
+    // The medium the ray is in (a look; absorption 0: none) since depth `last`: from the
+    // eye, in the eye's medium.
+    var medium = eye_medium();
+    var last = EYE_Z;
+    if next == 0u && medium.a <= 0.0 {
         discard;
     }
     // The nearest MAX_LAYERS fragments of the first MAX_WALK of the list, nearest (largest reverse-Z depth) first, by
@@ -64,9 +69,6 @@ fn fs_resolve(in: FullscreenOut) -> @location(0) vec4<f32> {
         n = min(n + 1u, MAX_LAYERS);
     }
     var acc = vec4<f32>(0.0);
-    // The medium the ray is in (a look; absorption 0: none) since depth `last`.
-    var medium = vec4<f32>(0.0);
-    var last = 0.0;
     for (var i = 0u; i < n; i += 1u) {
         let node = kept[i];
         let c = vec4<f32>(unpack2x16float(node.color.x), unpack2x16float(node.color.y));

@@ -89,10 +89,6 @@ impl TechniqueKind for Sorted {
 
     const SORTS: bool = true;
 
-    fn composes_inside_volumes(_: Technique) -> bool {
-        true
-    }
-
     fn key(_: Technique, _: &OitConfig, _: &Capabilities) {}
 
     fn create(setup: &Setup, technique: Technique, _: &OitConfig) -> Result<Self> {
@@ -309,7 +305,7 @@ impl TranslucentTechnique for Sorted {
                 "struct OitOutput {\n    @location(0) color: vec4<f32>,\n};\n\n\
                  // Blended SrcAlpha, OneMinusSrcAlpha over what is behind.\n\
                  fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
-                 return OitOutput(inside_volume(position.xy, position.z, color));\n}\n",
+                 return OitOutput(fogged(position.xy, position.z, color));\n}\n",
             ),
             targets: vec![gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
             depth_stencil: gpu::depth_state(DepthMode::ReadOnly),

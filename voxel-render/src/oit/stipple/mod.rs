@@ -245,7 +245,7 @@ impl TranslucentTechnique for Stipple {
                 "struct OitOutput {\n    @location(0) color: vec4<f32>,\n};\n\n\
                  // Kept opaque through the screen door, or discarded.\n\
                  fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
-                 return OitOutput(stipple(position, color));\n}\n",
+                 return OitOutput(stipple(position, fogged(position.xy, position.z, color)));\n}\n",
             ),
             targets: vec![gpu::scene_target(None)],
             depth_stencil: gpu::depth_state(if self.depth_write {

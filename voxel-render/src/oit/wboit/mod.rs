@@ -213,7 +213,7 @@ fn game_output(accumulation: bool, revealage: bool) -> String {
     let mut location = 0;
     if accumulation {
         fields += &format!("    @location({location}) accumulation: vec4<f32>,\n");
-        body += "    out.accumulation = wboit_accumulation(position, oit_view_depth(position), color);\n";
+        body += "    out.accumulation = wboit_accumulation(position, oit_view_depth(position), fogged(position.xy, position.z, color));\n";
         location += 1;
     }
     if revealage {
