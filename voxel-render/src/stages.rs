@@ -93,17 +93,40 @@ impl TranslucentObject {
 }
 
 /// Where a run of objects is drawn: after quads `..quad` of chunk `chunk` (its position
-/// in the draw order; quad 0: before the chunk), objects of the order up to `end`
-/// (made by the sorted techniques, `oit::sorted::interleave`).
+/// in the draw order; quad 0: before the chunk; past the last chunk: after every chunk),
+/// objects of the order up to `end`, clipped by the frame's clip `clip` (0: not clipped;
+/// the parts of an object cut at planes it reaches through), made by the sorted
+/// techniques (`oit::sorted::interleave`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Split {
+pub(crate) struct Split {
     /// The chunk, by its position in the draw order.
     pub chunk: u32,
     /// How many of its quads (in their drawn order) come before the objects.
     pub quad: u32,
     /// The objects of the order drawn here end at this position.
     pub end: u32,
+    /// The clip of the run's parts (an index into the frame's clips; 0: none).
+    pub clip: u32,
 }
+
+/// A plane a part of an object is cut at, and which side of it the part keeps: the world
+/// coordinate `at` along `axis`, the part on the eye's side (`far` false: there and in the
+/// plane itself, the rule for equal depths) or beyond it (`far`: strictly beyond).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ClipPlane {
+    /// The axis (0 x, 1 y, 2 z).
+    pub axis: usize,
+    /// Where the plane lies on it, world blocks.
+    pub at: f64,
+    /// Which side of it the eye is on: +1 above `at`, -1 below.
+    pub eye_side: f64,
+    /// The part keeps what lies beyond the plane (else the eye's side and the plane).
+    pub far: bool,
+}
+
+/// The planes a part of an object is clipped by (none: the whole object; the sorted
+/// techniques' order, `oit::sorted::interleave`).
+pub(crate) type Clip = Vec<ClipPlane>;
 
 /// What a game needs to draw in a stage.
 #[derive(Debug)]
@@ -271,7 +294,7 @@ impl GameStages for NoGame {
 }
 
 /// The game's translucent part of a frame as the techniques see it.
-pub struct GameDraw<'a> {
+pub(crate) struct GameDraw<'a> {
     /// The game.
     pub stages: &'a dyn GameStages,
     /// The frame it draws in.
@@ -280,8 +303,11 @@ pub struct GameDraw<'a> {
     pub objects: usize,
     /// Sorted techniques: where runs of the ordered objects are drawn among the visible
     /// translucent chunks (in draw order); the objects after the last run come after every
-    /// chunk.
+    /// chunk, unclipped.
     pub splits: &'a [Split],
+    /// Sorted techniques: the planes that clip the parts of objects cut where they reach
+    /// through a plane of quads ([`Split::clip`]; the first is none).
+    pub clips: &'a [Clip],
     /// The resources a technique binds into its group for the game (group 0's frame
     /// uniforms and medium boundary, besides its own).
     pub frame_buffer: &'a wgpu::Buffer,

@@ -487,10 +487,20 @@ impl GameStages for ContentStages {
             )
             .collect();
         if let Some(order) = frame.order {
+            // An object cut at a plane it reaches through is in the order once per part.
             translucent = order
                 .iter()
                 .filter_map(|&i| translucent.get(i as usize).copied())
                 .collect();
+            let need = (translucent.len() * std::mem::size_of::<Prim>()) as u64;
+            if self.translucent.buffer.size() < need {
+                self.translucent = Buffer::new(
+                    &ctx.device,
+                    &self.prims_layout,
+                    "content_translucent",
+                    2 * translucent.len(),
+                );
+            }
         }
         for (buffer, prims) in [
             (&mut self.opaque, opaque),

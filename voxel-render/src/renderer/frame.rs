@@ -19,7 +19,7 @@ use crate::gpu::{self, Depth, Pass};
 use crate::medium::{self, MediumLook};
 use crate::oit::sorted::interleave::ChunkSequence;
 use crate::oit::{FrameView, Technique, TechniqueReport, TranslucentFrame};
-use crate::stages::{GameDraw, GameFrame, GameStages, Split, TranslucentContract};
+use crate::stages::{Clip, GameDraw, GameFrame, GameStages, Split, TranslucentContract};
 use crate::timing::{GpuPass, Timer};
 use crate::{Camera, Error, Result};
 
@@ -208,10 +208,10 @@ impl Renderer {
                 split_quads,
             );
         }
-        let (order, splits): (&[u32], &[Split]) = if sorts {
+        let (order, splits, clips): (&[u32], &[Split], &[Clip]) = if sorts {
             self.interleaver.result()
         } else {
-            (&[], &[])
+            (&[], &[], &[])
         };
         let game_sort_ms = sort_start.elapsed().as_secs_f64() * 1e3;
         let objects = if sorts {
@@ -308,6 +308,7 @@ impl Renderer {
             frame: &game_frame,
             objects,
             splits,
+            clips,
             frame_buffer: &self.scene.frame_buffer,
             boundary: &t.boundary.view,
             depth_sampler: &self.scene.depth_sampler,

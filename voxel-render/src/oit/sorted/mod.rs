@@ -41,7 +41,7 @@ use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
 };
-use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
+use crate::stages::{Clip, GameDraw, TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{GpuContext, Result};
 
@@ -72,12 +72,65 @@ struct ChunkOrder {
     cycles: (u32, u32),
 }
 
+/// The most planes a part of an object is clipped by (two an axis); `clip.wgsl`'s array.
+const CLIP_PLANES: usize = 6;
+const _: () = assert!(2 * interleave::MAX_SPLIT_PLANES <= CLIP_PLANES);
+
+/// A fragment within this share of its view depth of a clip plane lies in it
+/// (`clip.wgsl`): far above what reconstructing its position from the depth errs by (about
+/// 1e-6 of it in 32-bit floats), far below what a player sees (1 mm at 10 blocks).
+const CLIP_EPSILON: f32 = 1e-4;
+
+/// One clip as `clip.wgsl` reads it (`OitClip`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+struct ClipUniform {
+    planes: [[f32; 4]; CLIP_PLANES],
+    count: u32,
+    far: u32,
+    _pad: [u32; 2],
+}
+
+impl ClipUniform {
+    /// `clip` for a frame drawn with `view_proj` from `eye` (the camera-relative origin of
+    /// `view_proj`: its integer and fractional parts, as the frame splits it).
+    fn new(clip: &Clip, view_proj: glam::Mat4, eye: glam::DVec3) -> Self {
+        // A plane (n, w) of camera-relative positions is (M⁻¹)ᵀ (n, w) in clip space.
+        let to_clip = glam::DMat4::from_cols_array(&view_proj.to_cols_array().map(f64::from))
+            .inverse()
+            .transpose();
+        let mut out = Self::default();
+        for (i, c) in clip.iter().take(CLIP_PLANES).enumerate() {
+            let mut n = glam::DVec4::ZERO;
+            n[c.axis] = c.eye_side;
+            // Signed distance toward the eye: eye_side · (eye + rel − at) along the axis.
+            n.w = c.eye_side * (eye[c.axis] - c.at);
+            out.planes[i] = (to_clip * n).as_vec4().to_array();
+            out.far |= u32::from(c.far) << i;
+            out.count += 1;
+        }
+        out
+    }
+}
+
+/// The clip WGSL of a game's prelude (`clip.wgsl`, after its constant).
+fn clip_wgsl() -> String {
+    gpu::WgslConsts::default()
+        .f32("OIT_CLIP_EPSILON", CLIP_EPSILON)
+        .finish()
+        + include_str!("clip.wgsl")
+}
+
 /// The blending pipeline, and for `sorted-quads` each chunk's exact order.
 #[derive(Debug)]
 pub(crate) struct Sorted {
     pipeline: SidedPipeline,
-    /// The group games bind (frame and boundary only: the pass has no group of its own).
+    /// The group games bind (frame and boundary, and the clip of the parts drawn, at a
+    /// dynamic offset).
     game_layout: wgpu::BindGroupLayout,
+    /// Bytes between two clips in a frame's clip buffer (the device's uniform offset
+    /// alignment).
+    clip_stride: u64,
     sort_quads: bool,
     orders: PosMap<ChunkPos, ChunkOrder>,
     scratch: Vec<PackedQuad>,
@@ -108,9 +161,22 @@ impl TechniqueKind for Sorted {
             samples: 1,
         }
         .build_sided(device);
+        let clip_entry = wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<ClipUniform>() as u64),
+            },
+            count: None,
+        };
+        let align = u64::from(device.limits().min_uniform_buffer_offset_alignment);
+        let size = std::mem::size_of::<ClipUniform>() as u64;
         Ok(Self {
             pipeline,
-            game_layout: game_layout(device, "sorted_game", &[]),
+            game_layout: game_layout(device, "sorted_game", &[clip_entry]),
+            clip_stride: size.div_ceil(align) * align,
             sort_quads: technique == Technique::SortedQuads,
             orders: PosMap::default(),
             scratch: Vec::new(),
@@ -166,6 +232,115 @@ impl Sorted {
         entry.cycles = (stats.cycles, stats.quads_in_cycles);
         chunks.reorder_translucent(ctx, pos, std::mem::take(&mut self.scratch));
         (built, true)
+    }
+}
+
+impl Sorted {
+    /// The game's group for a frame: the renderer's resources and the frame's clips (the
+    /// first none), one every `clip_stride` bytes.
+    fn game_group(&self, ctx: &GpuContext, game: &GameDraw<'_>) -> wgpu::BindGroup {
+        use wgpu::util::DeviceExt;
+        let (eye_int, eye_frac) = (game.frame.eye_int, game.frame.eye_frac);
+        let eye = glam::DVec3::new(
+            eye_int[0] as f64 + f64::from(eye_frac.x),
+            eye_int[1] as f64 + f64::from(eye_frac.y),
+            eye_int[2] as f64 + f64::from(eye_frac.z),
+        );
+        let none = Clip::new();
+        let clips = if game.clips.is_empty() {
+            std::slice::from_ref(&none)
+        } else {
+            game.clips
+        };
+        let stride = self.clip_stride as usize;
+        let mut bytes = vec![0u8; stride * clips.len()];
+        for (i, clip) in clips.iter().enumerate() {
+            let uniform = ClipUniform::new(clip, game.frame.view_proj, eye);
+            let at = i * stride;
+            bytes[at..at + std::mem::size_of::<ClipUniform>()]
+                .copy_from_slice(bytemuck::bytes_of(&uniform));
+        }
+        // A buffer of the frame's own: a frame recorded before the last one is submitted
+        // keeps its clips.
+        let buffer = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("sorted_clips"),
+                contents: &bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        let clip = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of::<ClipUniform>() as u64),
+        });
+        game_group(&ctx.device, "sorted_game", &self.game_layout, game, &[clip])
+    }
+}
+
+#[cfg(test)]
+mod clip_tests {
+    use super::*;
+    use crate::stages::ClipPlane;
+
+    /// A clip plane in clip space gives, at a point's normalised device position, its
+    /// signed distance from the plane over its view depth: what `clip.wgsl` compares.
+    #[test]
+    fn clip_planes_measure_the_distance_to_the_plane_over_the_view_depth() {
+        let eye = glam::DVec3::new(1000.25, 64.5, -3000.75);
+        let camera = crate::Camera::look_at(
+            eye,
+            eye + glam::DVec3::new(3.0, -1.0, -8.0),
+            70.0,
+            0.1,
+            500.0,
+        )
+        .expect("a valid camera");
+        let view_proj = camera.view_proj(16.0 / 9.0);
+        for (axis, at) in [(1usize, 64.0), (0, 1003.0), (2, -3010.0)] {
+            let eye_side = if eye[axis] >= at { 1.0 } else { -1.0 };
+            let clip = vec![ClipPlane {
+                axis,
+                at,
+                eye_side,
+                far: false,
+            }];
+            let u = ClipUniform::new(&clip, view_proj, eye);
+            assert_eq!(u.count, 1);
+            let plane = glam::Vec4::from_array(u.planes[0]);
+            for k in 0..50 {
+                let t = f64::from(k) / 50.0;
+                let p = eye
+                    + glam::DVec3::new(3.0 + 4.0 * t, -1.0 - 2.0 * t, -8.0 + t) * (1.0 + 5.0 * t);
+                let rel = (p - eye).as_vec3();
+                let c = view_proj * rel.extend(1.0);
+                let ndc = glam::Vec4::new(c.x / c.w, c.y / c.w, c.z / c.w, 1.0);
+                let want = (p[axis] - at) * eye_side;
+                let got = f64::from(plane.dot(ndc)) * f64::from(c.w);
+                assert!(
+                    (got - want).abs() < 1e-3 * (1.0 + want.abs()),
+                    "axis {axis}: {got} against {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_clip_uniform_is_laid_out_as_its_wgsl() {
+        use crate::wgsl_layout::{assert_layout, field};
+        let module = crate::wgsl_layout::parse(
+            &("struct Frame { viewport: vec2<f32> };\n@group(0) @binding(0) var<uniform> frame: Frame;\n".to_owned()
+                + &clip_wgsl()),
+        );
+        assert_layout::<ClipUniform>(
+            &module,
+            "OitClip",
+            &[
+                field!(ClipUniform, planes),
+                field!(ClipUniform, count),
+                field!(ClipUniform, far),
+            ],
+        );
     }
 }
 
@@ -246,9 +421,8 @@ impl TranslucentTechnique for Sorted {
     ) -> Result<()> {
         let colors = [gpu::load(&frame.target.view)];
         let pipeline = self.pipeline.get(frame.two_sided);
-        let group = frame
-            .game
-            .map(|g| game_group(&ctx.device, "sorted_game", &self.game_layout, g, &[]));
+        let group = frame.game.map(|g| self.game_group(ctx, g));
+        let stride = self.clip_stride;
         Pass::new("sorted", GpuPass::Translucent, &colors)
             .depth(Depth::ReadOnly(&frame.depth.view))
             .record(encoder, frame.timer, |pass| {
@@ -258,9 +432,15 @@ impl TranslucentTechnique for Sorted {
                     return;
                 };
                 // The objects where `interleave` put them (before a chunk, or among its
-                // quads), then the rest.
+                // quads), each run with its clip, then the rest.
                 pass.set_bind_group(0, frame.scene, &[]);
                 let draws = frame.draws;
+                let objects = |pass: &mut wgpu::RenderPass<'_>, range, clip: u32| {
+                    let offset = (u64::from(clip) * stride) as u32;
+                    game.draw_offsets(pass, 0, group, &[offset], range);
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, frame.scene, &[]);
+                };
                 // Chunks before `chunk` are drawn, and quads `..quad` of it.
                 let (mut next, mut chunk, mut quad) = (0, 0usize, 0u32);
                 for split in game.splits {
@@ -279,9 +459,7 @@ impl TranslucentTechnique for Sorted {
                     }
                     let end = split.end as usize;
                     if end > next {
-                        game.draw(pass, 0, group, next..end);
-                        pass.set_pipeline(pipeline);
-                        pass.set_bind_group(0, frame.scene, &[]);
+                        objects(pass, next..end, split.clip);
                         next = end;
                     }
                 }
@@ -291,7 +469,7 @@ impl TranslucentTechnique for Sorted {
                 }
                 draws.draw_range(frame.chunks, chunk..usize::MAX, pass);
                 if next < game.objects {
-                    game.draw(pass, 0, group, next..game.objects);
+                    objects(pass, next..game.objects, 0);
                 }
             });
         Ok(())
@@ -301,10 +479,12 @@ impl TranslucentTechnique for Sorted {
         vec![TranslucentVariant {
             name: "sorted",
             wgsl: game_prelude(
-                "",
+                &clip_wgsl(),
                 "struct OitOutput {\n    @location(0) color: vec4<f32>,\n};\n\n\
-                 // Blended SrcAlpha, OneMinusSrcAlpha over what is behind.\n\
+                 // Blended SrcAlpha, OneMinusSrcAlpha over what is behind, outside the\n\
+                 // part being drawn discarded.\n\
                  fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
+                 if oit_clipped(position) {\n        discard;\n    }\n    \
                  return OitOutput(fogged(position.xy, position.z, color));\n}\n",
             ),
             targets: vec![gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],

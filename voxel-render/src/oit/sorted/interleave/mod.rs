@@ -123,7 +123,11 @@ fn safe(
     let (mut front, mut behind) = (o + r < near, o - r > far);
     for a in 0..3 {
         let (lo, hi, ea) = (s.lo[a], s.hi[a], eye[a]);
-        let (below, above) = (p[a] + h[a] < lo, p[a] - h[a] > hi);
+        // Touching a face of the box counts as reaching it (`side_of_plane`).
+        let (below, above) = (
+            p[a] + h[a] < lo - TOUCH * (1.0 + lo.abs()),
+            p[a] - h[a] > hi + TOUCH * (1.0 + hi.abs()),
+        );
         front |= (below && ea <= lo) || (above && ea >= hi);
         behind |= (below && ea >= lo) || (above && ea <= hi);
     }
@@ -134,15 +138,11 @@ fn safe(
     // with it beyond.
     let (mut eye_side, mut beyond) = (false, false);
     for pl in planes {
-        let q = (p[pl.axis] - pl.at) * pl.facing;
-        if q.abs() <= h[pl.axis] {
+        match plane_weight(b, pl) {
+            1 => eye_side = true,
+            -1 => beyond = true,
             // Through the plane: neither.
-            eye_side = true;
-            beyond = true;
-        } else if (pl.eye > 0.0) == (q > 0.0) {
-            eye_side = true;
-        } else {
-            beyond = true;
+            _ => (eye_side, beyond) = (true, true),
         }
     }
     front |= !beyond;
@@ -192,11 +192,14 @@ fn quad_side(
     let n = if q.face.is_positive() { 1.0 } else { -1.0 };
     let plane = origin[a] + q.bounds().0[a];
     let e = (eye[a] - plane) * n;
-    let d = (b.center[a] - plane) * n;
-    if (!two_sided && e <= 0.0) || e == 0.0 || d.abs() <= b.half[a] {
+    if (!two_sided && e <= 0.0) || e == 0.0 {
         return None;
     }
-    Some((e > 0.0) == (d > 0.0))
+    match side_of_plane(b, a, plane, eye[a] - plane) {
+        1 => Some(true),
+        -1 => Some(false),
+        _ => None,
+    }
 }
 
 /// The visible translucent chunks of a frame in draw order, as [`Interleaver::order`] reads them.
@@ -216,6 +219,8 @@ pub(crate) struct ChunkSequence<'a> {
 /// the greatest [`voxel_mesh::order::chunk_order_key`] among them.
 fn cells_and_keys(b: Ball, eye: [i64; 3]) -> ([[i64; 2]; 3], [u128; 2]) {
     let s = 1.0 / voxel_core::CHUNK_SIZE as f64;
+    // Touching a cell's face within rounding counts as touching it (`side_of_plane`).
+    let half = |a: usize| b.half[a] + TOUCH * (1.0 + b.center[a].abs());
     // Most balls lie inside the cell of their centre, off its borders.
     let cell = [
         floor_i64(b.center.x * s),
@@ -224,7 +229,7 @@ fn cells_and_keys(b: Ball, eye: [i64; 3]) -> ([[i64; 2]; 3], [u128; 2]) {
     ];
     let inside = (0..3).all(|a| {
         let lo = cell[a] as f64 * voxel_core::CHUNK_SIZE as f64;
-        b.center[a] - b.half[a] > lo && b.center[a] + b.half[a] < lo + voxel_core::CHUNK_SIZE as f64
+        b.center[a] - half(a) > lo && b.center[a] + half(a) < lo + voxel_core::CHUNK_SIZE as f64
     });
     if inside {
         let k = (0..3)
@@ -239,8 +244,8 @@ fn cells_and_keys(b: Ball, eye: [i64; 3]) -> ([[i64; 2]; 3], [u128; 2]) {
     let (mut kmin, mut kmax) = (0u128, 0u128);
     for a in 0..3 {
         // `ceil(x) - 1` is `floor(x)` except on a border, where it is the cell below.
-        let lo = ceil_i64((b.center[a] - b.half[a]) * s) - 1;
-        let hi = floor_i64((b.center[a] + b.half[a]) * s);
+        let lo = ceil_i64((b.center[a] - half(a)) * s) - 1;
+        let hi = floor_i64((b.center[a] + half(a)) * s);
         cells[a] = [lo, hi];
         let (dl, dh) = (lo - eye[a], hi - eye[a]);
         let sq = |d: i64| u128::from(d.unsigned_abs()) * u128::from(d.unsigned_abs());
@@ -303,12 +308,34 @@ fn plane_runs(s: &Surfaces<'_>, out: &mut Vec<(u32, u32)>) {
 /// How a seen plane orders ball `b` (see [`quad_side`]), as a weight: 1 when the plane's
 /// quads come before the ball, -1 after it, 0 when the ball reaches through it.
 fn plane_weight(b: Ball, pl: &SeenPlane) -> i64 {
-    let d = (b.center[pl.axis] - pl.at) * pl.facing;
-    if d.abs() <= b.half[pl.axis] {
-        return 0;
-    }
-    if (pl.eye > 0.0) == (d > 0.0) { 1 } else { -1 }
+    side_of_plane(b, pl.axis, pl.at, pl.eye * pl.facing)
 }
+
+/// Where ball `b` lies against the plane at `at` along `axis`, the eye on the side of sign
+/// `eye_side` (nonzero): 1 wholly on the eye's side, -1 wholly beyond, 0 through the
+/// plane. A face of the object lying in the plane counts on the eye's side (the rule for
+/// equal depths, `stages::OBJECT_DEPTH_BIAS`: foam lying in a water surface is in front
+/// of it from either side), so an object beyond the plane that touches it is through it.
+fn side_of_plane(b: Ball, axis: usize, at: f64, eye_side: f64) -> i64 {
+    let s = (b.center[axis] - at) * eye_side.signum();
+    let h = b.half[axis];
+    // An object's face computed to lie in the plane may miss it by a rounding error (a
+    // turned box's extent along the axis).
+    let tol = TOUCH * (1.0 + at.abs());
+    if s - h >= -tol {
+        1
+    } else if s + h < -tol {
+        -1
+    } else {
+        0
+    }
+}
+
+/// How near a plane (in blocks, relative to its coordinate) an object's extent counts as
+/// reaching it: a game's sizes are 32-bit floats (foam half a size of 0.02 thick, resting
+/// on a surface at 0.01, misses it by 2e-10), and the exact methods' tie rule puts faces
+/// that near in the plane (`stages::OBJECT_DEPTH_BIAS`).
+const TOUCH: f64 = 1e-6;
 
 /// How many chunks of the sequence have a key above a given one: a table by key when the
 /// keys are small (they are squared distances in chunks from the eye's chunk, below
@@ -428,7 +455,8 @@ struct ChunkFacts {
     runs: Option<(u32, u32)>,
 }
 
-/// [`Interleaver::order`] of `balls` in fresh buffers (for the tests).
+/// [`Interleaver::order`] of `balls` in fresh buffers (for the tests): the objects of the
+/// parts in draw order, and the runs.
 #[cfg(test)]
 pub(crate) fn interleave(
     balls: &[Ball],
@@ -449,26 +477,61 @@ pub(crate) fn interleave(
     (orderer.order, orderer.splits)
 }
 
+/// The most planes an object is split at (into at most 2³ parts, each clipped by at most
+/// two planes an axis): a thing crosses a handful of a chunk's planes, not hundreds.
+pub(crate) const MAX_SPLIT_PLANES: usize = 3;
+
+pub(crate) use crate::stages::{Clip, ClipPlane};
+
+/// One piece of an object to draw: the whole of it, or the part between the planes it was
+/// split at (`Interleaver`'s clips).
+#[derive(Clone, Copy, Debug)]
+struct Part {
+    object: u32,
+    ball: Ball,
+    clip: u32,
+}
+
 /// Orders a game's objects among the chunks ([`Interleaver::order`]), its buffers kept
 /// between frames (thousands of objects a frame would otherwise allocate and fault in
 /// megabytes each time): the renderer holds one.
 #[derive(Debug, Default)]
 pub(crate) struct Interleaver {
-    /// Each object's place (chunk, quad).
+    /// The parts drawn: each object, or its pieces where it was split.
+    parts: Vec<Part>,
+    /// Each part's place (chunk, quad).
     places: Vec<(u32, u32)>,
-    /// Each object's distance as a key that orders farthest first, and the object.
+    /// Each part's distance as a key that orders farthest first, and the part.
     farthest: Vec<(u32, u32)>,
     /// Room for the radix sort.
     spare: Vec<(u32, u32)>,
     items: Vec<(u32, u32, i64)>,
     weights: Vec<i64>,
+    /// The planes an object crosses in the chunks no sound test decides: (axis, at).
+    crossings: Vec<(usize, f64)>,
     /// Per chunk, and the seen planes and runs they name.
     facts: Vec<ChunkFacts>,
     seen: Vec<SeenPlane>,
     runs: Vec<(u32, u32)>,
-    /// The objects in draw order, and where runs of them are drawn.
+    /// The distinct clips of the parts (0: none).
+    clips: Vec<Clip>,
+    /// The parts' objects in draw order, their parts in that order, and where runs of them
+    /// are drawn.
     order: Vec<u32>,
+    drawn: Vec<u32>,
     splits: Vec<Split>,
+}
+
+/// What [`Interleaver::place`] reads of a frame.
+struct Frame<'a, 'c> {
+    chunks: &'a ChunkSequence<'c>,
+    keys: KeyIndex<'a>,
+    cells: CellIndex,
+    eye: DVec3,
+    eye_cell: [i64; 3],
+    last: u32,
+    two_sided: bool,
+    split_quads: bool,
 }
 
 impl Interleaver {
@@ -497,9 +560,18 @@ impl Interleaver {
     /// decides with weight 1. Objects at one place go farthest centre first, so those that
     /// share a place are one run: one draw of the game's instances.
     ///
-    /// An object whose centre or radius is not finite, and one the eye is inside of (a game's
-    /// translucent volume seen from within: its far faces are nearer than any chunk outside
-    /// it), go after every chunk.
+    /// **Objects through a plane** (`split_quads`). An object that reaches through planes
+    /// of quads in a chunk no test decides (a cube through a water surface, a pole through
+    /// panes, foam whose face lies in the surface) is cut at up to [`MAX_SPLIT_PLANES`] of
+    /// them, those nearest its centre: each part (the object's box between the planes) is
+    /// placed on its own and drawn with its clip (the renderer discards the fragments
+    /// outside it), so that each lies wholly on one side of each plane it was cut at and
+    /// the planes order it exactly. A part appears in the order as its object again.
+    ///
+    /// An object whose centre or radius is not finite goes after every chunk, and so, for
+    /// `sorted`, does one the eye is inside of (a game's translucent volume seen from within:
+    /// its far faces are nearer than any chunk outside it); `sorted-quads` cuts such an
+    /// object at the planes it reaches through and places the parts.
     pub(crate) fn order(
         &mut self,
         objects: &[crate::stages::TranslucentObject],
@@ -515,9 +587,10 @@ impl Interleaver {
         self.run(objects.len(), ball, eye, chunks, two_sided, split_quads);
     }
 
-    /// The last order: the objects in draw order, and where runs of them are drawn.
-    pub(crate) fn result(&self) -> (&[u32], &[Split]) {
-        (&self.order, &self.splits)
+    /// The last order: the objects in draw order (an object cut into parts once per part),
+    /// where runs of them are drawn, and the clips the runs name ([`Split::clip`]; 0 none).
+    pub(crate) fn result(&self) -> (&[u32], &[Split], &[Clip]) {
+        (&self.order, &self.splits, &self.clips)
     }
 
     fn run(
@@ -529,159 +602,320 @@ impl Interleaver {
         two_sided: bool,
         split_quads: bool,
     ) {
+        let frame = Frame {
+            chunks,
+            keys: KeyIndex::new(chunks.keys),
+            cells: CellIndex::new(chunks.positions),
+            eye,
+            eye_cell: eye_cell(eye),
+            last: chunks.surfaces.len() as u32,
+            two_sided,
+            split_quads,
+        };
+        self.facts.clear();
+        self.facts
+            .resize(chunks.surfaces.len(), ChunkFacts::default());
+        self.seen.clear();
+        self.runs.clear();
+        self.parts.clear();
+        self.places.clear();
+        self.farthest.clear();
+        self.clips.clear();
+        self.clips.push(Vec::new());
+        let last = frame.last;
+        for i in 0..count {
+            let b = ball(i);
+            let whole = Part {
+                object: i as u32,
+                ball: b,
+                clip: 0,
+            };
+            // Squared distances order like distances: the root only where a test needs it.
+            let o2 = b.center.distance_squared(eye);
+            if !o2.is_finite() || !b.radius.is_finite() {
+                self.push(whole, (last, 0), u32::MAX);
+                continue;
+            }
+            let inside = o2 < b.radius * b.radius
+                && (0..3).all(|a| (b.center[a] - eye[a]).abs() < b.half[a]);
+            if inside && !split_quads {
+                // The eye is inside it (a volume seen from within, whose far faces are drawn):
+                // after every chunk, as what lies nearest.
+                self.push(whole, (last, 0), farthest_key(o2));
+                continue;
+            }
+            self.crossings.clear();
+            let at = self.place(&frame, b, split_quads);
+            if self.crossings.is_empty() {
+                self.push(whole, at, farthest_key(o2));
+                continue;
+            }
+            self.split(&frame, whole);
+        }
         let Self {
+            parts,
             places,
             farthest,
             spare,
+            order,
+            drawn,
+            splits,
+            ..
+        } = self;
+        order_by_place(places, farthest, spare, last, drawn);
+        order.clear();
+        order.extend(drawn.iter().map(|&p| parts[p as usize].object));
+        splits.clear();
+        for (n, &p) in drawn.iter().enumerate() {
+            let (c, k) = places[p as usize];
+            let clip = parts[p as usize].clip;
+            let next = drawn
+                .get(n + 1)
+                .map(|&q| (places[q as usize], parts[q as usize].clip));
+            if next != Some(((c, k), clip)) && (c < last || clip != 0 || next.is_some()) {
+                splits.push(Split {
+                    chunk: c,
+                    quad: k,
+                    end: n as u32 + 1,
+                    clip,
+                });
+            }
+        }
+    }
+
+    /// Adds a part at place `at`, with distance key `key` (`farthest_key`).
+    fn push(&mut self, part: Part, at: (u32, u32), key: u32) {
+        self.farthest.push((key, self.parts.len() as u32));
+        self.places.push(at);
+        self.parts.push(part);
+    }
+
+    /// Cuts `whole` at the planes it crosses (`self.crossings`, the nearest
+    /// [`MAX_SPLIT_PLANES`] to its centre) into the parts between them, and places each.
+    fn split(&mut self, frame: &Frame<'_, '_>, whole: Part) {
+        let b = whole.ball;
+        let c = b.center;
+        let crossings = &mut self.crossings;
+        crossings.sort_by(|x, y| (x.0, x.1.to_bits()).cmp(&(y.0, y.1.to_bits())));
+        crossings.dedup();
+        crossings.sort_by(|x, y| (c[x.0] - x.1).abs().total_cmp(&(c[y.0] - y.1).abs()));
+        crossings.truncate(MAX_SPLIT_PLANES);
+        // Per axis: the box's ends and the cuts between them.
+        let mut bounds: [Vec<f64>; 3] = Default::default();
+        for a in 0..3 {
+            let mut cuts: Vec<f64> = crossings
+                .iter()
+                .filter(|&&(axis, _)| axis == a)
+                .map(|&(_, at)| at)
+                .collect();
+            cuts.sort_by(f64::total_cmp);
+            // A cut the box touches within rounding (`TOUCH`) bounds it.
+            let lo = cuts
+                .first()
+                .map_or(c[a] - b.half[a], |&at| at.min(c[a] - b.half[a]));
+            let hi = cuts
+                .last()
+                .map_or(c[a] + b.half[a], |&at| at.max(c[a] + b.half[a]));
+            bounds[a] = std::iter::once(lo)
+                .chain(cuts)
+                .chain(std::iter::once(hi))
+                .collect();
+        }
+        let eye = frame.eye;
+        // The cells between consecutive bounds: per axis the interval's index.
+        let n = bounds.each_ref().map(|v| v.len() - 1);
+        for i in 0..n[0] * n[1] * n[2] {
+            let index = [i % n[0], i / n[0] % n[1], i / (n[0] * n[1])];
+            let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ZERO);
+            let mut clip = Vec::new();
+            let mut empty = false;
+            for a in 0..3 {
+                let (j, v) = (index[a], &bounds[a]);
+                let (mut l, mut h) = (v[j], v[j + 1]);
+                // A bound that is a cut (not the box's own end) clips the part. On the
+                // far side of a cut the part keeps what lies strictly beyond it: its box
+                // stops a hair short, so that the planes order it as wholly beyond.
+                for (end, is_upper) in [(j, false), (j + 1, true)] {
+                    let is_cut = end > 0 && end < v.len() - 1;
+                    if !is_cut {
+                        continue;
+                    }
+                    let at = v[end];
+                    let eye_side = if eye[a] >= at { 1.0 } else { -1.0 };
+                    // Below an upper cut, above a lower one.
+                    let far = (eye_side > 0.0) == is_upper;
+                    let hair = 2.0 * TOUCH * (1.0 + at.abs());
+                    if far && is_upper {
+                        h = at - hair;
+                    } else if far {
+                        l = at + hair;
+                    }
+                    clip.push(ClipPlane {
+                        axis: a,
+                        at,
+                        eye_side,
+                        far,
+                    });
+                }
+                empty |= h < l;
+                lo[a] = l;
+                hi[a] = h;
+            }
+            if empty {
+                continue;
+            }
+            let half = (hi - lo) * 0.5;
+            let center = lo + half;
+            let ball = Ball::new(
+                center,
+                half.length().min(b.radius + (center - c).length()),
+                Some(half),
+            );
+            let clip = self.clip_id(clip);
+            let at = self.place(frame, ball, false);
+            let o2 = center.distance_squared(eye);
+            self.push(
+                Part {
+                    object: whole.object,
+                    ball,
+                    clip,
+                },
+                at,
+                farthest_key(o2),
+            );
+        }
+    }
+
+    /// The index of `clip` among the frame's clips (added if new).
+    fn clip_id(&mut self, clip: Clip) -> u32 {
+        if let Some(i) = self.clips.iter().position(|c| *c == clip) {
+            return i as u32;
+        }
+        self.clips.push(clip);
+        (self.clips.len() - 1) as u32
+    }
+
+    /// The place of ball `b` in the sequence (see [`Interleaver::order`]); with `collect`,
+    /// the planes it reaches through in the chunks no sound test decides go to
+    /// `self.crossings`.
+    fn place(&mut self, f: &Frame<'_, '_>, b: Ball, collect: bool) -> (u32, u32) {
+        let Self {
             items,
             weights,
             facts,
             seen,
             runs,
-            order,
-            splits,
+            crossings,
+            ..
         } = self;
-        let last = chunks.surfaces.len() as u32;
-        let e = eye_cell(eye);
-        let keys = KeyIndex::new(chunks.keys);
-        let cells_index = CellIndex::new(chunks.positions);
-        facts.clear();
-        facts.resize(chunks.surfaces.len(), ChunkFacts::default());
-        seen.clear();
-        runs.clear();
-        places.clear();
-        farthest.clear();
-        for i in 0..count {
-            let b = ball(i);
-            // Squared distances order like distances: the root only where a test needs it.
-            let o2 = b.center.distance_squared(eye);
-            if !o2.is_finite() || !b.radius.is_finite() {
-                places.push((last, 0));
-                farthest.push((u32::MAX, i as u32));
-                continue;
+        let (chunks, eye, last) = (f.chunks, f.eye, f.last);
+        let (cells, [kmin, kmax]) = cells_and_keys(b, f.eye_cell);
+        // The part of the sequence whose keys lie in [kmin, kmax] (largest first).
+        let first = f.keys.above(kmax);
+        let end = match kmin.checked_sub(1) {
+            Some(k) => f.keys.above(k),
+            None => chunks.keys.len(),
+        };
+        let single = (0..3).all(|a| cells[a][0] == cells[a][1]);
+        let range = if single {
+            // One cell: its chunk, if it is in the sequence; else no chunk constrains.
+            match f.cells.get([cells[0][0], cells[1][0], cells[2][0]]) {
+                Some(at) if (first..end).contains(&at) => at..at + 1,
+                _ => first..first,
             }
-            // The squared distance's bits as a 32-bit float order like the number (enough to
-            // tell objects apart at one place: 24 bits of mantissa).
-            farthest.push((!(o2 as f32).to_bits(), i as u32));
-            if o2 < b.radius * b.radius && (0..3).all(|a| (b.center[a] - eye[a]).abs() < b.half[a])
-            {
-                // The eye is inside it (a volume seen from within, whose far faces are drawn):
-                // after every chunk, as what lies nearest.
-                places.push((last, 0));
-                continue;
+        } else {
+            first..end
+        };
+        if range.is_empty() {
+            // Nothing constrains it: after the chunks of larger keys.
+            let mut at = range.start as u32;
+            while at < last && chunks.surfaces[at as usize].is_none() {
+                at += 1;
             }
-            let (cells, [kmin, kmax]) = cells_and_keys(b, e);
-            // The part of the sequence whose keys lie in [kmin, kmax] (largest first).
-            let first = keys.above(kmax);
-            let end = match kmin.checked_sub(1) {
-                Some(k) => keys.above(k),
-                None => chunks.keys.len(),
+            return (at, 0);
+        }
+        let o = b.center.distance(eye);
+        // The constraints in draw order: (chunk, quad after which it applies, weight:
+        // positive when the item must come before the object, negative after it).
+        items.clear();
+        for c in range.clone() {
+            let Some(s) = &chunks.surfaces[c] else {
+                continue;
             };
-            let single = (0..3).all(|a| cells[a][0] == cells[a][1]);
-            let range = if single {
-                // One cell: its chunk, if it is in the sequence; else no chunk constrains.
-                match cells_index.get([cells[0][0], cells[1][0], cells[2][0]]) {
-                    Some(at) if (first..end).contains(&at) => at..at + 1,
-                    _ => first..first,
-                }
-            } else {
-                first..end
-            };
-            if range.is_empty() {
-                // Nothing constrains it: after the chunks of larger keys.
-                let mut at = range.start as u32;
-                while at < last && chunks.surfaces[at as usize].is_none() {
-                    at += 1;
-                }
-                places.push((at, 0));
-                continue;
-            }
-            let o = o2.sqrt();
-            // The constraints in draw order: (chunk, quad after which it applies, weight:
-            // positive when the item must come before the object, negative after it).
-            items.clear();
-            for c in range.clone() {
-                let Some(s) = &chunks.surfaces[c] else {
-                    continue;
-                };
-                let f = &mut facts[c];
-                let (from, to) = *f.planes.get_or_insert_with(|| {
-                    f.distances = s.distances(eye);
-                    let from = seen.len() as u32;
-                    seen_planes(s, eye, two_sided, seen);
-                    (from, seen.len() as u32)
-                });
-                let (d, planes) = (f.distances, &seen[from as usize..to as usize]);
-                let c32 = c as u32;
-                match safe(b, o, eye, s, planes, d, range.len() > 1) {
-                    // Apart on screen: any place is right.
-                    [true, true] => {}
-                    [true, false] => items.push((c32, 0, SOUND)),
-                    [false, true] => items.push((c32, 0, -SOUND)),
-                    [false, false] if split_quads => {
-                        let (from, to) = *f.runs.get_or_insert_with(|| {
-                            let from = runs.len() as u32;
-                            plane_runs(s, runs);
-                            (from, runs.len() as u32)
-                        });
-                        let runs = &runs[from as usize..to as usize];
-                        weights.clear();
-                        weights.resize(s.planes.len(), 0);
-                        for pl in planes.iter() {
-                            weights[pl.index as usize] = plane_weight(b, pl);
-                        }
-                        let mut k = 0u32;
-                        for &(p, n) in runs.iter() {
-                            let w = weights[p as usize];
-                            if w != 0 {
-                                // A run weighs its count; the place after it is after its
-                                // last quad.
-                                items.push((c32, k + n - 1, w * i64::from(n)));
-                            }
-                            k += n;
+            let fc = &mut facts[c];
+            let (from, to) = *fc.planes.get_or_insert_with(|| {
+                fc.distances = s.distances(eye);
+                let from = seen.len() as u32;
+                seen_planes(s, eye, f.two_sided, seen);
+                (from, seen.len() as u32)
+            });
+            let (d, planes) = (fc.distances, &seen[from as usize..to as usize]);
+            let c32 = c as u32;
+            match safe(b, o, eye, s, planes, d, range.len() > 1) {
+                // Apart on screen: any place is right.
+                [true, true] => {}
+                [true, false] => items.push((c32, 0, SOUND)),
+                [false, true] => items.push((c32, 0, -SOUND)),
+                [false, false] if f.split_quads => {
+                    let (from, to) = *fc.runs.get_or_insert_with(|| {
+                        let from = runs.len() as u32;
+                        plane_runs(s, runs);
+                        (from, runs.len() as u32)
+                    });
+                    let runs = &runs[from as usize..to as usize];
+                    weights.clear();
+                    weights.resize(s.planes.len(), 0);
+                    for pl in planes.iter() {
+                        let w = plane_weight(b, pl);
+                        weights[pl.index as usize] = w;
+                        if w == 0 && collect {
+                            crossings.push((pl.axis, pl.at));
                         }
                     }
-                    [false, false] => items.push((c32, 0, if o > d[1] { -1 } else { 1 })),
+                    let mut k = 0u32;
+                    for &(p, n) in runs.iter() {
+                        let w = weights[p as usize];
+                        if w != 0 {
+                            // A run weighs its count; the place after it is after its
+                            // last quad.
+                            items.push((c32, k + n - 1, w * i64::from(n)));
+                        }
+                        k += n;
+                    }
                 }
-            }
-            // Before everything in range, every item that must come before the object is
-            // violated; passing an item changes the cost by its weight.
-            let mut cost: i64 = items.iter().map(|it| it.2.max(0)).sum();
-            let (mut min, mut at) = (cost, (range.start as u32, 0));
-            for &(c, k, w) in items.iter() {
-                cost -= w;
-                if cost < min {
-                    // Just after the item: after the whole chunk where it stood for it.
-                    let whole = w.abs() == SOUND || !split_quads;
-                    (min, at) = (cost, if whole { (c + 1, 0) } else { (c, k + 1) });
-                }
-            }
-            let (c, k) = at;
-            // After quads `..k` of chunk `c`; past the end of a chunk is before the next one.
-            let mut at = match chunks.surfaces.get(c as usize).and_then(Option::as_ref) {
-                Some(s) if k as usize >= s.quads.len() && k > 0 => (c + 1, 0),
-                _ => (c, k),
-            };
-            // Chunks with nothing translucent draw nothing: the next one that does.
-            while at.0 < last && chunks.surfaces[at.0 as usize].is_none() {
-                at = (at.0 + 1, 0);
-            }
-            places.push(at);
-        }
-        order_by_place(places, farthest, spare, last, order);
-        splits.clear();
-        for (n, &i) in order.iter().enumerate() {
-            let (c, k) = places[i as usize];
-            let next = order.get(n + 1).map(|&j| places[j as usize]);
-            if c < last && next != Some((c, k)) {
-                splits.push(Split {
-                    chunk: c,
-                    quad: k,
-                    end: n as u32 + 1,
-                });
+                [false, false] => items.push((c32, 0, if o > d[1] { -1 } else { 1 })),
             }
         }
+        // Before everything in range, every item that must come before the object is
+        // violated; passing an item changes the cost by its weight.
+        let mut cost: i64 = items.iter().map(|it| it.2.max(0)).sum();
+        let (mut min, mut at) = (cost, (range.start as u32, 0));
+        for &(c, k, w) in items.iter() {
+            cost -= w;
+            if cost < min {
+                // Just after the item: after the whole chunk where it stood for it.
+                let whole = w.abs() == SOUND || !f.split_quads;
+                (min, at) = (cost, if whole { (c + 1, 0) } else { (c, k + 1) });
+            }
+        }
+        let (c, k) = at;
+        // After quads `..k` of chunk `c`; past the end of a chunk is before the next one.
+        let mut at = match chunks.surfaces.get(c as usize).and_then(Option::as_ref) {
+            Some(s) if k as usize >= s.quads.len() && k > 0 => (c + 1, 0),
+            _ => (c, k),
+        };
+        // Chunks with nothing translucent draw nothing: the next one that does.
+        while at.0 < last && chunks.surfaces[at.0 as usize].is_none() {
+            at = (at.0 + 1, 0);
+        }
+        at
     }
+}
+
+/// A key that orders squared distances `o2` farthest first: the bits of the 32-bit float
+/// order like the number (enough to tell objects apart at one place: 24 bits of mantissa).
+fn farthest_key(o2: f64) -> u32 {
+    !(o2 as f32).to_bits()
 }
 
 /// Sorts `(key, value)` pairs by key, stably, in three passes of eleven bits (Bevy sorts

@@ -300,6 +300,7 @@ fn objects_go_before_the_first_chunk_they_are_behind() {
         chunk,
         quad: 0,
         end,
+        clip: 0,
     };
     assert_eq!(splits, vec![at(0, 1), at(2, 3)]);
     assert_eq!(order[..3], [0, 1, 2]);
@@ -354,6 +355,7 @@ fn between_water_and_a_pane_of_one_chunk_an_object_goes_between_their_quads() {
         chunk: 0,
         quad: 1,
         end: 1,
+        clip: 0,
     };
     assert_eq!(splits, [want]);
     // Without splitting, the box's centre decides: the ball is farther, so it is drawn
@@ -385,4 +387,118 @@ fn quad_planes_of(quads: &[PackedQuad]) -> Vec<(Face, u8)> {
     planes.sort_unstable_by_key(|&(f, c)| (f as u8, c));
     planes.dedup();
     planes
+}
+
+/// One chunk with a water surface (top faces of y = 3) for the eye at `eye`.
+fn water_surface<'a>(quads: &'a [PackedQuad], planes: &'a [(Face, u8)]) -> Surfaces<'a> {
+    Surfaces {
+        lo: DVec3::new(0.0, 4.0, 0.0),
+        hi: DVec3::new(32.0, 4.0, 32.0),
+        origin: [0.0; 3],
+        planes,
+        quads,
+    }
+}
+
+#[test]
+fn an_object_through_a_surface_is_cut_and_each_part_placed_on_its_side() {
+    use voxel_core::BlockId;
+    use voxel_mesh::Quad;
+    let quads = [PackedQuad::pack(&Quad {
+        pos: [0, 3, 0],
+        size: [32, 32],
+        face: Face::PosY,
+        block: BlockId(1),
+    })];
+    let planes = quad_planes_of(&quads);
+    let s = water_surface(&quads, &planes);
+    let positions = [ChunkPos::new(0, 0, 0)];
+    for eye in [DVec3::new(16.0, 9.0, 40.0), DVec3::new(16.0, 1.0, 40.0)] {
+        let two_sided = eye.y < 4.0;
+        let keys = keys_of(&positions, eye);
+        let one = [Some(s)];
+        let seq = ChunkSequence {
+            surfaces: &one,
+            keys: &keys,
+            positions: &positions,
+        };
+        // A cube from y = 3 to 5 through the surface at y = 4.
+        let cube = Ball::new(DVec3::new(16.0, 4.0, 16.0), 3f64.sqrt(), Some(DVec3::ONE));
+        let mut orderer = Interleaver::default();
+        orderer.run(1, |_| cube, eye, &seq, two_sided, true);
+        let (order, splits, clips) = orderer.result();
+        assert_eq!(order, [0, 0], "two parts of object 0");
+        // The part beyond the surface before its quad, the part on the eye's side after it
+        // (past the chunk's last quad: after the chunk).
+        let far = splits
+            .iter()
+            .find(|s| clips[s.clip as usize].iter().any(|c| c.far));
+        let near = splits
+            .iter()
+            .find(|s| clips[s.clip as usize].iter().any(|c| !c.far));
+        let (Some(far), Some(near)) = (far, near) else {
+            panic!("a part on each side: {splits:?} {clips:?}");
+        };
+        assert_eq!((far.chunk, far.quad), (0, 0), "beyond: before the surface");
+        assert!(
+            near.chunk == 1 || near.quad == 1,
+            "eye's side: after the surface"
+        );
+        let clip = &clips[near.clip as usize];
+        assert_eq!(clip.len(), 1);
+        assert_eq!((clip[0].axis, clip[0].at), (1, 4.0));
+        assert_eq!(clip[0].eye_side, if eye.y > 4.0 { 1.0 } else { -1.0 });
+        // The same cube without sorted-quads' cut: one place.
+        let (order, _) = interleave(&[cube], eye, &seq, two_sided, false);
+        assert_eq!(order, [0]);
+    }
+}
+
+#[test]
+fn a_face_lying_in_a_surface_is_on_the_eyes_side_of_it() {
+    use voxel_core::BlockId;
+    use voxel_mesh::Quad;
+    let quads = [PackedQuad::pack(&Quad {
+        pos: [0, 3, 0],
+        size: [32, 32],
+        face: Face::PosY,
+        block: BlockId(1),
+    })];
+    let planes = quad_planes_of(&quads);
+    let s = water_surface(&quads, &planes);
+    let positions = [ChunkPos::new(0, 0, 0)];
+    // Foam resting on the surface: its bottom face in the plane (to 32-bit rounding).
+    let foam = Ball::new(
+        DVec3::new(16.0, 4.01, 16.0),
+        2.0,
+        Some(DVec3::new(1.5, f64::from(0.01f32), 1.0)),
+    );
+    let place = |eye: DVec3| {
+        let keys = keys_of(&positions, eye);
+        let one = [Some(s)];
+        let seq = ChunkSequence {
+            surfaces: &one,
+            keys: &keys,
+            positions: &positions,
+        };
+        let mut orderer = Interleaver::default();
+        orderer.run(1, |_| foam, eye, &seq, eye.y < 4.0, true);
+        let (order, splits, clips) = orderer.result();
+        (order.len(), splits.to_vec(), clips.to_vec())
+    };
+    // From above: wholly on the eye's side, after the surface, not cut.
+    let (parts, splits, _) = place(DVec3::new(16.0, 9.0, 40.0));
+    assert_eq!(parts, 1);
+    assert!(
+        splits
+            .iter()
+            .all(|s| s.clip == 0 && (s.chunk == 1 || s.quad == 1))
+    );
+    // From below: the face in the plane after the surface (in front), the rest before.
+    let (parts, splits, clips) = place(DVec3::new(16.0, 1.0, 40.0));
+    assert_eq!(parts, 2);
+    for s in &splits {
+        let far = clips[s.clip as usize][0].far;
+        assert_eq!(far, s.quad == 0 && s.chunk == 0, "{splits:?} {clips:?}");
+    }
 }
