@@ -152,7 +152,8 @@ pub(crate) const MEDIA_NONE: u32 = 0;
 pub(crate) const MEDIA_EYE: u32 = 1;
 /// [`FrameUniforms::volumes`], real-time techniques: a volume in view too; `volume_depth`
 /// holds where volumes end, `volume_entry` and `entry_look` the nearest entry into one,
-/// `opaque_copy` the opaque depth.
+/// `volume_entry2` and `entry2_look` the nearest entry beyond where that one ends,
+/// `volume_far` the farthest back face of one beyond that, `opaque_copy` the opaque depth.
 pub(crate) const MEDIA_VOLUMES: u32 = 2;
 /// [`FrameUniforms::volumes`], exact references: they walk the media from the eye along
 /// their sorted fragments; `volume_depth` holds the opaque depth.
@@ -221,6 +222,11 @@ impl SharedLayouts {
             gpu::texture_entry(9, gpu::DEPTH_READ),
             gpu::texture_entry(10, wgpu::TextureSampleType::Float { filterable: false }),
             gpu::texture_entry(11, gpu::DEPTH_READ),
+            // The farthest back face of a volume, and the nearest entry beyond where the
+            // nearest volume ends with its look.
+            gpu::texture_entry(12, gpu::DEPTH_READ),
+            gpu::texture_entry(13, gpu::DEPTH_READ),
+            gpu::texture_entry(14, wgpu::TextureSampleType::Float { filterable: false }),
         ];
         // Group 0's block layers (read where the quad is expanded) and group 1, as
         // `common.wgsl` declares them for each way of fetching quads.

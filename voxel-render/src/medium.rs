@@ -120,7 +120,10 @@ pub(crate) fn media_wgsl() -> String {
            @group(0) @binding(7) var volume_depth: texture_2d<f32>;\n\
            @group(0) @binding(9) var volume_entry: texture_2d<f32>;\n\
            @group(0) @binding(10) var entry_look: texture_2d<f32>;\n\
-           @group(0) @binding(11) var opaque_copy: texture_2d<f32>;\n\n\
+           @group(0) @binding(11) var opaque_copy: texture_2d<f32>;\n\
+           @group(0) @binding(12) var volume_far: texture_2d<f32>;\n\
+           @group(0) @binding(13) var volume_entry2: texture_2d<f32>;\n\
+           @group(0) @binding(14) var entry2_look: texture_2d<f32>;\n\n\
            fn boundary_depth(xy: vec2<f32>) -> f32 {\n    \
            return depth_at(medium_boundary, xy);\n}\n\n"
         + crate::bindings::VOLUME_WGSL
@@ -139,6 +142,10 @@ pub(crate) struct MediumPass {
     volume_exit: wgpu::RenderPipeline,
     /// The nearest front face of a volume and its look (`volume_exit.wgsl`).
     volume_entry: wgpu::RenderPipeline,
+    /// The farthest back face of a volume (`volume_exit.wgsl`).
+    volume_far: wgpu::RenderPipeline,
+    /// The nearest entry beyond where the nearest volume ends (`volume_exit.wgsl`).
+    volume_entry2: wgpu::RenderPipeline,
     /// The media over the opaque picture (`media.wgsl`), with the scene group.
     media: wgpu::RenderPipeline,
     /// Copies the opaque depth into the boundary and the volume depths.
@@ -173,6 +180,30 @@ impl MediumPass {
             samples: 1,
         }
         .build_two_sided(device);
+        let volume_far = ChunkPipeline {
+            label: "volume_far",
+            module: &exit_module,
+            fragment_entry: "fs_volume_far",
+            groups: &groups,
+            targets: &[],
+            depth: DepthMode::WriteFarthest,
+            samples: 1,
+        }
+        .build_two_sided(device);
+        let volume_entry2 = ChunkPipeline {
+            label: "volume_entry2",
+            module: &exit_module,
+            fragment_entry: "fs_volume_entry2",
+            groups: &groups,
+            targets: &[Some(wgpu::ColorTargetState {
+                format: ENTRY_LOOK_FORMAT,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+            depth: DepthMode::Write,
+            samples: 1,
+        }
+        .build_two_sided(device);
         let volume_entry = ChunkPipeline {
             label: "volume_entry",
             module: &exit_module,
@@ -203,6 +234,8 @@ impl MediumPass {
             boundary,
             volume_exit,
             volume_entry,
+            volume_far,
+            volume_entry2,
             media,
             depth_copy: gpu::DepthCopy::new(ctx),
         }
@@ -294,6 +327,58 @@ impl MediumPass {
             faces,
             timer,
         );
+    }
+
+    /// Writes into `entry_depth` and `entry_look` the nearest front face of a volume beyond
+    /// where the nearest volume ends (`volume_depth`) and beyond its entry, in front of
+    /// `opaque_depth`, and its medium's look (`scene`: group 0 with the opaque depth in
+    /// `volume_entry2`'s place). After [`Self::volume_entry_pass`].
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn volume_entry2_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        opaque_depth: &Target,
+        (entry_depth, entry_look): (&Target, &Target),
+        scene: &wgpu::BindGroup,
+        draws: &FrameDraws<'_>,
+        chunks: &DrawList,
+        timer: Option<&Timer>,
+    ) {
+        self.depth_copy
+            .record(encoder, opaque_depth, entry_depth, GpuPass::Medium, timer);
+        let colors = [gpu::clear(&entry_look.view, wgpu::Color::TRANSPARENT)];
+        let faces = (scene, draws, chunks);
+        nearest_faces(
+            encoder,
+            "volume_entry2",
+            &self.volume_entry2,
+            entry_depth,
+            &colors,
+            faces,
+            timer,
+        );
+    }
+
+    /// Writes into `far` the farthest back face of a volume in front of the opaque surface
+    /// (1, the near plane, where there is none; `scene`: group 0 with the opaque depth in
+    /// `volume_far`'s place). After [`Self::volume_entry_pass`], which copies the opaque
+    /// depth the pass reads.
+    pub(crate) fn volume_far_pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        far: &Target,
+        scene: &wgpu::BindGroup,
+        draws: &FrameDraws<'_>,
+        chunks: &DrawList,
+        timer: Option<&Timer>,
+    ) {
+        Pass::new("volume_far", GpuPass::Medium, &[])
+            .depth(Depth::Clear(&far.view, 1.0))
+            .record(encoder, timer, |pass| {
+                pass.set_pipeline(&self.volume_far);
+                pass.set_bind_group(0, scene, &[]);
+                draws.draw(chunks, pass);
+            });
     }
 
     /// Blends over `target` (the opaque picture) the media in front of it: the eye's

@@ -311,18 +311,30 @@ pub(crate) struct GameDraw<'a> {
     /// The resources a technique binds into its group for the game (group 0's frame
     /// uniforms and medium boundary, besides its own).
     pub frame_buffer: &'a wgpu::Buffer,
-    /// The medium boundary depth (see `medium.rs`).
-    pub boundary: &'a wgpu::TextureView,
     /// The nearest sampler depth textures are read with (`gpu::DEPTH_READ`).
     pub depth_sampler: &'a wgpu::Sampler,
-    /// Where volumes end, the nearest entry into a volume and its medium's look
-    /// (`shaders/path.wgsl`).
-    pub volume_depth: &'a wgpu::TextureView,
-    /// See `volume_depth`.
-    pub volume_entry: &'a wgpu::TextureView,
-    /// See `volume_depth`.
-    pub entry_look: &'a wgpu::TextureView,
+    /// The media the fragments are seen through (`shaders/path.wgsl`), in the order of
+    /// [`MEDIA_WGSL_NAMES`]: the medium boundary depth (see `medium.rs`), where volumes
+    /// end, the nearest entry into a volume and its medium's look, the nearest entry beyond
+    /// where that one ends and its look, the farthest back face of a volume, the opaque
+    /// depth.
+    pub media: [&'a wgpu::TextureView; MEDIA_VIEWS],
 }
+
+/// How many views of the media a game's group binds ([`GameDraw::media`]).
+pub(crate) const MEDIA_VIEWS: usize = 8;
+
+/// The WGSL names of [`GameDraw::media`] (group 0's in the chunk shaders).
+const MEDIA_WGSL_NAMES: [&str; MEDIA_VIEWS] = [
+    "medium_boundary",
+    "volume_depth",
+    "volume_entry",
+    "entry_look",
+    "volume_entry2",
+    "entry2_look",
+    "volume_far",
+    "opaque_copy",
+];
 
 impl std::fmt::Debug for GameDraw<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -370,10 +382,9 @@ impl GameDraw<'_> {
 }
 
 /// The group a technique binds for games at [`OIT_GROUP`]: binding 0 the frame uniforms,
-/// 1 the medium boundary, 2 the sampler depth textures are read with, 3 where volumes end,
-/// 4 and 5 the nearest entry into a volume and its look (what the techniques' WGSL reads
-/// of group 0), then the technique's own entries (its chunk pipelines' group 2) moved up by
-/// [`OWN_SHIFT`].
+/// 1 the sampler depth textures are read with, then the media ([`GameDraw::media`], what
+/// the techniques' WGSL reads of group 0), then the technique's own entries (its chunk
+/// pipelines' group 2) moved up by [`OWN_SHIFT`].
 pub(crate) fn game_layout(
     device: &wgpu::Device,
     label: &str,
@@ -382,12 +393,17 @@ pub(crate) fn game_layout(
     use wgpu::ShaderStages as S;
     let mut entries = vec![
         crate::gpu::buffer_entry(0, S::VERTEX_FRAGMENT, wgpu::BufferBindingType::Uniform),
-        crate::gpu::texture_entry(1, crate::gpu::DEPTH_READ),
-        crate::gpu::depth_sampler_entry(2),
-        crate::gpu::texture_entry(3, crate::gpu::DEPTH_READ),
-        crate::gpu::texture_entry(4, crate::gpu::DEPTH_READ),
-        crate::gpu::texture_entry(5, wgpu::TextureSampleType::Float { filterable: false }),
+        crate::gpu::depth_sampler_entry(1),
     ];
+    // The looks are colours, the rest depths (both read unfiltered).
+    entries.extend(MEDIA_WGSL_NAMES.iter().enumerate().map(|(i, name)| {
+        let kind = if name.ends_with("_look") {
+            wgpu::TextureSampleType::Float { filterable: false }
+        } else {
+            crate::gpu::DEPTH_READ
+        };
+        crate::gpu::texture_entry(2 + i as u32, kind)
+    }));
     entries.extend(own.iter().map(|e| wgpu::BindGroupLayoutEntry {
         binding: e.binding + OWN_SHIFT,
         visibility: S::FRAGMENT,
@@ -407,23 +423,30 @@ pub(crate) fn game_group(
 ) -> wgpu::BindGroup {
     let mut resources = vec![
         draw.frame_buffer.as_entire_binding(),
-        wgpu::BindingResource::TextureView(draw.boundary),
         wgpu::BindingResource::Sampler(draw.depth_sampler),
-        wgpu::BindingResource::TextureView(draw.volume_depth),
-        wgpu::BindingResource::TextureView(draw.volume_entry),
-        wgpu::BindingResource::TextureView(draw.entry_look),
     ];
+    resources.extend(draw.media.map(wgpu::BindingResource::TextureView));
     resources.extend(own.iter().cloned());
     crate::gpu::bind_group(device, label, layout, &resources)
 }
 
 /// How far a technique's own bindings (its group 2) move up in the game's group.
-const OWN_SHIFT: u32 = 6;
+const OWN_SHIFT: u32 = 2 + MEDIA_VIEWS as u32;
 
 /// A game's prelude: the frame uniforms, the medium boundary and the depth sampler at
 /// [`OIT_GROUP`], the technique's WGSL `own` (its group-2 bindings moved to [`OIT_GROUP`],
 /// [`OWN_SHIFT`] up), and `output` (which declares `OitOutput` and `oit_output`).
 pub(crate) fn game_prelude(own: &str, output: &str) -> String {
+    let media: String = MEDIA_WGSL_NAMES
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            format!(
+                "@group({OIT_GROUP}) @binding({}) var {name}: texture_2d<f32>;\n",
+                2 + i
+            )
+        })
+        .collect();
     let header = crate::gpu::WgslConsts::default()
         .u32("NO_MEDIUM", crate::bindings::NO_MEDIUM)
         .u32("FLAG_INTERFACE", voxel_mesh::FLAG_INTERFACE)
@@ -433,11 +456,8 @@ pub(crate) fn game_prelude(own: &str, output: &str) -> String {
         + crate::gpu::DEPTH_UV_WGSL
         + &format!(
             "@group({OIT_GROUP}) @binding(0) var<uniform> frame: Frame;\n\
-             @group({OIT_GROUP}) @binding(1) var medium_boundary: texture_2d<f32>;\n\
-             @group({OIT_GROUP}) @binding(2) var depth_sampler: sampler;\n\
-             @group({OIT_GROUP}) @binding(3) var volume_depth: texture_2d<f32>;\n\
-             @group({OIT_GROUP}) @binding(4) var volume_entry: texture_2d<f32>;\n\
-             @group({OIT_GROUP}) @binding(5) var entry_look: texture_2d<f32>;\n\n\
+             @group({OIT_GROUP}) @binding(1) var depth_sampler: sampler;\n\
+             {media}\n\
              // The medium boundary's depth at pixel `xy`.\n\
              fn boundary_depth(xy: vec2<f32>) -> f32 {{\n    \
              let uv = depth_uv(xy, textureDimensions(medium_boundary));\n    \

@@ -296,6 +296,23 @@ impl Renderer {
                 translucent,
                 timer,
             );
+            self.medium.volume_entry2_pass(
+                encoder,
+                &t.depth,
+                (&t.volume_entry2, &t.entry2_look),
+                &t.entry2_scene_group,
+                &draws,
+                translucent,
+                timer,
+            );
+            self.medium.volume_far_pass(
+                encoder,
+                &t.volume_far,
+                &t.far_scene_group,
+                &draws,
+                translucent,
+                timer,
+            );
         }
         if media == MEDIA_EYE || media == MEDIA_VOLUMES {
             // The opaque picture seen through the media; each translucent fragment is seen
@@ -310,11 +327,17 @@ impl Renderer {
             splits,
             clips,
             frame_buffer: &self.scene.frame_buffer,
-            boundary: &t.boundary.view,
             depth_sampler: &self.scene.depth_sampler,
-            volume_depth: &t.volume_depth.view,
-            volume_entry: &t.volume_entry.view,
-            entry_look: &t.entry_look.view,
+            media: [
+                &t.boundary.view,
+                &t.volume_depth.view,
+                &t.volume_entry.view,
+                &t.entry_look.view,
+                &t.volume_entry2.view,
+                &t.entry2_look.view,
+                &t.volume_far.view,
+                &t.opaque_copy.view,
+            ],
         });
         self.oit.render(
             encoder,

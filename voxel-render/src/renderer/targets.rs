@@ -54,6 +54,15 @@ pub(super) struct SceneTargets {
     pub(super) entry_look: Target,
     /// A copy of the opaque depth the chunk passes read (`opaque_copy` in `common.wgsl`).
     pub(super) opaque_copy: Target,
+    /// The farthest back face of a volume (`volume_far` in `common.wgsl`).
+    pub(super) volume_far: Target,
+    /// The nearest entry into a volume beyond where the nearest volume ends, and its look.
+    pub(super) volume_entry2: Target,
+    pub(super) entry2_look: Target,
+    /// The scene group of the pass writing `volume_entry2` and `entry2_look`.
+    pub(super) entry2_scene_group: wgpu::BindGroup,
+    /// The scene group of the pass writing `volume_far` (the opaque depth in its place).
+    pub(super) far_scene_group: wgpu::BindGroup,
     /// MSAA colour and depth, resolved into `color` and `depth`.
     pub(super) msaa: Option<(Target, Target)>,
     pub(super) tonemap_group: wgpu::BindGroup,
@@ -224,6 +233,9 @@ impl SceneTargets {
         let volume_entry = volume_target("volume_entry", DEPTH_FORMAT);
         let entry_look = volume_target("entry_look", medium::ENTRY_LOOK_FORMAT);
         let opaque_copy = volume_target("opaque_copy", DEPTH_FORMAT);
+        let volume_far = volume_target("volume_far", DEPTH_FORMAT);
+        let volume_entry2 = volume_target("volume_entry2", DEPTH_FORMAT);
+        let entry2_look = volume_target("entry2_look", medium::ENTRY_LOOK_FORMAT);
         // The block layers: binding 4 (a storage buffer) or 5 (a table texture),
         // `shaders/common.wgsl`.
         let layers = match &scene.layer_table {
@@ -233,7 +245,9 @@ impl SceneTargets {
         let group = |label,
                      boundary: &Target,
                      volume_depth: &Target,
-                     entry: (&Target, &wgpu::TextureView)| {
+                     entry: (&Target, &wgpu::TextureView),
+                     far: &Target,
+                     entry2: (&Target, &wgpu::TextureView)| {
             let resources = [
                 (0, scene.frame_buffer.as_entire_binding()),
                 (1, wgpu::BindingResource::TextureView(&scene.textures.view)),
@@ -246,6 +260,9 @@ impl SceneTargets {
                 (9, wgpu::BindingResource::TextureView(&entry.0.view)),
                 (10, wgpu::BindingResource::TextureView(entry.1)),
                 (11, wgpu::BindingResource::TextureView(&opaque_copy.view)),
+                (12, wgpu::BindingResource::TextureView(&far.view)),
+                (13, wgpu::BindingResource::TextureView(&entry2.0.view)),
+                (14, wgpu::BindingResource::TextureView(entry2.1)),
             ];
             let entries =
                 resources.map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
@@ -256,17 +273,57 @@ impl SceneTargets {
             })
         };
         let entry = (&volume_entry, &entry_look.view);
-        let scene_group = group("scene", &boundary, &volume_depth, entry);
+        let entry2 = (&volume_entry2, &entry2_look.view);
+        let scene_group = group(
+            "scene",
+            &boundary,
+            &volume_depth,
+            entry,
+            &volume_far,
+            entry2,
+        );
         // The pass writing the boundary reads the opaque depth in its place (ties with
         // cutout faces, `shaders/medium_boundary.wgsl`), and so do the passes writing the
         // volume depth and the volume entry (which reads the media table for the look).
-        let boundary_scene_group = group("scene_writing_boundary", &depth, &volume_depth, entry);
-        let exit_scene_group = group("scene_writing_volume_depth", &boundary, &depth, entry);
+        let boundary_scene_group = group(
+            "scene_writing_boundary",
+            &depth,
+            &volume_depth,
+            entry,
+            &volume_far,
+            entry2,
+        );
+        let exit_scene_group = group(
+            "scene_writing_volume_depth",
+            &boundary,
+            &depth,
+            entry,
+            &volume_far,
+            entry2,
+        );
         let entry_scene_group = group(
             "scene_writing_volume_entry",
             &boundary,
             &volume_depth,
             (&depth, &scene.media.view),
+            &volume_far,
+            entry2,
+        );
+        let entry2_scene_group = group(
+            "scene_writing_volume_entry2",
+            &boundary,
+            &volume_depth,
+            entry,
+            &volume_far,
+            (&depth, &scene.media.view),
+        );
+        let far_scene_group = group(
+            "scene_writing_volume_far",
+            &boundary,
+            &volume_depth,
+            entry,
+            &depth,
+            entry2,
         );
         let tonemap_group =
             gpu::texture_group(device, "tonemap", &post.tonemap_layout, &[&color.view]);
@@ -292,6 +349,11 @@ impl SceneTargets {
             volume_entry,
             entry_look,
             opaque_copy,
+            volume_far,
+            far_scene_group,
+            volume_entry2,
+            entry2_look,
+            entry2_scene_group,
             msaa,
             tonemap_group,
             depth_resolve_group,

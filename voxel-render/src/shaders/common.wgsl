@@ -36,6 +36,12 @@ struct ChunkInfo {
 @group(0) @binding(9) var volume_entry: texture_2d<f32>;
 @group(0) @binding(10) var entry_look: texture_2d<f32>;
 @group(0) @binding(11) var opaque_copy: texture_2d<f32>;
+// The farthest back face of a volume beyond the second entry (1 where none), and the
+// nearest entry into a volume beyond where the nearest one ends with its look, when
+// `frame.volumes` is MEDIA_VOLUMES (`volume_exit.wgsl`).
+@group(0) @binding(12) var volume_far: texture_2d<f32>;
+@group(0) @binding(13) var volume_entry2: texture_2d<f32>;
+@group(0) @binding(14) var entry2_look: texture_2d<f32>;
 
 // How quads and their tables reach the vertex stage (`fetch.rs`); a pipeline uses one of
 // the two, and binds only that one's resources.
@@ -305,24 +311,27 @@ fn medium_look(block: u32) -> vec4<f32> {
 }
 
 // What every real-time technique composes for a translucent fragment: its face, seen
-// through the media in front of it (`fogged`, `path.wgsl`). The path through the nearest
-// volume behind it is the media pass's, which lies it over the opaque picture; the entry
-// face of a volume beyond where that one ends (the sea behind a glass pillar standing in
-// it, water under ice) composes its own volume behind it down to the opaque surface: exact
-// where the volume ends there with nothing translucent inside it. The exact references walk
-// the media along their sorted fragments themselves and take `surface_color`.
+// through the media in front of it (`fogged`, `path.wgsl`: the eye's medium, the nearest
+// volume and the nearest one beyond where that ends, whose paths the media pass also lies
+// over the opaque picture). The entry face of a third volume along the ray composes its
+// own volume behind it, down to where the second one ends at worst or else the opaque
+// surface: exact where that is where it ends, with nothing translucent inside it. The exact
+// references walk the media along their sorted fragments themselves and take
+// `surface_color`.
 fn translucent_color(in: VsOut, front: bool) -> vec4<f32> {
     let c = surface_color(in, front);
     if (frame.volumes != MEDIA_EYE && frame.volumes != MEDIA_VOLUMES) || c.a <= 0.0 {
         return c;
     }
     let m = medium_look(in.block);
-    if frame.volumes == MEDIA_VOLUMES && front && m.a > 0.0 && in.clip.z < depth_at(volume_entry, in.clip.xy) {
-        let v = medium_segment(m, ray_length(in.clip.xy, in.clip.z, depth_at(opaque_copy, in.clip.xy)));
+    let z = in.clip.z;
+    let entry2 = depth_at(volume_entry2, in.clip.xy);
+    if frame.volumes == MEDIA_VOLUMES && front && m.a > 0.0 && z < entry2 * (1.0 - PATH_TIE) {
+        let v = medium_segment(m, ray_length(in.clip.xy, z, volume_end(in.clip.xy, z)));
         let all = in_front_of(vec4<f32>(0.0), c) + (1.0 - c.a) * v;
-        return fogged(in.clip.xy, in.clip.z, vec4<f32>(all.rgb / all.a, all.a));
+        return fogged(in.clip.xy, z, vec4<f32>(all.rgb / all.a, all.a));
     }
-    return fogged(in.clip.xy, in.clip.z, c);
+    return fogged(in.clip.xy, z, c);
 }
 
 // Level of the n×n Bayer matrix (n a power of two) at a pixel, over n²: the matrix

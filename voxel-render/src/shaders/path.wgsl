@@ -2,11 +2,13 @@
 // volume.wgsl; needs `frame`, `volume_depth`, `volume_entry`, `entry_look`,
 // `depth_sampler` and `boundary_depth`). `medium.rs` has the model.
 //
-// Along a pixel's ray the real-time techniques know two stretches of medium: the eye's own
-// medium up to its boundary (the first surface of its type, or the opaque surface), and
+// Along a pixel's ray the real-time techniques know three stretches of medium: the eye's
+// own medium up to its boundary (the first surface of its type, or the opaque surface),
 // the nearest volume entered beyond it (`volume_entry`, with its look in `entry_look`) up
 // to where volumes end (`volume_depth`: the first back face of a volume, or the opaque
-// surface). Every translucent fragment is seen through the part of that path in front of
+// surface), and the nearest volume entered beyond that end (`volume_entry2`,
+// `entry2_look`) up to the farthest back face of a volume or else the opaque surface
+// (`volume_end`). Every translucent fragment is seen through the part of that path in front of
 // it, `fogged`, and the opaque picture through all of it, by the media pass before the
 // technique draws (`media.wgsl`). With layers (straight colour c_i, opacity a_i) at path
 // transmittances T_i and the light E_i the path adds in front of each (premultiplied),
@@ -36,12 +38,35 @@ fn path_to(xy: vec2<f32>, z: f32) -> vec4<f32> {
     if frame.volumes == MEDIA_VOLUMES {
         let entry = depth_at(volume_entry, xy);
         if z < entry {
-            let look = textureSampleLevel(entry_look, depth_sampler, depth_uv(xy, textureDimensions(entry_look)), 0.0);
+            let look = look_at(entry_look, xy);
             let end = max(z, depth_at(volume_depth, xy));
             p += (1.0 - p.a) * medium_segment(look, ray_length(xy, entry, end));
         }
+        let entry2 = depth_at(volume_entry2, xy);
+        if z < entry2 {
+            let look = look_at(entry2_look, xy);
+            let end = max(z, volume_end(xy, entry2));
+            p += (1.0 - p.a) * medium_segment(look, ray_length(xy, entry2, end));
+        }
     }
     return p;
+}
+
+// Two depths closer than this share of their value lie in one plane (two quads of one
+// plane interpolate its depth with different rounding).
+const PATH_TIE: f32 = 1.0 / 65536.0;
+
+// A medium's look at pixel `xy` of a look target.
+fn look_at(t: texture_2d<f32>, xy: vec2<f32>) -> vec4<f32> {
+    return textureSampleLevel(t, depth_sampler, depth_uv(xy, textureDimensions(t)), 0.0);
+}
+
+// Where a volume entered at depth `z` ends at pixel `xy`, as far as the real-time
+// techniques know: the farthest back face of a volume, where it lies beyond `z`, or else
+// the opaque surface.
+fn volume_end(xy: vec2<f32>, z: f32) -> f32 {
+    let far = depth_at(volume_far, xy);
+    return select(depth_at(opaque_copy, xy), far, far < z);
 }
 
 // A translucent fragment's straight colour `c` at pixel `xy` and window depth `z`, seen

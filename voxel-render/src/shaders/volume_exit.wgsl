@@ -30,3 +30,36 @@ fn fs_volume_entry(in: VsOut, @builtin(front_facing) front: bool) -> @location(0
     }
     return m;
 }
+
+// The farthest back face of a volume in front of the opaque surface and beyond the second
+// entry (`fs_volume_entry2`): where the second volume ends, at worst (the sea behind a
+// glass pillar standing in it, which leaves the loaded world through its side). The depth
+// attachment starts at the near plane (1: no face), the farthest fragment kept; in this
+// pass group 0's `volume_far` binding holds the opaque depth. After the second entry.
+@fragment
+fn fs_volume_far(in: VsOut, @builtin(front_facing) front: bool) {
+    if front || medium_look(in.block).a <= 0.0 || in.clip.z <= depth_at(opaque_copy, in.clip.xy)
+        || in.clip.z >= depth_at(volume_entry2, in.clip.xy) {
+        discard;
+    }
+    if frame.medium != NO_MEDIUM && in.clip.z >= boundary_depth(in.clip.xy) {
+        discard;
+    }
+}
+
+// The nearest entry into a volume beyond where the nearest volume ends (at its end or
+// farther, and beyond its entry), its medium's look in the colour target: the second
+// volume along the ray (the sea behind a glass pillar standing in it, water under ice),
+// which the real-time techniques see fragments through too (`path.wgsl`). A face at the
+// first volume's end counts within rounding (another quad in the same plane). In this
+// pass group 0's `volume_entry2` binding holds the opaque depth itself.
+@fragment
+fn fs_volume_entry2(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let m = medium_look(in.block);
+    let z = in.clip.z;
+    if !front || m.a <= 0.0 || faded_out(in) || z >= depth_at(volume_entry, in.clip.xy)
+        || z > depth_at(volume_depth, in.clip.xy) * (1.0 + PATH_TIE) {
+        discard;
+    }
+    return m;
+}
