@@ -41,6 +41,7 @@ const LAB: &[&str] = &[
     "random",
     "edges",
     "content",
+    "overlaps",
     "raymarch",
     "summary",
     "metrics",

@@ -128,12 +128,29 @@ fn ray_segment(d: DVec3, a: DVec3, b: DVec3) -> Option<(f64, f64)> {
     Some((t, (d * t - p).length()))
 }
 
-/// The largest channel difference of `test` against `reference` over the pixels that are
-/// not edge pixels, and how many differing pixels (by more than 1/255) were edge pixels.
-/// Past [`MAX_CLASSIFIED`] differing pixels, the rest count as off edges.
-pub fn error_off_edges(edges: &Edges, reference: &Image, test: &Image) -> (u32, u32) {
-    let mut max = 0u32;
-    let mut on_edges = 0u32;
+/// Where an exact order's error against the reference stands: the largest channel error
+/// over the pixels off translucent quad edges and off `overlaps` (pixels showing two of a
+/// game's objects that interpenetrate, [`crate::overlaps`]), and how many pixels off by
+/// more than 1/255 lie on an edge and on such objects (an edge first).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OffEdges {
+    /// The largest channel error elsewhere (1/255).
+    pub max: u32,
+    /// Pixels off by more than 1/255 on a quad edge.
+    pub on_edges: u32,
+    /// Pixels off by more than 1/255 on interpenetrating objects.
+    pub on_overlaps: u32,
+}
+
+/// [`OffEdges`] of `test` against `reference`, with `edges` and the mask `overlaps` (one
+/// flag a pixel, row by row; empty: none).
+pub fn error_off_edges(
+    edges: &Edges,
+    overlaps: &[bool],
+    reference: &Image,
+    test: &Image,
+) -> OffEdges {
+    let mut out = OffEdges::default();
     let mut classified = 0usize;
     for y in 0..reference.height {
         for x in 0..reference.width {
@@ -147,13 +164,19 @@ pub fn error_off_edges(edges: &Edges, reference: &Image, test: &Image) -> (u32, 
             }
             classified += 1;
             if classified <= MAX_CLASSIFIED && edges.is_edge(x, y) {
-                on_edges += 1;
+                out.on_edges += 1;
+            } else if overlaps
+                .get((y * reference.width + x) as usize)
+                .copied()
+                .unwrap_or(false)
+            {
+                out.on_overlaps += 1;
             } else {
-                max = max.max(err);
+                out.max = out.max.max(err);
             }
         }
     }
-    (max, on_edges)
+    out
 }
 
 #[cfg(test)]

@@ -356,6 +356,7 @@ fn scene_records(
 
     let mut records = Vec::new();
     let mut quad_edges = None;
+    let mut overlaps = None;
     for (name, config) in runs(opts) {
         progress.step(&format!("{stem}: {name}"));
         let m = measure(
@@ -386,10 +387,11 @@ fn scene_records(
         // An exact order's error off the quad edges (sub-pixel snapping decides the rest),
         // seen from where the renderer drew (an eye on a face plane is moved off it).
         let off_edges = report.sort.map(|_| {
-            let e = quad_edges.get_or_insert_with(|| {
-                Edges::new(&scene.world, &renderer.drawn_camera(&camera), size)
-            });
-            edges::error_off_edges(e, &reference.image, &m.image)
+            let drawn = renderer.drawn_camera(&camera);
+            let e = quad_edges.get_or_insert_with(|| Edges::new(&scene.world, &drawn, size));
+            let o = overlaps
+                .get_or_insert_with(|| crate::overlaps::overlap_mask(&scene.content, &drawn, size));
+            edges::error_off_edges(e, o, &reference.image, &m.image)
         });
         records.push(Record {
             scene: stem.clone(),
@@ -413,8 +415,9 @@ fn scene_records(
             reference_exact: reference.check.exact,
             sort_cycles: report.sort.map(|s| s.cycles),
             quads_in_cycles: report.sort.map(|s| s.quads_in_cycles),
-            max_abs_err_off_edges: off_edges.map(|e| e.0),
-            edge_px: off_edges.map(|e| e.1),
+            max_abs_err_off_edges: off_edges.map(|e| e.max),
+            edge_px: off_edges.map(|e| e.on_edges),
+            overlap_px: off_edges.map(|e| e.on_overlaps),
             heatmap,
         });
     }

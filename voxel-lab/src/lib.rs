@@ -7,6 +7,7 @@
 //!   documented caps on a run), [`progress`], [`random`]
 //!   (random scenes as scene-file text), [`edges`] (which pixels lie on quad edges),
 //!   [`content`] (what the ray march needs of a game's particles and entities),
+//!   [`overlaps`] (which pixels show two of a game's objects that interpenetrate),
 //!   [`raymarch`] (the CPU ray-march reference),
 //!   [`summary`], [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the
@@ -32,6 +33,7 @@ pub mod gallery;
 pub mod headless;
 pub mod limits;
 pub mod metrics;
+pub mod overlaps;
 pub mod progress;
 pub mod random;
 pub mod raymarch;

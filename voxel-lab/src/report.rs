@@ -19,8 +19,16 @@ fn row(r: &Record) -> String {
     let sort = r
         .game_sort_ms
         .map_or(String::new(), |s| format!(" (objects {s:.3})"));
+    // An exact order's error where the order alone decides: off quad edges and off a
+    // game's objects that interpenetrate (pixels off by more than 1/255 there, counted).
+    let off = match (r.max_abs_err_off_edges, r.edge_px, r.overlap_px) {
+        (Some(m), Some(e), Some(o)) if e > 0 || o > 0 || m != r.max_abs_err => {
+            format!(" ({m} off {e} edge and {o} overlap px)")
+        }
+        _ => String::new(),
+    };
     format!(
-        "| {} | {} | {:.3}{sort} | {:.4} | {:.4} | {:.1} | {} | {:.4} | {} | [map]({}) |",
+        "| {} | {} | {:.3}{sort} | {:.4} | {:.4} | {:.1} | {}{off} | {:.4} | {} | [map]({}) |",
         r.technique,
         ms(r.gpu_ms),
         r.cpu_ms,

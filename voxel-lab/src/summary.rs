@@ -93,11 +93,15 @@ pub struct Record {
     pub sort_cycles: Option<u32>,
     /// `sorted-quads`: quads in those cycles.
     pub quads_in_cycles: Option<u32>,
-    /// `sorted-quads`: the largest channel error over the pixels off translucent quad
-    /// edges ([`crate::edges`]), where the order alone decides the colour.
+    /// The sorted techniques: the largest channel error over the pixels off translucent
+    /// quad edges ([`crate::edges`]) and off a game's objects that interpenetrate
+    /// ([`crate::overlaps`]), where the order alone decides the colour.
     pub max_abs_err_off_edges: Option<u32>,
-    /// `sorted-quads`: pixels off by more than 1/255 that lie on a quad edge.
+    /// The sorted techniques: pixels off by more than 1/255 that lie on a quad edge.
     pub edge_px: Option<u32>,
+    /// The sorted techniques: pixels off by more than 1/255 that show two of a game's
+    /// objects that interpenetrate (no order of whole objects is right there).
+    pub overlap_px: Option<u32>,
     /// The FLIP heat map, relative to the output folder (empty when not saved: random
     /// scenes save none).
     pub heatmap: String,

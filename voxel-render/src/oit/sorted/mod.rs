@@ -74,7 +74,8 @@ struct ChunkOrder {
 
 /// The most planes a part of an object is clipped by (two an axis); `clip.wgsl`'s array.
 const CLIP_PLANES: usize = 6;
-const _: () = assert!(2 * interleave::MAX_SPLIT_PLANES <= CLIP_PLANES);
+// A part lies between at most two cuts an axis.
+const _: () = assert!(CLIP_PLANES >= 2 * 3);
 
 /// A fragment within this share of its view depth of a clip plane lies in it
 /// (`clip.wgsl`): far above what reconstructing its position from the depth errs by (about

@@ -125,8 +125,8 @@ fn safe(
         let (lo, hi, ea) = (s.lo[a], s.hi[a], eye[a]);
         // Touching a face of the box counts as reaching it (`side_of_plane`).
         let (below, above) = (
-            p[a] + h[a] < lo - TOUCH * (1.0 + lo.abs()),
-            p[a] - h[a] > hi + TOUCH * (1.0 + hi.abs()),
+            p[a] + h[a] < lo - touch(h[a]),
+            p[a] - h[a] > hi + touch(h[a]),
         );
         front |= (below && ea <= lo) || (above && ea >= hi);
         behind |= (below && ea >= lo) || (above && ea <= hi);
@@ -220,7 +220,7 @@ pub(crate) struct ChunkSequence<'a> {
 fn cells_and_keys(b: Ball, eye: [i64; 3]) -> ([[i64; 2]; 3], [u128; 2]) {
     let s = 1.0 / voxel_core::CHUNK_SIZE as f64;
     // Touching a cell's face within rounding counts as touching it (`side_of_plane`).
-    let half = |a: usize| b.half[a] + TOUCH * (1.0 + b.center[a].abs());
+    let half = |a: usize| b.half[a] + touch(b.half[a]);
     // Most balls lie inside the cell of their centre, off its borders.
     let cell = [
         floor_i64(b.center.x * s),
@@ -287,22 +287,75 @@ fn eye_cell(eye: DVec3) -> [i64; 3] {
 /// A chunk's quads as runs of one plane in their drawn order (index into
 /// [`Surfaces::planes`], count), appended to `out`: every quad of a plane stands alike against a ball
 /// ([`quad_side`] depends only on the plane), so a split is chosen per run boundary.
-fn plane_runs(s: &Surfaces<'_>, out: &mut Vec<(u32, u32)>) {
+fn plane_runs(s: &Surfaces<'_>, out: &mut Vec<(u32, u32)>, boxes: &mut Vec<(DVec3, DVec3)>) {
     let start = out.len();
+    let first_box = boxes.len();
+    boxes.resize(
+        first_box + s.planes.len(),
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+    );
+    let o = DVec3::from(s.origin);
     for q in s.quads {
         let Some(q) = q.unpack() else { continue };
-        let plane = (q.face, q.bounds().0[q.face.axis()] as u8);
+        let (lo, hi) = q.bounds();
+        let plane = (q.face, lo[q.face.axis()] as u8);
         let Ok(i) = s
             .planes
             .binary_search_by_key(&(plane.0 as u8, plane.1), |&(f, c)| (f as u8, c))
         else {
             continue;
         };
+        let b = &mut boxes[first_box + i];
+        b.0 = b.0.min(DVec3::from(lo) + o);
+        b.1 = b.1.max(DVec3::from(hi) + o);
         match out[start..].last_mut() {
             Some((p, n)) if *p == i as u32 => *n += 1,
             _ => out.push((i as u32, 1)),
         }
     }
+}
+
+/// Whether no ray from `eye` through ball `b`'s box can meet the rectangle `(lo, hi)` of a
+/// plane along `axis` (the box of its quads): the box lies wholly on the other side of the
+/// eye (the rays through it go away from the plane), or its shadow cast from the eye onto
+/// the plane misses the rectangle. Then the plane's quads and the object never overlap on
+/// screen and the plane orders nothing. `false` where it cannot tell (the eye within the
+/// box's reach along the axis).
+fn shadow_misses(b: Ball, eye: DVec3, axis: usize, (lo, hi): (DVec3, DVec3)) -> bool {
+    let at = lo[axis];
+    let to_plane = at - eye[axis];
+    let (near, far) = (b.center[axis] - b.half[axis], b.center[axis] + b.half[axis]);
+    let (dn, df) = ((near - eye[axis]) * to_plane, (far - eye[axis]) * to_plane);
+    if to_plane == 0.0 {
+        return false;
+    }
+    if dn < 0.0 && df < 0.0 {
+        return true;
+    }
+    // Every point of the box on the plane's side of the eye, off the eye's own plane.
+    if dn <= 0.0 || df <= 0.0 {
+        return false;
+    }
+    let [u, v] = [(axis + 1) % 3, (axis + 2) % 3];
+    let (mut smin, mut smax) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for k in 0..8 {
+        let corner = DVec3::new(
+            b.center.x + if k & 1 == 0 { -b.half.x } else { b.half.x },
+            b.center.y + if k & 2 == 0 { -b.half.y } else { b.half.y },
+            b.center.z + if k & 4 == 0 { -b.half.z } else { b.half.z },
+        );
+        let t = to_plane / (corner[axis] - eye[axis]);
+        for (i, a) in [u, v].into_iter().enumerate() {
+            let p = eye[a] + (corner[a] - eye[a]) * t;
+            smin[i] = smin[i].min(p);
+            smax[i] = smax[i].max(p);
+        }
+    }
+    // Apart on either axis of the plane (by more than rounding).
+    [u, v].into_iter().enumerate().any(|(i, a)| {
+        let slack = touch(hi[a] - lo[a]);
+        smax[i] < lo[a] - slack || smin[i] > hi[a] + slack
+    })
 }
 
 /// How a seen plane orders ball `b` (see [`quad_side`]), as a weight: 1 when the plane's
@@ -321,7 +374,7 @@ fn side_of_plane(b: Ball, axis: usize, at: f64, eye_side: f64) -> i64 {
     let h = b.half[axis];
     // An object's face computed to lie in the plane may miss it by a rounding error (a
     // turned box's extent along the axis).
-    let tol = TOUCH * (1.0 + at.abs());
+    let tol = touch(h);
     if s - h >= -tol {
         1
     } else if s + h < -tol {
@@ -331,11 +384,16 @@ fn side_of_plane(b: Ball, axis: usize, at: f64, eye_side: f64) -> i64 {
     }
 }
 
-/// How near a plane (in blocks, relative to its coordinate) an object's extent counts as
-/// reaching it: a game's sizes are 32-bit floats (foam half a size of 0.02 thick, resting
-/// on a surface at 0.01, misses it by 2e-10), and the exact methods' tie rule puts faces
-/// that near in the plane (`stages::OBJECT_DEPTH_BIAS`).
+/// How near a plane an object's extent counts as reaching it, relative to the extent (plus
+/// a block): a game's sizes are 32-bit floats (foam 0.02 thick, resting on a surface at
+/// 0.01, misses it by 2e-10), and the exact methods' tie rule puts faces that near in the
+/// plane (`stages::OBJECT_DEPTH_BIAS`).
 const TOUCH: f64 = 1e-6;
+
+/// [`TOUCH`] for an extent `h`, blocks.
+fn touch(h: f64) -> f64 {
+    TOUCH * (1.0 + h)
+}
 
 /// How many chunks of the sequence have a key above a given one: a table by key when the
 /// keys are small (they are squared distances in chunks from the eye's chunk, below
@@ -452,7 +510,8 @@ impl CellIndex {
 struct ChunkFacts {
     distances: [f64; 3],
     planes: Option<(u32, u32)>,
-    runs: Option<(u32, u32)>,
+    /// The runs, and where the boxes of its planes' quads start.
+    runs: Option<(u32, u32, u32)>,
 }
 
 /// [`Interleaver::order`] of `balls` in fresh buffers (for the tests): the objects of the
@@ -477,9 +536,14 @@ pub(crate) fn interleave(
     (orderer.order, orderer.splits)
 }
 
-/// The most planes an object is split at (into at most 2³ parts, each clipped by at most
-/// two planes an axis): a thing crosses a handful of a chunk's planes, not hundreds.
-pub(crate) const MAX_SPLIT_PLANES: usize = 3;
+/// The most planes an object is split at (into at most 12 parts, each clipped by at most
+/// two planes an axis): a thing crosses a handful of a chunk's planes, not hundreds (a pole
+/// through three panes and a chunk border).
+pub(crate) const MAX_SPLIT_PLANES: usize = 4;
+
+/// How many times a part is cut again (where its cuts leave it across chunks no one place
+/// suits).
+const MAX_SPLIT_DEPTH: u32 = 2;
 
 pub(crate) use crate::stages::{Clip, ClipPlane};
 
@@ -508,11 +572,13 @@ pub(crate) struct Interleaver {
     items: Vec<(u32, u32, i64)>,
     weights: Vec<i64>,
     /// The planes an object crosses in the chunks no sound test decides: (axis, at).
-    crossings: Vec<(usize, f64)>,
+    crossings: Vec<(usize, f64, bool)>,
     /// Per chunk, and the seen planes and runs they name.
     facts: Vec<ChunkFacts>,
     seen: Vec<SeenPlane>,
     runs: Vec<(u32, u32)>,
+    /// Per chunk that needs them, the box of each plane's quads, world blocks.
+    boxes: Vec<(DVec3, DVec3)>,
     /// The distinct clips of the parts (0: none).
     clips: Vec<Clip>,
     /// The parts' objects in draw order, their parts in that order, and where runs of them
@@ -566,7 +632,9 @@ impl Interleaver {
     /// them, those nearest its centre: each part (the object's box between the planes) is
     /// placed on its own and drawn with its clip (the renderer discards the fragments
     /// outside it), so that each lies wholly on one side of each plane it was cut at and
-    /// the planes order it exactly. A part appears in the order as its object again.
+    /// the planes order it exactly. So is an object across chunk borders that no one place
+    /// suits (a slab through a pane two chunks hold), at those borders. A part appears in
+    /// the order as its object again.
     ///
     /// An object whose centre or radius is not finite goes after every chunk, and so, for
     /// `sorted`, does one the eye is inside of (a game's translucent volume seen from within:
@@ -617,6 +685,7 @@ impl Interleaver {
             .resize(chunks.surfaces.len(), ChunkFacts::default());
         self.seen.clear();
         self.runs.clear();
+        self.boxes.clear();
         self.parts.clear();
         self.places.clear();
         self.farthest.clear();
@@ -650,7 +719,7 @@ impl Interleaver {
                 self.push(whole, at, farthest_key(o2));
                 continue;
             }
-            self.split(&frame, whole);
+            self.split(&frame, whole, &[], 0);
         }
         let Self {
             parts,
@@ -692,33 +761,34 @@ impl Interleaver {
 
     /// Cuts `whole` at the planes it crosses (`self.crossings`, the nearest
     /// [`MAX_SPLIT_PLANES`] to its centre) into the parts between them, and places each.
-    fn split(&mut self, frame: &Frame<'_, '_>, whole: Part) {
+    fn split(&mut self, frame: &Frame<'_, '_>, whole: Part, parent: &[ClipPlane], depth: u32) {
         let b = whole.ball;
         let c = b.center;
-        let crossings = &mut self.crossings;
-        crossings.sort_by(|x, y| (x.0, x.1.to_bits()).cmp(&(y.0, y.1.to_bits())));
-        crossings.dedup();
+        let mut crossings = std::mem::take(&mut self.crossings);
+        crossings.sort_by(|x, y| (x.0, x.1.to_bits(), x.2).cmp(&(y.0, y.1.to_bits(), y.2)));
+        // A plane of quads that is also a chunk border is cut as a plane of quads.
+        crossings.dedup_by(|x, y| (x.0, x.1) == (y.0, y.1));
         crossings.sort_by(|x, y| (c[x.0] - x.1).abs().total_cmp(&(c[y.0] - y.1).abs()));
         crossings.truncate(MAX_SPLIT_PLANES);
         // Per axis: the box's ends and the cuts between them.
-        let mut bounds: [Vec<f64>; 3] = Default::default();
+        let mut bounds: [Vec<(f64, bool)>; 3] = Default::default();
         for a in 0..3 {
-            let mut cuts: Vec<f64> = crossings
+            let mut cuts: Vec<(f64, bool)> = crossings
                 .iter()
-                .filter(|&&(axis, _)| axis == a)
-                .map(|&(_, at)| at)
+                .filter(|&&(axis, ..)| axis == a)
+                .map(|&(_, at, border)| (at, border))
                 .collect();
-            cuts.sort_by(f64::total_cmp);
+            cuts.sort_by(|x, y| x.0.total_cmp(&y.0));
             // A cut the box touches within rounding (`TOUCH`) bounds it.
             let lo = cuts
                 .first()
-                .map_or(c[a] - b.half[a], |&at| at.min(c[a] - b.half[a]));
+                .map_or(c[a] - b.half[a], |&(at, _)| at.min(c[a] - b.half[a]));
             let hi = cuts
                 .last()
-                .map_or(c[a] + b.half[a], |&at| at.max(c[a] + b.half[a]));
-            bounds[a] = std::iter::once(lo)
+                .map_or(c[a] + b.half[a], |&(at, _)| at.max(c[a] + b.half[a]));
+            bounds[a] = std::iter::once((lo, false))
                 .chain(cuts)
-                .chain(std::iter::once(hi))
+                .chain(std::iter::once((hi, false)))
                 .collect();
         }
         let eye = frame.eye;
@@ -731,23 +801,25 @@ impl Interleaver {
             let mut empty = false;
             for a in 0..3 {
                 let (j, v) = (index[a], &bounds[a]);
-                let (mut l, mut h) = (v[j], v[j + 1]);
+                let (mut l, mut h) = (v[j].0, v[j + 1].0);
                 // A bound that is a cut (not the box's own end) clips the part. On the
                 // far side of a cut the part keeps what lies strictly beyond it: its box
-                // stops a hair short, so that the planes order it as wholly beyond.
+                // stops a hair short, so that the planes order it as wholly beyond. At a
+                // chunk border (no quad lies in it) both parts stop short of it, so that
+                // neither reaches into the other's chunk.
+                let hair = 4.0 * touch(b.half[a]);
                 for (end, is_upper) in [(j, false), (j + 1, true)] {
                     let is_cut = end > 0 && end < v.len() - 1;
                     if !is_cut {
                         continue;
                     }
-                    let at = v[end];
+                    let (at, border) = v[end];
                     let eye_side = if eye[a] >= at { 1.0 } else { -1.0 };
                     // Below an upper cut, above a lower one.
                     let far = (eye_side > 0.0) == is_upper;
-                    let hair = 2.0 * TOUCH * (1.0 + at.abs());
-                    if far && is_upper {
+                    if (far || border) && is_upper {
                         h = at - hair;
-                    } else if far {
+                    } else if far || border {
                         l = at + hair;
                     }
                     clip.push(ClipPlane {
@@ -771,19 +843,26 @@ impl Interleaver {
                 half.length().min(b.radius + (center - c).length()),
                 Some(half),
             );
+            let clip: Clip = parent.iter().copied().chain(clip).collect();
+            // A part may still meet planes no one place suits (the chunk borders it spans,
+            // where its own cuts left none): cut it once more.
+            let again = depth + 1 < MAX_SPLIT_DEPTH && clip.len() + 2 <= 6;
+            self.crossings.clear();
+            let at = self.place(frame, ball, again);
+            let part = Part {
+                object: whole.object,
+                ball,
+                clip: 0,
+            };
+            if again && !self.crossings.is_empty() {
+                self.split(frame, part, &clip, depth + 1);
+                continue;
+            }
             let clip = self.clip_id(clip);
-            let at = self.place(frame, ball, false);
             let o2 = center.distance_squared(eye);
-            self.push(
-                Part {
-                    object: whole.object,
-                    ball,
-                    clip,
-                },
-                at,
-                farthest_key(o2),
-            );
+            self.push(Part { clip, ..part }, at, farthest_key(o2));
         }
+        self.crossings = crossings;
     }
 
     /// The index of `clip` among the frame's clips (added if new).
@@ -805,6 +884,7 @@ impl Interleaver {
             facts,
             seen,
             runs,
+            boxes,
             crossings,
             ..
         } = self;
@@ -857,19 +937,25 @@ impl Interleaver {
                 [true, false] => items.push((c32, 0, SOUND)),
                 [false, true] => items.push((c32, 0, -SOUND)),
                 [false, false] if f.split_quads => {
-                    let (from, to) = *fc.runs.get_or_insert_with(|| {
-                        let from = runs.len() as u32;
-                        plane_runs(s, runs);
-                        (from, runs.len() as u32)
+                    let (from, to, first_box) = *fc.runs.get_or_insert_with(|| {
+                        let (from, first_box) = (runs.len() as u32, boxes.len() as u32);
+                        plane_runs(s, runs, boxes);
+                        (from, runs.len() as u32, first_box)
                     });
                     let runs = &runs[from as usize..to as usize];
                     weights.clear();
                     weights.resize(s.planes.len(), 0);
                     for pl in planes.iter() {
+                        let quads = boxes[(first_box + pl.index) as usize];
+                        // A plane whose quads the object cannot overlap on screen orders
+                        // nothing (the top of a glass wall above a fish behind it).
+                        if shadow_misses(b, eye, pl.axis, quads) {
+                            continue;
+                        }
                         let w = plane_weight(b, pl);
                         weights[pl.index as usize] = w;
                         if w == 0 && collect {
-                            crossings.push((pl.axis, pl.at));
+                            crossings.push((pl.axis, pl.at, false));
                         }
                     }
                     let mut k = 0u32;
@@ -896,6 +982,16 @@ impl Interleaver {
                 // Just after the item: after the whole chunk where it stood for it.
                 let whole = w.abs() == SOUND || !f.split_quads;
                 (min, at) = (cost, if whole { (c + 1, 0) } else { (c, k + 1) });
+            }
+        }
+        if collect && min > 0 && !single {
+            // No one place meets every chunk the object spans (a slab through a pane that
+            // two chunks hold, each with its own layers): the parts in each cell meet their
+            // own chunk's.
+            for (a, &[lo, hi]) in cells.iter().enumerate() {
+                for cell in lo + 1..=hi {
+                    crossings.push((a, (cell * voxel_core::CHUNK_SIZE as i64) as f64, true));
+                }
             }
         }
         let (c, k) = at;
