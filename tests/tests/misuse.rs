@@ -160,6 +160,10 @@ fn a_depth_texture_on_gl_is_read_through_a_pass() {
         .filter(|(a, b)| (*a - *b).abs() <= 1e-6)
         .count();
     // Two rasterisers may split an edge pixel differently; nothing else may differ.
+    eprintln!(
+        "GL depth equal to Vulkan's on {same} of {} pixels",
+        on_gl.len()
+    );
     assert!(same * 100 >= on_gl.len() * 98, "{same} of {}", on_gl.len());
 }
 

@@ -62,15 +62,24 @@ impl Renderer {
     /// planes), a mismatched output ([`Error::Output`]) or a lost device
     /// ([`Error::DeviceLost`]).
     ///
-    /// Submit each frame before recording the next: what changes between `render` and
-    /// the submit (chunks uploaded or removed) never changes what this frame draws, and
-    /// the arena places it draws are reused only after [`Renderer::after_submit`] or the
-    /// next `render`.
+    /// What changes between `render` and the submit (chunks uploaded or removed) never
+    /// changes what this frame draws: the arena places it draws are reused only after
+    /// [`Renderer::after_submit`] or the next `render`. Several frames may be recorded
+    /// before one submit (in this encoder, or in others submitted in the order recorded):
+    /// each frame's buffer writes are copies recorded into its encoder, so each draws with
+    /// its own camera, settings and game data (a game writes its own with
+    /// [`crate::stages::GameFrame::write_buffer`]); upload or remove chunks only between a
+    /// submit and the next frame.
     ///
     /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
     /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
-    /// encoder that replaces it (the order of commands is kept). Real-time techniques never
-    /// submit.
+    /// encoder that replaces it (the order of commands is kept). After a frame recorded
+    /// into another encoder that is not yet submitted, they refuse with
+    /// [`Error::FrameOrder`] (that frame would run after their first half). Real-time
+    /// techniques never submit.
+    ///
+    /// `encoder` must come from the renderer's device: wgpu offers no way to ask an
+    /// encoder's device, and one of another device fails when it is finished.
     ///
     /// `game` draws the game's own geometry in the frame's stages: its opaque geometry
     /// after the world's, its translucent geometry composed by the technique with the
