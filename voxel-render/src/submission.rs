@@ -3,12 +3,15 @@
 //! starts when the encoder is submitted (`map_buffer_on_submit`), and whose callback is
 //! dropped, unrun, when the encoder is dropped unsubmitted. The next frame looks.
 //!
-//! The renderer uses it for two things: GPU timings end a profiler frame only once its
-//! encoder is submitted (the timing module), and a frame whose encoder was dropped has
-//! its queue writes (uniforms, draw commands) flushed by an empty submit. wgpu keeps
-//! queue writes, and their staging memory, until the next submit: a game that drops
-//! every encoder would otherwise grow by each frame's writes (about 20 KiB at view
-//! distance 2).
+//! The renderer uses it for three things: GPU timings end a profiler frame only once its
+//! encoder is submitted (the timing module); a frame whose encoder was dropped has the
+//! queue writes made meanwhile (chunk uploads) flushed by an empty submit, since wgpu
+//! keeps queue writes, and their staging memory, until the next submit; and an exact
+//! technique refuses to follow a frame in another encoder not yet submitted.
+//!
+//! A frame's own writes (uniforms, draw commands, quad order) are no queue writes:
+//! [`FrameWrites`] records them as copies into the frame's encoder, from a staging buffer
+//! the encoder keeps alive and frees with it, submitted or dropped.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
