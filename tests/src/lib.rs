@@ -287,15 +287,10 @@ pub fn gpu_with_limits(change: impl FnOnce(&mut wgpu::Limits)) -> Option<GpuCont
     desc.backends = wgpu::Backends::VULKAN;
     let instance = wgpu::Instance::new(desc);
     let adapter = pollster::block_on(instance.request_adapter(&Default::default())).unwrap();
-    let mut limits = adapter.limits();
-    change(&mut limits);
-    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-        label: Some("limited"),
-        required_features: adapter.features() & voxel_render::low_level::WANTED_FEATURES,
-        required_limits: limits,
-        ..Default::default()
-    }))
-    .unwrap();
+    // What a game that requests its own device does: the renderer's request, changed.
+    let mut request = voxel_render::device_descriptor(&adapter, LimitsPreset::Adapter);
+    change(&mut request.required_limits);
+    let (device, queue) = pollster::block_on(adapter.request_device(&request)).unwrap();
     Some(GpuContext::from_device(&adapter, device, queue))
 }
 

@@ -7,9 +7,19 @@ use std::sync::Arc;
 
 use crate::{Error, Face, Result};
 
-/// Index of a block in a [`BlockRegistry`]. Id 0 is always air.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+/// Index of a block in a [`BlockRegistry`]. Id 0 is always air. `Debug` writes
+/// `BlockId(3)` on one line, pretty-printed (`{:#?}`) too; `Display` writes `#3`. An id
+/// does not know its name: [`BlockRegistry::get`] gives its definition.
+#[derive(Clone, Copy, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct BlockId(pub u16);
+
+impl fmt::Debug for BlockId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // Not `debug_tuple`: pretty-printed it would spread one number over three lines
+        // inside every struct that holds an id (a ray hit, a camera's medium).
+        write!(f, "BlockId({})", self.0)
+    }
+}
 
 impl BlockId {
     /// The empty block, present in every registry at index 0.
@@ -539,6 +549,17 @@ impl Default for BlockRegistry {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ids_print_on_one_line() {
+        assert_eq!(format!("{:?}", BlockId(3)), "BlockId(3)");
+        assert_eq!(format!("{:#?}", BlockId(3)), "BlockId(3)");
+        assert_eq!(
+            format!("{:#?}", Some(BlockId(7))),
+            "Some(\n    BlockId(7),\n)"
+        );
+        assert_eq!(BlockId(3).to_string(), "#3");
+    }
 
     #[test]
     fn defaults_match_the_id_constants() {

@@ -175,7 +175,9 @@ impl TerrainBlocks {
         }
         if !missing.is_empty() {
             return Err(Error::TerrainBlocks(format!(
-                "the registry lacks blocks for the roles {}; map them with TerrainBlocks::from_registry",
+                "the registry lacks blocks for the roles {}: register a block named like each \
+                 role, or give the role a block of the registry in the `map` argument, e.g. \
+                 &[(TerrainRole::Log, oak_id)]",
                 missing.join(", ")
             )));
         }
@@ -775,6 +777,12 @@ mod tests {
         }
         assert!(!err.contains("stone ("), "stone is there: {err}");
         assert!(!err.contains("log ("), "wood stands in for log: {err}");
+        // The hint says what to do, not to call the function that failed.
+        assert!(
+            err.contains("named like each role") && err.contains("`map`"),
+            "{err}"
+        );
+        assert!(!err.contains("from_registry"), "a circular hint: {err}");
         // An id the registry does not hold is named too.
         let err = TerrainBlocks::from_registry(&r, &config, &[(TerrainRole::Stone, BlockId(77))])
             .unwrap_err()

@@ -9,8 +9,9 @@ use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, World
 use voxel_render::{Camera, GpuContext, NoGame, Renderer, RendererConfig, Technique, readback};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    // The game's own GPU objects.
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    // The game's own GPU objects, on the backend `WGPU_BACKEND` names (else wgpu's choice).
+    let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    let instance = wgpu::Instance::new(desc);
     let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
     let (device, queue) = pollster::block_on(voxel_render::request_device(&adapter))?;
     let ctx = GpuContext::from_device(&adapter, device, queue);

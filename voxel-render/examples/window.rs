@@ -3,8 +3,10 @@
 //! (`window.wgsl`): a box around the block under the crosshair, tested against the frame's
 //! depth (reverse-Z, camera-relative), and a HUD. Keys 1-8 pick a real-time technique
 //! (built ahead: no frame stalls at a switch; the title names it); resizing works. Nothing
-//! is called after the submit. Scripted: `cargo run --release -p voxel-render --example
-//! window -- --frames N --screenshot FILE.png`.
+//! is called after the submit. The backend is wgpu's choice or `WGPU_BACKEND` (`gl`,
+//! `vulkan`, ...); a screenshot draws the frame a second time into a texture of its own,
+//! since a surface texture may not be copied from (GL's never are). Scripted: `cargo run
+//! --release -p voxel-render --example window -- --frames N --screenshot FILE.png`.
 
 use std::sync::Arc;
 
@@ -15,7 +17,7 @@ use wgpu::CurrentSurfaceTexture::Success;
 use wgpu::PrimitiveTopology::{LineList, TriangleList};
 use wgpu::util::DeviceExt;
 use winit::event::WindowEvent;
-use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::event_loop::{ActiveEventLoop, EventLoop, OwnedDisplayHandle};
 use winit::window::{Window, WindowId};
 
 /// Where the game's camera stands and what it looks at.
@@ -42,14 +44,21 @@ struct Game {
     screenshot: Option<String>,
 }
 
-fn setup(window: Arc<Window>, world: World) -> Result<Gfx, Box<dyn std::error::Error>> {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+fn setup(
+    window: Arc<Window>,
+    display: OwnedDisplayHandle,
+    world: World,
+) -> Result<Gfx, Box<dyn std::error::Error>> {
+    // `WGPU_BACKEND` (and wgpu's other variables) honoured; the display handle is what GL
+    // needs to present (Vulkan ignores it).
+    let desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(display));
+    let instance = wgpu::Instance::new(desc);
     let surface = instance.create_surface(window.clone())?;
     let (ctx, adapter) = GpuContext::for_surface(&instance, &surface)?;
+    println!("drawing on {}", ctx.caps.adapter_name);
     let (width, height) = window.inner_size().into();
     let config = surface.get_default_config(&adapter, width, height);
-    let mut config = config.ok_or("the surface offers no format")?;
-    config.usage |= surface.get_capabilities(&adapter).usages & wgpu::TextureUsages::COPY_SRC;
+    let config = config.ok_or("the surface offers no format")?;
     surface.configure(&ctx.device, &config);
     let mut rc = RendererConfig::default();
     (rc.width, rc.height, rc.output_format) = (config.width, config.height, config.format);
@@ -87,6 +96,46 @@ fn setup(window: Arc<Window>, world: World) -> Result<Gfx, Box<dyn std::error::E
     })
 }
 
+impl Gfx {
+    /// The frame into `view`: the renderer's, then the game's selection box and HUD.
+    fn draw(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::TextureView,
+        camera: &Camera,
+    ) -> Result<(), Box<dyn std::error::Error>> {
+        self.renderer.render(encoder, view, camera, &mut NoGame)?;
+        // The game's passes see what the renderer drew, from the camera it drew with.
+        let drawn = self.renderer.drawn_camera(camera);
+        let (eye, forward) = (drawn.eye.to_array(), drawn.forward.to_array());
+        let visible = RenderClass::VISIBLE;
+        let hit = self.world.raycast(eye, forward, 300.0, &visible)?;
+        let block = hit.map_or(DVec3::ZERO, |h| DVec3::from(h.pos.corner()) - drawn.eye);
+        let (w, h) = (self.config.width as f32, self.config.height as f32);
+        // The box's corners relative to the eye; their w: the window size, for the HUD.
+        let lo = (block - 0.01).as_vec3().extend(w);
+        let hi = (block + 1.01).as_vec3().extend(h);
+        let vp = drawn.view_proj(f64::from(w / h));
+        let u = [vp.x_axis, vp.y_axis, vp.z_axis, vp.w_axis, lo, hi];
+        let queue = &self.ctx.queue;
+        queue.write_buffer(&self.uniforms, 0, bytemuck::cast_slice(&u));
+        let counts = [24 * u32::from(hit.is_some()), 12];
+        for (i, (pipeline, group)) in self.passes.iter().enumerate() {
+            // The box tests the frame's depth, read only: nearer blocks hide it.
+            let depth = stages::Depth::ReadOnly(self.renderer.scene_depth_view());
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                color_attachments: &[stages::load(view)],
+                depth_stencil_attachment: depth.attachment().filter(|_| i == 0),
+                ..Default::default()
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, group, &[]);
+            pass.draw(0..counts[i], 0..1);
+        }
+        Ok(())
+    }
+}
+
 impl Game {
     fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<(), Box<dyn std::error::Error>> {
         let g = self.gfx.as_mut().ok_or("no window yet")?;
@@ -98,46 +147,41 @@ impl Game {
         let camera = Camera::look_at(EYE, TARGET, 70.0, 0.1, 400.0)?;
         let view = frame.texture.create_view(&Default::default());
         let mut encoder = g.ctx.device.create_command_encoder(&Default::default());
-        g.renderer
-            .render(&mut encoder, &view, &camera, &mut NoGame)?;
-        // The game's passes see what the renderer drew, from the camera it drew with.
-        let drawn = g.renderer.drawn_camera(&camera);
-        let (eye, forward) = (drawn.eye.to_array(), drawn.forward.to_array());
-        let visible = RenderClass::VISIBLE;
-        let hit = g.world.raycast(eye, forward, 300.0, &visible)?;
-        let block = hit.map_or(DVec3::ZERO, |h| DVec3::from(h.pos.corner()) - drawn.eye);
-        let (w, h) = (g.config.width as f32, g.config.height as f32);
-        // The box's corners relative to the eye; their w: the window size, for the HUD.
-        let lo = (block - 0.01).as_vec3().extend(w);
-        let hi = (block + 1.01).as_vec3().extend(h);
-        let vp = drawn.view_proj(f64::from(w / h));
-        let u = [vp.x_axis, vp.y_axis, vp.z_axis, vp.w_axis, lo, hi];
-        let queue = &g.ctx.queue;
-        queue.write_buffer(&g.uniforms, 0, bytemuck::cast_slice(&u));
-        let counts = [24 * u32::from(hit.is_some()), 12];
-        for (i, (pipeline, group)) in g.passes.iter().enumerate() {
-            // The box tests the frame's depth, read only: nearer blocks hide it.
-            let depth = stages::Depth::ReadOnly(g.renderer.scene_depth_view());
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                color_attachments: &[stages::load(&view)],
-                depth_stencil_attachment: depth.attachment().filter(|_| i == 0),
-                ..Default::default()
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, group, &[]);
-            pass.draw(0..counts[i], 0..1);
-        }
-        queue.submit([encoder.finish()]);
+        g.draw(&mut encoder, &view, &camera)?;
         self.frames = self.frames.map(|n| n.saturating_sub(1));
-        if self.frames == Some(0) {
-            if let Some(path) = &self.screenshot {
-                let image = voxel_render::readback::read_image(&g.ctx, &frame.texture)?;
-                image.save_png(path.as_ref())?;
-                println!("wrote {path}: GPU ms {:?}", g.renderer.gpu_times_blocking());
-            }
+        let last = self.frames == Some(0);
+        // The screenshot: the same frame drawn again into a texture that can be copied
+        // from, in the same encoder (each frame recorded before a submit draws its own).
+        let shot = self.screenshot.as_ref().filter(|_| last).map(|path| {
+            let texture = g.ctx.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("screenshot"),
+                size: frame.texture.size(),
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: g.config.format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            (path, texture)
+        });
+        if let Some((_, texture)) = &shot {
+            g.draw(
+                &mut encoder,
+                &texture.create_view(&Default::default()),
+                &camera,
+            )?;
+        }
+        g.ctx.queue.submit([encoder.finish()]);
+        if let Some((path, texture)) = shot {
+            let image = voxel_render::readback::read_image(&g.ctx, &texture)?;
+            image.save_png(path.as_ref())?;
+            println!("wrote {path}: GPU ms {:?}", g.renderer.gpu_times_blocking());
+        }
+        if last {
             event_loop.exit();
         }
-        queue.present(frame);
+        g.ctx.queue.present(frame);
         Ok(())
     }
 }
@@ -150,7 +194,8 @@ impl winit::application::ApplicationHandler for Game {
         let (min, max) = (ChunkPos::new(-4, 0, -5), ChunkPos::new(2, 1, 1));
         let world = generator.generate_world(Arc::new(BlockRegistry::default()), min, max);
         let world = world.expect("terrain of the default blocks");
-        let gfx = setup(Arc::new(window.expect("a window")), world);
+        let display = event_loop.owned_display_handle();
+        let gfx = setup(Arc::new(window.expect("a window")), display, world);
         self.gfx = Some(gfx.expect("a device and a renderer"));
     }
 

@@ -24,6 +24,7 @@ use voxel_mesh::PackedQuad;
 
 use crate::Result;
 use crate::error::scoped;
+use crate::submission::Upload;
 
 /// Quads in the first page: 4 MiB.
 pub(crate) const FIRST_PAGE_QUADS: u32 = 1 << 19;
@@ -301,10 +302,10 @@ impl QuadArena {
     }
 
     /// Writes `quads` into `a` (as many as both hold).
-    pub(crate) fn write(&self, queue: &wgpu::Queue, a: Alloc, quads: &[PackedQuad]) {
+    pub(crate) fn write(&self, to: &mut Upload<'_>, a: Alloc, quads: &[PackedQuad]) {
         if let Some(Some(p)) = self.pages.get(a.page as usize) {
             let n = quads.len().min(a.quads as usize);
-            queue.write_buffer(
+            to.write(
                 &p.buffer,
                 u64::from(a.offset) * QUAD_BYTES,
                 bytemuck::cast_slice(&quads[..n]),

@@ -119,7 +119,10 @@ pub struct GpuContext {
     probe: wgpu::Buffer,
 }
 
-/// Optional features the renderer uses when the adapter has them.
+/// Optional features the renderer uses when the adapter has them (GPU timings, one
+/// indirect draw per page, 32-bit float moments for MBOIT). A game that requests its own
+/// device asks for `adapter.features() & WANTED_FEATURES` besides its own, or builds the
+/// whole request with [`device_descriptor`]; without them the renderer falls back (logged).
 pub const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
     .union(wgpu::Features::INDIRECT_FIRST_INSTANCE)
     .union(wgpu::Features::FLOAT32_BLENDABLE);
@@ -131,8 +134,9 @@ impl GpuContext {
     /// Installs the device's lost callback (wgpu keeps one per device, so this replaces a
     /// callback set before): the renderer learns of a loss through it and answers every
     /// call after it with [`Error::DeviceLost`]. A game that wants to know too asks
-    /// `GpuContext::check_device` rather than setting a callback of its own (which would
-    /// replace this one).
+    /// [`GpuContext::check_device`] rather than setting a callback of its own (which would
+    /// replace this one). So make one context per device and clone it (clones share the
+    /// callback's state; [`GpuContext::same_device`] tells them apart from other devices').
     pub fn from_device(adapter: &wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
         let caps = Capabilities::new(adapter, device.features(), device.limits());
         let lost = Arc::new(Mutex::new(None));
@@ -160,13 +164,14 @@ impl GpuContext {
         }
     }
 
-    /// [`Error::DeviceLost`] once the device is lost, else `Ok`. Polls the device first
+    /// [`Error::DeviceLost`] once the device is lost, else `Ok`: what a game asks to learn
+    /// of a loss (every renderer call returning a `Result` asks it too). Polls the device first
     /// (without waiting), because wgpu runs the lost callback only when it maintains the
     /// device; and since it runs it only once the device's queue has drained, a device
     /// destroyed or lost with work in flight is found by a four-byte queue write, which
     /// wgpu refuses at once on such a device (a few microseconds; the write lands in a
     /// buffer of the context's own at the next submit).
-    pub(crate) fn check_device(&self) -> Result<()> {
+    pub fn check_device(&self) -> Result<()> {
         // A poll error on a lost device says no more than the callback does.
         let _ = self.device.poll(wgpu::PollType::Poll);
         let mut lost = self.lost.lock().unwrap_or_else(PoisonError::into_inner);
@@ -183,6 +188,14 @@ impl GpuContext {
             }),
             None => Ok(()),
         }
+    }
+
+    /// Whether `other` is this context or a clone of it (the same device, made into a
+    /// context once). wgpu tells devices of different instances apart by no public means,
+    /// so the renderer and `content::ContentStages` compare contexts: a game wraps its
+    /// device in one `GpuContext` and clones it.
+    pub fn same_device(&self, other: &GpuContext) -> bool {
+        Arc::ptr_eq(&self.lost, &other.lost)
     }
 
     /// Whether the device is known to be lost (no poll: what the last one found).
@@ -295,21 +308,32 @@ pub async fn request_device(adapter: &wgpu::Adapter) -> Result<(wgpu::Device, wg
     request_device_with(adapter, LimitsPreset::Adapter).await
 }
 
-/// Requests a device with the limits and features of `preset`.
+/// Requests a device with the limits and features of `preset` ([`device_descriptor`]).
 pub async fn request_device_with(
     adapter: &wgpu::Adapter,
     preset: LimitsPreset,
 ) -> Result<(wgpu::Device, wgpu::Queue)> {
-    let (limits, features) = preset.request(adapter);
     adapter
-        .request_device(&wgpu::DeviceDescriptor {
-            label: Some("voxel_render_device"),
-            required_features: features,
-            required_limits: limits,
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::Performance,
-            trace: wgpu::Trace::Off,
-        })
+        .request_device(&device_descriptor(adapter, preset))
         .await
         .map_err(Error::Device)
+}
+
+/// The device request [`request_device_with`] makes of `adapter`: `preset`'s limits and
+/// the [`WANTED_FEATURES`] it has (none with [`LimitsPreset::WebGl2`]). A game that
+/// requests its own device starts from it, adding its own features and limits, and wraps
+/// the device with [`GpuContext::from_device`].
+pub fn device_descriptor(
+    adapter: &wgpu::Adapter,
+    preset: LimitsPreset,
+) -> wgpu::DeviceDescriptor<'static> {
+    let (limits, features) = preset.request(adapter);
+    wgpu::DeviceDescriptor {
+        label: Some("voxel_render_device"),
+        required_features: features,
+        required_limits: limits,
+        experimental_features: wgpu::ExperimentalFeatures::disabled(),
+        memory_hints: wgpu::MemoryHints::Performance,
+        trace: wgpu::Trace::Off,
+    }
 }

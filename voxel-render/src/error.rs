@@ -42,7 +42,7 @@ pub enum Error {
     #[error("invalid setting: {0}")]
     InvalidSetting(String),
     /// A size beyond what this adapter can do.
-    #[error("{what} {value} exceeds this adapter's {limit_name} ({limit})")]
+    #[error("{what} {value} exceeds this device's {limit_name} ({limit})")]
     TooLarge {
         /// What was too large (e.g. "render width").
         what: String,
@@ -56,8 +56,10 @@ pub enum Error {
     /// The texture given to draw into does not match the renderer.
     #[error("output texture: {0}")]
     Output(String),
-    /// The adapter cannot do something that has no fallback.
-    #[error("unsupported by this adapter: {0}")]
+    /// The device cannot do something that has no fallback: its adapter lacks it, or the
+    /// limits it was made with (`LimitsPreset::WebGl2`) leave it out. The message names
+    /// what needs what.
+    #[error("not supported on this device: {0}")]
     Unsupported(String),
     /// A file could not be read or written.
     #[error("{}: {error}", path.display())]
@@ -109,6 +111,18 @@ pub enum Error {
     /// A mapped buffer's contents could not be accessed.
     #[error("reading GPU results back: {0}")]
     MapRange(wgpu::MapRangeError),
+    /// A texture that cannot be read back as asked: without `COPY_SRC` usage (or, for
+    /// `readback::read_depth`, `TEXTURE_BINDING`), multisampled, not a single 2D layer, a
+    /// texel size that is not its format's, or a depth texture on a device that copies
+    /// none to buffers (wgpu's GL backend: `readback::read_depth` reads those). Nothing
+    /// was recorded.
+    #[error("cannot read the texture back: {0}")]
+    Unreadable(String),
+    /// A game's buffer write the frame cannot make (`stages::GameFrame::write_buffer`):
+    /// no `COPY_DST` usage, an offset or length not a multiple of 4, past the buffer's
+    /// end, or after `GameStages::prepare`. Nothing was written.
+    #[error("buffer write: {0}")]
+    BufferWrite(String),
     /// A readback finished but its data cannot be what the GPU wrote (wrong length).
     #[error("reading GPU results back: {0}")]
     ReadbackData(String),
@@ -137,6 +151,15 @@ pub enum Error {
         /// The technique in force.
         technique: &'static str,
     },
+    /// Something given to the renderer was made on another device than the renderer's
+    /// (`Renderer::context`): a game's stages, or an output view. Nothing was recorded.
+    #[error("made on another device than the renderer's: {0}")]
+    OtherDevice(String),
+    /// A frame that cannot be recorded into the encoder given now: an exact technique,
+    /// which submits inside its frame, after a frame recorded into another encoder that is
+    /// not submitted yet. Nothing was recorded.
+    #[error("frame order: {0}")]
+    FrameOrder(String),
     /// The device is lost (destroyed, reset, driver failure): nothing made on it can be
     /// used again. Make a new `GpuContext` (a new device) and a new renderer on it.
     #[error("the GPU device is lost ({reason}); make a new device and renderer")]

@@ -8,6 +8,7 @@
 
 use crate::context::Capabilities;
 use crate::ladder::{self, Limit, Need};
+use crate::submission::Upload;
 use crate::{Error, Result};
 
 /// How quads reach the vertex shader.
@@ -328,10 +329,10 @@ impl Records {
     }
 
     /// Writes `records` ([`RECORD_BYTES`] each) from slot `first` on.
-    pub(crate) fn write(&self, queue: &wgpu::Queue, first: usize, records: &[u8]) {
+    pub(crate) fn write(&self, to: &mut Upload<'_>, first: usize, records: &[u8]) {
         let at = first as u64 * self.stride;
         if self.stride == RECORD_BYTES as u64 {
-            queue.write_buffer(&self.buffer, at, records);
+            to.write(&self.buffer, at, records);
             return;
         }
         let mut spread = vec![0; records.len() / RECORD_BYTES * self.stride as usize];
@@ -341,7 +342,7 @@ impl Records {
         {
             to[..RECORD_BYTES].copy_from_slice(from);
         }
-        queue.write_buffer(&self.buffer, at, &spread);
+        to.write(&self.buffer, at, &spread);
     }
 
     /// Its bind group resource: the whole array, or one record (the dynamic offset picks

@@ -153,7 +153,7 @@ pub fn check(what: &str, needs: &[Need], caps: &Capabilities) -> Result<()> {
     match missing(needs, caps) {
         None => Ok(()),
         Some(lacking) => Err(Error::Unsupported(format!(
-            "{what} needs {lacking}, which {} lacks",
+            "{what} needs {lacking}, which this device ({}) lacks",
             caps.adapter_name
         ))),
     }

@@ -3,7 +3,8 @@
 //! What a game needs is at the root:
 //!
 //! - [`GpuContext`]: the game's device and queue, or a headless one; [`Capabilities`] and
-//!   [`LimitsPreset`] say what it can do.
+//!   [`LimitsPreset`] say what it can do; [`WANTED_FEATURES`] and [`device_descriptor`]
+//!   for a game that requests its device itself.
 //! - [`Renderer`] with its [`RendererConfig`] and [`Lighting`]: chunks on the GPU and the
 //!   passes of a frame ([`Renderer::render`]); [`Camera`] to look with.
 //! - [`Technique`] and its settings in [`OitConfig`]: how translucent water, glass and
@@ -59,7 +60,10 @@ mod wgsl_layout;
 
 pub use camera::Camera;
 pub use chunks::DrawMode;
-pub use context::{Capabilities, GpuContext, LimitsPreset, request_device, request_device_with};
+pub use context::{
+    Capabilities, GpuContext, LimitsPreset, WANTED_FEATURES, device_descriptor, request_device,
+    request_device_with,
+};
 pub use error::{Error, Result};
 pub use fetch::QuadFetch;
 pub use oit::{

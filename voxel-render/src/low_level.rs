@@ -8,7 +8,6 @@ pub use crate::arena::QUAD_BYTES;
 pub use crate::bindings::{AO_DEPTH, OPAQUE_EXPANSION_PX, TONEMAP_SHOULDER};
 pub use crate::camera::{MAX_FAR, MAX_FOV_DEG, MIN_FOV_DEG, MIN_NEAR, WORLD_EXTENT};
 pub use crate::chunks::{ChunkStore, GpuChunk, MeshKind};
-pub use crate::context::WANTED_FEATURES;
 pub use crate::gpu::{Pass, clear, pipelines_built};
 pub use crate::ladder::{Limit, Need, check};
 pub use crate::oit::moments::single_precision;

@@ -140,12 +140,20 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
 
 /// Copies a whole single-sample 2D texture to the CPU, row padding removed. Blocks until
 /// the GPU is done. Returns `width * height * bytes_per_texel` bytes.
+///
+/// The texture needs `COPY_SRC` usage, one sample and one layer, and `bytes_per_texel`
+/// must be its format's (4 for `Rgba8Unorm` and `Depth32Float`, 8 for `Rgba16Float`);
+/// anything else is an [`Error::Unreadable`] naming what is wrong, before anything is
+/// recorded. So is a depth texture on a device without
+/// `DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES` (wgpu's GL backend): read those
+/// with [`read_depth`].
 pub fn read_texture(
     ctx: &GpuContext,
     texture: &wgpu::Texture,
     bytes_per_texel: u32,
 ) -> Result<Vec<u8>> {
     ctx.check_device()?;
+    check_copyable(ctx, texture, bytes_per_texel)?;
     let (w, h) = (texture.width(), texture.height());
     let row = w * bytes_per_texel;
     let padded =
@@ -162,32 +170,34 @@ pub fn read_texture(
             limit,
         });
     }
-    let buffer = crate::error::scoped(&ctx.device, "making a readback buffer", || {
-        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+    // What the checks above cannot see (a texture of another device) is an error too.
+    let (buffer, commands) = crate::error::scoped(&ctx.device, "reading a texture back", || {
+        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
-        })
-    })?;
-    let mut encoder = ctx
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("readback"),
         });
-    encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(h),
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("readback"),
+            });
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(h),
+                },
             },
-        },
-        texture.size(),
-    );
-    ctx.queue.submit([encoder.finish()]);
+            texture.size(),
+        );
+        (buffer, encoder.finish())
+    })?;
+    ctx.queue.submit([commands]);
     let bytes = map_read(ctx, &buffer)?;
     let mut out = Vec::with_capacity((row * h) as usize);
     for r in 0..h as usize {
@@ -196,6 +206,241 @@ pub fn read_texture(
     }
     Ok(out)
 }
+
+/// What [`read_texture`] needs of `texture`, checked before anything is recorded.
+fn check_copyable(ctx: &GpuContext, texture: &wgpu::Texture, bytes_per_texel: u32) -> Result<()> {
+    let format = texture.format();
+    let bad = |why: String| Err(Error::Unreadable(format!("a {format:?} texture: {why}")));
+    if !texture.usage().contains(wgpu::TextureUsages::COPY_SRC) {
+        return bad(format!("no COPY_SRC usage ({:?})", texture.usage()));
+    }
+    if texture.sample_count() != 1 {
+        return bad(format!(
+            "{} samples (only single-sample textures are copied)",
+            texture.sample_count()
+        ));
+    }
+    if texture.dimension() != wgpu::TextureDimension::D2 || texture.depth_or_array_layers() != 1 {
+        return bad(format!(
+            "{:?} with {} layers (only a single 2D layer is read)",
+            texture.dimension(),
+            texture.depth_or_array_layers()
+        ));
+    }
+    if format.is_depth_stencil_format()
+        && !ctx
+            .caps
+            .downlevel
+            .contains(wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES)
+    {
+        return bad(format!(
+            "{} copies no depth texture to a buffer (it lacks \
+             DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES, as wgpu's GL backend does); \
+             readback::read_depth reads it through a pass",
+            ctx.caps.adapter_name
+        ));
+    }
+    match format.block_copy_size(None) {
+        Some(size) if format.block_dimensions() == (1, 1) && size == bytes_per_texel => Ok(()),
+        Some(size) if format.block_dimensions() == (1, 1) => bad(format!(
+            "{bytes_per_texel} bytes a texel asked, the format has {size}"
+        )),
+        _ => bad("a format copied by aspect or in blocks, which is not read here".into()),
+    }
+}
+
+/// Reads a whole single-sample 2D depth texture back, one `f32` a texel, rows top to
+/// bottom. Blocks until the GPU is done. A `Depth32Float` texture with `COPY_SRC` usage
+/// is copied where the device copies depth textures; otherwise (wgpu's GL backend, which
+/// has no depth-to-buffer copy, or another depth format) a pass samples it into an
+/// `R32Uint` texture, bit for bit, and that is read: the texture then needs
+/// `TEXTURE_BINDING` usage. A texture that allows neither, is not a depth format, is
+/// multisampled or is not a single 2D layer is an [`Error::Unreadable`].
+pub fn read_depth(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32>> {
+    ctx.check_device()?;
+    let format = texture.format();
+    if !format.has_depth_aspect() {
+        return Err(Error::Unreadable(format!(
+            "a {format:?} texture is not a depth texture (read_texture reads colour)"
+        )));
+    }
+    let copies = ctx
+        .caps
+        .downlevel
+        .contains(wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES);
+    let bytes = if format == wgpu::TextureFormat::Depth32Float
+        && copies
+        && texture.usage().contains(wgpu::TextureUsages::COPY_SRC)
+    {
+        read_texture(ctx, texture, 4)?
+    } else {
+        read_depth_through_pass(ctx, texture)?
+    };
+    Ok(bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect())
+}
+
+/// The depth of each texel as the bits of an `f32`, written by a full-screen pass into an
+/// `R32Uint` texture (colour-renderable everywhere, WebGL2 included) and read back.
+///
+/// The depth is sampled with a nearest sampler at the texel's centre through a
+/// non-filterable float binding, as the renderer's passes read depth (`gpu::DEPTH_READ`
+/// says why: GLSL has no load from depth textures).
+fn read_depth_through_pass(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>> {
+    let format = texture.format();
+    if !texture
+        .usage()
+        .contains(wgpu::TextureUsages::TEXTURE_BINDING)
+        || texture.sample_count() != 1
+        || texture.dimension() != wgpu::TextureDimension::D2
+        || texture.depth_or_array_layers() != 1
+    {
+        return Err(Error::Unreadable(format!(
+            "a {format:?} texture: a depth texture is read with COPY_SRC usage where the device \
+             copies depth ({}), else through a pass, which needs TEXTURE_BINDING usage, one \
+             sample and one 2D layer (this one: {:?}, {} samples, {:?} with {} layers)",
+            ctx.caps.adapter_name,
+            texture.usage(),
+            texture.sample_count(),
+            texture.dimension(),
+            texture.depth_or_array_layers()
+        )));
+    }
+    let device = &ctx.device;
+    let bits = crate::error::scoped(device, "reading a depth texture through a pass", || {
+        let bits = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("depth_readback_bits"),
+            size: texture.size(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Uint,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("depth_readback"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
+                    count: None,
+                },
+            ],
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("depth_readback"),
+            source: wgpu::ShaderSource::Wgsl(DEPTH_READBACK_WGSL.into()),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("depth_readback"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("depth_readback"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::TextureFormat::R32Uint.into())],
+            }),
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let source = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("depth_readback_source"),
+            aspect: wgpu::TextureAspect::DepthOnly,
+            ..Default::default()
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("depth_readback"),
+            ..Default::default()
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("depth_readback"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&source),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(&sampler),
+                },
+            ],
+        });
+        let target = bits.create_view(&Default::default());
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("depth_readback"),
+        });
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("depth_readback"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        (bits, encoder.finish())
+    })?;
+    let (bits, commands) = bits;
+    ctx.queue.submit([commands]);
+    read_texture(ctx, &bits, 4)
+}
+
+/// [`read_depth_through_pass`]'s shader: a full-screen triangle writing each texel's
+/// depth, sampled at its centre, as bits.
+const DEPTH_READBACK_WGSL: &str = "
+@group(0) @binding(0) var depth: texture_2d<f32>;
+@group(0) @binding(1) var nearest: sampler;
+
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+@fragment
+fn fs_main(@builtin(position) p: vec4<f32>) -> @location(0) u32 {
+    let uv = (floor(p.xy) + 0.5) / vec2<f32>(textureDimensions(depth));
+    return bitcast<u32>(textureSampleLevel(depth, nearest, uv, 0.0).x);
+}
+";
 
 /// Copies a whole single-sample 2D texture of 8-bit RGBA or BGRA (sRGB or not) to the CPU
 /// as an [`Image`] (BGRA swizzled to RGBA, bytes as stored). Blocks until the GPU is done.

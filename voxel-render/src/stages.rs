@@ -4,14 +4,15 @@
 //! with the chunks, an HDR overlay before tonemapping and an overlay after it.
 //!
 //! A game implements [`GameStages`] and passes it to `Renderer::render`. The renderer
-//! calls [`GameStages::prepare`] once the frame's camera is known (write uniforms there),
-//! then records each stage the game declared ([`GameStages::stages`]) into a pass it opens.
+//! calls [`GameStages::prepare`] once the frame's camera is known (write uniforms there,
+//! with [`GameFrame::write_buffer`]), then records each stage the game declared
+//! ([`GameStages::stages`]) into a pass it opens.
 //!
 //! **Translucent geometry, the same for every technique.** The game's fragment shader ends
 //! with `return oit_output(in.position, color);` after a prelude the renderer gives
-//! ([`TranslucentVariant::wgsl`], like Bevy's `oit_draw`): it turns a colour and opacity into
-//! whatever the technique's pass writes (weighted sums, a stipple test, a peel layer, an
-//! A-buffer node, a blended colour). A technique draws in several passes, each a
+//! ([`TranslucentVariant::wgsl`], like Bevy's `oit_draw`): it turns a linear colour and
+//! opacity into whatever the technique's pass writes (weighted sums, a stipple test, a
+//! peel layer, an A-buffer node, a blended colour). A technique draws in several passes, each a
 //! [`TranslucentVariant`] with its own prelude, colour targets, depth state and bind group
 //! layout at [`OIT_GROUP`]; the game builds one pipeline per variant of the
 //! [`TranslucentContract`] in force and rebuilds them when its `id` changes (a technique
@@ -21,10 +22,12 @@
 //! the game sets its pipeline and its own groups (0 to `OIT_GROUP - 1`).
 
 use std::ops::Range;
+use std::sync::{Mutex, PoisonError};
 
 use glam::{DVec3, Mat4, Vec3};
 
-use crate::{Camera, GpuContext};
+use crate::submission::FrameWrites;
+use crate::{Camera, Error, GpuContext, Result};
 
 pub use crate::gpu::{
     Depth, Target, bind_group, load, overlay_depth, overlay_pipeline, shader, target,
@@ -37,18 +40,21 @@ pub const OIT_GROUP: u32 = 3;
 /// Which stages a game draws in this frame; a stage it leaves out costs nothing (no pass).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Stages {
-    /// Opaque geometry into the scene colour and depth, after the world's opaque and
-    /// cutout passes (before translucency, so water and glass are seen over it).
+    /// Opaque geometry into the scene colour (linear HDR) and depth, after the world's
+    /// opaque and cutout passes (before translucency, so water and glass are seen over it).
     pub opaque: bool,
     /// Translucent geometry, composed with the chunks by the active technique.
     pub translucent: bool,
-    /// An overlay into the HDR scene colour with the scene depth (read-only) after
+    /// An overlay into the HDR scene colour (linear) with the scene depth (read-only) after
     /// translucency and fog, before tonemapping: a selection box.
     pub hdr_overlay: bool,
     /// An overlay into the output after tonemapping: a HUD. Its one colour target is the
     /// view the frame renders into, in that view's format ([`GameFrame::output_format`],
     /// one of `OUTPUT_FORMATS`; it changes only when the game renders into another view),
     /// single-sampled and without depth: the game builds its overlay pipelines for it.
+    /// Colours written there are stored as the view's format stores them: an sRGB view
+    /// takes linear colour (the GPU encodes it); a linear 8- or 10-bit view takes
+    /// sRGB-encoded colour, as the tonemap writes there, to show the same.
     pub overlay: bool,
 }
 
@@ -151,7 +157,7 @@ pub struct GameFrame<'a> {
     pub output_format: wgpu::TextureFormat,
     /// The lighting in force, to light the game's things as the world is lit: the unit
     /// direction towards the sun (or moon), the ambient share, and the brightness every
-    /// lit colour is scaled by (`Lighting`): a face of normal `n` and colour `c` is
+    /// lit colour is scaled by (`Lighting`): a face of normal `n` and linear colour `c` is
     /// `c * brightness * (ambient + (1 - ambient) * max(dot(n, sun_dir), 0))`.
     pub sun_dir: Vec3,
     /// The ambient share, 0 to 1 (see `sun_dir`).
@@ -162,9 +168,87 @@ pub struct GameFrame<'a> {
     /// [`GameStages::translucent_objects`]); `None` when the technique does not sort. A
     /// game drawing instances uploads them in this order in `prepare`.
     pub order: Option<&'a [u32]>,
+    /// The writes [`GameFrame::write_buffer`] gathers in `prepare`.
+    pub(crate) writes: &'a GameWrites,
+}
+
+/// The writes a game makes in [`GameStages::prepare`] ([`GameFrame::write_buffer`]):
+/// open until the renderer takes them, after `prepare`, to record into the frame's
+/// encoder.
+#[derive(Debug)]
+pub(crate) struct GameWrites(Mutex<Option<FrameWrites>>);
+
+impl GameWrites {
+    /// Open for a frame's `prepare`.
+    pub(crate) fn open() -> Self {
+        Self(Mutex::new(Some(FrameWrites::default())))
+    }
+
+    /// What was written; later writes are refused.
+    pub(crate) fn take(&self) -> FrameWrites {
+        self.0
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .take()
+            .unwrap_or_default()
+    }
 }
 
 impl GameFrame<'_> {
+    /// Writes `data` into `buffer` at `offset` where this frame's commands are: a copy
+    /// recorded into the frame's encoder before its first pass. `Queue::write_buffer`
+    /// lands at the next submit instead, before every command of it, so a game that
+    /// records two frames before one submit and writes its uniforms with it draws both
+    /// with the second's; written here, each frame draws with its own. Call it in
+    /// [`GameStages::prepare`].
+    ///
+    /// As for `Queue::write_buffer`, `buffer` needs `COPY_DST` usage and `offset` and the
+    /// length are multiples of 4 ([`wgpu::COPY_BUFFER_ALIGNMENT`]) within the buffer;
+    /// otherwise, or after `prepare` has returned, it is an `Error::BufferWrite` and
+    /// nothing is written. An empty `data` writes nothing.
+    pub fn write_buffer(&self, buffer: &wgpu::Buffer, offset: u64, data: &[u8]) -> Result<()> {
+        let align = wgpu::COPY_BUFFER_ALIGNMENT;
+        let len = data.len() as u64;
+        let bad = |why: String| Err(Error::BufferWrite(why));
+        if !buffer.usage().contains(wgpu::BufferUsages::COPY_DST) {
+            return bad(format!(
+                "the buffer has no COPY_DST usage ({:?})",
+                buffer.usage()
+            ));
+        }
+        if !offset.is_multiple_of(align) || !len.is_multiple_of(align) {
+            return bad(format!(
+                "offset {offset} and length {len}: both must be multiples of {align}"
+            ));
+        }
+        if offset
+            .checked_add(len)
+            .is_none_or(|end| end > buffer.size())
+        {
+            return bad(format!(
+                "{len} bytes at offset {offset} end past the buffer's {} bytes",
+                buffer.size()
+            ));
+        }
+        match self
+            .writes
+            .0
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .as_mut()
+        {
+            Some(writes) => {
+                writes.write(buffer, offset, data);
+                Ok(())
+            }
+            None => bad(
+                "after GameStages::prepare: the frame's writes are recorded by then (write in \
+                 prepare)"
+                    .into(),
+            ),
+        }
+    }
+
     /// The camera-relative position of a world point (what `view_proj` takes).
     pub fn relative(&self, p: DVec3) -> Vec3 {
         let i = self.eye_int.map(|v| v as f64);
@@ -218,8 +302,11 @@ pub struct TranslucentVariant {
 pub struct TranslucentContract {
     /// Changes whenever the variants do: a game rebuilds its pipelines then. The same
     /// technique with the same settings keeps its id on a renderer (switching away and
-    /// back, pipelines built for it are still right). The game tells the renderer which
-    /// id its pipelines were built for ([`GameStages::translucent_contract_id`]).
+    /// back, pipelines built for it are still right). Ids are unique in the process: no
+    /// two renderers give out the same one, so pipelines built for another renderer (whose
+    /// group layouts are its own) are refused, never drawn with. The game tells the
+    /// renderer which id its pipelines were built for
+    /// ([`GameStages::translucent_contract_id`]).
     pub id: u64,
     /// The name of the technique in force (`Technique::name`).
     pub technique: &'static str,
@@ -232,6 +319,14 @@ pub struct TranslucentContract {
 pub trait GameStages {
     /// Which stages the game draws this frame.
     fn stages(&self) -> Stages;
+
+    /// The context the game's resources were made on, when it keeps one (default: `None`,
+    /// not checked). A frame whose game names a context of another device than the
+    /// renderer's ([`GpuContext::same_device`]) is refused with `Error::OtherDevice` before
+    /// anything is recorded: its pipelines and buffers cannot be used there.
+    fn context(&self) -> Option<&GpuContext> {
+        None
+    }
 
     /// The translucent things it draws, for the sorted techniques' order (default: none,
     /// drawn after the chunks, in one call).
@@ -255,10 +350,12 @@ pub trait GameStages {
     fn follow_contract(&mut self, _ctx: &GpuContext, _contract: &TranslucentContract) {}
 
     /// Before any pass is recorded: write uniforms and instance buffers (`frame.order`
-    /// gives the sorted order when the technique sorts).
+    /// gives the sorted order when the technique sorts) with
+    /// [`GameFrame::write_buffer`], which lands in this frame's encoder (a frame recorded
+    /// before this one and not yet submitted keeps what it wrote).
     fn prepare(&mut self, _ctx: &GpuContext, _frame: &GameFrame<'_>) {}
 
-    /// Opaque geometry, into the scene colour ([`crate::SCENE_FORMAT`]) and depth
+    /// Opaque geometry, into the scene colour ([`crate::SCENE_FORMAT`], linear HDR) and depth
     /// ([`crate::DEPTH_FORMAT`], reverse-Z, test `Greater` and write) with
     /// `frame.opaque_samples` samples.
     fn opaque(&self, _pass: &mut wgpu::RenderPass<'_>, _frame: &GameFrame<'_>) {}
@@ -276,7 +373,7 @@ pub trait GameStages {
     ) {
     }
 
-    /// An overlay into the HDR scene colour with the scene depth, read-only.
+    /// An overlay into the HDR scene colour (linear) with the scene depth, read-only.
     fn hdr_overlay(&self, _pass: &mut wgpu::RenderPass<'_>, _frame: &GameFrame<'_>) {}
 
     /// An overlay into the output (format `frame.output_format`), no depth.

@@ -3,12 +3,15 @@
 //! starts when the encoder is submitted (`map_buffer_on_submit`), and whose callback is
 //! dropped, unrun, when the encoder is dropped unsubmitted. The next frame looks.
 //!
-//! The renderer uses it for two things: GPU timings end a profiler frame only once its
-//! encoder is submitted (the timing module), and a frame whose encoder was dropped has
-//! its queue writes (uniforms, draw commands) flushed by an empty submit. wgpu keeps
-//! queue writes, and their staging memory, until the next submit: a game that drops
-//! every encoder would otherwise grow by each frame's writes (about 20 KiB at view
-//! distance 2).
+//! The renderer uses it for three things: GPU timings end a profiler frame only once its
+//! encoder is submitted (the timing module); a frame whose encoder was dropped has the
+//! queue writes made meanwhile (chunk uploads) flushed by an empty submit, since wgpu
+//! keeps queue writes, and their staging memory, until the next submit; and an exact
+//! technique refuses to follow a frame in another encoder not yet submitted.
+//!
+//! A frame's own writes (uniforms, draw commands, quad order) are no queue writes:
+//! [`FrameWrites`] records them as copies into the frame's encoder, from a staging buffer
+//! the encoder keeps alive and frees with it, submitted or dropped.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -111,5 +114,96 @@ impl Submissions {
             signal.0.store(state, Ordering::Release);
         });
         self.waiting = Some(sentinel);
+    }
+}
+
+/// Buffer writes of one frame that land where its commands are: copies recorded into its
+/// encoder (from one staging buffer made for them) by [`FrameWrites::record`], before its
+/// first pass. `Queue::write_buffer` lands at the next submit instead, before every command
+/// of it: two frames recorded before one submit would both read the second's uniforms,
+/// draw commands and quad order. Bytes are gathered on the CPU until recorded.
+#[derive(Debug, Default)]
+pub(crate) struct FrameWrites {
+    /// Every write's bytes, each padded to [`wgpu::COPY_BUFFER_ALIGNMENT`].
+    bytes: Vec<u8>,
+    /// Target buffer, offset in it, offset in `bytes`, length.
+    copies: Vec<(wgpu::Buffer, u64, u64, u64)>,
+}
+
+impl FrameWrites {
+    /// Writes `data` into `target` at `offset` (both as `Queue::write_buffer` needs them:
+    /// multiples of 4, in bounds, `COPY_DST` usage) when recorded.
+    pub(crate) fn write(&mut self, target: &wgpu::Buffer, offset: u64, data: &[u8]) {
+        if data.is_empty() {
+            return;
+        }
+        let at = self.bytes.len() as u64;
+        self.bytes.extend_from_slice(data);
+        let align = wgpu::COPY_BUFFER_ALIGNMENT as usize;
+        self.bytes
+            .resize(self.bytes.len().next_multiple_of(align), 0);
+        self.copies
+            .push((target.clone(), offset, at, data.len() as u64));
+    }
+
+    /// Moves `other`'s writes after this one's.
+    pub(crate) fn append(&mut self, other: &mut FrameWrites) {
+        let base = self.bytes.len() as u64;
+        self.bytes.append(&mut other.bytes);
+        self.copies.extend(
+            other
+                .copies
+                .drain(..)
+                .map(|(target, offset, at, len)| (target, offset, at + base, len)),
+        );
+    }
+
+    /// Records the copies into `encoder`, in the order written, and forgets them.
+    pub(crate) fn record(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+    ) -> crate::Result<()> {
+        if self.copies.is_empty() {
+            return Ok(());
+        }
+        // Mapped at creation and written once: no map request, nothing to wait for. wgpu
+        // keeps it until the copies have run (or their encoder is dropped).
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame_writes"),
+            size: self.bytes.len() as u64,
+            usage: wgpu::BufferUsages::MAP_WRITE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: true,
+        });
+        staging
+            .slice(..)
+            .get_mapped_range_mut()?
+            .copy_from_slice(&self.bytes);
+        staging.unmap();
+        for (target, offset, at, len) in self.copies.drain(..) {
+            encoder.copy_buffer_to_buffer(&staging, at, &target, offset, len);
+        }
+        self.bytes.clear();
+        Ok(())
+    }
+}
+
+/// Where a buffer write lands: at the next submit (data uploaded between frames), or in
+/// the frame being recorded ([`FrameWrites`]).
+#[derive(Debug)]
+pub(crate) enum Upload<'a> {
+    /// `Queue::write_buffer`.
+    Queue(&'a wgpu::Queue),
+    /// A copy in the frame's encoder.
+    Frame(&'a mut FrameWrites),
+}
+
+impl Upload<'_> {
+    /// Writes `data` into `target` at `offset`.
+    pub(crate) fn write(&mut self, target: &wgpu::Buffer, offset: u64, data: &[u8]) {
+        match self {
+            Upload::Queue(queue) => queue.write_buffer(target, offset, data),
+            Upload::Frame(writes) => writes.write(target, offset, data),
+        }
     }
 }

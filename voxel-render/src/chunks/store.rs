@@ -15,6 +15,7 @@ use crate::bindings::ChunkUniforms;
 use crate::fetch::{QuadFetch, Records};
 use crate::gpu;
 use crate::layers;
+use crate::submission::{FrameWrites, Upload};
 use crate::{Error, GpuContext, Result};
 
 /// All chunks on the GPU.
@@ -48,6 +49,9 @@ pub struct ChunkStore {
     block_opacity: Arc<[f32]>,
     /// Whether each block id is a volume (has absorption).
     volume_blocks: Arc<[bool]>,
+    /// What the frame being recorded writes (its draw commands, a sorted chunk's quad
+    /// order, fading records), recorded into its encoder by the renderer.
+    writes: FrameWrites,
 }
 
 const FIRST_SLOTS: usize = 1024;
@@ -86,6 +90,7 @@ impl ChunkStore {
             retired_slots: Vec::new(),
             block_opacity,
             volume_blocks,
+            writes: FrameWrites::default(),
         }
     }
 
@@ -199,8 +204,9 @@ impl ChunkStore {
         self.arena.free(a) && self.arena.drop_page(a.page)
     }
 
-    /// Writes slot `slot`'s record (growing the record buffer when needed).
-    fn write_info(&mut self, ctx: &GpuContext, slot: u32, info: ChunkUniforms) {
+    /// Writes slot `slot`'s record (growing the record buffer when needed): at the next
+    /// submit, or `in_frame` in the frame being recorded ([`ChunkStore::writes`]).
+    fn write_info(&mut self, ctx: &GpuContext, slot: u32, info: ChunkUniforms, in_frame: bool) {
         let i = slot as usize;
         if i >= self.info_data.len() {
             self.info_data.resize(i + 1, ChunkUniforms::default());
@@ -209,11 +215,19 @@ impl ChunkStore {
         if i >= self.infos.capacity() {
             let slots = (self.infos.capacity() * 2).max(i + 1);
             self.infos = Records::new(&ctx.device, self.fetch, &ctx.caps.limits, slots);
-            self.infos
-                .write(&ctx.queue, 0, bytemuck::cast_slice(&self.info_data));
+            // A new buffer: no frame recorded before reads it.
+            self.infos.write(
+                &mut Upload::Queue(&ctx.queue),
+                0,
+                bytemuck::cast_slice(&self.info_data),
+            );
             self.remake_groups(&ctx.device);
+        } else if in_frame {
+            let mut to = Upload::Frame(&mut self.writes);
+            self.infos.write(&mut to, i, bytemuck::bytes_of(&info));
         } else {
-            self.infos.write(&ctx.queue, i, bytemuck::bytes_of(&info));
+            let mut to = Upload::Queue(&ctx.queue);
+            self.infos.write(&mut to, i, bytemuck::bytes_of(&info));
         }
     }
 
@@ -229,7 +243,7 @@ impl ChunkStore {
         if grew {
             self.remake_groups(&ctx.device);
         }
-        self.arena.write(&ctx.queue, a, quads);
+        self.arena.write(&mut Upload::Queue(&ctx.queue), a, quads);
         Ok(Some(a))
     }
 
@@ -314,7 +328,7 @@ impl ChunkStore {
             }
         };
         let origin = pos.origin().map(|v| v as i32);
-        self.write_info(ctx, slot, ChunkUniforms { origin, alpha });
+        self.write_info(ctx, slot, ChunkUniforms { origin, alpha }, false);
         // One pass over the translucent quads; their box and distinct planes follow.
         let planes = layers::planes(&meshes.translucent, &self.block_opacity);
         self.regions.set(slot, pos, allocs, Some(&planes));
@@ -406,10 +420,12 @@ impl ChunkStore {
     }
 
     /// Rewrites a chunk's translucent quads in a new order (the same quads: a permutation
-    /// of [`GpuChunk::translucent_quads`]), for sorting. The generation stays.
+    /// of [`GpuChunk::translucent_quads`]), for sorting, in the frame being recorded
+    /// ([`ChunkStore::writes`]): a frame recorded before it keeps its own order. The
+    /// generation stays. The write goes into the frame's writes: `_ctx` is not needed.
     pub(crate) fn reorder_translucent(
         &mut self,
-        ctx: &GpuContext,
+        _ctx: &GpuContext,
         pos: ChunkPos,
         quads: Vec<PackedQuad>,
     ) {
@@ -422,20 +438,34 @@ impl ChunkStore {
         if let Some(a) = c.meshes[MeshKind::Translucent as usize]
             && quads.len() == a.quads as usize
         {
-            self.arena.write(&ctx.queue, a, &quads);
+            self.arena
+                .write(&mut Upload::Frame(&mut self.writes), a, &quads);
             c.translucent = quads;
         }
     }
 
-    /// Sets a chunk's whole-chunk opacity (fade-in).
-    pub(crate) fn set_alpha(&mut self, ctx: &GpuContext, pos: ChunkPos, alpha: f32) {
+    /// Sets a chunk's whole-chunk opacity (fade-in): at the next submit, or `in_frame` in
+    /// the frame being recorded.
+    pub(crate) fn set_alpha(
+        &mut self,
+        ctx: &GpuContext,
+        pos: ChunkPos,
+        alpha: f32,
+        in_frame: bool,
+    ) {
         if let Some(&slot) = self.by_pos.get(&pos) {
             let info = ChunkUniforms {
                 origin: pos.origin().map(|v| v as i32),
                 alpha: alpha.clamp(0.0, 1.0),
             };
-            self.write_info(ctx, slot, info);
+            self.write_info(ctx, slot, info, in_frame);
         }
+    }
+
+    /// The writes of the frame being recorded (its draw commands, sorted quads, fading
+    /// records): the renderer records them into the frame's encoder before its first pass.
+    pub(crate) fn writes(&mut self) -> &mut FrameWrites {
+        &mut self.writes
     }
 
     /// Finds the visible meshes of every kind in one pass over the regions (see the module
@@ -486,16 +516,15 @@ impl ChunkStore {
         out.keys.extend(out.far.iter().map(|e| e.key));
     }
 
-    /// Uploads a frame's draw commands to the indirect buffer (growing it when needed).
+    /// Uploads a frame's draw commands to the indirect buffer (growing it when needed), in
+    /// the frame being recorded ([`ChunkStore::writes`]).
     pub(crate) fn upload_draws(&mut self, ctx: &GpuContext, commands: &[DrawCommand]) {
         let bytes = std::mem::size_of_val(commands) as u64;
         if bytes > self.indirect.size() {
             self.indirect = Self::indirect_buffer(&ctx.device, commands.len() * 2);
         }
-        if !commands.is_empty() {
-            ctx.queue
-                .write_buffer(&self.indirect, 0, bytemuck::cast_slice(commands));
-        }
+        self.writes
+            .write(&self.indirect, 0, bytemuck::cast_slice(commands));
     }
 
     /// Moves the meshes off the arena's emptiest page when more than half of the arena is

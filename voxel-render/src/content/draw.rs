@@ -47,6 +47,8 @@ struct View {
 /// [`ContentStages::prebuild`].
 #[derive(Debug)]
 pub struct ContentStages {
+    /// The renderer's context its resources are made on.
+    ctx: GpuContext,
     content: Content,
     module_src: String,
     view: wgpu::Buffer,
@@ -158,6 +160,7 @@ impl ContentStages {
         let translucent_count = content.particles.len() + content.entities.len() - opaque_count;
         let objects = Self::objects(&content);
         Self {
+            ctx: ctx.clone(),
             module_src: CONTENT_WGSL.to_owned(),
             opaque: buffer("content_opaque", opaque_count),
             translucent: buffer("content_translucent", translucent_count),
@@ -220,6 +223,7 @@ impl ContentStages {
     /// next frame would otherwise build (cheap when nothing changed): at loading time, or
     /// after a switch when it does not follow the contract ([`Self::set_follow_contract`]).
     pub fn update_pipelines(&mut self, renderer: &mut Renderer) -> Result<()> {
+        self.check_renderer(renderer)?;
         let contract = renderer.translucent_contract()?;
         self.build_for(renderer, &contract);
         self.contract = Some(contract.id);
@@ -299,9 +303,21 @@ impl ContentStages {
     /// compiles nothing (its opaque pipeline is built too). Pipelines are kept by contract
     /// id.
     pub fn prebuild(&mut self, renderer: &mut Renderer, technique: Technique) -> Result<()> {
+        self.check_renderer(renderer)?;
         let contract = renderer.translucent_contract_for(technique)?;
         self.build_for(renderer, &contract);
         Ok(())
+    }
+
+    /// A renderer of another device is an error: the resources are this one's.
+    fn check_renderer(&self, renderer: &Renderer) -> Result<()> {
+        if renderer.context().same_device(&self.ctx) {
+            Ok(())
+        } else {
+            Err(crate::Error::OtherDevice(
+                "content stages made for a renderer of another device".into(),
+            ))
+        }
     }
 
     fn translucent_for(
@@ -437,6 +453,10 @@ impl GameStages for ContentStages {
         &self.objects
     }
 
+    fn context(&self) -> Option<&GpuContext> {
+        Some(&self.ctx)
+    }
+
     fn translucent_contract_id(&self) -> Option<u64> {
         self.contract
     }
@@ -464,8 +484,8 @@ impl GameStages for ContentStages {
             brightness: frame.brightness,
             _pad: [0.0; 3],
         };
-        ctx.queue
-            .write_buffer(&self.view, 0, bytemuck::bytes_of(&view));
+        // In the frame's encoder: a frame recorded before this one keeps its own view.
+        let mut written = frame.write_buffer(&self.view, 0, bytemuck::bytes_of(&view));
         let opaque: Vec<Prim> = self
             .content
             .entities
@@ -507,10 +527,12 @@ impl GameStages for ContentStages {
             (&mut self.translucent, translucent),
         ] {
             buffer.count = prims.len() as u32;
-            if !prims.is_empty() {
-                ctx.queue
-                    .write_buffer(&buffer.buffer, 0, bytemuck::cast_slice(&prims));
-            }
+            written =
+                written.and(frame.write_buffer(&buffer.buffer, 0, bytemuck::cast_slice(&prims)));
+        }
+        // The buffers are made for these writes (`set_content` grows them).
+        if let Err(e) = written {
+            log::error!("content: {e}");
         }
     }
 

@@ -417,6 +417,19 @@ pub(crate) struct FrameView<'a> {
     /// The game's translucent objects when it draws translucent geometry this frame
     /// (`None` when it does not; an empty slice when it draws without declaring them).
     pub game_objects: Option<&'a [TranslucentObject]>,
+    /// Where a technique writes its uniforms for the frame: copies in the frame's encoder,
+    /// so that a frame recorded before it (and not yet submitted) keeps its own.
+    pub writes: &'a std::sync::Mutex<crate::submission::FrameWrites>,
+}
+
+impl FrameView<'_> {
+    /// Writes `data` into `target` at `offset` in the frame being recorded.
+    pub fn write(&self, target: &wgpu::Buffer, offset: u64, data: &[u8]) {
+        self.writes
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .write(target, offset, data);
+    }
 }
 
 /// What a technique draws with and into, for one frame.
@@ -519,11 +532,17 @@ pub struct OitManager {
     prepare_ms: f64,
     /// The game's contract for the active technique, made when first asked for.
     contract: Option<Arc<TranslucentContract>>,
-    /// The key of every contract made so far: a contract's id is its key's place here
-    /// plus one, so the same technique with the same settings always has the same id and
-    /// a game's pipelines built for it stay valid across switches away and back.
-    contract_keys: Vec<Key>,
+    /// The key and id of every contract made so far, so the same technique with the same
+    /// settings always has the same id on this renderer and a game's pipelines built for
+    /// it stay valid across switches away and back. Ids come from [`NEXT_CONTRACT_ID`], so
+    /// no two renderers share one: pipelines built for another renderer's contract (whose
+    /// group layouts are that renderer's) are refused, never taken for this one's.
+    contract_keys: Vec<(Key, u64)>,
 }
+
+/// The next [`TranslucentContract::id`] given out, by any renderer of the process (ids
+/// start at 1).
+static NEXT_CONTRACT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
 
 impl OitManager {
     /// A manager for `config`. No GPU resource is created until a frame needs one. A
@@ -552,9 +571,16 @@ impl OitManager {
     /// `technique`, or what replaces it on this adapter (logged), with `config`'s
     /// settings; [`Error::Unsupported`] when neither can run.
     fn resolve_with(setup: &Setup, config: &OitConfig, technique: Technique) -> Result<Technique> {
-        let t = technique.resolve(config, &setup.ctx.caps)?;
+        let caps = &setup.ctx.caps;
+        let t = technique.resolve(config, caps)?;
         if t != technique {
-            log::warn!("this adapter cannot run {technique}: using {t} instead");
+            let lacking = ladder::missing(&technique.needs(config, caps), caps)
+                .unwrap_or_else(|| "what it needs".into());
+            log::warn!(
+                "technique {technique} needs {lacking}, which this device ({}) lacks: drawing \
+                 with {t} instead",
+                caps.adapter_name
+            );
         }
         Ok(t)
     }
@@ -652,17 +678,15 @@ impl OitManager {
         Ok(c)
     }
 
-    /// The id of the contract of the technique of `key`: its key's place among the keys
-    /// seen so far, plus one.
+    /// The id of the contract of the technique of `key`: the one it got when first seen
+    /// on this renderer, else a new one, unique in the process.
     fn contract_id(&mut self, key: Key) -> u64 {
-        let place = match self.contract_keys.iter().position(|k| *k == key) {
-            Some(i) => i,
-            None => {
-                self.contract_keys.push(key);
-                self.contract_keys.len() - 1
-            }
-        };
-        place as u64 + 1
+        if let Some((_, id)) = self.contract_keys.iter().find(|(k, _)| *k == key) {
+            return *id;
+        }
+        let id = NEXT_CONTRACT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        self.contract_keys.push((key, id));
+        id
     }
 
     /// What a game's translucent pipelines must match for `technique` (or what replaces

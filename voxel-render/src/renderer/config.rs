@@ -40,12 +40,13 @@ pub struct RendererConfig {
     /// Ambient share of the lighting, 0 to 1 (outside, NaN or infinite: an error at
     /// [`Renderer::new`]). Default 0.45: faces away from the sun stay readable.
     pub ambient: f32,
-    /// How bright the sun's (or the moon's) and the ambient light are, finite and at
-    /// least 0 (else an error at [`Renderer::new`]): every lit colour is scaled by it, the
-    /// sky is not. Default 1, daylight; [`Lighting::daytime`] lowers it at night.
+    /// How bright the sun's (or the moon's) and the ambient light are, from 0 to
+    /// [`Lighting::MAX_BRIGHTNESS`] (else an error at [`Renderer::new`]): every lit colour
+    /// is scaled by it, the sky is not. Default 1, daylight; [`Lighting::daytime`] lowers
+    /// it at night.
     pub brightness: f32,
-    /// Sky colour (linear), each channel finite and at least 0 (else an error at
-    /// [`Renderer::new`]). Default a light blue.
+    /// Sky colour (linear), each channel from 0 to [`Lighting::MAX_BRIGHTNESS`] (else an
+    /// error at [`Renderer::new`]). Default a light blue.
     pub sky: [f32; 3],
     /// How chunk meshes are drawn. Default: indirect (`multi_draw_indirect` per page and
     /// pass), which costs the CPU next to nothing per chunk; adapters without indirect
@@ -126,9 +127,11 @@ pub struct Lighting {
     pub sun_dir: [f32; 3],
     /// Ambient share of the lighting, 0 to 1.
     pub ambient: f32,
-    /// How bright the light is (1 by day, [`Lighting::MOONLIGHT`] at night), at least 0.
+    /// How bright the light is (1 by day, [`Lighting::MOONLIGHT`] at night), from 0 to
+    /// [`Lighting::MAX_BRIGHTNESS`].
     pub brightness: f32,
-    /// Sky colour (linear), what the background is cleared to.
+    /// Sky colour (linear), what the background is cleared to, each channel from 0 to
+    /// [`Lighting::MAX_BRIGHTNESS`].
     pub sky: [f32; 3],
 }
 
@@ -139,6 +142,15 @@ impl Lighting {
     pub const SUNSET: f32 = 18.0;
     /// The brightness of moonlight (night in [`Lighting::daytime`]), a share of daylight.
     pub const MOONLIGHT: f32 = 0.12;
+    /// The largest brightness, and sky channel, a renderer takes: a larger one (up to
+    /// `f32::MAX`) is an `Error::InvalidSetting`. The scene colour is half floats
+    /// ([`crate::SCENE_FORMAT`], largest finite value 65 504), where a GPU makes a larger
+    /// value infinite (lavapipe saturates it) and the tonemap shows infinity as magenta;
+    /// with lit colours at most 64, the techniques' sums of them stay finite too (WBOIT
+    /// sums 22 layers of its largest weight before 65 504, with its default headroom).
+    /// Nothing is lost: the tonemap rolls every channel above 0.8 towards 1, so a face lit
+    /// 64 times daylight is already white.
+    pub const MAX_BRIGHTNESS: f32 = 64.0;
 
     /// The lighting of [`RendererConfig::default`].
     pub fn default_day() -> Self {
@@ -241,7 +253,7 @@ impl Lighting {
     }
 
     /// Checks the values: a finite non-zero sun direction, an ambient share from 0 to 1, a
-    /// finite brightness of at least 0, a finite sky colour of non-negative channels.
+    /// brightness and sky channels from 0 to [`Lighting::MAX_BRIGHTNESS`].
     pub fn validate(&self) -> Result<()> {
         let bad = |what: String| Err(Error::InvalidSetting(what));
         if let Err(why) = voxel_core::unit_direction(self.sun_dir.map(f64::from)) {
@@ -250,19 +262,7 @@ impl Lighting {
         if !(0.0..=1.0).contains(&self.ambient) {
             return bad(format!("ambient {}: it must be from 0 to 1", self.ambient));
         }
-        if !(self.brightness.is_finite() && self.brightness >= 0.0) {
-            return bad(format!(
-                "brightness {}: it must be finite and not negative",
-                self.brightness
-            ));
-        }
-        if !self.sky.iter().all(|c| c.is_finite() && *c >= 0.0) {
-            return bad(format!(
-                "sky colour {:?}: every channel must be finite and not negative",
-                self.sky
-            ));
-        }
-        Ok(())
+        check_light(self.brightness, self.sky)
     }
 }
 
@@ -311,17 +311,23 @@ pub(super) fn check_lighting(config: &RendererConfig) -> Result<()> {
             config.ambient
         ));
     }
-    if !(config.brightness.is_finite() && config.brightness >= 0.0) {
-        return bad(format!(
-            "brightness {}: it must be finite and at least 0",
-            config.brightness
-        ));
+    check_light(config.brightness, config.sky)
+}
+
+/// A brightness and sky channels from 0 to [`Lighting::MAX_BRIGHTNESS`] (NaN is neither).
+fn check_light(brightness: f32, sky: [f32; 3]) -> Result<()> {
+    let range = 0.0..=Lighting::MAX_BRIGHTNESS;
+    if !range.contains(&brightness) {
+        return Err(Error::InvalidSetting(format!(
+            "brightness {brightness}: it must be from 0 to {} (Lighting::MAX_BRIGHTNESS)",
+            Lighting::MAX_BRIGHTNESS
+        )));
     }
-    if !config.sky.iter().all(|v| v.is_finite() && *v >= 0.0) {
-        return bad(format!(
-            "sky {:?}: every channel must be finite and at least 0",
-            config.sky
-        ));
+    if !sky.iter().all(|c| range.contains(c)) {
+        return Err(Error::InvalidSetting(format!(
+            "sky colour {sky:?}: every channel must be from 0 to {} (Lighting::MAX_BRIGHTNESS)",
+            Lighting::MAX_BRIGHTNESS
+        )));
     }
     Ok(())
 }

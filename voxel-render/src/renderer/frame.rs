@@ -1,7 +1,7 @@
 //! Recording a frame: the camera and output checks, the frame uniforms, and the passes
 //! in order (opaque, the game's stages, the technique, tonemap).
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Instant;
 
 use glam::Mat4;
@@ -19,7 +19,8 @@ use crate::gpu::{self, Depth, Pass};
 use crate::medium::{self, MediumLook};
 use crate::oit::sorted::interleave::ChunkSequence;
 use crate::oit::{FrameView, Technique, TechniqueReport, TranslucentFrame};
-use crate::stages::{Clip, GameDraw, GameFrame, GameStages, Split, TranslucentContract};
+use crate::stages::{Clip, GameDraw, GameFrame, GameStages, GameWrites, Split, TranslucentContract};
+use crate::submission::Outcome;
 use crate::timing::{GpuPass, Timer};
 use crate::{Camera, Error, Result};
 
@@ -61,15 +62,24 @@ impl Renderer {
     /// planes), a mismatched output ([`Error::Output`]) or a lost device
     /// ([`Error::DeviceLost`]).
     ///
-    /// Submit each frame before recording the next: what changes between `render` and
-    /// the submit (chunks uploaded or removed) never changes what this frame draws, and
-    /// the arena places it draws are reused only after [`Renderer::after_submit`] or the
-    /// next `render`.
+    /// What changes between `render` and the submit (chunks uploaded or removed) never
+    /// changes what this frame draws: the arena places it draws are reused only after
+    /// [`Renderer::after_submit`] or the next `render`. Several frames may be recorded
+    /// before one submit (in this encoder, or in others submitted in the order recorded):
+    /// each frame's buffer writes are copies recorded into its encoder, so each draws with
+    /// its own camera, settings and game data (a game writes its own with
+    /// [`crate::stages::GameFrame::write_buffer`]); upload or remove chunks only between a
+    /// submit and the next frame.
     ///
     /// The exact techniques (`Reference`, `PeelReference`) wait for GPU results in the
     /// middle of the frame: they submit what `encoder` holds so far and go on in a fresh
-    /// encoder that replaces it (the order of commands is kept). Real-time techniques never
-    /// submit.
+    /// encoder that replaces it (the order of commands is kept). After a frame recorded
+    /// into another encoder that is not yet submitted, they refuse with
+    /// [`Error::FrameOrder`] (that frame would run after their first half). Real-time
+    /// techniques never submit.
+    ///
+    /// `encoder` must come from the renderer's device: wgpu offers no way to ask an
+    /// encoder's device, and one of another device fails when it is finished.
     ///
     /// `game` draws the game's own geometry in the frame's stages: its opaque geometry
     /// after the world's, its translucent geometry composed by the technique with the
@@ -90,6 +100,15 @@ impl Renderer {
             self.post.make_tonemap(&self.ctx, format);
         }
         self.check_output(output, format)?;
+        if let Some(theirs) = game.context()
+            && !theirs.same_device(&self.ctx)
+        {
+            return Err(Error::OtherDevice(format!(
+                "the game's stages were made on {}, the renderer draws on {} (a renderer and \
+                 the stages it draws share one GpuContext, cloned)",
+                theirs.caps.adapter_name, self.ctx.caps.adapter_name
+            )));
+        }
         let stages = game.stages();
         if stages.translucent {
             let contract = self.oit.contract()?;
@@ -106,6 +125,9 @@ impl Renderer {
                 });
             }
         }
+        // Ends the last timed frame if it was submitted since; this one is timed unless
+        // it is not.
+        let last = self.frame_order(encoder)?;
         if format != self.config.output_format {
             log::info!(
                 "drawing into {format:?} from now on (was {:?})",
@@ -114,9 +136,6 @@ impl Renderer {
             self.config.output_format = format;
         }
         let start = Instant::now();
-        // Ends the last timed frame if it was submitted since; this one is timed unless
-        // it is not.
-        let last = self.settle_submission();
         let ctx = &self.ctx;
         let timed = self
             .timer
@@ -169,6 +188,10 @@ impl Renderer {
             })?;
             self.targets = targets;
         }
+        // The frame's buffer writes land in its encoder, not at the next submit: a frame
+        // recorded before this one and not yet submitted keeps its own camera, settings,
+        // quad order and draws (see `FrameWrites`).
+        let writes = Mutex::new(std::mem::take(&mut self.writes));
         // The technique's CPU work (it may reorder quads within their places).
         let view = FrameView {
             camera,
@@ -176,6 +199,7 @@ impl Renderer {
             translucent: self.culled.translucent_positions(),
             layers: self.culled.translucent_layers(),
             game_objects: stages.translucent.then(|| game.translucent_objects()),
+            writes: &writes,
         };
         self.oit
             .prepare(&mut self.chunks, &view, stages.translucent)?;
@@ -219,13 +243,16 @@ impl Renderer {
         } else {
             game.translucent_objects().len()
         };
-        self.write_frame_uniforms(
+        let uniforms = self.frame_uniforms(
             camera,
             view_proj,
             medium.as_ref().map(|(b, look)| (*b, look)),
             media,
         );
+        let mut writes = writes.into_inner().unwrap_or_else(PoisonError::into_inner);
+        writes.write(&self.scene.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
         let (eye_int, eye_frac) = camera.eye_split();
+        let game_writes = GameWrites::open();
         let game_frame = GameFrame {
             camera,
             view_proj,
@@ -238,6 +265,7 @@ impl Renderer {
             ambient: self.config.ambient,
             brightness: self.config.brightness,
             order: sorts.then_some(order),
+            writes: &game_writes,
         };
         if stages != crate::stages::Stages::default() {
             game.prepare(&self.ctx, &game_frame);
@@ -245,6 +273,7 @@ impl Renderer {
             // nothing more is recorded.
             self.ctx.check_device()?;
         }
+        writes.append(&mut game_writes.take());
         let game = &*game;
 
         let builder = &mut self.builder;
@@ -255,6 +284,11 @@ impl Renderer {
         if self.config.draw == DrawMode::Indirect {
             self.chunks.upload_draws(&self.ctx, self.builder.commands());
         }
+        // Every write of the frame, in its encoder before its first pass.
+        writes.append(self.chunks.writes());
+        let recorded = writes.record(&self.ctx.device, encoder);
+        self.writes = writes;
+        recorded?;
         let draws = FrameDraws {
             store: &self.chunks,
             commands: self.builder.commands(),
@@ -383,11 +417,38 @@ impl Renderer {
             t.end_frame(&self.ctx, encoder);
         }
         self.submissions.attach(&self.ctx, encoder);
+        self.last_encoder = Some(encoder_key(encoder));
         Ok(FrameStats {
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
             technique: self.oit.report(),
             ..stats
         })
+    }
+
+    /// What became of the last frame's encoder; an [`Error::FrameOrder`] when this frame
+    /// cannot be recorded into `encoder` now. An exact technique (`Technique::stalls`)
+    /// submits inside its frame, so the frame before it must be in the same encoder or
+    /// submitted: recorded in another encoder and submitted after, that frame would run
+    /// after this one's first half, over the targets both draw in. A frame whose encoder
+    /// was submitted but not yet done is waited for (the exact frame waits anyway).
+    fn frame_order(&mut self, encoder: &wgpu::CommandEncoder) -> Result<Outcome> {
+        let last = self.settle_submission();
+        let other = self
+            .last_encoder
+            .is_some_and(|key| key != encoder_key(encoder));
+        if last != Outcome::Pending || !other || !self.oit.technique().stalls() {
+            return Ok(last);
+        }
+        self.ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
+        match self.settle_submission() {
+            Outcome::Pending => Err(Error::FrameOrder(format!(
+                "{} submits inside its frame, but the frame before was recorded into another \
+                 encoder that is not submitted yet: submit that encoder first, or record both \
+                 frames into one",
+                self.oit.technique().name()
+            ))),
+            settled => Ok(settled),
+        }
     }
 
     /// The camera a frame of `camera` is drawn with: no translucent face closer than the
@@ -465,6 +526,13 @@ impl Renderer {
                 t.usage()
             )));
         }
+        if *t == self.targets.color.texture {
+            return Err(Error::Output(
+                "the renderer's own scene colour texture (Renderer::scene_color): the tonemap \
+                 reads it while it writes the output; draw into a texture of your own"
+                    .into(),
+            ));
+        }
         if self.checked_view.as_ref() == Some(output) {
             return Ok(());
         }
@@ -478,10 +546,14 @@ impl Renderer {
             });
             let color = [gpu::load(output)];
             // One pass (about 10 µs on lavapipe): the scene depth beside the output fails
-            // on another size, the pipeline on another view format.
+            // on another size, the pipeline on another view format, the tonemap's group on
+            // an output it reads, a view of another device on that.
             Pass::new("output_view_check", GpuPass::Tonemap, &color)
                 .depth(Depth::Load(&self.targets.depth.view))
-                .record(&mut encoder, None, |pass| pass.set_pipeline(check));
+                .record(&mut encoder, None, |pass| {
+                    pass.set_pipeline(check);
+                    pass.set_bind_group(0, &self.targets.tonemap_group, &[]);
+                });
             // Never submitted: recording and finishing are what validate.
             drop(encoder.finish());
         });
@@ -493,6 +565,14 @@ impl Renderer {
                 Error::Gpu { error, .. } => error.to_string(),
                 other => other.to_string(),
             };
+            // wgpu's `DeviceMismatch`: "Device with '…' label of TextureView … doesn't
+            // match Device …".
+            if why.contains("doesn't match Device") {
+                return Error::OtherDevice(format!(
+                    "the output view: {}",
+                    why.lines().map(str::trim).collect::<Vec<_>>().join(" ")
+                ));
+            }
             Error::Output(format!(
                 "the view must be a 2D view of mip level 0 ({w}x{h}) viewed as {want:?}: {}",
                 why.lines()
@@ -511,7 +591,7 @@ impl Renderer {
         let mut done = Vec::new();
         for (&pos, &start) in &self.fading {
             let t = now.wrapping_sub(start) as f32 / frames as f32;
-            self.chunks.set_alpha(&self.ctx, pos, t.min(1.0));
+            self.chunks.set_alpha(&self.ctx, pos, t.min(1.0), true);
             if t >= 1.0 {
                 done.push(pos);
             }
@@ -522,19 +602,20 @@ impl Renderer {
         self.frame_index = self.frame_index.wrapping_add(1);
     }
 
-    fn write_frame_uniforms(
+    /// The frame's uniforms (group 0's `frame`).
+    fn frame_uniforms(
         &self,
         camera: &Camera,
         view_proj: Mat4,
         medium: Option<(BlockId, &MediumLook)>,
         media: u32,
-    ) {
+    ) -> FrameUniforms {
         let (eye_int, eye_frac) = camera.eye_split();
         let sun = sun_unit(self.config.sun_dir);
         let (w, h) = self.size();
         let tan_y = (camera.fov_y_deg.to_radians() / 2.0).tan();
         let tan_x = tan_y * f64::from(w) / f64::from(h);
-        let uniforms = FrameUniforms {
+        FrameUniforms {
             view_proj: view_proj.to_cols_array_2d(),
             eye_int: eye_int.map(|v| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32),
             near: camera.near as f32,
@@ -554,10 +635,7 @@ impl Renderer {
                 [r, g, b, look.absorption]
             }),
             ..FrameUniforms::default()
-        };
-        self.ctx
-            .queue
-            .write_buffer(&self.scene.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
+        }
     }
 
     /// The opaque pass, the cutout pass, then the game's opaque stage; with MSAA the
@@ -654,4 +732,12 @@ impl Renderer {
             pass.draw(0..3, 0..1);
         });
     }
+}
+
+/// Tells encoders apart while they live (wgpu's id; no two live encoders share one).
+fn encoder_key(encoder: &wgpu::CommandEncoder) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    encoder.hash(&mut h);
+    h.finish()
 }

@@ -24,7 +24,7 @@ use crate::ladder;
 use crate::medium::{self, MediumLook, MediumPass};
 use crate::oit::sorted::interleave::Interleaver;
 use crate::oit::{OitConfig, OitManager, Setup, Technique, TechniqueReport};
-use crate::submission::{Outcome, Submissions};
+use crate::submission::{FrameWrites, Outcome, Submissions};
 use crate::textures::BlockTextures;
 use crate::timing::{GpuTimes, Timer};
 use crate::{Error, GpuContext, Result};
@@ -106,6 +106,10 @@ pub struct Renderer {
     /// that drawing into the same view again skips it (a window's views are new each
     /// frame and pay it: about 0.08 ms on this project's 2-core machine).
     checked_view: Option<wgpu::TextureView>,
+    /// The frame's buffer writes (kept between frames for their room).
+    writes: FrameWrites,
+    /// The encoder the last frame ended in (`frame::encoder_key`).
+    last_encoder: Option<u64>,
 }
 
 impl Renderer {
@@ -247,6 +251,8 @@ impl Renderer {
             culled: Culled::default(),
             builder: DrawBuilder::default(),
             checked_view: None,
+            writes: FrameWrites::default(),
+            last_encoder: None,
             config,
         })
     }
@@ -318,7 +324,7 @@ impl Renderer {
         self.chunks.upload(&self.ctx, pos, meshes)?;
         if new && self.config.fade_in_frames > 0 && self.chunks.get(pos).is_some() {
             self.fading.insert(pos, self.frame_index);
-            self.chunks.set_alpha(&self.ctx, pos, 0.0);
+            self.chunks.set_alpha(&self.ctx, pos, 0.0, false);
         }
         Ok(())
     }
@@ -440,7 +446,7 @@ impl Renderer {
         self.config.fade_in_frames = frames;
         if frames == 0 {
             for (pos, _) in self.fading.drain() {
-                self.chunks.set_alpha(&self.ctx, pos, 1.0);
+                self.chunks.set_alpha(&self.ctx, pos, 1.0, false);
             }
         }
     }

@@ -510,15 +510,14 @@ impl TranslucentTechnique for Mboit {
 
     fn prepare(
         &mut self,
-        ctx: &GpuContext,
+        _ctx: &GpuContext,
         config: &OitConfig,
         _chunks: &mut ChunkStore,
         view: &FrameView<'_>,
     ) -> Result<()> {
         let range = depth_range(view.camera, view.layers.boxes(), view.game_objects);
         let params = MboitParams::new(range, self.bias(), config.mboit.overestimation);
-        ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        view.write(&self.params, 0, bytemuck::bytes_of(&params));
         self.report = Some(MboitReport {
             moments: self.targets.moments.texture.format(),
             depth_range: range,

@@ -34,6 +34,7 @@ use crate::oit::{
     TranslucentTechnique,
 };
 use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
+use crate::submission::FrameWrites;
 use crate::timing::GpuPass;
 use crate::{Error, GpuContext, Result, readback};
 
@@ -397,8 +398,8 @@ impl Reference {
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         frame: &TranslucentFrame<'_>,
-    ) -> u32 {
-        let Some(b) = &self.buffers else { return 0 };
+    ) -> Result<u32> {
+        let Some(b) = &self.buffers else { return Ok(0) };
         let game = frame.game.map(|g| {
             let own = [
                 b.heads.as_entire_binding(),
@@ -418,63 +419,67 @@ impl Reference {
         });
         let (width, height) = self.size;
         let (tw, th) = self.tile_size(self.tiles);
-        let mut k = 0u32;
-        for ty in 0..self.tiles {
-            for tx in 0..self.tiles {
-                let (x, y) = (tx * tw, ty * th);
-                if x >= width || y >= height {
-                    continue;
-                }
-                let (w, h) = (tw.min(width - x), th.min(height - y));
-                let offset = u64::from(k) * self.params_stride;
-                let params = Params {
-                    origin: [x, y],
-                    tile_width: tw,
-                    capacity: b.capacity,
-                };
-                ctx.queue
-                    .write_buffer(&self.params, offset, bytemuck::bytes_of(&params));
-                let dynamic = [offset as u32];
-                encoder.clear_buffer(&b.heads, 0, None);
-                encoder.clear_buffer(&self.counters, 0, None);
-                Pass {
-                    colors: &[],
-                    ..Pass::new("abuffer_build", GpuPass::Translucent, &[])
-                }
-                .depth(Depth::ReadOnly(&frame.depth.view))
-                .record(encoder, frame.timer, |pass| {
-                    pass.set_scissor_rect(x, y, w, h);
-                    // Volumes: the faces where the ray leaves them (seen from behind) too.
-                    pass.set_pipeline(self.build.get(frame.two_sided || frame.volumes));
-                    pass.set_bind_group(2, &b.build_group, &dynamic);
-                    frame.draw_chunks(pass);
-                    if let Some((g, group)) = &game {
-                        g.draw_offsets(pass, 0, group, &dynamic, 0..g.objects);
-                    }
-                });
-                let colors = [gpu::load(&frame.target.view)];
-                Pass::new("abuffer_resolve", GpuPass::Composite, &colors).record(
-                    encoder,
-                    frame.timer,
-                    |pass| {
-                        pass.set_scissor_rect(x, y, w, h);
-                        pass.set_pipeline(&self.resolve);
-                        pass.set_bind_group(0, &b.resolve_group, &dynamic);
-                        pass.set_bind_group(1, frame.scene, &[]);
-                        pass.draw(0..3, 0..1);
-                    },
-                );
-                encoder.copy_buffer_to_buffer(
-                    &self.counters,
-                    0,
-                    &self.counters_readback,
-                    COUNTERS_BYTES * u64::from(k),
-                    COUNTERS_BYTES,
-                );
-                k += 1;
-            }
+        // The tiles in order, and each one's parameters in the encoder before the first
+        // (where a frame recorded earlier, not yet submitted, cannot see them).
+        let tiles: Vec<(u32, u32)> = (0..self.tiles)
+            .flat_map(|ty| (0..self.tiles).map(move |tx| (tx * tw, ty * th)))
+            .filter(|&(x, y)| x < width && y < height)
+            .collect();
+        let mut writes = FrameWrites::default();
+        for (k, &(x, y)) in tiles.iter().enumerate() {
+            let params = Params {
+                origin: [x, y],
+                tile_width: tw,
+                capacity: b.capacity,
+            };
+            let offset = k as u64 * self.params_stride;
+            writes.write(&self.params, offset, bytemuck::bytes_of(&params));
         }
-        k
+        writes.record(&ctx.device, encoder)?;
+        let mut k = 0u32;
+        for &(x, y) in &tiles {
+            let (w, h) = (tw.min(width - x), th.min(height - y));
+            let offset = u64::from(k) * self.params_stride;
+            let dynamic = [offset as u32];
+            encoder.clear_buffer(&b.heads, 0, None);
+            encoder.clear_buffer(&self.counters, 0, None);
+            Pass {
+                colors: &[],
+                ..Pass::new("abuffer_build", GpuPass::Translucent, &[])
+            }
+            .depth(Depth::ReadOnly(&frame.depth.view))
+            .record(encoder, frame.timer, |pass| {
+                pass.set_scissor_rect(x, y, w, h);
+                // Volumes: the faces where the ray leaves them (seen from behind) too.
+                pass.set_pipeline(self.build.get(frame.two_sided || frame.volumes));
+                pass.set_bind_group(2, &b.build_group, &dynamic);
+                frame.draw_chunks(pass);
+                if let Some((g, group)) = &game {
+                    g.draw_offsets(pass, 0, group, &dynamic, 0..g.objects);
+                }
+            });
+            let colors = [gpu::load(&frame.target.view)];
+            Pass::new("abuffer_resolve", GpuPass::Composite, &colors).record(
+                encoder,
+                frame.timer,
+                |pass| {
+                    pass.set_scissor_rect(x, y, w, h);
+                    pass.set_pipeline(&self.resolve);
+                    pass.set_bind_group(0, &b.resolve_group, &dynamic);
+                    pass.set_bind_group(1, frame.scene, &[]);
+                    pass.draw(0..3, 0..1);
+                },
+            );
+            encoder.copy_buffer_to_buffer(
+                &self.counters,
+                0,
+                &self.counters_readback,
+                COUNTERS_BYTES * u64::from(k),
+                COUNTERS_BYTES,
+            );
+            k += 1;
+        }
+        Ok(k)
     }
 
     /// Sums the counters of `tiles` tiles: (lost nodes, most nodes one tile asked for,
@@ -576,7 +581,7 @@ impl TranslucentTechnique for Reference {
         let mut attempts = 0;
         loop {
             attempts += 1;
-            let tiles_recorded = self.record(ctx, encoder, frame);
+            let tiles_recorded = self.record(ctx, encoder, frame)?;
             gpu::flush(ctx, encoder)?;
             let (lost, needed, capped, capped_visible) = self.read_counters(ctx, tiles_recorded)?;
             let capacity = self.buffers.as_ref().map_or(0, |b| u64::from(b.capacity));

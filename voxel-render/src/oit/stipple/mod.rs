@@ -188,16 +188,15 @@ impl TranslucentTechnique for Stipple {
 
     fn prepare(
         &mut self,
-        ctx: &GpuContext,
+        _ctx: &GpuContext,
         config: &OitConfig,
         _chunks: &mut crate::chunks::ChunkStore,
-        _view: &FrameView<'_>,
+        view: &FrameView<'_>,
     ) -> Result<()> {
         let params = StippleParams {
             shading_state: config.stipple.shading_state().pack(),
         };
-        ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        view.write(&self.params, 0, bytemuck::bytes_of(&params));
         Ok(())
     }
 

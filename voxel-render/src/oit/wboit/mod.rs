@@ -558,8 +558,7 @@ impl TranslucentTechnique for Wboit {
             let n = fit.optical_depth.len().min(flat.len());
             flat[..n].copy_from_slice(&fit.optical_depth[..n]);
         }
-        ctx.queue
-            .write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        view.write(&self.params, 0, bytemuck::bytes_of(&params));
         let size = self.targets.accumulation.texture.size();
         let size = (size.width, size.height);
         // The fit projected every plane drawn (front faces, with the eye in air) already;
