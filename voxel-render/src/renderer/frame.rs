@@ -524,7 +524,7 @@ impl Renderer {
             volumes,
             medium_look: medium.map_or([0.0; 4], |(_, look)| {
                 let [r, g, b] = look.color;
-                [r, g, b, look.absorption]
+                [r, g, b, look.fog]
             }),
             ..FrameUniforms::default()
         };
