@@ -287,6 +287,7 @@ fn things_inside_water_are_composed_with_the_path_split_at_them() {
                 half_size: 0.8,
                 color: [225, 240, 255],
                 opacity: 0.5,
+                emissive: 0.0,
             })
             .collect(),
         entities: vec![Entity {
@@ -295,6 +296,7 @@ fn things_inside_water_are_composed_with_the_path_split_at_them() {
             rotation: glam::DQuat::IDENTITY,
             color: [230, 60, 40],
             opacity: 0.6,
+            emissive: 0.0,
         }],
     };
     let scene = Scene { content, ..lake };
