@@ -246,3 +246,58 @@ fn the_window_opens_a_vox_model() {
         "sky above the model: {top_left_sky:?}"
     );
 }
+
+/// The window under WebGL2's limits (no storage buffers in the vertex stage) draws its game
+/// content, on as by default in an interactive run, from vertex buffers: on Vulkan and on
+/// GL it starts, draws and saves its screenshot, and the content is in it (the picture
+/// differs from the one without it).
+#[test]
+fn the_window_draws_its_game_content_under_webgl2_limits() {
+    let Some(x) = Xvfb::start() else {
+        return skip_or_fail("Xvfb could not be started (install xvfb)");
+    };
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/test-output/window-webgl2");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for (backend, backends) in [
+        ("vulkan", wgpu::Backends::VULKAN),
+        ("gl", wgpu::Backends::GL),
+    ] {
+        if GpuContext::headless(backends).is_err() {
+            skip_or_fail(&format!("no {backend} adapter"));
+            continue;
+        }
+        let shot = |game: &str| {
+            let path = dir.join(format!("{backend}_game_{game}.png"));
+            demo(
+                &x,
+                &[
+                    "--backend",
+                    backend,
+                    "--limits",
+                    "webgl2",
+                    "--size",
+                    "640x360",
+                    "--frames",
+                    "3",
+                    "--game",
+                    game,
+                    "--screenshot",
+                    path.to_str().unwrap(),
+                ],
+            );
+            view(&Image::load_png(&path).unwrap())
+        };
+        let (with, without) = (shot("true"), shot("false"));
+        assert!(
+            distinct(&with) > 200,
+            "{backend}: {} colours",
+            distinct(&with)
+        );
+        let differing = with.iter().zip(&without).filter(|(a, b)| a != b).count();
+        assert!(
+            differing > 50,
+            "{backend}: the game content changes {differing} pixels"
+        );
+    }
+}

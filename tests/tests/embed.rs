@@ -661,6 +661,7 @@ fn switching_to_prebuilt_techniques_builds_no_pipeline() {
                     half_size: 0.2,
                     color: [240, 200, 120],
                     opacity: 0.5,
+                    emissive: 0.0,
                 })
                 .collect(),
             entities: vec![],

@@ -45,6 +45,7 @@ fn scene() -> (Scene, [Camera; 2]) {
                 rotation: DQuat::from_rotation_y(0.5),
                 color: [60, 200, 90],
                 opacity: 0.5,
+                emissive: 0.0,
             },
             Entity {
                 center: DVec3::new(2.0, -0.5, 5.0),
@@ -52,6 +53,7 @@ fn scene() -> (Scene, [Camera; 2]) {
                 rotation: DQuat::from_rotation_z(0.3),
                 color: [150, 90, 40],
                 opacity: 1.0,
+                emissive: 0.0,
             },
         ],
     };
@@ -69,7 +71,7 @@ fn scene() -> (Scene, [Camera; 2]) {
 
 /// The content stages of `renderer`.
 fn content(renderer: &Renderer, content: &Content) -> ContentStages {
-    ContentStages::new(renderer, content.clone())
+    ContentStages::new(renderer, content.clone()).expect("content that validates")
 }
 
 /// Saves the pictures side by side when they differ, and fails naming the case.

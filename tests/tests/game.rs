@@ -33,6 +33,7 @@ fn quad(center: [f64; 3]) -> Particle {
         half_size: 1.5,
         color: [230, 40, 40],
         opacity: 0.5,
+        emissive: 0.0,
     }
 }
 
@@ -45,6 +46,7 @@ fn plate(center: [f64; 3], opacity: f32) -> Entity {
             * DQuat::from_rotation_x(-25f64.to_radians()),
         color: [40, 60, 230],
         opacity,
+        emissive: 0.0,
     }
 }
 
@@ -434,7 +436,7 @@ fn content_stages_follow_switches_and_msaa_by_themselves() {
     let camera = scene.cameras[0];
     let mut r =
         tests::renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, W, H)).unwrap();
-    let mut game = ContentStages::new(&r.renderer, scene.content.clone());
+    let mut game = ContentStages::new(&r.renderer, scene.content.clone()).unwrap();
     let target = tests::Offscreen::new(&ctx, W, H);
     let shot = |r: &mut voxel_render::Renderer, game: &mut ContentStages| {
         r.render_and_submit(&target.view, &camera, game).unwrap();
@@ -480,6 +482,7 @@ fn a_slab_beyond_the_water_surface_is_exact_from_either_side() {
         rotation: DQuat::IDENTITY,
         color: [230, 60, 40],
         opacity: 0.5,
+        emissive: 0.0,
     };
     let dir = out_dir("game_slab");
     for (name, eye, y) in [
@@ -527,6 +530,7 @@ fn objects_in_a_block_face_plane_follow_one_rule_in_every_reference() {
         rotation: DQuat::IDENTITY,
         color,
         opacity: 0.55,
+        emissive: 0.0,
     };
     // The water's surface is the plane y = 1; the pane's +z face the plane z = 7: the
     // plates' faces seen from the camera lie in them (their other halves in the blocks).
@@ -583,6 +587,7 @@ fn the_eye_inside_a_translucent_entity_is_tinted_by_it() {
         rotation: DQuat::from_rotation_y(0.4),
         color: [90, 220, 80],
         opacity: 0.4,
+        emissive: 0.0,
     };
     let scene = with(&base, entities(vec![slime]));
     let cam = scene.cameras[0];

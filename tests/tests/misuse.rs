@@ -199,7 +199,7 @@ fn contract_ids_differ_between_renderers() {
         particles: vec![particle()],
         entities: vec![],
     };
-    let mut game = ContentStages::new(&a.renderer, content);
+    let mut game = ContentStages::new(&a.renderer, content).expect("content that validates");
     game.set_follow_contract(false);
     game.update_pipelines(&mut a.renderer).unwrap();
     let target = Offscreen::new(&ctx, W, H);
@@ -220,6 +220,7 @@ fn particle() -> Particle {
         half_size: 1.5,
         color: [230, 40, 40],
         opacity: 0.6,
+        emissive: 0.0,
     }
 }
 
@@ -242,14 +243,16 @@ fn content_stages_shared_by_two_renderers_draw_right_for_both() {
     let own: Vec<_> = renderers
         .iter_mut()
         .map(|r| {
-            let mut game = ContentStages::new(r, scene.content.clone());
+            let mut game =
+                ContentStages::new(r, scene.content.clone()).expect("content that validates");
             let target = Offscreen::new(&ctx, W, H);
             r.render_and_submit(&target.view, &camera, &mut game)
                 .unwrap();
             target.read(&ctx).unwrap()
         })
         .collect();
-    let mut shared = ContentStages::new(&renderers[0], scene.content.clone());
+    let mut shared =
+        ContentStages::new(&renderers[0], scene.content.clone()).expect("content that validates");
     for _ in 0..2 {
         for (r, expected) in renderers.iter_mut().zip(&own) {
             let target = Offscreen::new(&ctx, W, H);
@@ -276,7 +279,8 @@ fn content_stages_of_another_device_are_refused() {
     };
     let a = renderer_for(&ctx, &scene, config()).unwrap();
     let mut b = renderer_for(&other, &scene, config()).unwrap();
-    let mut game = ContentStages::new(&a.renderer, scene.content.clone());
+    let mut game =
+        ContentStages::new(&a.renderer, scene.content.clone()).expect("content that validates");
     let target = Offscreen::new(&other, W, H);
     let e = b
         .renderer

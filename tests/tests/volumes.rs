@@ -287,6 +287,7 @@ fn things_inside_water_are_composed_with_the_path_split_at_them() {
                 half_size: 0.8,
                 color: [225, 240, 255],
                 opacity: 0.5,
+                emissive: 0.0,
             })
             .collect(),
         entities: vec![Entity {
@@ -295,6 +296,7 @@ fn things_inside_water_are_composed_with_the_path_split_at_them() {
             rotation: glam::DQuat::IDENTITY,
             color: [230, 60, 40],
             opacity: 0.6,
+            emissive: 0.0,
         }],
     };
     let scene = Scene { content, ..lake };
@@ -317,5 +319,100 @@ fn things_inside_water_are_composed_with_the_path_split_at_them() {
     ] {
         let img = render_with(&ctx, &scene, config(t));
         assert_close(&format!("things_in_water_{t}"), &img, &reference, 2);
+    }
+}
+
+/// A game's water as a game defines it with `BlockDef::new` (no absorption: not a volume)
+/// between the eye and a wall, as in [`passage`]; `volume`: the built-in water instead.
+fn games_water_passage(inside: Option<bool>, wall: voxel_core::BlockId, volume: bool) -> Scene {
+    let mut registry = BlockRegistry::default();
+    let own = registry
+        .register(BlockDef::new("lake_water", [25, 105, 165], 0.7))
+        .unwrap();
+    let water = if volume { WATER } else { own };
+    let mut world = World::new(Arc::new(registry));
+    let fill = voxel_lab::scene::fill_box;
+    fill(&mut world, [-20, -20, -9], [20, 20, -9], wall).unwrap();
+    match inside {
+        Some(false) => fill(&mut world, [-20, -20, -8], [20, 20, 0], water).unwrap(),
+        Some(true) => fill(&mut world, [-20, -20, 2], [20, 20, 20], water).unwrap(),
+        None => {}
+    }
+    let s = scene("games_water", world, [0.5, 0.5, 11.0], [0.5, 0.5, -20.0]);
+    assert_eq!(s.cameras[0].medium.is_some(), inside == Some(true));
+    s
+}
+
+/// A game's own water block made as before volumes existed (`BlockDef::new`, opacity 0.7)
+/// keeps the look it had: from inside, the fog every translucent block had (16 blocks dim
+/// as one surface), which is exactly the built-in water's absorption at that opacity;
+/// from outside, a thin surface (only its opacity tints what lies behind, however deep).
+/// The ray march, which knows only the blocks, agrees.
+#[test]
+fn a_games_own_water_keeps_its_look() {
+    let Some(ctx) = gpu() else { return };
+    let centre: Vec<usize> = (H / 2 - 8..H / 2 + 8)
+        .flat_map(|y| (W / 2 - 8..W / 2 + 8).map(move |x| (y * W + x) as usize))
+        .collect();
+    // What comes through of a wall's colour difference (sand against stone).
+    let delta = |inside: Option<bool>, volume: bool, t: Technique| -> Vec<[f32; 3]> {
+        let a = hdr(&ctx, &games_water_passage(inside, SAND, volume), t);
+        let b = hdr(&ctx, &games_water_passage(inside, STONE, volume), t);
+        centre
+            .iter()
+            .map(|&i| std::array::from_fn(|c| a[i][c] - b[i][c]))
+            .collect()
+    };
+    let bare = delta(None, false, Technique::Reference);
+    for t in [
+        Technique::Reference,
+        Technique::SortedQuads,
+        Technique::WboitMrt,
+        Technique::Mboit,
+    ] {
+        // From inside: fogged as the built-in water (a volume of the same opacity) is.
+        let own = hdr(&ctx, &games_water_passage(Some(true), SAND, false), t);
+        let built_in = hdr(&ctx, &games_water_passage(Some(true), SAND, true), t);
+        for &i in &centre {
+            for c in 0..3 {
+                assert!(
+                    (own[i][c] - built_in[i][c]).abs() <= 1.0 / 255.0,
+                    "{t}: the game's water from inside {:?}, the built-in {:?}",
+                    own[i],
+                    built_in[i]
+                );
+            }
+        }
+        let inside = delta(Some(true), false, t);
+        let outside = delta(Some(false), false, t);
+        for ((i, o), b) in inside.iter().zip(&outside).zip(&bare) {
+            for c in 0..3 {
+                // Inside: 0.3 of the surface's and exp(−0.075 · 9) ≈ 0.51 of the fog's.
+                let kept = i[c] / b[c];
+                assert!(
+                    (0.1..0.2).contains(&kept),
+                    "{t}: from inside {kept} of the wall's difference comes through"
+                );
+                // Outside: the surface alone, 0.3, however deep the water behind it.
+                let kept = o[c] / b[c];
+                assert!(
+                    (0.27..0.33).contains(&kept),
+                    "{t}: from outside {kept} of the wall's difference comes through"
+                );
+            }
+        }
+    }
+    for inside in [Some(true), Some(false)] {
+        let s = games_water_passage(inside, SAND, false);
+        let check = raymarch_check(&ctx, &s, &s.cameras[0], (W, H)).unwrap();
+        let c = &check.comparison;
+        assert_eq!(
+            (c.differing, c.cracks),
+            (0, 0),
+            "{inside:?}: {} pixels off edges differ (max {}/255): {:?}",
+            c.differing,
+            c.max_abs_err_off_edges,
+            c.worst
+        );
     }
 }

@@ -262,8 +262,11 @@ pub struct BlockDef {
     /// it absorbs per block. What lies behind its surface, or beyond it from inside,
     /// keeps `exp(−absorption · d)` of its light over a path of `d` blocks through it and
     /// takes the block's colour (lit like a face turned to the sky) for the rest. 0 (the
-    /// default): a thin surface such as glass, which only its faces' opacity tints. The
-    /// built-in water absorbs `−ln(1 − 0.7) / 16` ≈ 0.075 a block ([`WATER_ABSORPTION`]).
+    /// default of [`BlockDef::new`]): a thin surface, which only its faces' opacity tints
+    /// seen from outside, and whose inside an eye sees fogged as every translucent block
+    /// always was ([`BlockDef::eye_absorption`]). Volumes are chosen, never given: the
+    /// built-in water is one, absorbing `−ln(1 − 0.7) / 16` ≈ 0.075 a block
+    /// ([`WATER_ABSORPTION`]); [`BlockDef::volume`] makes a game's block one the same way.
     pub absorption: f32,
     /// For a cutout block (kelp, seagrass, a fence): the volume it stands in, a
     /// translucent block with absorption ("waterlogged"). The medium's faces toward it are
@@ -281,6 +284,22 @@ pub const WATER_ABSORPTION: f32 = 0.075_248_3;
 /// The largest absorption per block: beyond it a single block lets through less than
 /// `e^-64` of the light, all but opaque.
 pub const MAX_ABSORPTION: f32 = 64.0;
+
+/// Blocks of a translucent block's inside that dim what lies beyond as much as one of its
+/// surfaces: the fog an eye inside a thin translucent block sees
+/// ([`BlockDef::eye_absorption`]), and the absorption [`BlockDef::volume`] gives.
+pub const FOG_BLOCKS: f32 = 16.0;
+
+/// The absorption per block that dims as much over [`FOG_BLOCKS`] blocks as one surface of
+/// `opacity` does: `−ln(1 − opacity) / FOG_BLOCKS` (0 for an opacity outside `(0, 1)`, at
+/// most [`MAX_ABSORPTION`]).
+pub fn fog_absorption(opacity: f32) -> f32 {
+    if opacity > 0.0 && opacity < 1.0 {
+        (-(1.0 - opacity).ln() / FOG_BLOCKS).min(MAX_ABSORPTION)
+    } else {
+        0.0
+    }
+}
 
 impl BlockDef {
     /// A block whose class follows from its opacity: translucent below 1, opaque at 1;
@@ -300,6 +319,28 @@ impl BlockDef {
             images: FaceImages::default(),
             absorption: 0.0,
             medium: None,
+        }
+    }
+
+    /// A translucent block that is a volume like the built-in water: its absorption is
+    /// [`fog_absorption`] of its opacity, so that [`FOG_BLOCKS`] blocks of it dim as much
+    /// as one of its surfaces (the built-in water's [`WATER_ABSORPTION`] at opacity 0.7).
+    /// Its inside is fogged as a thin block's is; seen from outside it darkens with the
+    /// depth of the path through it. `with_absorption` sets another absorption.
+    pub fn volume(name: impl Into<String>, color: [u8; 3], opacity: f32) -> Self {
+        Self::new(name, color, opacity).with_absorption(fog_absorption(opacity))
+    }
+
+    /// How much an eye inside a block of this type has absorbed per block of the way to
+    /// the medium's first surface (the fog under water): a volume's [`BlockDef::absorption`];
+    /// for a thin translucent block (absorption 0), [`fog_absorption`] of its opacity, the
+    /// fog every translucent block had before volumes existed, so that a game's water made
+    /// with [`BlockDef::new`] keeps it; 0 for a block that is not translucent.
+    pub fn eye_absorption(&self) -> f32 {
+        match self.class {
+            RenderClass::Translucent if self.absorption > 0.0 => self.absorption,
+            RenderClass::Translucent => fog_absorption(self.opacity),
+            _ => 0.0,
         }
     }
 
@@ -531,7 +572,7 @@ impl Default for BlockRegistry {
             BlockDef::new("sand", [219, 205, 150], 1.0),
             BlockDef::new("wood", [110, 80, 45], 1.0),
             BlockDef::cutout("leaves", [60, 130, 45]),
-            BlockDef::new("water", [25, 105, 165], 0.7).with_absorption(WATER_ABSORPTION),
+            BlockDef::volume("water", [25, 105, 165], 0.7),
             framed(BlockDef::new("glass", [225, 240, 245], 0.2)),
             BlockDef::new("ice", [170, 210, 245], 0.92),
             framed(BlockDef::new("red_glass", [210, 40, 40], 0.5)),
@@ -579,6 +620,30 @@ mod tests {
             assert_eq!(r.class(id).unwrap(), class);
         }
         assert!(r.get(blocks::ICE).unwrap().opacity >= 0.9);
+    }
+
+    /// The built-in water is a volume made by `volume`, and a thin block of its opacity
+    /// fogs an eye inside it the same: a game's water made with `new` keeps its fog.
+    #[test]
+    fn a_thin_block_fogs_the_eye_as_a_volume_of_its_opacity() {
+        let r = BlockRegistry::default();
+        let water = r.get(blocks::WATER).unwrap();
+        assert!((water.absorption - WATER_ABSORPTION).abs() < 1e-6);
+        assert_eq!(water.eye_absorption(), water.absorption);
+        let thin = BlockDef::new("my_water", [30, 90, 160], 0.7);
+        assert_eq!(thin.absorption, 0.0, "a volume only when chosen");
+        assert!((thin.eye_absorption() - WATER_ABSORPTION).abs() < 1e-6);
+        // Sixteen blocks of fog dim as one surface.
+        let glass = r.get(blocks::GLASS).unwrap();
+        let keep = (-glass.eye_absorption() * FOG_BLOCKS).exp();
+        assert!((keep - (1.0 - glass.opacity)).abs() < 1e-6);
+        let own = BlockDef::volume("lake", [30, 90, 160], 0.7).with_absorption(0.3);
+        assert_eq!(own.eye_absorption(), 0.3);
+        assert_eq!(r.get(blocks::STONE).unwrap().eye_absorption(), 0.0);
+        assert_eq!(BlockDef::cutout("kelp", [0; 3]).eye_absorption(), 0.0);
+        assert_eq!(fog_absorption(1.0), 0.0);
+        assert_eq!(fog_absorption(f32::NAN), 0.0);
+        assert!(fog_absorption(0.999_999_9) <= MAX_ABSORPTION);
     }
 
     #[test]

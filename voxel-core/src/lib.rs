@@ -15,8 +15,8 @@ pub mod vox;
 mod world;
 
 pub use block::{
-    BlockDef, BlockId, BlockImage, BlockRegistry, FaceGroup, FaceImages, MAX_ABSORPTION,
-    MAX_IMAGE_SIZE, Pattern, RenderClass, WATER_ABSORPTION, blocks,
+    BlockDef, BlockId, BlockImage, BlockRegistry, FOG_BLOCKS, FaceGroup, FaceImages,
+    MAX_ABSORPTION, MAX_IMAGE_SIZE, Pattern, RenderClass, WATER_ABSORPTION, blocks, fog_absorption,
 };
 pub use chunk::{
     CHUNK_AREA, CHUNK_SIZE, CHUNK_VOLUME, Chunk, ColumnMask, LayerMask, MaskBuffer, Occupancy,

@@ -61,6 +61,7 @@ fn content(cam: &Camera) -> Content {
                 half_size: 0.12,
                 color: [220, 235, 255],
                 opacity: 0.4,
+                emissive: 0.0,
             })
             .collect(),
         entities: vec![Entity {
@@ -69,6 +70,7 @@ fn content(cam: &Camera) -> Content {
             rotation: DQuat::from_rotation_y(0.6),
             color: [150, 220, 235],
             opacity: 0.45,
+            emissive: 0.0,
         }],
     }
 }
@@ -83,7 +85,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let cam = camera(vd)?;
     let first = Technique::REAL_TIME[0];
     let mut r = renderer(&ctx, vd, first)?;
-    let mut game = ContentStages::new(&r, content(&cam));
+    let mut game = ContentStages::new(&r, content(&cam))?;
     let start = Instant::now();
     for t in Technique::REAL_TIME {
         r.prebuild_technique(t)?;

@@ -53,6 +53,7 @@ mod tests {
             rotation: DQuat::IDENTITY,
             color: [0; 3],
             opacity: 1.0,
+            emissive: 0.0,
         };
         assert_eq!(entity_matrix(&e).y_axis, glam::Vec3::new(0.0, 2.0, 0.0));
     }

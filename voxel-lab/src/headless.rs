@@ -3,7 +3,6 @@
 use crate::{Error, Result};
 
 use voxel_mesh::mesh_chunks;
-use voxel_render::low_level::{Limit, Need};
 use voxel_render::{
     Camera, FrameStats, GpuContext, Image, LimitsPreset, NoGame, Renderer, RendererConfig, readback,
 };
@@ -156,27 +155,14 @@ impl SceneRenderer {
     }
 }
 
-/// What the scene's game content needs of a device: its shaders pull their instances from
-/// a storage buffer in the vertex stage (`content.wgsl`), as a desktop game's might.
-fn content_needs() -> [Need; 2] {
-    [
-        Need::Downlevel(wgpu::DownlevelFlags::VERTEX_STORAGE),
-        Need::Limit(Limit::StorageBuffersPerStage, 1),
-    ]
-}
-
-/// A renderer with every chunk of `scene` meshed and uploaded, and its content ready. A
-/// scene with game content on a device without storage buffers in the vertex stage (WebGL2's
-/// limits) is an error naming what is missing.
+/// A renderer with every chunk of `scene` meshed and uploaded, and its content ready (its
+/// instances fetched as the renderer fetches the world's quads: from storage buffers, or
+/// as vertex attributes under WebGL2's limits).
 pub fn renderer_for(
     ctx: &GpuContext,
     scene: &Scene,
     config: RendererConfig,
 ) -> Result<SceneRenderer> {
-    if !scene.content.is_empty() {
-        let what = format!("{}: the lab's game content", scene.name);
-        voxel_render::low_level::check(&what, &content_needs(), &ctx.caps)?;
-    }
     let mut renderer = Renderer::new(ctx, scene.world.registry(), config)?;
     let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
     for (pos, meshes) in mesh_chunks(&scene.world, &positions)? {
@@ -184,11 +170,13 @@ pub fn renderer_for(
     }
     // The lab builds its content's pipelines when it renders (`render_and_submit`), so that
     // its tests see the renderer refuse pipelines built for another contract.
-    let content = (!scene.content.is_empty()).then(|| {
-        let mut stages = ContentStages::new(&renderer, scene.content.clone());
+    let content = if scene.content.is_empty() {
+        None
+    } else {
+        let mut stages = ContentStages::new(&renderer, scene.content.clone())?;
         stages.set_follow_contract(false);
-        stages
-    });
+        Some(stages)
+    };
     Ok(SceneRenderer { renderer, content })
 }
 

@@ -192,6 +192,7 @@ mod tests {
             rotation,
             color: [200, 100, 50],
             opacity: 0.5,
+            emissive: 0.0,
         }
     }
 
@@ -239,6 +240,7 @@ mod tests {
             half_size: 0.2,
             color: [255; 3],
             opacity: 0.4,
+            emissive: 0.0,
         };
         let content = Content {
             particles: vec![

@@ -24,6 +24,7 @@ fn things(t: f64) -> Content {
         rotation: DQuat::from_rotation_y(0.3),
         color: [160, 118, 75],
         opacity: 1.0,
+        emissive: 0.0,
     };
     let cube = Entity {
         center: DVec3::new(2.5, 0.2 * (t * 0.9).sin(), -1.0),
@@ -31,6 +32,7 @@ fn things(t: f64) -> Content {
         rotation: DQuat::from_euler(glam::EulerRot::YXZ, t * 0.7, 0.6, 0.2),
         color: [89, 218, 137],
         opacity: 0.5,
+        emissive: 0.0,
     };
     let bubble = |i: u64| {
         let h = |k: u64| hash(i << 8 | k);
@@ -40,6 +42,7 @@ fn things(t: f64) -> Content {
             half_size: (0.08 + 0.1 * h(5)) as f32,
             color: [237, 246, 255],
             opacity: 0.45,
+            emissive: 0.0,
         }
     };
     Content {
@@ -124,9 +127,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     // The game's things, drawn by every technique: opaque boxes with the world's opaque
     // geometry, the bubbles and the glass cube composed with water and glass.
-    let mut game = ContentStages::new(&renderer, things(0.0));
+    let mut game = ContentStages::new(&renderer, things(0.0))?;
     for frame in 0..frames.max(1) {
-        game.set_content(&ctx, things(f64::from(frame) / 30.0));
+        game.set_content(&ctx, things(f64::from(frame) / 30.0))?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         renderer.render(&mut encoder, &output.view, &camera, &mut game)?;
         ctx.queue.submit([encoder.finish()]);

@@ -41,6 +41,20 @@ pub enum Error {
     /// the allowed range).
     #[error("invalid setting: {0}")]
     InvalidSetting(String),
+    /// A game's content (`content::Content`) holds a value outside its field's range: a
+    /// NaN or infinite number, an opacity outside 0 to 1, a size of 0, a rotation that is
+    /// not a unit quaternion. Nothing of it was taken.
+    #[error("game content: {kind} {index}: {field}: {message}")]
+    InvalidContent {
+        /// `"particle"` or `"entity"`.
+        kind: &'static str,
+        /// Its index in `Content::particles` or `Content::entities`.
+        index: usize,
+        /// The field (`"opacity"`, `"center"`, …).
+        field: &'static str,
+        /// The value and the range it must lie in.
+        message: String,
+    },
     /// A size beyond what this adapter can do.
     #[error("{what} {value} exceeds this device's {limit_name} ({limit})")]
     TooLarge {

@@ -12,7 +12,8 @@
 //! - [`ChunkStreamer`]: the chunks around a moving eye, generated, meshed and uploaded on
 //!   rayon's workers.
 //! - [`stages`]: the game's own geometry in the frame ([`GameStages`]), composed by every
-//!   technique, and the helpers its pipelines and overlays are built with.
+//!   technique, and the helpers its pipelines and overlays are built with; [`Both`] draws
+//!   two games' stages (the ready-made content and the game's own) as one.
 //! - [`content`]: a game's particles and boxes, opaque or translucent, drawn through the
 //!   frame's stages by every technique without WGSL of its own.
 //! - [`Image`] and [`readback`]: pictures back to the CPU, PNG files; [`textures`]: a
@@ -72,7 +73,9 @@ pub use oit::{
 };
 pub use readback::Image;
 pub use renderer::{FrameStats, Lighting, OUTPUT_FORMATS, Renderer, RendererConfig};
-pub use stages::{GameFrame, GameStages, NoGame, Stages, TranslucentContract, TranslucentObject};
+pub use stages::{
+    Both, GameFrame, GameStages, NoGame, Stages, TranslucentContract, TranslucentObject,
+};
 pub use stream::{ChunkSink, ChunkSource, ChunkStreamer, StreamConfig, StreamFrame};
 pub use timing::{GpuPass, GpuTimes};
 

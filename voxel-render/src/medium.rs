@@ -31,7 +31,10 @@
 //! **Fog.** Inside a volume, the way from the eye to the medium's first surface (or to the
 //! opaque surface behind it, whichever is nearer) is the same absorption: fog of the
 //! block's colour over the composited picture, opaque and translucent alike, the same for
-//! every technique. Inside a thin surface's block nothing is fogged.
+//! every technique. Inside a thin surface's block the fog is what every translucent block
+//! had before volumes existed: 16 blocks of it dim as much as one of its surfaces
+//! ([`voxel_core::BlockDef::eye_absorption`]), so that a game's own water keeps its look
+//! without being made a volume.
 //!
 //! **How.** With the eye inside a medium, a frame adds two passes: a depth pass over the
 //! visible translucent meshes that keeps, per pixel, the nearest surface of the medium's
@@ -71,6 +74,10 @@ pub(crate) struct MediumLook {
     /// Absorption per block of the volume ([`voxel_core::BlockDef::absorption`]; 0: a
     /// thin surface).
     pub absorption: f32,
+    /// Absorption per block of the fog an eye inside it sees
+    /// ([`voxel_core::BlockDef::eye_absorption`]: a volume's absorption, or a thin
+    /// block's fog).
+    pub fog: f32,
 }
 
 /// The look of every translucent block type, by block id (`None`: not translucent).
@@ -90,6 +97,7 @@ pub(crate) fn looks(registry: &BlockRegistry) -> Vec<Option<MediumLook>> {
                 color: def.color.map(linear),
                 opacity: def.opacity,
                 absorption: def.absorption,
+                fog: def.eye_absorption(),
             })
         })
         .collect()

@@ -390,6 +390,301 @@ impl GameStages for NoGame {
     }
 }
 
+/// A game's stages borrowed: `Both::new(&mut content, &mut own)` keeps both where the game
+/// keeps them.
+impl<T: GameStages + ?Sized> GameStages for &mut T {
+    fn stages(&self) -> Stages {
+        (**self).stages()
+    }
+    fn context(&self) -> Option<&GpuContext> {
+        (**self).context()
+    }
+    fn translucent_objects(&self) -> &[TranslucentObject] {
+        (**self).translucent_objects()
+    }
+    fn translucent_contract_id(&self) -> Option<u64> {
+        (**self).translucent_contract_id()
+    }
+    fn follow_contract(&mut self, ctx: &GpuContext, contract: &TranslucentContract) {
+        (**self).follow_contract(ctx, contract);
+    }
+    fn prepare(&mut self, ctx: &GpuContext, frame: &GameFrame<'_>) {
+        (**self).prepare(ctx, frame);
+    }
+    fn opaque(&self, pass: &mut wgpu::RenderPass<'_>, frame: &GameFrame<'_>) {
+        (**self).opaque(pass, frame);
+    }
+    fn translucent(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        frame: &GameFrame<'_>,
+        variant: usize,
+        objects: Range<usize>,
+    ) {
+        (**self).translucent(pass, frame, variant, objects);
+    }
+    fn hdr_overlay(&self, pass: &mut wgpu::RenderPass<'_>, frame: &GameFrame<'_>) {
+        (**self).hdr_overlay(pass, frame);
+    }
+    fn overlay(&self, pass: &mut wgpu::RenderPass<'_>, frame: &GameFrame<'_>) {
+        (**self).overlay(pass, frame);
+    }
+}
+
+/// Two games' stages drawn as one frame's game: the ready-made content beside a game's
+/// own stages (its own translucent shader, its overlays), or any two. Each stage draws
+/// `first`'s part, then `second`'s. Their translucent objects are one list (`first`'s, then
+/// `second`'s) that the sorted techniques order together: each part uploads its own
+/// objects in its share of that order (its [`GameFrame::order`] holds indices into its own
+/// objects) and draws its own runs of it, so things of both are blended back to front with
+/// each other and the chunks. A part that declares the translucent stage with no objects
+/// is drawn after the last object (as the renderer draws a game without objects). Each
+/// part follows or checks the technique's contract as it would alone: the pair's
+/// contract id is the one in force only when both parts' are.
+///
+/// ```no_run
+/// # fn f(renderer: &mut voxel_render::Renderer, content: voxel_render::content::ContentStages,
+/// #      mine: voxel_render::NoGame, camera: &voxel_render::Camera,
+/// #      encoder: &mut wgpu::CommandEncoder, view: &wgpu::TextureView) -> voxel_render::Result<()> {
+/// use voxel_render::stages::Both;
+/// let mut game = Both::new(content, mine);
+/// renderer.render(encoder, view, camera, &mut game)?;
+/// // game.first.set_content(..) and game.second between frames.
+/// # Ok(()) }
+/// ```
+#[derive(Debug, Default)]
+pub struct Both<A, B> {
+    /// Drawn first in each stage.
+    pub first: A,
+    /// Drawn second in each stage.
+    pub second: B,
+    /// Which parts draw translucent geometry this frame (noted at `follow_contract`).
+    translucent: [bool; 2],
+    /// `first`'s translucent objects, then `second`'s.
+    objects: Vec<TranslucentObject>,
+    /// How many of `objects` are `first`'s.
+    split: usize,
+    /// The id of the contract in force (noted at `follow_contract`).
+    contract: Option<u64>,
+    /// Sorted techniques: each part's share of the frame's order (indices into its own
+    /// objects), and per position of the frame's order the part that draws it and the
+    /// position in its share.
+    orders: [Vec<u32>; 2],
+    positions: Vec<(u8, u32)>,
+}
+
+impl<A: GameStages, B: GameStages> Both<A, B> {
+    /// `first` and `second` drawn as one game.
+    pub fn new(first: A, second: B) -> Self {
+        Self {
+            first,
+            second,
+            translucent: [false; 2],
+            objects: Vec::new(),
+            split: 0,
+            contract: None,
+            orders: [Vec::new(), Vec::new()],
+            positions: Vec::new(),
+        }
+    }
+
+    /// The two parts.
+    pub fn into_parts(self) -> (A, B) {
+        (self.first, self.second)
+    }
+
+    fn part(&self, k: usize) -> &dyn GameStages {
+        if k == 0 { &self.first } else { &self.second }
+    }
+
+    /// `frame` with part `k`'s share of the order.
+    fn frame_of<'f>(&'f self, frame: &GameFrame<'f>, k: usize) -> GameFrame<'f> {
+        GameFrame {
+            order: frame.order.map(|_| self.orders[k].as_slice()),
+            ..*frame
+        }
+    }
+}
+
+impl<A: GameStages, B: GameStages> GameStages for Both<A, B> {
+    fn stages(&self) -> Stages {
+        let (a, b) = (self.first.stages(), self.second.stages());
+        Stages {
+            opaque: a.opaque || b.opaque,
+            translucent: a.translucent || b.translucent,
+            hdr_overlay: a.hdr_overlay || b.hdr_overlay,
+            overlay: a.overlay || b.overlay,
+        }
+    }
+
+    fn translucent_objects(&self) -> &[TranslucentObject] {
+        &self.objects
+    }
+
+    /// The first part's context, else the second's; where both name one and they are of two
+    /// devices, the second's (one of them is not the renderer's: the frame is refused
+    /// unless the renderer's is the second's).
+    fn context(&self) -> Option<&GpuContext> {
+        match (self.first.context(), self.second.context()) {
+            (Some(a), Some(b)) if !a.same_device(b) => Some(b),
+            (a, b) => a.or(b),
+        }
+    }
+
+    fn translucent_contract_id(&self) -> Option<u64> {
+        let ids = [
+            self.first.translucent_contract_id(),
+            self.second.translucent_contract_id(),
+        ];
+        // The first part whose id is not the one in force, else the one in force.
+        (0..2)
+            .filter(|&k| self.translucent[k])
+            .map(|k| ids[k])
+            .find(|&id| id != self.contract)
+            .unwrap_or(self.contract)
+    }
+
+    fn follow_contract(&mut self, ctx: &GpuContext, contract: &TranslucentContract) {
+        self.contract = Some(contract.id);
+        self.translucent = [
+            self.first.stages().translucent,
+            self.second.stages().translucent,
+        ];
+        if self.translucent[0] {
+            self.first.follow_contract(ctx, contract);
+        }
+        if self.translucent[1] {
+            self.second.follow_contract(ctx, contract);
+        }
+        // The objects after following (a part may change them there).
+        self.objects.clear();
+        if self.translucent[0] {
+            self.objects
+                .extend_from_slice(self.first.translucent_objects());
+        }
+        self.split = self.objects.len();
+        if self.translucent[1] {
+            self.objects
+                .extend_from_slice(self.second.translucent_objects());
+        }
+    }
+
+    fn prepare(&mut self, ctx: &GpuContext, frame: &GameFrame<'_>) {
+        let stages = [self.first.stages(), self.second.stages()];
+        if !(stages[0].translucent || stages[1].translucent) {
+            // No translucent stage this frame: `follow_contract` was not called.
+            self.translucent = [false; 2];
+            self.objects.clear();
+            self.split = 0;
+        }
+        let [a, b] = &mut self.orders;
+        a.clear();
+        b.clear();
+        self.positions.clear();
+        if let Some(order) = frame.order {
+            let split = self.split as u32;
+            for &i in order {
+                let (k, share, index) = if i < split {
+                    (0, &mut *a, i)
+                } else {
+                    (1, &mut *b, i - split)
+                };
+                self.positions.push((k, share.len() as u32));
+                share.push(index);
+            }
+        }
+        let sorted = frame.order.is_some();
+        if stages[0] != Stages::default() {
+            let f = GameFrame {
+                order: sorted.then_some(self.orders[0].as_slice()),
+                ..*frame
+            };
+            self.first.prepare(ctx, &f);
+        }
+        if stages[1] != Stages::default() {
+            let f = GameFrame {
+                order: sorted.then_some(self.orders[1].as_slice()),
+                ..*frame
+            };
+            self.second.prepare(ctx, &f);
+        }
+    }
+
+    fn opaque(&self, pass: &mut wgpu::RenderPass<'_>, frame: &GameFrame<'_>) {
+        if self.first.stages().opaque {
+            self.first.opaque(pass, frame);
+        }
+        if self.second.stages().opaque {
+            self.second.opaque(pass, frame);
+        }
+    }
+
+    fn translucent(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        frame: &GameFrame<'_>,
+        variant: usize,
+        objects: Range<usize>,
+    ) {
+        let total = self.objects.len();
+        let (start, end) = (objects.start.min(total), objects.end.min(total));
+        if frame.order.is_some() {
+            // Positions in the order: each run of one part's objects in one call.
+            let mut i = start;
+            while i < end {
+                let k = self.positions[i].0;
+                let mut j = i + 1;
+                while j < end && self.positions[j].0 == k {
+                    j += 1;
+                }
+                let range = self.positions[i].1 as usize..self.positions[j - 1].1 as usize + 1;
+                let part = usize::from(k);
+                self.part(part)
+                    .translucent(pass, &self.frame_of(frame, part), variant, range);
+                i = j;
+            }
+        } else {
+            // Indices: `first`'s below the split, `second`'s above it.
+            let a = start.min(self.split)..end.min(self.split);
+            if self.translucent[0] && !a.is_empty() {
+                self.first.translucent(pass, frame, variant, a);
+            }
+            let b = start.max(self.split) - self.split..end.max(self.split) - self.split;
+            if self.translucent[1] && !b.is_empty() {
+                self.second.translucent(pass, frame, variant, b);
+            }
+        }
+        // A part without objects draws everything, after the last object.
+        if end == total {
+            let counts = [self.split, total - self.split];
+            for (k, count) in counts.into_iter().enumerate() {
+                if self.translucent[k] && count == 0 {
+                    self.part(k)
+                        .translucent(pass, &self.frame_of(frame, k), variant, 0..0);
+                }
+            }
+        }
+    }
+
+    fn hdr_overlay(&self, pass: &mut wgpu::RenderPass<'_>, frame: &GameFrame<'_>) {
+        if self.first.stages().hdr_overlay {
+            self.first.hdr_overlay(pass, frame);
+        }
+        if self.second.stages().hdr_overlay {
+            self.second.hdr_overlay(pass, frame);
+        }
+    }
+
+    fn overlay(&self, pass: &mut wgpu::RenderPass<'_>, frame: &GameFrame<'_>) {
+        if self.first.stages().overlay {
+            self.first.overlay(pass, frame);
+        }
+        if self.second.stages().overlay {
+            self.second.overlay(pass, frame);
+        }
+    }
+}
+
 /// The game's translucent part of a frame as the techniques see it.
 pub(crate) struct GameDraw<'a> {
     /// The game.

@@ -115,6 +115,7 @@ impl Game {
                         half_size: size as f32,
                         color: [225, 240, 255],
                         opacity: 0.45,
+                        emissive: 0.0,
                     }
                 })
                 .collect();
@@ -126,6 +127,7 @@ impl Game {
                 rotation: DQuat::from_euler(glam::EulerRot::YXZ, time * 0.6, 0.5, 0.3),
                 color: [90, 225, 140],
                 opacity: 0.45,
+                emissive: 0.0,
             });
         }
         if toggles.boat {
@@ -140,6 +142,7 @@ impl Game {
                 ),
                 color: [125, 82, 45],
                 opacity: 1.0,
+                emissive: 0.0,
             });
         }
         content
@@ -191,9 +194,9 @@ fn prepare(
     ahead: bool,
 ) -> voxel_render::Result<()> {
     match stages {
-        Some(s) => s.set_content(ctx, content.clone()),
+        Some(s) => s.set_content(ctx, content.clone())?,
         None => {
-            let s = stages.insert(ContentStages::new(renderer, content.clone()));
+            let s = stages.insert(ContentStages::new(renderer, content.clone())?);
             if ahead {
                 for t in Technique::supported(&ctx.caps) {
                     if !t.stalls() {

@@ -41,7 +41,8 @@ impl RayMarcher {
             if q.dot(right).abs() > s || q.dot(up).abs() > s {
                 continue;
             }
-            let l = light.sky();
+            // Lit, plus its own light (`content.wgsl`).
+            let l = light.sky() + f64::from(p.emissive);
             hits.push(ContentHit {
                 t,
                 color: p.color.map(|c| srgb_to_linear(c) * l),
@@ -100,7 +101,7 @@ impl RayMarcher {
                     && t <= far
                 {
                     let normal = box_normal(e.rotation, a, sign);
-                    let l = light.on(normal);
+                    let l = light.on(normal) + f64::from(e.emissive);
                     hits.push(ContentHit {
                         t,
                         color: e.color.map(|c| srgb_to_linear(c) * l),
@@ -115,7 +116,7 @@ impl RayMarcher {
                 continue;
             }
             let normal = box_normal(e.rotation, face.0, face.1);
-            let l = light.on(normal);
+            let l = light.on(normal) + f64::from(e.emissive);
             hits.push(ContentHit {
                 t: t_in,
                 color: e.color.map(|c| srgb_to_linear(c) * l),

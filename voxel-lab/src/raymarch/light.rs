@@ -94,7 +94,7 @@ impl Light {
             .and_then(|id| m.media.get(id.index()).copied().flatten())
             .map(|look| Fog {
                 color: look.color.map(|c| c * medium_light),
-                density: look.absorption,
+                density: look.fog,
             });
         let f = camera.unit_forward();
         let up = if f.y.abs() > 0.999 {

@@ -161,7 +161,8 @@ pub struct RayMarcher {
     textures: voxel_render::textures::TextureSet,
     flat: Vec<[f64; 4]>,
     /// Per block: the medium a ray inside it is in (a translucent block's own, a cutout
-    /// block's [`voxel_core::BlockDef::medium`]): linear colour and absorption per block.
+    /// block's [`voxel_core::BlockDef::medium`]): linear colour, absorption per block and
+    /// the fog an eye inside it sees.
     media: Vec<Option<Medium>>,
     /// Per block: the medium a cutout block stands in.
     medium_of: Vec<Option<BlockId>>,
@@ -217,6 +218,7 @@ impl RayMarcher {
                     let own = |d: &voxel_core::BlockDef| Medium {
                         color: d.color.map(srgb_to_linear),
                         absorption: f64::from(d.absorption),
+                        fog: f64::from(d.eye_absorption()),
                     };
                     match d.class {
                         RenderClass::Translucent => Some(own(d)),

@@ -385,11 +385,13 @@ pub(super) struct Walker<'a> {
     pub(super) faces: &'a mut std::collections::hash_map::DefaultHasher,
 }
 
-/// A medium: linear colour, absorption per block.
+/// A medium: linear colour, absorption per block as a volume and as the fog an eye inside
+/// it sees (`BlockDef::eye_absorption`).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Medium {
     pub(super) color: [f64; 3],
     pub(super) absorption: f64,
+    pub(super) fog: f64,
 }
 
 /// A volume the ray is in: since `start` (a ray parameter), lit colour and absorption.

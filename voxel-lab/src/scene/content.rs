@@ -8,9 +8,9 @@ use voxel_render::low_level::WORLD_EXTENT;
 use super::format::SceneFile;
 use super::parse::at_line;
 use crate::content::rotation;
-use voxel_render::content::{Content, Entity};
+use voxel_render::content::{Content, Entity, MAX_EMISSIVE, Particle};
 
-/// Most particles a scene file may ask for, in all: a frame draws each one (36 vertices),
+/// Most particles a scene file may ask for, in all: a frame draws each one (6 vertices),
 /// and the ray march bins them per picture.
 pub const MAX_PARTICLES: usize = 1_000_000;
 
@@ -33,15 +33,25 @@ pub(super) fn content_of(text: &str, file: &SceneFile) -> Result<Content> {
         if !(d.opacity.is_finite() && d.opacity > 0.0 && d.opacity <= 1.0) {
             return bad("opacity must be above 0 and at most 1");
         }
-        content.particles.extend(Content::scatter(
-            DVec3::from(d.min),
-            DVec3::from(d.max),
-            d.count,
-            d.seed,
-            d.size,
-            d.color,
-            d.opacity,
-        ));
+        if !(0.0..=MAX_EMISSIVE).contains(&d.emissive) {
+            return bad(&format!(
+                "emissive must be a number from 0 to {MAX_EMISSIVE}"
+            ));
+        }
+        let emissive = d.emissive;
+        content.particles.extend(
+            Content::scatter(
+                DVec3::from(d.min),
+                DVec3::from(d.max),
+                d.count,
+                d.seed,
+                d.size,
+                d.color,
+                d.opacity,
+            )
+            .into_iter()
+            .map(|p| Particle { emissive, ..p }),
+        );
     }
     for e in &file.entities {
         let (span, d) = (e.span(), e.get_ref());
@@ -59,12 +69,18 @@ pub(super) fn content_of(text: &str, file: &SceneFile) -> Result<Content> {
         if !(d.opacity.is_finite() && d.opacity > 0.0 && d.opacity <= 1.0) {
             return bad("opacity must be above 0 and at most 1 (1: opaque)");
         }
+        if !(0.0..=MAX_EMISSIVE).contains(&d.emissive) {
+            return bad(&format!(
+                "emissive must be a number from 0 to {MAX_EMISSIVE}"
+            ));
+        }
         content.entities.push(Entity {
             center: DVec3::from(d.center),
             half_extents: d.size.map(|s| s / 2.0),
             rotation: rotation(d.rotation),
             color: d.color,
             opacity: d.opacity,
+            emissive: d.emissive,
         });
     }
     Ok(content)

@@ -65,6 +65,9 @@ pub(super) struct ParticlesDef {
     #[serde(deserialize_with = "exact")]
     pub(super) color: [u8; 3],
     pub(super) opacity: f32,
+    /// The light they give off, in multiples of their colour (default 0).
+    #[serde(default)]
+    pub(super) emissive: f32,
 }
 
 fn default_particle_seed() -> u64 {
@@ -88,6 +91,9 @@ pub(super) struct EntityDef {
     pub(super) color: [u8; 3],
     #[serde(default = "default_entity_opacity")]
     pub(super) opacity: f32,
+    /// The light it gives off, in multiples of its colour (default 0).
+    #[serde(default)]
+    pub(super) emissive: f32,
 }
 
 fn default_entity_opacity() -> f32 {

@@ -1,7 +1,9 @@
 // A game's content drawn through the renderer's stages (draw.rs): boxes turned any way
-// and camera-facing particles, pulled from a storage buffer, 36 vertices each (a particle
-// uses the first 6). Lit like the world's faces: Lambert with the sun plus ambient at the light's
-// brightness, a particle as a face turned to the sky.
+// and camera-facing particles, 36 vertices a box and 6 a particle, each instance a `Prim`
+// (from a storage buffer, `content_storage.wgsl`, or per-instance vertex attributes,
+// `content_instanced.wgsl`, appended after this). Lit like the world's faces: Lambert with
+// the sun plus ambient at the light's brightness, a particle as a face turned to the sky;
+// plus the light it gives off, in multiples of its linear colour.
 
 struct View {
     view_proj: mat4x4<f32>,
@@ -18,7 +20,9 @@ struct Prim {
     // 0: box, 1: particle.
     kind: u32,
     // Box axes scaled by the half extents; a particle's half size in axis_x.x.
-    axis_x: vec4<f32>,
+    axis_x: vec3<f32>,
+    // The light it gives off, in multiples of its linear colour.
+    emissive: f32,
     axis_y: vec4<f32>,
     axis_z: vec4<f32>,
     // Linear colour and opacity.
@@ -26,7 +30,6 @@ struct Prim {
 };
 
 @group(0) @binding(0) var<uniform> view: View;
-@group(1) @binding(0) var<storage, read> prims: array<Prim>;
 
 struct ContentOut {
     // Invariant, as depth peeling needs of every translucent surface.
@@ -40,14 +43,18 @@ const SQUARE = array<vec2<f32>, 6>(
     vec2(-1.0, -1.0), vec2(1.0, 1.0), vec2(-1.0, 1.0),
 );
 
-@vertex
-fn vs_content(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> ContentOut {
-    let p = prims[ii];
+// The colour of `p` lit by `light`, plus its own light.
+fn content_color(p: Prim, light: f32) -> vec4<f32> {
+    return vec4<f32>(p.color.rgb * (light + p.emissive), p.color.a);
+}
+
+// Vertex `vi` of primitive `p`.
+fn content_vertex(vi: u32, p: Prim) -> ContentOut {
     var out: ContentOut;
     let c = SQUARE[vi % 6u];
     if p.kind == 1u {
         if vi >= 6u {
-            // Collapsed: no area, nothing drawn.
+            // A particle is drawn with 6 vertices; any more collapse to nothing.
             out.position = vec4<f32>(0.0, 0.0, 0.0, 1.0);
             out.color = vec4<f32>(0.0);
             return out;
@@ -55,14 +62,14 @@ fn vs_content(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) 
         let world = p.center + (view.right.xyz * c.x + view.up.xyz * c.y) * p.axis_x.x;
         out.position = view.view_proj * vec4<f32>(world, 1.0);
         let light = view.brightness * (view.ambient + (1.0 - view.ambient) * max(view.sun.y, 0.0));
-        out.color = vec4<f32>(p.color.rgb * light, p.color.a);
+        out.color = content_color(p, light);
         return out;
     }
     // Face f of a box: axis f / 2, on its + side for even f.
     let face = vi / 6u;
     let axis = face / 2u;
     let sign = select(-1.0, 1.0, (face & 1u) == 0u);
-    var axes = array<vec3<f32>, 3>(p.axis_x.xyz, p.axis_y.xyz, p.axis_z.xyz);
+    var axes = array<vec3<f32>, 3>(p.axis_x, p.axis_y.xyz, p.axis_z.xyz);
     let n = axes[axis] * sign;
     let u = axes[(axis + 1u) % 3u];
     let v = axes[(axis + 2u) % 3u];
@@ -71,7 +78,7 @@ fn vs_content(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) 
     let world = p.center + n + u * k.x + v * k.y;
     out.position = view.view_proj * vec4<f32>(world, 1.0);
     let light = view.brightness * (view.ambient + (1.0 - view.ambient) * max(dot(normalize(n), view.sun), 0.0));
-    out.color = vec4<f32>(p.color.rgb * light, p.color.a);
+    out.color = content_color(p, light);
     return out;
 }
 

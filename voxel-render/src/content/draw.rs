@@ -6,13 +6,15 @@ use std::ops::Range;
 use glam::DVec3;
 
 use super::{Content, Entity, Particle};
+use crate::error::scoped;
+use crate::ladder::{self, Limit, Need};
 use crate::stages::{
     DEPTH_COMPARE, GameFrame, GameStages, OIT_GROUP, Stages, TranslucentContract, TranslucentObject,
 };
 use crate::textures::srgb_to_linear;
-use crate::{DEPTH_FORMAT, GpuContext, Renderer, Result, SCENE_FORMAT, Technique};
+use crate::{DEPTH_FORMAT, GpuContext, QuadFetch, Renderer, Result, SCENE_FORMAT, Technique};
 
-/// One primitive of the instance buffer (`Prim` in `content.wgsl`).
+/// One primitive of the instances (`Prim` in `content.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 struct Prim {
@@ -21,12 +23,17 @@ struct Prim {
     /// 0: box, 1: particle.
     kind: u32,
     /// Box axes scaled by the half extents; a particle's half size in `axis_x[0]`.
-    axis_x: [f32; 4],
+    axis_x: [f32; 3],
+    /// The light it gives off, in multiples of its linear colour.
+    emissive: f32,
     axis_y: [f32; 4],
     axis_z: [f32; 4],
     /// Linear colour (lit per face in the shader) and opacity.
     color: [f32; 4],
 }
+
+/// Bytes of one primitive.
+const PRIM_BYTES: u64 = std::mem::size_of::<Prim>() as u64;
 
 /// The content shader's uniform (`View` in `content.wgsl`).
 #[repr(C)]
@@ -41,23 +48,103 @@ struct View {
     _pad: [f32; 3],
 }
 
+/// The fields of [`Prim`] as per-instance vertex attributes (`content_instanced.wgsl`).
+const PRIM_ATTRIBUTES: [wgpu::VertexAttribute; 7] = [
+    attribute(
+        0,
+        wgpu::VertexFormat::Float32x3,
+        std::mem::offset_of!(Prim, center),
+    ),
+    attribute(
+        1,
+        wgpu::VertexFormat::Uint32,
+        std::mem::offset_of!(Prim, kind),
+    ),
+    attribute(
+        2,
+        wgpu::VertexFormat::Float32x3,
+        std::mem::offset_of!(Prim, axis_x),
+    ),
+    attribute(
+        3,
+        wgpu::VertexFormat::Float32,
+        std::mem::offset_of!(Prim, emissive),
+    ),
+    attribute(
+        4,
+        wgpu::VertexFormat::Float32x4,
+        std::mem::offset_of!(Prim, axis_y),
+    ),
+    attribute(
+        5,
+        wgpu::VertexFormat::Float32x4,
+        std::mem::offset_of!(Prim, axis_z),
+    ),
+    attribute(
+        6,
+        wgpu::VertexFormat::Float32x4,
+        std::mem::offset_of!(Prim, color),
+    ),
+];
+
+const fn attribute(
+    location: u32,
+    format: wgpu::VertexFormat,
+    offset: usize,
+) -> wgpu::VertexAttribute {
+    wgpu::VertexAttribute {
+        format,
+        offset: offset as u64,
+        shader_location: location,
+    }
+}
+
+/// One [`Prim`] per instance.
+const PRIM_INSTANCES: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: PRIM_BYTES,
+    step_mode: wgpu::VertexStepMode::Instance,
+    attributes: &PRIM_ATTRIBUTES,
+};
+
+/// What the content needs of a device to fetch its instances the way `fetch` says.
+fn needs(fetch: QuadFetch) -> Vec<Need> {
+    match fetch {
+        QuadFetch::Storage => vec![
+            Need::Downlevel(wgpu::DownlevelFlags::VERTEX_STORAGE),
+            Need::Limit(Limit::StorageBuffersPerStage, 1),
+            Need::Limit(Limit::StorageBufferBindingSize, PRIM_BYTES),
+        ],
+        QuadFetch::Instanced => vec![
+            Need::Limit(Limit::VertexBuffers, 1),
+            Need::Limit(Limit::VertexAttributes, PRIM_ATTRIBUTES.len() as u64),
+            Need::Limit(Limit::VertexBufferArrayStride, PRIM_BYTES),
+        ],
+    }
+}
+
 /// Draws a [`Content`] through a renderer's stages: pass it to `Renderer::render`
 /// each frame. Its pipelines are built when a frame first needs them (the translucent ones
 /// per technique contract, kept by its id; the opaque one per sample count), or ahead with
-/// [`ContentStages::prebuild`].
+/// [`ContentStages::prebuild`]. Its instances reach the shader the way the renderer's
+/// world gets its quads (`RendererConfig::quad_fetch`): from storage buffers, or as
+/// instanced vertex attributes where the vertex stage has no storage buffers.
 #[derive(Debug)]
 pub struct ContentStages {
     /// The renderer's context its resources are made on.
     ctx: GpuContext,
     content: Content,
+    fetch: QuadFetch,
     module_src: String,
     view: wgpu::Buffer,
     view_layout: wgpu::BindGroupLayout,
+    /// The instances' group (storage fetch).
     prims_layout: wgpu::BindGroupLayout,
     view_group: wgpu::BindGroup,
+    /// Instances a buffer holds at most: a storage binding's or a buffer's size.
+    per_page: usize,
     /// Opaque boxes, and the translucent things in draw order.
-    opaque: Buffer,
-    translucent: Buffer,
+    opaque: Instances,
+    translucent: Instances,
     opaque_pipeline: Option<(u32, wgpu::RenderPipeline)>,
     /// One translucent pipeline per variant of each contract built for (by its id), and
     /// the contract in force.
@@ -72,48 +159,156 @@ pub struct ContentStages {
     objects: Vec<TranslucentObject>,
 }
 
-/// An instance buffer with its group.
-#[derive(Debug)]
-struct Buffer {
-    buffer: wgpu::Buffer,
-    group: wgpu::BindGroup,
-    count: u32,
+/// Instances in buffers of at most `per_page` each (pages), for as many as the content
+/// holds: a storage binding (128 MiB by default, 1.68 million primitives) or a buffer
+/// cannot hold every count a game may draw.
+#[derive(Debug, Default)]
+struct Instances {
+    pages: Vec<Page>,
+    /// Instances it has room for.
+    capacity: usize,
+    /// Instances written this frame.
+    count: usize,
+    /// Per instance in draw order: whether it is a particle (6 vertices, else a box's 36),
+    /// and where the run of its kind it lies in ends.
+    particle: Vec<bool>,
+    run_end: Vec<u32>,
 }
 
-impl Buffer {
-    /// A storage buffer of room for `prims` primitives (at least one), bound alone in a
-    /// group of `layout`.
+/// One buffer of instances, with its group for the storage fetch.
+#[derive(Debug)]
+struct Page {
+    buffer: wgpu::Buffer,
+    group: Option<wgpu::BindGroup>,
+}
+
+impl Instances {
+    /// Room for `capacity` instances (at least one) in pages of at most `per_page`.
     fn new(
         device: &wgpu::Device,
+        fetch: QuadFetch,
         layout: &wgpu::BindGroupLayout,
         label: &str,
-        prims: usize,
+        capacity: usize,
+        per_page: usize,
     ) -> Self {
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: (prims.max(1) * std::mem::size_of::<Prim>()) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let group = crate::gpu::bind_group(device, label, layout, &[buffer.as_entire_binding()]);
+        let capacity = capacity.max(1);
+        let pages = (0..capacity.div_ceil(per_page))
+            .map(|p| {
+                let n = per_page.min(capacity - p * per_page);
+                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size: n as u64 * PRIM_BYTES,
+                    usage: match fetch {
+                        QuadFetch::Storage => wgpu::BufferUsages::STORAGE,
+                        QuadFetch::Instanced => wgpu::BufferUsages::VERTEX,
+                    } | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                let group = (fetch == QuadFetch::Storage).then(|| {
+                    crate::gpu::bind_group(device, label, layout, &[buffer.as_entire_binding()])
+                });
+                Page { buffer, group }
+            })
+            .collect();
         Self {
-            buffer,
-            group,
-            count: 0,
+            pages,
+            capacity,
+            ..Self::default()
+        }
+    }
+
+    /// Writes `prims` (at most its capacity) page by page in `frame`'s encoder (a frame
+    /// recorded before this one keeps its own), and notes their kinds.
+    fn write(&mut self, frame: &GameFrame<'_>, prims: &[Prim], per_page: usize) -> Result<()> {
+        self.count = prims.len().min(self.capacity);
+        let mut written = Ok(());
+        for (page, chunk) in self.pages.iter().zip(prims[..self.count].chunks(per_page)) {
+            written = written.and(frame.write_buffer(&page.buffer, 0, bytemuck::cast_slice(chunk)));
+        }
+        self.note_kinds(&prims[..self.count]);
+        written
+    }
+
+    /// Notes the kind of each of `prims` and where its run of one kind ends.
+    fn note_kinds(&mut self, prims: &[Prim]) {
+        self.count = prims.len();
+        self.particle.clear();
+        self.particle
+            .extend(prims.iter().map(|p| p.kind == PARTICLE));
+        self.run_end.clear();
+        self.run_end.resize(self.count, 0);
+        for i in (0..self.count).rev() {
+            let same = i + 1 < self.count && self.particle[i + 1] == self.particle[i];
+            self.run_end[i] = if same {
+                self.run_end[i + 1]
+            } else {
+                (i + 1) as u32
+            };
+        }
+    }
+
+    /// Draws instances `range` (clamped to those written): page by page, each run of one
+    /// kind in one draw.
+    fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        fetch: QuadFetch,
+        range: Range<usize>,
+        per_page: usize,
+    ) {
+        let end = range.end.min(self.count);
+        let mut i = range.start.min(end);
+        let mut bound = None;
+        while i < end {
+            let page = i / per_page;
+            let Some(p) = self.pages.get(page) else {
+                return;
+            };
+            if bound != Some(page) {
+                match (&p.group, fetch) {
+                    (Some(group), QuadFetch::Storage) => pass.set_bind_group(1, group, &[]),
+                    _ => pass.set_vertex_buffer(0, p.buffer.slice(..)),
+                }
+                bound = Some(page);
+            }
+            let base = page * per_page;
+            let j = (self.run_end[i] as usize).min(end).min(base + per_page);
+            let vertices = if self.particle[i] {
+                PARTICLE_VERTICES
+            } else {
+                BOX_VERTICES
+            };
+            pass.draw(0..vertices, (i - base) as u32..(j - base) as u32);
+            i = j;
         }
     }
 }
 
 const CONTENT_WGSL: &str = include_str!("content.wgsl");
+const STORAGE_WGSL: &str = include_str!("content_storage.wgsl");
+const INSTANCED_WGSL: &str = include_str!("content_instanced.wgsl");
 
-/// Vertices drawn per primitive: a box's 36 (a particle uses the first 6, the rest
-/// collapse to nothing).
-const VERTICES: u32 = 36;
+/// `Prim::kind` of a particle.
+const PARTICLE: u32 = 1;
+/// Vertices drawn per box (its 6 faces) and per particle (one square).
+const BOX_VERTICES: u32 = 36;
+const PARTICLE_VERTICES: u32 = 6;
 
 impl ContentStages {
-    /// Resources for `content` on `renderer`'s device, lit like `renderer`'s world.
-    pub fn new(renderer: &Renderer, content: Content) -> Self {
+    /// Resources for `content` on `renderer`'s device, lit like `renderer`'s world, its
+    /// instances fetched the way the renderer fetches the world's quads
+    /// (`RendererConfig::quad_fetch`: from storage buffers, or as instanced vertex
+    /// attributes on a device without storage buffers in the vertex stage, such as
+    /// WebGL2's). Fails on a value outside its range ([`Content::validate`]:
+    /// `Error::InvalidContent`), on a device that lacks what that fetch needs
+    /// (`Error::Unsupported` naming it), or when the device cannot hold the instances
+    /// (`Error::Gpu`).
+    pub fn new(renderer: &Renderer, content: Content) -> Result<Self> {
+        content.validate()?;
         let ctx = renderer.context();
+        let fetch = renderer.config().quad_fetch.unwrap_or_default();
+        ladder::check("drawing game content", &needs(fetch), &ctx.caps)?;
         let device = &ctx.device;
         let uniform = wgpu::BindGroupLayoutEntry {
             binding: 0,
@@ -133,14 +328,18 @@ impl ContentStages {
             },
             ..uniform
         };
-        let layout = |label, entry| {
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
             device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some(label),
-                entries: &[entry],
+                entries,
             })
         };
-        let view_layout = layout("content_view_layout", uniform);
-        let prims_layout = layout("content_prims_layout", storage);
+        let view_layout = layout("content_view_layout", &[uniform]);
+        // No storage binding at all where the fetch takes none (WebGL2 has none to give).
+        let prims_layout = match fetch {
+            QuadFetch::Storage => layout("content_prims_layout", &[storage]),
+            QuadFetch::Instanced => layout("content_prims_layout", &[]),
+        };
         let view = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("content_view"),
             size: std::mem::size_of::<View>() as u64,
@@ -155,48 +354,84 @@ impl ContentStages {
                 resource: view.as_entire_binding(),
             }],
         });
-        let buffer = |label, n: usize| Buffer::new(device, &prims_layout, label, n);
-        let opaque_count = content.entities.iter().filter(|e| e.is_opaque()).count();
-        let translucent_count = content.particles.len() + content.entities.len() - opaque_count;
-        let objects = Self::objects(&content);
-        Self {
+        let limits = &ctx.caps.limits;
+        let page_bytes = match fetch {
+            QuadFetch::Storage => limits
+                .max_storage_buffer_binding_size
+                .min(limits.max_buffer_size),
+            QuadFetch::Instanced => limits.max_buffer_size,
+        };
+        let per_page = usize::try_from(page_bytes / PRIM_BYTES)
+            .unwrap_or(usize::MAX)
+            .max(1);
+        let module_src = CONTENT_WGSL.to_owned()
+            + match fetch {
+                QuadFetch::Storage => STORAGE_WGSL,
+                QuadFetch::Instanced => INSTANCED_WGSL,
+            };
+        let mut stages = Self {
             ctx: ctx.clone(),
-            module_src: CONTENT_WGSL.to_owned(),
-            opaque: buffer("content_opaque", opaque_count),
-            translucent: buffer("content_translucent", translucent_count),
+            content: Content::default(),
+            fetch,
+            module_src,
             view,
             view_layout,
             prims_layout,
             view_group,
+            per_page,
+            opaque: Instances::default(),
+            translucent: Instances::default(),
             opaque_pipeline: None,
             translucent_pipelines: HashMap::new(),
             contract: None,
             follow: true,
             built: 0,
-            objects,
-            content,
-        }
+            objects: Vec::new(),
+        };
+        let (opaque, translucent) = counts(&content);
+        stages.allocate(ctx, opaque, translucent)?;
+        stages.objects = Self::objects(&content);
+        stages.content = content;
+        Ok(stages)
     }
 
-    /// Replaces what it draws (moving particles, a turning cube); the instance buffers grow
-    /// when needed.
-    pub fn set_content(&mut self, ctx: &GpuContext, content: Content) {
-        let opaque = content.entities.iter().filter(|e| e.is_opaque()).count();
-        let translucent = content.particles.len() + content.entities.len() - opaque;
-        let fits =
-            |b: &Buffer, n: usize| b.buffer.size() >= (n * std::mem::size_of::<Prim>()) as u64;
-        if !fits(&self.opaque, opaque) || !fits(&self.translucent, translucent) {
-            // Twice what is needed, so that content growing a little rebuilds nothing.
-            let make =
-                |label, n: usize| Buffer::new(&ctx.device, &self.prims_layout, label, 2 * n.max(1));
-            let rebuilt = (
-                make("content_opaque", opaque),
-                make("content_translucent", translucent),
-            );
-            (self.opaque, self.translucent) = rebuilt;
+    /// How its instances reach the shader: the renderer's quad fetch when it was made.
+    pub fn fetch(&self) -> QuadFetch {
+        self.fetch
+    }
+
+    /// Replaces what it draws (moving particles, a turning cube). The instance buffers grow
+    /// when needed (to twice what is needed, at most a buffer more, so that content growing
+    /// a little rebuilds nothing), over as many buffers as the device's binding size
+    /// needs. Fails, keeping what it drew, on a value outside its range
+    /// (`Error::InvalidContent`) or when the device cannot hold the instances
+    /// (`Error::Gpu`).
+    pub fn set_content(&mut self, ctx: &GpuContext, content: Content) -> Result<()> {
+        content.validate()?;
+        let (opaque, translucent) = counts(&content);
+        if opaque > self.opaque.capacity || translucent > self.translucent.capacity {
+            let room = |n: usize| n + n.min(self.per_page);
+            self.allocate(ctx, room(opaque), room(translucent))?;
         }
         self.objects = Self::objects(&content);
         self.content = content;
+        Ok(())
+    }
+
+    /// New instance buffers with room for `opaque` and `translucent` instances; on failure
+    /// (out of memory) the old ones stay.
+    fn allocate(&mut self, ctx: &GpuContext, opaque: usize, translucent: usize) -> Result<()> {
+        let device = &ctx.device;
+        let (fetch, per_page, layout) = (self.fetch, self.per_page, &self.prims_layout);
+        let make = |label, n| Instances::new(device, fetch, layout, label, n, per_page);
+        let (o, t) = scoped(device, "allocating the game content's instances", || {
+            (
+                make("content_opaque", opaque),
+                make("content_translucent", translucent),
+            )
+        })?;
+        (self.opaque, self.translucent) = (o, t);
+        Ok(())
     }
 
     /// The translucent objects in instance order before sorting: particles, then the
@@ -256,6 +491,15 @@ impl ContentStages {
         }
     }
 
+    /// The groups of its pipelines before [`OIT_GROUP`]: the view, and the instances'
+    /// group where they come from storage buffers.
+    fn groups(&self) -> Vec<Option<&wgpu::BindGroupLayout>> {
+        match self.fetch {
+            QuadFetch::Storage => vec![Some(&self.view_layout), Some(&self.prims_layout)],
+            QuadFetch::Instanced => vec![Some(&self.view_layout)],
+        }
+    }
+
     /// The opaque pipeline for `samples`, built if it has none.
     fn opaque_pipeline_for(&mut self, device: &wgpu::Device, samples: u32) {
         if self.opaque_pipeline.as_ref().map(|(s, _)| *s) != Some(samples) {
@@ -265,7 +509,7 @@ impl ContentStages {
             });
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("content_opaque"),
-                bind_group_layouts: &[Some(&self.view_layout), Some(&self.prims_layout)],
+                bind_group_layouts: &self.groups(),
                 immediate_size: 0,
             });
             let pipeline = self.pipeline(
@@ -334,10 +578,8 @@ impl ContentStages {
                     label: Some(v.name),
                     source: wgpu::ShaderSource::Wgsl(source.into()),
                 });
-                let mut groups = vec![Some(&self.view_layout), Some(&self.prims_layout)];
-                while groups.len() < OIT_GROUP as usize {
-                    groups.push(None);
-                }
+                let mut groups = self.groups();
+                groups.resize(OIT_GROUP as usize, None);
                 groups.push(Some(&v.layout));
                 let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                     label: Some(v.name),
@@ -368,6 +610,10 @@ impl ContentStages {
         depth: wgpu::DepthStencilState,
         samples: u32,
     ) -> wgpu::RenderPipeline {
+        let buffers: &[Option<wgpu::VertexBufferLayout<'_>>] = match self.fetch {
+            QuadFetch::Storage => &[],
+            QuadFetch::Instanced => &[Some(PRIM_INSTANCES)],
+        };
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some(fragment),
             layout: Some(layout),
@@ -375,7 +621,7 @@ impl ContentStages {
                 module,
                 entry_point: Some("vs_content"),
                 compilation_options: Default::default(),
-                buffers: &[],
+                buffers,
             },
             primitive: wgpu::PrimitiveState {
                 cull_mode: Some(wgpu::Face::Back),
@@ -405,13 +651,15 @@ impl ContentStages {
         if !e.is_opaque() && e.contains(frame.camera.eye) {
             axes[0] = -axes[0];
         }
-        let a = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
+        let a3 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
+        let a4 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
         Prim {
             center: frame.relative(e.center).to_array(),
             kind: 0,
-            axis_x: a(axes[0]),
-            axis_y: a(axes[1]),
-            axis_z: a(axes[2]),
+            axis_x: a3(axes[0]),
+            emissive: e.emissive,
+            axis_y: a4(axes[1]),
+            axis_z: a4(axes[2]),
             color: linear(e.color, e.opacity),
         }
     }
@@ -419,17 +667,34 @@ impl ContentStages {
     fn prim_of_particle(p: &Particle, frame: &GameFrame<'_>) -> Prim {
         Prim {
             center: frame.relative(p.center).to_array(),
-            kind: 1,
-            axis_x: [p.half_size, 0.0, 0.0, 0.0],
+            kind: PARTICLE,
+            axis_x: [p.half_size, 0.0, 0.0],
+            emissive: p.emissive,
             color: linear(p.color, p.opacity),
             ..Prim::default()
         }
     }
+
+    /// Binds what every draw of its pipelines reads besides the instances.
+    fn bind_view(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_bind_group(0, &self.view_group, &[]);
+    }
 }
 
+/// Opaque and translucent instances of `content`.
+fn counts(content: &Content) -> (usize, usize) {
+    let opaque = content.entities.iter().filter(|e| e.is_opaque()).count();
+    (
+        opaque,
+        content.particles.len() + content.entities.len() - opaque,
+    )
+}
+
+/// An sRGB colour and an opacity as the shader takes them: linear, the opacity as it is
+/// (checked to lie in 0 to 1).
 fn linear(c: [u8; 3], opacity: f32) -> [f32; 4] {
     let [r, g, b] = c.map(srgb_to_linear);
-    [r, g, b, opacity.clamp(0.0, 1.0)]
+    [r, g, b, opacity]
 }
 
 /// The translucent fragment entry, after a technique's prelude and the content shader.
@@ -507,30 +772,31 @@ impl GameStages for ContentStages {
             )
             .collect();
         if let Some(order) = frame.order {
-            // An object cut at a plane it reaches through is in the order once per part.
             translucent = order
                 .iter()
                 .filter_map(|&i| translucent.get(i as usize).copied())
                 .collect();
-            let need = (translucent.len() * std::mem::size_of::<Prim>()) as u64;
-            if self.translucent.buffer.size() < need {
-                self.translucent = Buffer::new(
-                    &ctx.device,
+        }
+        let per_page = self.per_page;
+        let device = &ctx.device;
+        for (instances, prims, label) in [
+            (&mut self.opaque, opaque, "content_opaque"),
+            (&mut self.translucent, translucent, "content_translucent"),
+        ] {
+            // An object cut at a plane it reaches through is in the order once per part:
+            // the instances may outgrow what `set_content` made room for.
+            if prims.len() > instances.capacity {
+                *instances = Instances::new(
+                    device,
+                    self.fetch,
                     &self.prims_layout,
-                    "content_translucent",
-                    2 * translucent.len(),
+                    label,
+                    2 * prims.len(),
+                    per_page,
                 );
             }
+            written = written.and(instances.write(frame, &prims, per_page));
         }
-        for (buffer, prims) in [
-            (&mut self.opaque, opaque),
-            (&mut self.translucent, translucent),
-        ] {
-            buffer.count = prims.len() as u32;
-            written =
-                written.and(frame.write_buffer(&buffer.buffer, 0, bytemuck::cast_slice(&prims)));
-        }
-        // The buffers are made for these writes (`set_content` grows them).
         if let Err(e) = written {
             log::error!("content: {e}");
         }
@@ -541,9 +807,9 @@ impl GameStages for ContentStages {
             return;
         };
         pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &self.view_group, &[]);
-        pass.set_bind_group(1, &self.opaque.group, &[]);
-        pass.draw(0..VERTICES, 0..self.opaque.count);
+        self.bind_view(pass);
+        self.opaque
+            .draw(pass, self.fetch, 0..self.opaque.count, self.per_page);
     }
 
     fn translucent(
@@ -560,14 +826,70 @@ impl GameStages for ContentStages {
         else {
             return;
         };
-        let end = (objects.end as u32).min(self.translucent.count);
-        let start = (objects.start as u32).min(end);
-        if start == end {
+        if objects.start >= objects.end.min(self.translucent.count) {
             return;
         }
         pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &self.view_group, &[]);
-        pass.set_bind_group(1, &self.translucent.group, &[]);
-        pass.draw(0..VERTICES, start..end);
+        self.bind_view(pass);
+        self.translucent
+            .draw(pass, self.fetch, objects, self.per_page);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::wgsl_layout::{assert_layout, field, parse};
+
+    #[test]
+    fn prim_and_view_match_the_wgsl() {
+        let module = parse(&(CONTENT_WGSL.to_owned() + STORAGE_WGSL));
+        assert_layout::<Prim>(
+            &module,
+            "Prim",
+            &[
+                field!(Prim, center),
+                field!(Prim, kind),
+                field!(Prim, axis_x),
+                field!(Prim, emissive),
+                field!(Prim, axis_y),
+                field!(Prim, axis_z),
+                field!(Prim, color),
+            ],
+        );
+        assert_layout::<View>(
+            &module,
+            "View",
+            &[
+                field!(View, view_proj),
+                field!(View, right),
+                field!(View, up),
+                field!(View, sun),
+                field!(View, ambient),
+                field!(View, brightness),
+            ],
+        );
+        // The instanced entry point parses too, its attributes at the fields' offsets.
+        let _ = parse(&(CONTENT_WGSL.to_owned() + INSTANCED_WGSL));
+        assert_eq!(PRIM_ATTRIBUTES[3].offset, 28);
+        assert_eq!(PRIM_BYTES, 80);
+    }
+
+    /// Runs of one kind end where the kind changes.
+    #[test]
+    fn runs_end_where_the_kind_changes() {
+        let prims: Vec<Prim> = [1, 1, 0, 0, 0, 1, 0]
+            .iter()
+            .map(|&kind| Prim {
+                kind,
+                ..Prim::default()
+            })
+            .collect();
+        let mut inst = Instances::default();
+        inst.note_kinds(&prims);
+        assert_eq!(inst.run_end, vec![2, 2, 5, 5, 5, 6, 7]);
+        assert_eq!(inst.particle[..3], [true, true, false]);
+        inst.note_kinds(&[]);
+        assert!(inst.run_end.is_empty());
     }
 }

@@ -19,7 +19,9 @@ use crate::gpu::{self, Depth, Pass};
 use crate::medium::{self, MediumLook};
 use crate::oit::sorted::interleave::ChunkSequence;
 use crate::oit::{FrameView, Technique, TechniqueReport, TranslucentFrame};
-use crate::stages::{Clip, GameDraw, GameFrame, GameStages, GameWrites, Split, TranslucentContract};
+use crate::stages::{
+    Clip, GameDraw, GameFrame, GameStages, GameWrites, Split, TranslucentContract,
+};
 use crate::submission::Outcome;
 use crate::timing::{GpuPass, Timer};
 use crate::{Camera, Error, Result};
@@ -632,7 +634,7 @@ impl Renderer {
             volumes: media,
             medium_look: medium.map_or([0.0; 4], |(_, look)| {
                 let [r, g, b] = look.color;
-                [r, g, b, look.absorption]
+                [r, g, b, look.fog]
             }),
             ..FrameUniforms::default()
         }

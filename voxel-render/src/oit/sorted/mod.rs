@@ -469,7 +469,8 @@ impl TranslucentTechnique for Sorted {
                     chunk += 1;
                 }
                 draws.draw_range(frame.chunks, chunk..usize::MAX, pass);
-                if next < game.objects {
+                // A game that orders nothing (no objects declared) draws everything here.
+                if next < game.objects || game.objects == 0 {
                     objects(pass, next..game.objects, 0);
                 }
             });
