@@ -5,9 +5,9 @@
 //! Modules depend on each other one way:
 //! - the model: [`error`] (what can go wrong, [`Error`]), [`files`] (result files written in one checked call), [`limits`] (the
 //!   documented caps on a run), [`progress`], [`random`]
-//!   (random scenes as scene-file text), [`edges`] (which pixels lie on quad edges),
+//!   (random scenes as scene-file text), [`overlaps`] (which pixels show two of a game's
+//!   objects that interpenetrate), [`edges`] (which pixels lie on quad edges),
 //!   [`content`] (what the ray march needs of a game's particles and entities),
-//!   [`overlaps`] (which pixels show two of a game's objects that interpenetrate),
 //!   [`raymarch`] (the CPU ray-march reference),
 //!   [`summary`], [`metrics`], [`scene`], [`headless`];
 //! - the runs, which use the model: [`eval`] (every scene × technique against the

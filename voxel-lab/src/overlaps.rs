@@ -220,9 +220,9 @@ mod tests {
         assert!(!intersect(&s[0], &s[1]));
         assert!(intersect(&s[0], &s[2]));
         assert_eq!(intersecting(&s, 0), vec![(0, 2)]);
-        let mask = overlap_mask(&content, &camera, (64, 36));
+        let mask = overlap_mask(&content, &camera, (256, 144));
         let n = mask.iter().filter(|&&m| m).count();
-        assert!(n > 10 && n < 64 * 36 / 4, "{n} pixels");
+        assert!(n > 20 && n < 256 * 144 / 8, "{n} pixels");
         // Apart: nothing.
         let apart = Content {
             particles: vec![],

@@ -626,7 +626,13 @@ impl<A: GameStages, B: GameStages> GameStages for Both<A, B> {
         variant: usize,
         objects: Range<usize>,
     ) {
-        let total = self.objects.len();
+        // Positions in the order (an object cut into parts is there once per part), or
+        // indices into the objects.
+        let total = if frame.order.is_some() {
+            self.positions.len()
+        } else {
+            self.objects.len()
+        };
         let (start, end) = (objects.start.min(total), objects.end.min(total));
         if frame.order.is_some() {
             // Positions in the order: each run of one part's objects in one call.

@@ -130,4 +130,14 @@ impl RayMarcher {
     pub(super) fn medium_block(&self, id: BlockId) -> Option<BlockId> {
         self.medium_of.get(id.index()).copied().flatten()
     }
+
+    /// The translucent type a cell of block `id` holds: its own, or the medium it stands in
+    /// (a waterlogged block's cell holds its water, the mesher's rule).
+    pub(super) fn holds(&self, id: BlockId) -> Option<BlockId> {
+        match self.class(id) {
+            RenderClass::Translucent => Some(id),
+            RenderClass::Cutout => self.medium_block(id),
+            _ => None,
+        }
+    }
 }

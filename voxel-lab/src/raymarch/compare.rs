@@ -63,10 +63,10 @@ impl RayMarcher {
     /// `shading`) with a GPU picture of the same scene, and with the GPU's opaque depth
     /// (reverse-Z, 0 where nothing opaque was drawn) for cracks. A pixel whose colours
     /// differ by more than 1/255 is marched again at 96 points around its centre within
-    /// [`EDGE_RADIUS_PX`]: if one meets other surfaces or ends on another block's face, an
-    /// edge passes there (a face's edge, where faces the eye cannot see may touch the
-    /// visible one at the same depth) and the pixel is on an edge; otherwise it counts as
-    /// differing.
+    /// [`EDGE_RADIUS_PX`]: if one meets other surfaces or ends on a face of another plane or
+    /// block type, an edge passes there (a face's edge, where faces the eye cannot see may
+    /// touch the visible one at the same depth) and the pixel is on an edge; otherwise it
+    /// counts as differing.
     pub fn compare(
         &self,
         ray: &RayMarched,
@@ -131,10 +131,15 @@ impl RayMarcher {
                 c.max_abs_err_off_edges = c.max_abs_err_off_edges.max(diff);
                 continue;
             }
+            // An edge is where the surfaces change: another plane or block type met or
+            // ended on (the signature), not another block of the same type in the same plane
+            // (with flat textures and the same light, a far floor's blocks, which a pixel's
+            // ring spans under water and far away, draw as one surface).
+            let plane = |s: Option<Surface>| s.map(|s| s.plane());
             let mut seam = false;
             let near_edge = ring(i).any(|r| {
                 seam |= r.layer_faces != ray.layer_faces[i];
-                r.signature != ray.signature[i] || r.end != ray.end[i]
+                r.signature != ray.signature[i] || plane(r.end) != plane(ray.end[i])
             });
             if near_edge {
                 c.differing_on_edges += 1;

@@ -112,7 +112,7 @@ impl Surface {
 
     /// The plane the face lies in, as (face, coordinate along its axis): what makes two
     /// faces the same surface for edge finding (a merged quad is one plane of one type).
-    fn plane(&self) -> (Face, i64, BlockId) {
+    pub(super) fn plane(&self) -> (Face, i64, BlockId) {
         let axis = self.face.axis();
         let c = self.block[axis] + i64::from(self.face.is_positive());
         (self.face, c, self.id)

@@ -184,7 +184,10 @@ impl RayMarcher {
                     content_end = true;
                     break;
                 }
-                if t > t1 {
+                // The crossing out of the loaded box (into the air of absent chunks, where
+                // the mesher closes a volume with faces) is a crossing too: `t_max` and `t1`
+                // are computed apart and may differ by a rounding.
+                if t > t1 + 1e-9 * t1.abs().max(1.0) {
                     break;
                 }
                 cell[axis] += step[axis];
@@ -259,33 +262,24 @@ impl RayMarcher {
             return false;
         }
         let (ca, cb) = (self.class(x.from), self.class(x.to));
+        // The translucent type each cell holds (a waterlogged block's cell holds its medium).
+        let (ha, hb) = (self.holds(x.from), self.holds(x.to));
         let p = w.eye + w.dir * x.t;
         // The volume the ray was in, up to here.
         w.absorb_to(x.t);
-        // A cutout block standing in a medium hides the medium's faces toward it.
-        let stands_in = |cutout: BlockId, medium: BlockId| {
-            self.class(cutout) == RenderClass::Cutout && self.medium_block(cutout) == Some(medium)
-        };
-        // The face of `to` facing the ray: its normal points back along the step.
+        // The faces of `to` facing the ray (their normal points back along the step): its
+        // own opaque or cutout face, then (where a cutout texel lets it through) the face of
+        // the translucent type it holds, unless `from` holds that type too.
         let front_face = face_of(x.axis, x.step < 0);
-        let front = cb != RenderClass::Air
-            && !(ca == RenderClass::Opaque || (cb == RenderClass::Translucent && x.from == x.to))
-            && !stands_in(x.from, x.to);
-        let mut ended = false;
-        if front {
+        let (u, v) = face_uv(p, x.axis);
+        if ca != RenderClass::Opaque && matches!(cb, RenderClass::Opaque | RenderClass::Cutout) {
             let surface = Surface {
                 block: x.to_cell,
                 face: front_face,
                 id: x.to,
             };
-            let (u, v) = face_uv(p, x.axis);
             let a = self.albedo(x.to, front_face, u, v, w.shading.texturing);
-            match cb {
-                RenderClass::Opaque => ended = true,
-                RenderClass::Cutout => ended = a[3] >= CUTOUT_ALPHA_TEST,
-                _ => {}
-            }
-            if ended {
+            if cb == RenderClass::Opaque || a[3] >= CUTOUT_ALPHA_TEST {
                 let color = if w.want_color {
                     self.lit(surface, p, a, w)
                 } else {
@@ -294,32 +288,42 @@ impl RayMarcher {
                 *w.end = Some((surface, color));
                 return true;
             }
-            if cb == RenderClass::Translucent {
-                if Some(x.to) == w.medium && w.boundary.is_none() {
-                    w.set_boundary(x.t, surface);
-                }
-                w.layer(self, surface, p, a);
-            }
         }
-        // From inside a medium the renderer draws translucent back faces too.
+        if let Some(t) = hb
+            && ca != RenderClass::Opaque
+            && ha != Some(t)
+        {
+            let surface = Surface {
+                block: x.to_cell,
+                face: front_face,
+                id: t,
+            };
+            if Some(t) == w.medium && w.boundary.is_none() {
+                w.set_boundary(x.t, surface);
+            }
+            let a = self.albedo(t, front_face, u, v, w.shading.texturing);
+            w.layer(self, surface, p, a);
+        }
+        // From inside a medium the renderer draws translucent back faces too: the face of
+        // the type `from` holds, where `to` neither hides it nor holds that type.
         if let Some(m) = w.medium
-            && ca == RenderClass::Translucent
-            && !(cb == RenderClass::Opaque || x.from == x.to || stands_in(x.to, x.from))
+            && let Some(t) = ha
+            && cb != RenderClass::Opaque
+            && hb != Some(t)
         {
             let back = Surface {
                 block: [0, 1, 2].map(|a| x.to_cell[a] - if a == x.axis { x.step } else { 0 }),
                 face: face_of(x.axis, x.step > 0),
-                id: x.from,
+                id: t,
             };
-            let first = x.from == m && w.boundary.is_none();
+            let first = t == m && w.boundary.is_none();
             if first {
                 w.set_boundary(x.t, back);
             }
             // It counts when it is the medium's, not toward another translucent type, and
             // the first surface of the medium the ray meets.
-            if first && cb != RenderClass::Translucent {
-                let (u, v) = face_uv(p, x.axis);
-                let a = self.albedo(x.from, back.face, u, v, w.shading.texturing);
+            if first && hb.is_none() {
+                let a = self.albedo(t, back.face, u, v, w.shading.texturing);
                 w.layer(self, back, p, a);
             }
         }
@@ -339,7 +343,7 @@ impl RayMarcher {
                     absorption: m.absorption,
                 });
         }
-        ended
+        false
     }
 }
 

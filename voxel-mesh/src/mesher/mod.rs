@@ -10,7 +10,10 @@
 //!   that the renderer can tell, seen from inside a volume, where it meets air from where it
 //!   meets another translucent type.
 //! - A block standing in a medium (waterlogged kelp, [`voxel_core::BlockDef::medium`])
-//!   hides that medium's faces, as the medium does: the volume goes on through it.
+//!   holds that medium too: the medium's faces are meshed as if its cell were the
+//!   medium's (the volume goes on through it, and where it pokes out of the water the
+//!   medium's faces stand around and over it, Minecraft's rule for waterlogged blocks: the
+//!   medium of a waterlogged block ends at the block's top when no water is above it).
 //! - Air and cutout blocks hide nothing, so cutout faces stay against air, translucent and
 //!   other cutout blocks, leaves against leaves included (the holes of one leaf block show
 //!   the leaves behind it, as in Minecraft's fancy leaves).
@@ -400,6 +403,14 @@ impl Mesher {
         let medium = |id: BlockId| media[id.index()];
         let is_opaque = |id: BlockId| class(id) == RenderClass::Opaque;
         let is_translucent = |id: BlockId| class(id) == RenderClass::Translucent;
+        // The translucent type a block's cell holds: its own, or the medium it stands in.
+        let holds = |id: BlockId| {
+            if is_translucent(id) {
+                Some(id)
+            } else {
+                medium(id)
+            }
+        };
 
         // The centre's masks: stored, or built from the packed form (air is never meshed
         // and hides nothing, so it is left out).
@@ -453,21 +464,22 @@ impl Mesher {
             .flatten()
             .chain([&chunk])
             .flat_map(|c| c.palette())
-            .map(|(id, _)| id)
-            .filter(|&id| is_translucent(id));
+            .filter_map(|(id, _)| holds(id));
         let interfaces = types
             .next()
             .is_some_and(|first| types.any(|id| id != first));
         if interfaces {
             s.translucent.by_y.fill(0);
             s.translucent.by_x.fill(0);
-            for (_, bits) in entries().filter(|(id, _)| is_translucent(*id)) {
+            // A block standing in a medium holds it (a glass face toward waterlogged kelp
+            // meets water).
+            for (_, bits) in entries().filter(|(id, _)| holds(*id).is_some()) {
                 or_into(&mut s.translucent.by_y, &bits.by_y);
                 or_into(&mut s.translucent.by_x, &bits.by_x);
             }
             for face in Face::ALL {
                 s.nb_translucent[face as usize] =
-                    nb_union(&s.nb_layers[face as usize], &is_translucent);
+                    nb_union(&s.nb_layers[face as usize], &|id| holds(id).is_some());
             }
         }
         let full = |rows: &[u32]| rows.iter().all(|&r| r == u32::MAX);
@@ -499,10 +511,25 @@ impl Mesher {
             }
         }
 
-        for (id, bits) in entries() {
+        // The media that blocks of this chunk stand in: their cells hold the medium too.
+        let mut media_here: Vec<BlockId> = entries().filter_map(|(id, _)| medium(id)).collect();
+        media_here.sort_unstable();
+        media_here.dedup();
+        // Made only where something stands in a medium (8 KiB).
+        let mut pooled: Option<Box<Occupancy>> = None;
+        // A medium's cells: its blocks and those standing in it.
+        let pool = |pooled: &mut Occupancy, m: BlockId, own: Option<&Occupancy>| {
+            pooled.by_y = own.map_or([0; CHUNK_AREA], |o| o.by_y);
+            pooled.by_x = own.map_or([0; CHUNK_AREA], |o| o.by_x);
+            for (_, inside) in entries().filter(|(w, _)| medium(*w) == Some(m)) {
+                or_into(&mut pooled.by_y, &inside.by_y);
+                or_into(&mut pooled.by_x, &inside.by_x);
+            }
+        };
+        let mut mesh_one = |id: BlockId, bits: &Occupancy, uniform: bool| {
             let class = class(id);
             if class == RenderClass::Air {
-                continue;
+                return;
             }
             let mut nb_hide = s.nb_opaque;
             let hide = if class == RenderClass::Translucent {
@@ -543,7 +570,7 @@ impl Mesher {
                 out: out.for_class(class),
                 ao: occludes.then_some(&**pad),
             };
-            if chunk.as_uniform().is_some() {
+            if uniform {
                 // One block type everywhere. An opaque or translucent type hides itself, so
                 // only the border layers can show. A cutout type hides nothing: every inner
                 // layer is all faces, one 32×32 quad per layer and direction, exactly what
@@ -577,6 +604,23 @@ impl Mesher {
                 }
             } else {
                 mesh_type(bits, hide, &nb_hide, split, id, &mut sink);
+            }
+        };
+        for (id, bits) in entries() {
+            if media_here.contains(&id) {
+                let p = pooled.get_or_insert_with(|| Box::new(EMPTY_OCCUPANCY));
+                pool(p, id, Some(bits));
+                mesh_one(id, p, false);
+            } else {
+                mesh_one(id, bits, chunk.as_uniform().is_some());
+            }
+        }
+        // A medium only blocks standing in it bring into the chunk (kelp poking out).
+        for &m in &media_here {
+            if !entries().any(|(id, _)| id == m) {
+                let p = pooled.get_or_insert_with(|| Box::new(EMPTY_OCCUPANCY));
+                pool(p, m, None);
+                mesh_one(m, p, false);
             }
         }
         Ok(())

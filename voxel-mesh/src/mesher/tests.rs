@@ -209,6 +209,14 @@ fn naive<'n>(reg: &BlockRegistry, chunk: &Chunk, nb: impl Into<Neighbourhood<'n>
                 if ca == RenderClass::Air {
                     continue;
                 }
+                // The translucent type a cell holds: its block's, or the medium it stands in.
+                let holds = |id: BlockId| {
+                    if class(id) == RenderClass::Translucent {
+                        Some(id)
+                    } else {
+                        reg.get(id).expect("known").medium
+                    }
+                };
                 for face in Face::ALL {
                     let n = face.normal();
                     let b = get([
@@ -216,11 +224,11 @@ fn naive<'n>(reg: &BlockRegistry, chunk: &Chunk, nb: impl Into<Neighbourhood<'n>
                         y as i64 + i64::from(n[1]),
                         z as i64 + i64::from(n[2]),
                     ]);
-                    // A block standing in a medium hides the medium's faces.
-                    let medium_of_b = reg.get(b).expect("known").medium;
+                    // The block's own face: an opaque neighbour hides it, and a translucent
+                    // one the cells that hold its type (waterlogged blocks hold their medium).
                     let hidden = class(b) == RenderClass::Opaque
-                        || (ca == RenderClass::Translucent && (a == b || medium_of_b == Some(a)));
-                    if !hidden {
+                        || (ca == RenderClass::Translucent && holds(b) == Some(a));
+                    if !hidden && ca != RenderClass::Air {
                         let k = match ca {
                             RenderClass::Cutout => 1,
                             RenderClass::Translucent => 2,
@@ -228,13 +236,22 @@ fn naive<'n>(reg: &BlockRegistry, chunk: &Chunk, nb: impl Into<Neighbourhood<'n>
                         };
                         // A translucent face toward another translucent type.
                         let interface =
-                            ca == RenderClass::Translucent && class(b) == RenderClass::Translucent;
+                            ca == RenderClass::Translucent && holds(b).is_some_and(|t| t != a);
                         let ao = if ca == RenderClass::Translucent {
                             AO_NONE
                         } else {
                             ao_of([x, y, z].map(|v| v as i64), face)
                         };
                         out.insert(k, face as usize, [x, y, z], a, interface, ao);
+                    }
+                    // A block standing in a medium holds it: the medium's face where the
+                    // neighbour neither hides it nor holds the medium too.
+                    if let Some(m) = reg.get(a).expect("known").medium
+                        && class(b) != RenderClass::Opaque
+                        && holds(b) != Some(m)
+                    {
+                        let interface = holds(b).is_some();
+                        out.insert(2, face as usize, [x, y, z], m, interface, AO_NONE);
                     }
                 }
             }
@@ -806,4 +823,57 @@ fn same_quads(a: &ChunkMeshes, b: &ChunkMeshes) -> bool {
     ]
     .into_iter()
     .all(|(x, y)| sorted(x) == sorted(y))
+}
+
+/// A waterlogged block holds its water: where a kelp column pokes out of a pool, the water
+/// stands around and over it (Minecraft's rule: the medium of a waterlogged block ends at
+/// the block's top when no water is above it), and no water face lies inside the column.
+#[test]
+fn a_waterlogged_block_above_the_water_line_holds_its_water() {
+    let mut reg = registry();
+    let kelp = reg
+        .register(BlockDef::cutout("kelp", [40, 120, 60]).in_medium(WATER))
+        .unwrap();
+    let mut c = Chunk::default();
+    // A pool 4 deep (y 0..=3) and a kelp column from its floor to y = 6.
+    c.fill_box([0, 0, 0], [9, 3, 9], WATER).unwrap();
+    c.fill_box([5, 0, 5], [5, 6, 5], kelp).unwrap();
+    let m = Mesher::new(&reg).mesh(&c, NONE).expect("known blocks");
+    let water = |pos: [usize; 3], face: Face| {
+        unit_faces(&m.translucent).contains(&(pos, face as usize, WATER.0))
+    };
+    // Over the column's top, and around it above the water line.
+    assert!(
+        water([5, 6, 5], Face::PosY),
+        "the water over the kelp's top"
+    );
+    for y in 4..=6 {
+        for face in [Face::PosX, Face::NegX, Face::PosZ, Face::NegZ] {
+            assert!(
+                water([5, y, 5], face),
+                "the water around the kelp at y = {y}, {face:?}"
+            );
+        }
+    }
+    // Inside the column (the water line at y = 3 → 4) and toward the pool: none.
+    assert!(!water([5, 3, 5], Face::PosY) && !water([5, 4, 5], Face::NegY));
+    for face in [Face::PosX, Face::NegX, Face::PosZ, Face::NegZ] {
+        assert!(
+            !water([5, 2, 5], face),
+            "no water face inside the pool at the kelp"
+        );
+    }
+    // The pool's surface all around the column, none over it.
+    assert!(water([4, 3, 5], Face::PosY) && water([6, 3, 5], Face::PosY));
+    // The kelp's own faces are cutout, unchanged.
+    assert!(has(&m.cutout, [5, 6, 5], Face::PosY));
+    // A column of kelp alone (no water anywhere in the chunk) still holds its water.
+    let mut dry = Chunk::default();
+    dry.fill_box([2, 2, 2], [2, 4, 2], kelp).unwrap();
+    let m = Mesher::new(&reg).mesh(&dry, NONE).expect("known blocks");
+    assert_eq!(
+        unit_faces(&m.translucent).len(),
+        14,
+        "a 1×3×1 column of water around the kelp"
+    );
 }

@@ -175,7 +175,7 @@ impl Renderer {
                 .culled
                 .translucent_slots()
                 .any(|slot| self.chunks.by_slot(slot).is_some_and(GpuChunk::has_volume));
-        let eye_absorbs = medium.is_some_and(|(_, look)| look.absorption > 0.0);
+        let eye_absorbs = medium.is_some_and(|(_, look)| look.fog > 0.0);
         let media = match (exact, volumes, eye_absorbs) {
             (_, false, false) => MEDIA_NONE,
             (true, _, _) => MEDIA_WALK,

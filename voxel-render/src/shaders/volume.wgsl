@@ -58,10 +58,20 @@ fn medium_after(current: vec4<f32>, look: vec4<f32>, info: u32) -> vec4<f32> {
     if look.a > 0.0 && front {
         return look;
     }
-    if (look.a > 0.0 && !at_interface) || (front && at_interface) {
+    if leaves_volume(look, info) || (front && at_interface) {
         return vec4<f32>(0.0);
     }
     return current;
+}
+
+// Whether a fragment is a way out of a volume: a back face of a volume not toward another
+// translucent type, or of the eye's own medium, which fogs the eye even where its type is
+// a thin surface seen from outside (`BlockDef::eye_absorption`).
+fn leaves_volume(look: vec4<f32>, info: u32) -> bool {
+    let front = (info & INFO_FRONT) != 0u;
+    let at_interface = (info & INFO_INTERFACE) != 0u;
+    let eyes = frame.medium != NO_MEDIUM && (info & 0xffffu) == frame.medium;
+    return !front && !at_interface && (look.a > 0.0 || eyes);
 }
 
 // The medium a walk from the eye starts in (the exact references): the eye's, or none.
@@ -78,7 +88,7 @@ fn changes_medium(look: vec4<f32>, info: u32) -> bool {
     let front = (info & INFO_FRONT) != 0u;
     let at_interface = (info & INFO_INTERFACE) != 0u;
     return frame.volumes == MEDIA_WALK && (info & 0xffffu) != OBJECT_BLOCK
-        && ((look.a > 0.0 && (front || !at_interface)) || (front && at_interface));
+        && ((look.a > 0.0 && front) || leaves_volume(look, info) || (front && at_interface));
 }
 
 // `segment` (premultiplied) in front of `surface` (straight), premultiplied.
