@@ -43,7 +43,7 @@ struct Game {
 }
 
 fn setup(window: Arc<Window>, world: World) -> Result<Gfx, Box<dyn std::error::Error>> {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let instance = wgpu::Instance::new(voxel_render::instance_descriptor(wgpu::Backends::all()));
     let surface = instance.create_surface(window.clone())?;
     let (ctx, adapter) = GpuContext::for_surface(&instance, &surface)?;
     let (width, height) = window.inner_size().into();

@@ -9,7 +9,7 @@
 //! - [`Technique`] and its settings in [`OitConfig`]: how translucent water, glass and
 //!   leaves are composed, switchable at run time.
 //! - [`ChunkStreamer`]: the chunks around a moving eye, generated, meshed and uploaded on
-//!   rayon's workers.
+//!   rayon's workers (not on wasm32: a browser page has one thread).
 //! - [`stages`]: the game's own geometry in the frame ([`GameStages`]), composed by every
 //!   technique, and the helpers its pipelines and overlays are built with.
 //! - [`content`]: a game's particles and boxes, opaque or translucent, drawn through the
@@ -50,6 +50,7 @@ mod oit;
 pub mod readback;
 mod renderer;
 pub mod stages;
+#[cfg(not(target_arch = "wasm32"))]
 mod stream;
 mod submission;
 pub mod textures;
@@ -59,7 +60,10 @@ mod wgsl_layout;
 
 pub use camera::Camera;
 pub use chunks::DrawMode;
-pub use context::{Capabilities, GpuContext, LimitsPreset, request_device, request_device_with};
+pub use context::{
+    Capabilities, GpuContext, LimitsPreset, instance_descriptor, instance_flags, request_device,
+    request_device_with,
+};
 pub use error::{Error, Result};
 pub use fetch::QuadFetch;
 pub use oit::{
@@ -69,6 +73,7 @@ pub use oit::{
 pub use readback::Image;
 pub use renderer::{FrameStats, Lighting, OUTPUT_FORMATS, Renderer, RendererConfig};
 pub use stages::{GameFrame, GameStages, NoGame, Stages, TranslucentContract, TranslucentObject};
+#[cfg(not(target_arch = "wasm32"))]
 pub use stream::{ChunkSink, ChunkSource, ChunkStreamer, StreamConfig, StreamFrame};
 pub use timing::{GpuPass, GpuTimes};
 
