@@ -283,9 +283,7 @@ pub fn distinct_colours(img: &Image) -> usize {
 /// the renderer at an adapter's limits without a huge render). `None` as [`gpu`].
 pub fn gpu_with_limits(change: impl FnOnce(&mut wgpu::Limits)) -> Option<GpuContext> {
     gpu()?;
-    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-    desc.backends = wgpu::Backends::VULKAN;
-    let instance = wgpu::Instance::new(desc);
+    let instance = wgpu::Instance::new(voxel_render::instance_descriptor(wgpu::Backends::VULKAN));
     let adapter = pollster::block_on(instance.request_adapter(&Default::default())).unwrap();
     // What a game that requests its own device does: the renderer's request, changed.
     let mut request = voxel_render::device_descriptor(&adapter, LimitsPreset::Adapter);

@@ -13,6 +13,7 @@
 use std::sync::Arc;
 
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
+#[cfg(not(target_arch = "wasm32"))]
 use rayon::prelude::*;
 
 use crate::{BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Error, World, blocks};
@@ -561,10 +562,11 @@ impl TerrainGenerator {
                 }
             }
         }
-        let chunks: Vec<_> = positions
-            .into_par_iter()
-            .map(|p| (p, self.generate_chunk(p)))
-            .collect();
+        #[cfg(not(target_arch = "wasm32"))]
+        let positions = positions.into_par_iter();
+        #[cfg(target_arch = "wasm32")]
+        let positions = positions.into_iter();
+        let chunks: Vec<_> = positions.map(|p| (p, self.generate_chunk(p))).collect();
         let mut world = World::new(registry);
         for (p, c) in chunks {
             world.insert_chunk(p, c)?;

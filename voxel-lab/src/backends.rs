@@ -29,13 +29,14 @@ pub struct Options {
 pub struct Device {
     /// Its name in the table.
     pub name: String,
-    /// The context.
-    pub ctx: GpuContext,
+    /// The context, or why it could not be made.
+    pub ctx: Result<GpuContext>,
 }
 
 /// The four devices: Vulkan, GL, and both with WebGL2's limits and no optional feature but
-/// timestamp queries (which WebGL2 lacks; asked for here only to time the passes).
-pub fn devices() -> Result<Vec<Device>> {
+/// timestamp queries (which WebGL2 lacks; asked for here only to time the passes). A device
+/// that cannot be made is one too, with its error: the table goes on with the others.
+pub fn devices() -> Vec<Device> {
     let vulkan = headless::Device {
         backends: wgpu::Backends::VULKAN,
         limits: voxel_render::LimitsPreset::Adapter,
@@ -44,32 +45,30 @@ pub fn devices() -> Result<Vec<Device>> {
         backends: wgpu::Backends::GL,
         ..vulkan
     };
-    Ok(vec![
+    vec![
         Device {
             name: "Vulkan".into(),
-            ctx: vulkan.context()?,
+            ctx: vulkan.context(),
         },
         Device {
             name: "GL".into(),
-            ctx: gl.context()?,
+            ctx: gl.context(),
         },
         Device {
             name: "Vulkan, WebGL2 limits".into(),
-            ctx: webgl2_timed(wgpu::Backends::VULKAN)?,
+            ctx: webgl2_timed(wgpu::Backends::VULKAN),
         },
         Device {
             name: "GL, WebGL2 limits".into(),
-            ctx: webgl2_timed(wgpu::Backends::GL)?,
+            ctx: webgl2_timed(wgpu::Backends::GL),
         },
-    ])
+    ]
 }
 
 /// A device of `backends` with WebGL2's limits and timestamp queries (when the adapter has
 /// them).
 fn webgl2_timed(backends: wgpu::Backends) -> Result<GpuContext> {
-    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-    desc.backends = backends;
-    let instance = wgpu::Instance::new(desc);
+    let instance = wgpu::Instance::new(voxel_render::instance_descriptor(backends));
     pollster::block_on(async {
         let adapter = instance
             .request_adapter(&Default::default())
@@ -106,6 +105,9 @@ pub enum Outcome {
     },
     /// It was refused: the error's message.
     Unsupported(String),
+    /// It failed otherwise (the device could not be made, was lost, or the renderer
+    /// failed): the error's message.
+    Failed(String),
 }
 
 /// One cell of the table.
@@ -113,8 +115,8 @@ pub enum Outcome {
 pub struct Row {
     /// The device's name.
     pub device: String,
-    /// The technique asked for.
-    pub technique: Technique,
+    /// The technique asked for (`None`: the device could not be made).
+    pub technique: Option<Technique>,
     /// What happened.
     pub outcome: Outcome,
 }
@@ -161,56 +163,46 @@ fn draw(ctx: &GpuContext, scene: &Scene, config: RendererConfig, frames: u32) ->
 }
 
 /// Runs every technique on every device of [`devices`] and writes `report.md` and the
-/// pictures into `opts.out`; returns the rows.
+/// pictures into `opts.out`; returns the rows. A device that cannot be made, or a
+/// technique that fails on one, is a row with its error and the table goes on; it is an
+/// error ([`Error::NoDeviceRuns`], after the report is written) only when no device draws.
 pub fn run(opts: &Options) -> Result<Vec<Row>> {
     let scene = scene::default_scene(1)?;
-    let devices = devices()?;
-    let vulkan = &devices[0].ctx;
+    let devices = devices();
+    // The pictures are compared with the first device's (Vulkan), when it exists.
+    let reference = devices.first().and_then(|d| d.ctx.as_ref().ok());
     let mut rows = Vec::new();
     for d in &devices {
+        let ctx = match &d.ctx {
+            Ok(ctx) => ctx,
+            Err(e) => {
+                let outcome = Outcome::Failed(format!("no device: {}", crate::chain(e)));
+                eprintln!("{}: {outcome:?}", d.name);
+                rows.push(Row {
+                    device: d.name.clone(),
+                    technique: None,
+                    outcome,
+                });
+                continue;
+            }
+        };
         let dir = opts
             .out
             .join(d.name.replace([',', ' '], "_").replace("__", "_"));
         std::fs::create_dir_all(&dir).map_err(Error::io(&dir))?;
+        let compare_with = reference.filter(|r| !std::ptr::eq(*r, ctx));
         for t in Technique::ALL {
-            let config = config_like(&d.ctx, t, opts.size);
-            // Refused before anything is made when the device cannot run it.
-            let outcome = match Renderer::new(&d.ctx, scene.world.registry(), config.clone()) {
-                Err(e @ voxel_render::Error::Unsupported(_)) => Outcome::Unsupported(e.to_string()),
-                Err(source) => {
-                    return Err(Error::Technique {
-                        device: d.name.clone(),
-                        technique: t,
-                        source: Box::new(source),
-                    });
+            let outcome = match technique(ctx, compare_with, &scene, t, opts, &dir) {
+                Ok(outcome) => outcome,
+                Err(Error::Render(e @ voxel_render::Error::Unsupported(_))) => {
+                    Outcome::Unsupported(e.to_string())
                 }
-                Ok(_) => {
-                    let (drew, image, fetch, gpu_ms) = draw(&d.ctx, &scene, config, opts.frames)?;
-                    save(&image, &dir.join(format!("{t}.png")))?;
-                    let (mean, max) = if std::ptr::eq(d, &devices[0]) {
-                        (None, 0)
-                    } else {
-                        let config = config_like(&d.ctx, drew, opts.size);
-                        let (_, expected, _, _) = draw(vulkan, &scene, config, 0)?;
-                        let (m, _) = metrics::compare(&expected, &image);
-                        (
-                            Some(metrics::mean_abs_diff(&expected, &image)),
-                            m.max_abs_err,
-                        )
-                    };
-                    Outcome::Runs {
-                        drew,
-                        fetch,
-                        mean,
-                        max,
-                        gpu_ms,
-                    }
-                }
+                Err(e) => Outcome::Failed(crate::chain(&e)),
             };
             eprintln!("{}: {t}: {outcome:?}", d.name);
             rows.push(Row {
                 device: d.name.clone(),
-                technique: t,
+                technique: Some(t),
                 outcome,
             });
         }
@@ -218,7 +210,63 @@ pub fn run(opts: &Options) -> Result<Vec<Row>> {
     let report = markdown(&rows, &devices, opts);
     let path = opts.out.join("report.md");
     std::fs::write(&path, report).map_err(Error::io(&path))?;
+    if !rows
+        .iter()
+        .any(|r| matches!(r.outcome, Outcome::Runs { .. }))
+    {
+        let devices = devices
+            .iter()
+            .map(|d| {
+                let why = rows
+                    .iter()
+                    .filter(|r| r.device == d.name)
+                    .find_map(|r| match &r.outcome {
+                        Outcome::Failed(why) | Outcome::Unsupported(why) => Some(why.as_str()),
+                        Outcome::Runs { .. } => None,
+                    })
+                    .unwrap_or("nothing drew");
+                format!("{}: {why}", d.name)
+            })
+            .collect::<Vec<_>>()
+            .join("; ");
+        return Err(Error::NoDeviceRuns { devices });
+    }
     Ok(rows)
+}
+
+/// Draws `t` on `ctx` (refused before anything is made when the device cannot run it),
+/// saves the picture into `dir` and compares it with `compare_with`'s picture of what drew.
+fn technique(
+    ctx: &GpuContext,
+    compare_with: Option<&GpuContext>,
+    scene: &Scene,
+    t: Technique,
+    opts: &Options,
+    dir: &Path,
+) -> Result<Outcome> {
+    let config = config_like(ctx, t, opts.size);
+    Renderer::new(ctx, scene.world.registry(), config.clone())?;
+    let (drew, image, fetch, gpu_ms) = draw(ctx, scene, config, opts.frames)?;
+    save(&image, &dir.join(format!("{t}.png")))?;
+    let (mean, max) = match compare_with {
+        None => (None, 0),
+        Some(reference) => {
+            let config = config_like(ctx, drew, opts.size);
+            let (_, expected, _, _) = draw(reference, scene, config, 0)?;
+            let (m, _) = metrics::compare(&expected, &image);
+            (
+                Some(metrics::mean_abs_diff(&expected, &image)),
+                m.max_abs_err,
+            )
+        }
+    };
+    Ok(Outcome::Runs {
+        drew,
+        fetch,
+        mean,
+        max,
+        gpu_ms,
+    })
 }
 
 fn save(image: &Image, path: &Path) -> Result<()> {
@@ -239,10 +287,14 @@ pub fn markdown(rows: &[Row], devices: &[Device], opts: &Options) -> String {
         opts.out.display()
     );
     for d in devices {
-        s += &format!("- {}: {}\n", d.name, d.ctx.caps.adapter_name);
+        match &d.ctx {
+            Ok(ctx) => s += &format!("- {}: {}\n", d.name, ctx.caps.adapter_name),
+            Err(e) => s += &format!("- {}: could not be made ({})\n", d.name, crate::chain(e)),
+        }
     }
     s += "\n| device | technique | runs | quads | error vs Vulkan (mean / max) | GPU ms |\n|---|---|---|---|---|---:|\n";
     for r in rows {
+        let technique = r.technique.map_or("(all)".to_owned(), |t| format!("`{t}`"));
         match &r.outcome {
             Outcome::Runs {
                 drew,
@@ -251,26 +303,36 @@ pub fn markdown(rows: &[Row], devices: &[Device], opts: &Options) -> String {
                 max,
                 gpu_ms,
             } => {
-                let runs = if *drew == r.technique {
+                let runs = if Some(*drew) == r.technique {
                     "yes".to_owned()
                 } else {
                     format!("as `{drew}`")
                 };
-                let err = mean.map_or("(the reference picture)".to_owned(), |m| {
-                    format!("{m:.4} / {max}")
-                });
+                let err = match mean {
+                    Some(m) => format!("{m:.4} / {max}"),
+                    None if devices.first().is_some_and(|d| d.name == r.device) => {
+                        "(the reference picture)".to_owned()
+                    }
+                    None => "(no Vulkan picture)".to_owned(),
+                };
                 let ms = gpu_ms.map_or("n/a".to_owned(), |v| format!("{v:.1}"));
                 s += &format!(
-                    "| {} | `{}` | {runs} | {fetch} | {err} | {ms} |\n",
-                    r.device, r.technique
+                    "| {} | {technique} | {runs} | {fetch} | {err} | {ms} |\n",
+                    r.device
                 );
             }
             Outcome::Unsupported(why) => {
                 s += &format!(
-                    "| {} | `{}` | unsupported: {} | | | |\n",
+                    "| {} | {technique} | unsupported: {} | | | |\n",
                     r.device,
-                    r.technique,
                     why.replace('|', "/")
+                );
+            }
+            Outcome::Failed(why) => {
+                s += &format!(
+                    "| {} | {technique} | failed: {} | | | |\n",
+                    r.device,
+                    why.replace(['|', '\n'], " ")
                 );
             }
         }

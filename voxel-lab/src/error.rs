@@ -9,8 +9,6 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use voxel_render::Technique;
-
 /// An error of the lab.
 #[derive(Debug)]
 #[non_exhaustive]
@@ -84,15 +82,6 @@ pub enum Error {
     /// An error of the renderer (making a device, rendering, reading back, saving a PNG),
     /// as it is: its message and its sources are the renderer error's.
     Render(voxel_render::Error),
-    /// A renderer error of one technique on one device of `demo backends`.
-    Technique {
-        /// The device's name.
-        device: String,
-        /// The technique.
-        technique: Technique,
-        /// What the renderer said (boxed: it is the largest of the lab's errors).
-        source: Box<voxel_render::Error>,
-    },
     /// No adapter of the given backends (`demo backends`).
     NoAdapter {
         /// The backends searched.
@@ -102,6 +91,12 @@ pub enum Error {
     },
     /// The adapter refused a device with WebGL2's limits (`demo backends`).
     NoWebGl2Device(wgpu::RequestDeviceError),
+    /// No device of `demo backends` drew a technique (the report, written anyway, gives
+    /// each one's error).
+    NoDeviceRuns {
+        /// Each device's name and why it did not run, `; `-joined.
+        devices: String,
+    },
     /// A picture size past the caps of `limits`.
     Size {
         /// The option or field that gave it.
@@ -252,13 +247,9 @@ impl fmt::Display for Error {
             Self::Core(e) => e.fmt(f),
             Self::Mesh(e) => e.fmt(f),
             Self::Render(e) => e.fmt(f),
-            Self::Technique {
-                device,
-                technique,
-                source,
-            } => write!(f, "{device}, {technique}: {}", crate::chain(source)),
             Self::NoAdapter { backends, source } => write!(f, "no {backends:?} adapter: {source}"),
             Self::NoWebGl2Device(e) => write!(f, "no device with WebGL2's limits: {e}"),
+            Self::NoDeviceRuns { devices } => write!(f, "no device drew a technique: {devices}"),
             Self::Size {
                 what,
                 size: (w, h),

@@ -1,28 +1,35 @@
-//! Meshing many chunks of a world at once, in parallel with rayon.
+//! Meshing many chunks of a world at once, in parallel with rayon (one after another on
+//! wasm32, where a browser page has one thread).
 
+#[cfg(not(target_arch = "wasm32"))]
 use rayon::prelude::*;
 use voxel_core::{ChunkPos, World};
 
 use crate::{ChunkMeshes, Mesher, Result};
 
-/// Meshes the chunks at `positions` in parallel (one [`Mesher`] per rayon worker). A
-/// position with no loaded chunk gets empty meshes, so a renderer can drop what it drew
-/// there.
+/// Meshes the chunks at `positions` in parallel (one [`Mesher`] per rayon worker; one
+/// mesher in turn on wasm32). A position with no loaded chunk gets empty meshes, so a
+/// renderer can drop what it drew there.
 pub fn mesh_chunks(world: &World, positions: &[ChunkPos]) -> Result<Vec<(ChunkPos, ChunkMeshes)>> {
     let proto = Mesher::new(world.registry());
-    positions
+    let mesh = |mesher: &mut Mesher, &p: &ChunkPos| {
+        let meshes = match world.chunk(p) {
+            Some(c) => mesher.mesh(c, world.neighbourhood(p))?,
+            None => ChunkMeshes::default(),
+        };
+        Ok((p, meshes))
+    };
+    #[cfg(not(target_arch = "wasm32"))]
+    let meshes = positions
         .par_iter()
-        .map_init(
-            || proto.clone(),
-            |mesher, &p| {
-                let meshes = match world.chunk(p) {
-                    Some(c) => mesher.mesh(c, world.neighbourhood(p))?,
-                    None => ChunkMeshes::default(),
-                };
-                Ok((p, meshes))
-            },
-        )
-        .collect()
+        .map_init(|| proto.clone(), mesh)
+        .collect();
+    #[cfg(target_arch = "wasm32")]
+    let meshes = {
+        let mut mesher = proto;
+        positions.iter().map(|p| mesh(&mut mesher, p)).collect()
+    };
+    meshes
 }
 
 /// Takes the world's dirty set and meshes those chunks in parallel. On error the dirty set

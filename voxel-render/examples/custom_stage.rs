@@ -417,7 +417,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
 
     // The game's own GPU objects.
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let instance = wgpu::Instance::new(voxel_render::instance_descriptor(wgpu::Backends::all()));
     let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
     let (device, queue) = pollster::block_on(voxel_render::request_device(&adapter))?;
     let ctx = GpuContext::from_device(&adapter, device, queue);

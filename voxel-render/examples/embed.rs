@@ -9,9 +9,11 @@ use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, World
 use voxel_render::{Camera, GpuContext, NoGame, Renderer, RendererConfig, Technique, readback};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    // The game's own GPU objects, on the backend `WGPU_BACKEND` names (else wgpu's choice).
-    let desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-    let instance = wgpu::Instance::new(desc);
+    // The game's own GPU objects, on the backend `WGPU_BACKEND` names (else wgpu's choice),
+    // without wgpu's indirect-call validation on GL (`instance_descriptor`).
+    let instance = wgpu::Instance::new(voxel_render::instance_descriptor(
+        wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all()),
+    ));
     let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
     let (device, queue) = pollster::block_on(voxel_render::request_device(&adapter))?;
     let ctx = GpuContext::from_device(&adapter, device, queue);

@@ -51,7 +51,9 @@ fn setup(
 ) -> Result<Gfx, Box<dyn std::error::Error>> {
     // `WGPU_BACKEND` (and wgpu's other variables) honoured; the display handle is what GL
     // needs to present (Vulkan ignores it).
-    let desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(display));
+    let mut desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(display));
+    // Without wgpu's indirect-call validation on GL (`voxel_render::instance_flags`).
+    desc.flags = voxel_render::instance_flags(desc.backends);
     let instance = wgpu::Instance::new(desc);
     let surface = instance.create_surface(window.clone())?;
     let (ctx, adapter) = GpuContext::for_surface(&instance, &surface)?;

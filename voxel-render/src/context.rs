@@ -24,14 +24,43 @@ pub struct Capabilities {
     pub msaa4: bool,
     /// Device limits.
     pub limits: wgpu::Limits,
+    /// Whether wgpu binds each resource where the shaders declare it: not on desktop GL
+    /// below 4.2 that reports compute shaders (see [`Capabilities::new`]).
+    shader_bindings: bool,
     /// The adapter, for the features of texture formats ([`Capabilities::renders_to`]).
     adapter: wgpu::Adapter,
 }
 
 impl Capabilities {
-    /// Reads the capabilities of `adapter` for a device created with `features`.
+    /// Reads the capabilities of `adapter` for a device created with `features` and
+    /// `limits`. On desktop GL older than 4.0 storage buffers and textures count as absent
+    /// whatever the driver's extensions say, and on desktop GL older than 4.2 that reports
+    /// compute shaders the world cannot be drawn ([`Capabilities::shader_bindings`]).
     pub fn new(adapter: &wgpu::Adapter, features: wgpu::Features, limits: wgpu::Limits) -> Self {
         let info = adapter.get_info();
+        let mut limits = limits;
+        let mut downlevel = adapter.get_downlevel_capabilities().flags;
+        let desktop_gl = desktop_gl_version(info.backend, &info.driver_info);
+        // wgpu writes the GLSL of the context's version (desktop GL 3.3 and later: the
+        // version of `GL_VERSION`), and naga declares storage buffers from GLSL 4.00 and
+        // compute shaders from 4.20; a driver may list the extensions that offer both on an
+        // older context (NVIDIA's EGL gives a 3.3 context with them), and wgpu reports them.
+        if desktop_gl.is_some_and(|v| v < (4, 0)) {
+            limits.max_storage_buffers_per_shader_stage = 0;
+            limits.max_storage_textures_per_shader_stage = 0;
+            downlevel.remove(
+                wgpu::DownlevelFlags::VERTEX_STORAGE
+                    | wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE,
+            );
+        }
+        // wgpu (30) takes a GL adapter with compute shaders to have `layout(binding = n)`
+        // in its shaders and binds nothing by name; naga writes those from GLSL 4.20 only,
+        // so below it every uniform block and texture of a pipeline lands on slot 0.
+        let shader_bindings = !(desktop_gl.is_some_and(|v| v < (4, 2))
+            && downlevel.contains(wgpu::DownlevelFlags::COMPUTE_SHADERS));
+        if desktop_gl.is_some_and(|v| v < (4, 2)) {
+            downlevel.remove(wgpu::DownlevelFlags::COMPUTE_SHADERS);
+        }
         let f16 = adapter.get_texture_format_features(wgpu::TextureFormat::Rgba16Float);
         let depth = adapter.get_texture_format_features(crate::DEPTH_FORMAT);
         let msaa4 = f16
@@ -48,11 +77,15 @@ impl Capabilities {
             // so GL draws without MSAA (the fallback every device without 4× support takes).
             && info.backend != wgpu::Backend::Gl;
         Self {
-            adapter_name: format!("{} ({:?})", info.name, info.backend),
+            // A browser's WebGPU names no adapter.
+            adapter_name: match info.name.as_str() {
+                "" => format!("unnamed adapter ({:?})", info.backend),
+                name => format!("{name} ({:?})", info.backend),
+            },
             backend: info.backend,
             device_type: info.device_type,
             features,
-            downlevel: adapter.get_downlevel_capabilities().flags,
+            downlevel,
             rgba16f_blendable: f16
                 .allowed_usages
                 .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
@@ -61,6 +94,7 @@ impl Capabilities {
                     .contains(wgpu::TextureFormatFeatureFlags::BLENDABLE),
             msaa4,
             limits,
+            shader_bindings,
             adapter: adapter.clone(),
         }
     }
@@ -77,6 +111,22 @@ impl Capabilities {
         };
         ok(format.guaranteed_format_features(self.features))
             && ok(self.adapter.get_texture_format_features(format))
+    }
+
+    /// Whether wgpu binds each buffer and texture of a pipeline where its shaders declare
+    /// it. Not on desktop GL below 4.2 whose driver reports compute shaders (an extension
+    /// NVIDIA lists on its 3.3 context): wgpu 30 then expects the slots written in the
+    /// shaders, which its translator writes from GLSL 4.20 only, and every resource lands
+    /// on slot 0. Nothing can be drawn right there; the renderer refuses such a device.
+    pub fn shader_bindings(&self) -> bool {
+        self.shader_bindings
+    }
+
+    /// Whether render passes can count samples into occlusion queries. Not on a browser's
+    /// WebGPU: wgpu 30 leaves the pass's occlusion query set out of what it gives the
+    /// browser, which then refuses the pass's queries and the whole frame.
+    pub(crate) fn occlusion_queries(&self) -> bool {
+        self.backend != wgpu::Backend::BrowserWebGpu
     }
 
     /// Whether timestamp queries at pass boundaries are available.
@@ -98,6 +148,20 @@ impl Capabilities {
     /// moments; 16-bit ones otherwise).
     pub(crate) fn float32_blendable(&self) -> bool {
         self.features.contains(wgpu::Features::FLOAT32_BLENDABLE)
+    }
+}
+
+/// The version of a desktop GL context (`None` for another backend, GLES or WebGL), read
+/// from wgpu's `driver_info`, which on GL is the `GL_VERSION` string: `3.3.0 NVIDIA ...`
+/// on desktop GL, `OpenGL ES 3.2 ...` or `WebGL 2.0 ...` otherwise.
+pub(crate) fn desktop_gl_version(backend: wgpu::Backend, driver_info: &str) -> Option<(u32, u32)> {
+    if backend != wgpu::Backend::Gl {
+        return None;
+    }
+    let mut numbers = driver_info.split([' ', '.']).map(str::parse::<u32>);
+    match (numbers.next(), numbers.next()) {
+        (Some(Ok(major)), Some(Ok(minor))) => Some((major, minor)),
+        _ => None,
     }
 }
 
@@ -208,20 +272,26 @@ impl GpuContext {
 
     /// A headless context on the first adapter of `backends` (tests use
     /// `Backends::VULKAN`, which finds lavapipe on a machine without a GPU). Asks for
-    /// [`WANTED_FEATURES`] where the adapter has them.
+    /// [`WANTED_FEATURES`] where the adapter has them. Blocks until the device exists
+    /// (not on wasm32, where a page cannot block).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn headless(backends: wgpu::Backends) -> Result<Self> {
         Self::headless_with(backends, LimitsPreset::Adapter)
     }
 
     /// [`GpuContext::headless`] with the device's limits and features from `preset`
     /// ([`LimitsPreset::WebGl2`]: a device as small as WebGL2's on any adapter).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn headless_with(backends: wgpu::Backends, preset: LimitsPreset) -> Result<Self> {
         pollster::block_on(Self::headless_async(backends, preset))
     }
 
     /// A context on an adapter that can draw to `surface` (a game's window), asking for
     /// [`WANTED_FEATURES`] where it has them; also returns the adapter, for the surface's
-    /// capabilities and configuration. Blocks until the device exists.
+    /// capabilities and configuration. Blocks until the device exists (not on wasm32,
+    /// where a page cannot block: there [`request_device`] is awaited and the context made
+    /// with [`GpuContext::from_device`]).
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn for_surface(
         instance: &wgpu::Instance,
         surface: &wgpu::Surface<'_>,
@@ -242,10 +312,9 @@ impl GpuContext {
         })
     }
 
+    #[cfg(not(target_arch = "wasm32"))]
     async fn headless_async(backends: wgpu::Backends, preset: LimitsPreset) -> Result<Self> {
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = backends;
-        let instance = wgpu::Instance::new(desc);
+        let instance = wgpu::Instance::new(instance_descriptor(backends));
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
                 power_preference: wgpu::PowerPreference::HighPerformance,
@@ -256,6 +325,36 @@ impl GpuContext {
         let (device, queue) = request_device_with(&adapter, preset).await?;
         Ok(Self::from_device(&adapter, device, queue))
     }
+}
+
+/// The flags every wgpu instance of this crate (and of its lab, demo, examples and tests)
+/// is created with: wgpu's defaults and the `WGPU_*` environment variables
+/// (`wgpu::InstanceFlags::from_env_or_default`), less `VALIDATION_INDIRECT_CALL` when
+/// `backends` include GL.
+///
+/// wgpu's indirect-call validation builds a compute pipeline on every device. A GL driver
+/// can report compute shaders through an extension (`GL_ARB_compute_shader`) on a context
+/// whose shading language cannot compile one (NVIDIA's EGL gives a desktop GL 3.3 context
+/// with GLSL 3.30): the pipeline fails and wgpu loses the device before the first frame.
+/// Which GL context a driver gives is known only once the instance exists, so GL goes
+/// without that validation everywhere; the renderer writes every indirect draw itself
+/// (first instance zero unless the device has `INDIRECT_FIRST_INSTANCE`).
+pub fn instance_flags(backends: wgpu::Backends) -> wgpu::InstanceFlags {
+    let mut flags = wgpu::InstanceFlags::from_env_or_default();
+    if backends.contains(wgpu::Backends::GL) {
+        flags.remove(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL);
+    }
+    flags
+}
+
+/// An instance descriptor for `backends` without a display handle, with
+/// [`instance_flags`]. A window's instance (wgpu's GL backend wants the display) sets
+/// `flags` to [`instance_flags`] on its own descriptor.
+pub fn instance_descriptor(backends: wgpu::Backends) -> wgpu::InstanceDescriptor {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = backends;
+    desc.flags = instance_flags(backends);
+    desc
 }
 
 /// The limits and optional features a device is requested with.
@@ -335,5 +434,52 @@ pub fn device_descriptor(
         experimental_features: wgpu::ExperimentalFeatures::disabled(),
         memory_hints: wgpu::MemoryHints::Performance,
         trace: wgpu::Trace::Off,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn desktop_gl_versions() {
+        use wgpu::Backend::{Gl, Vulkan};
+        // NVIDIA's EGL context, and Mesa's with MESA_GL_VERSION_OVERRIDE=3.3.
+        assert_eq!(
+            desktop_gl_version(Gl, "3.3.0 NVIDIA 550.54.15"),
+            Some((3, 3))
+        );
+        assert_eq!(
+            desktop_gl_version(Gl, "3.3 (Core Profile) Mesa 22.3.6"),
+            Some((3, 3))
+        );
+        assert_eq!(
+            desktop_gl_version(Gl, "4.5 (Core Profile) Mesa 22.3.6"),
+            Some((4, 5))
+        );
+        // GLES and WebGL: wgpu offers storage and compute from GLES 3.1 only, where GLSL
+        // ES 3.10 has them and naga writes the bindings.
+        assert_eq!(desktop_gl_version(Gl, "OpenGL ES 3.2 Mesa 22.3.6"), None);
+        assert_eq!(
+            desktop_gl_version(Gl, "WebGL 2.0 (OpenGL ES 3.0 Chromium)"),
+            None
+        );
+        assert_eq!(desktop_gl_version(Gl, ""), None);
+        assert_eq!(desktop_gl_version(Vulkan, "3.3"), None);
+    }
+
+    #[test]
+    fn gl_instances_go_without_indirect_validation() {
+        let indirect = wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL;
+        assert!(!instance_flags(wgpu::Backends::GL).contains(indirect));
+        assert!(!instance_flags(wgpu::Backends::all()).contains(indirect));
+        assert_eq!(
+            instance_descriptor(wgpu::Backends::VULKAN).flags,
+            wgpu::InstanceFlags::from_env_or_default()
+        );
+        assert_eq!(
+            instance_descriptor(wgpu::Backends::GL).backends,
+            wgpu::Backends::GL
+        );
     }
 }

@@ -224,6 +224,10 @@ impl Error {
 /// Runs `f` inside a wgpu validation and out-of-memory error scope, so that what wgpu
 /// would report to the device's uncaptured-error handler (a panic by default) comes back
 /// as an [`Error::Gpu`] instead.
+///
+/// In a browser the page's one thread cannot wait: a scope whose result is not ready at
+/// once (WebGPU answers on the page's event loop; WebGL2, run by wgpu itself, at once)
+/// is logged as an error when it arrives, and `f`'s value is returned.
 pub(crate) fn scoped<T>(
     device: &wgpu::Device,
     operation: &'static str,
@@ -232,11 +236,42 @@ pub(crate) fn scoped<T>(
     let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
     let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let value = f();
-    let validation = pollster::block_on(validation.pop());
-    let oom = pollster::block_on(oom.pop());
+    let validation = wait_for_scope(operation, validation.pop());
+    let oom = wait_for_scope(operation, oom.pop());
     match validation.or(oom) {
         Some(error) => Err(Error::Gpu { operation, error }),
         None => Ok(value),
+    }
+}
+
+/// The error a popped scope caught (blocking until wgpu says).
+#[cfg(not(target_arch = "wasm32"))]
+fn wait_for_scope(
+    _operation: &'static str,
+    pop: impl std::future::Future<Output = Option<wgpu::Error>>,
+) -> Option<wgpu::Error> {
+    pollster::block_on(pop)
+}
+
+/// The error a popped scope caught when wgpu says at once; else `None`, and the error, if
+/// any, is logged when it arrives.
+#[cfg(target_arch = "wasm32")]
+fn wait_for_scope(
+    operation: &'static str,
+    pop: impl std::future::Future<Output = Option<wgpu::Error>> + 'static,
+) -> Option<wgpu::Error> {
+    use std::task::{Context, Poll, Waker};
+    let mut pop = Box::pin(pop);
+    match pop.as_mut().poll(&mut Context::from_waker(Waker::noop())) {
+        Poll::Ready(error) => error,
+        Poll::Pending => {
+            wasm_bindgen_futures::spawn_local(async move {
+                if let Some(error) = pop.await {
+                    log::error!("GPU {operation} failed: {error}");
+                }
+            });
+            None
+        }
     }
 }
 

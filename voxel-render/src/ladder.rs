@@ -97,6 +97,13 @@ pub enum Need {
     RenderTarget(wgpu::TextureFormat),
     /// A colour format that can be rendered to with blending.
     BlendableTarget(wgpu::TextureFormat),
+    /// Each buffer and texture bound where the shaders declare it (not so on desktop GL
+    /// below 4.2 that reports compute shaders: [`Capabilities::shader_bindings`]).
+    ShaderBindings,
+    /// Waiting for the GPU within a frame, for a result the frame goes on with (the
+    /// exact references' counts): not in a browser, whose page runs on one thread that
+    /// must not block.
+    WaitForGpu,
 }
 
 impl Need {
@@ -108,6 +115,8 @@ impl Need {
             Need::Limit(limit, value) => limit.of(&caps.limits) >= value,
             Need::RenderTarget(format) => caps.renders_to(format, false),
             Need::BlendableTarget(format) => caps.renders_to(format, true),
+            Need::ShaderBindings => caps.shader_bindings(),
+            Need::WaitForGpu => !cfg!(target_arch = "wasm32"),
         }
     }
 
@@ -132,6 +141,15 @@ impl fmt::Display for Need {
             Need::Limit(limit, value) => write!(f, "{} of at least {value}", limit.name()),
             Need::RenderTarget(format) => write!(f, "{format:?} render targets"),
             Need::BlendableTarget(format) => write!(f, "blending into {format:?} render targets"),
+            Need::ShaderBindings => write!(
+                f,
+                "resources bound where the shaders declare them (wgpu binds them all to \
+                 slot 0 on desktop GL below 4.2 with compute shaders)"
+            ),
+            Need::WaitForGpu => write!(
+                f,
+                "waiting for the GPU within a frame (a web page's thread cannot block)"
+            ),
         }
     }
 }
@@ -163,11 +181,12 @@ pub fn check(what: &str, needs: &[Need], caps: &Capabilities) -> Result<()> {
 /// vertex shader (`QuadFetch::needs` adds that way's needs): the HDR scene colour
 /// rendered to and blended into (the medium's fog, the composites, a game's overlays),
 /// and the chunk shaders' eight values passed from vertex to fragment (`VsOut` in
-/// `shaders/common.wgsl`).
+/// `shaders/common.wgsl`), each bound where the shaders declare it.
 pub(crate) fn world_needs() -> Vec<Need> {
     vec![
         Need::BlendableTarget(crate::SCENE_FORMAT),
         Need::Limit(Limit::InterStageShaderVariables, 8),
+        Need::ShaderBindings,
     ]
 }
 

@@ -10,7 +10,7 @@
 //! - [`Technique`] and its settings in [`OitConfig`]: how translucent water, glass and
 //!   leaves are composed, switchable at run time.
 //! - [`ChunkStreamer`]: the chunks around a moving eye, generated, meshed and uploaded on
-//!   rayon's workers.
+//!   rayon's workers (not on wasm32: a browser page has one thread).
 //! - [`stages`]: the game's own geometry in the frame ([`GameStages`]), composed by every
 //!   technique, and the helpers its pipelines and overlays are built with; [`Both`] draws
 //!   two games' stages (the ready-made content and the game's own) as one.
@@ -52,6 +52,7 @@ mod oit;
 pub mod readback;
 mod renderer;
 pub mod stages;
+#[cfg(not(target_arch = "wasm32"))]
 mod stream;
 mod submission;
 pub mod textures;
@@ -62,7 +63,8 @@ mod wgsl_layout;
 pub use camera::Camera;
 pub use chunks::DrawMode;
 pub use context::{
-    Capabilities, GpuContext, LimitsPreset, WANTED_FEATURES, device_descriptor, request_device,
+    Capabilities, GpuContext, LimitsPreset, WANTED_FEATURES, device_descriptor, instance_descriptor,
+    instance_flags, request_device,
     request_device_with,
 };
 pub use error::{Error, Result};
@@ -76,6 +78,7 @@ pub use renderer::{FrameStats, Lighting, OUTPUT_FORMATS, Renderer, RendererConfi
 pub use stages::{
     Both, GameFrame, GameStages, NoGame, Stages, TranslucentContract, TranslucentObject,
 };
+#[cfg(not(target_arch = "wasm32"))]
 pub use stream::{ChunkSink, ChunkSource, ChunkStreamer, StreamConfig, StreamFrame};
 pub use timing::{GpuPass, GpuTimes};
 

@@ -469,7 +469,8 @@ pub fn read_image(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Image> {
     })
 }
 
-/// Maps a `MAP_READ` buffer, waits, and copies its contents out.
+/// Maps a `MAP_READ` buffer, waits, and copies its contents out. In a browser, whose page
+/// cannot wait for the GPU, an error unless the mapping is done at once.
 pub(crate) fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     ctx.check_device()?;
     let (tx, rx) = std::sync::mpsc::channel();
@@ -477,8 +478,18 @@ pub(crate) fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8
         let _ = tx.send(r);
     });
     ctx.device.poll(wgpu::PollType::wait_indefinitely())?;
-    rx.recv()
-        .map_err(|_| Error::ReadbackData("the mapping callback never ran".into()))??;
+    #[cfg(not(target_arch = "wasm32"))]
+    let mapped = rx.recv().ok();
+    // Blocking on a channel panics on wasm32's one thread.
+    #[cfg(target_arch = "wasm32")]
+    let mapped = rx.try_recv().ok();
+    mapped.ok_or_else(|| {
+        Error::ReadbackData(
+            "the mapping callback never ran (a browser maps buffers on its event loop: \
+             map them with wgpu's map_async there)"
+                .into(),
+        )
+    })??;
     let data = buffer.slice(..).get_mapped_range()?.to_vec();
     buffer.unmap();
     Ok(data)

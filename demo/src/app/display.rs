@@ -28,6 +28,7 @@ impl Display {
         desc.backends = backends
             .or_else(wgpu::Backends::from_env)
             .unwrap_or(wgpu::Backends::PRIMARY);
+        desc.flags = voxel_render::instance_flags(desc.backends);
         let instance = wgpu::Instance::new(desc);
         let surface = instance
             .create_surface(window.clone())

@@ -13,6 +13,7 @@ mod tests;
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
+#[cfg(not(target_arch = "wasm32"))]
 use rayon::prelude::*;
 
 pub use coords::{ChunkPos, Face, WorldPos};
@@ -218,11 +219,13 @@ impl World {
             .is_some()
     }
 
-    /// Packs every loaded chunk, in parallel.
+    /// Packs every loaded chunk, in parallel (one after another on wasm32).
     pub fn pack_all(&mut self) {
-        self.chunks
-            .par_iter_mut()
-            .for_each(|(_, c)| Arc::make_mut(c).pack());
+        #[cfg(not(target_arch = "wasm32"))]
+        let chunks = self.chunks.par_iter_mut();
+        #[cfg(target_arch = "wasm32")]
+        let chunks = self.chunks.iter_mut();
+        chunks.for_each(|(_, c)| Arc::make_mut(c).pack());
     }
 
     /// Heap and inline bytes of the loaded chunks ([`Chunk::memory_bytes`] summed; the map

@@ -71,7 +71,7 @@ impl ChunkStore {
     ) -> Self {
         let l = &ctx.caps.limits;
         let infos = Records::new(&ctx.device, fetch, l, FIRST_SLOTS);
-        let indirect = Self::indirect_buffer(&ctx.device, FIRST_SLOTS);
+        let indirect = Self::indirect_buffer(ctx, FIRST_SLOTS);
         Self {
             layout,
             fetch,
@@ -94,11 +94,22 @@ impl ChunkStore {
         }
     }
 
-    fn indirect_buffer(device: &wgpu::Device, commands: usize) -> wgpu::Buffer {
-        device.create_buffer(&wgpu::BufferDescriptor {
+    /// The buffer of `commands` draw commands; an indirect buffer only where the device
+    /// executes indirect draws (WebGL2 and desktop GL 3.3 do not, and wgpu refuses the
+    /// usage there): elsewhere the draws are direct and read the commands on the CPU.
+    fn indirect_buffer(ctx: &GpuContext, commands: usize) -> wgpu::Buffer {
+        let mut usage = wgpu::BufferUsages::COPY_DST;
+        if ctx
+            .caps
+            .downlevel
+            .contains(wgpu::DownlevelFlags::INDIRECT_EXECUTION)
+        {
+            usage |= wgpu::BufferUsages::INDIRECT;
+        }
+        ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("chunk_draws"),
             size: (commands.max(1) * std::mem::size_of::<DrawCommand>()) as u64,
-            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            usage,
             mapped_at_creation: false,
         })
     }
@@ -521,7 +532,7 @@ impl ChunkStore {
     pub(crate) fn upload_draws(&mut self, ctx: &GpuContext, commands: &[DrawCommand]) {
         let bytes = std::mem::size_of_val(commands) as u64;
         if bytes > self.indirect.size() {
-            self.indirect = Self::indirect_buffer(&ctx.device, commands.len() * 2);
+            self.indirect = Self::indirect_buffer(ctx, commands.len() * 2);
         }
         self.writes
             .write(&self.indirect, 0, bytemuck::cast_slice(commands));

@@ -831,7 +831,7 @@ impl OitManager {
         view: &FrameView<'_>,
         game: bool,
     ) -> Result<()> {
-        let start = std::time::Instant::now();
+        let start = web_time::Instant::now();
         let (ctx, config) = (self.setup.ctx.clone(), self.config.clone());
         if let Some(t) = self.active(!view.translucent.is_empty() || game)? {
             t.prepare(&ctx, &config, chunks, view)?;

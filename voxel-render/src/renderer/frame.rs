@@ -2,7 +2,8 @@
 //! in order (opaque, the game's stages, the technique, tonemap).
 
 use std::sync::{Arc, Mutex, PoisonError};
-use std::time::Instant;
+// std's Instant panics in a browser; web_time's is std's elsewhere.
+use web_time::Instant;
 
 use glam::Mat4;
 use voxel_core::BlockId;
@@ -707,11 +708,11 @@ impl Renderer {
                     }
                 });
         }
-        if let Some(group) = &t.depth_resolve_group {
+        if let (Some(group), Some(resolve)) = (&t.depth_resolve_group, &self.post.depth_resolve) {
             Pass::new("depth_resolve", GpuPass::Opaque, &[])
                 .depth(Depth::Clear(&t.depth.view, 0.0))
                 .record(encoder, timer, |pass| {
-                    pass.set_pipeline(&self.post.depth_resolve);
+                    pass.set_pipeline(resolve);
                     pass.set_bind_group(0, group, &[]);
                     pass.draw(0..3, 0..1);
                 });

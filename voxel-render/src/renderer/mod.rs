@@ -205,7 +205,7 @@ impl Renderer {
             depth_sampler: gpu::depth_sampler(device),
         };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
-        let mut post = Post::new(device);
+        let mut post = Post::new(device, ctx.caps.msaa4);
         post.make_tonemap(ctx, config.output_format);
         let medium = MediumPass::new(ctx, &layouts);
         let size = (config.width, config.height);

@@ -78,7 +78,9 @@ pub(super) struct Post {
     /// [`Renderer::check_output`] sets in a pass beside the scene depth.
     pub(super) tonemap: HashMap<wgpu::TextureFormat, (wgpu::RenderPipeline, wgpu::RenderPipeline)>,
     depth_resolve_layout: wgpu::BindGroupLayout,
-    pub(super) depth_resolve: wgpu::RenderPipeline,
+    /// `None` on a device without 4× MSAA ([`crate::Capabilities::msaa4`]), whose shading
+    /// language may have no multisampled textures (GLSL ES 3.00: WebGL2).
+    pub(super) depth_resolve: Option<wgpu::RenderPipeline>,
 }
 
 pub(super) const MSAA_SAMPLES: u32 = 4;
@@ -99,7 +101,8 @@ impl Renderer {
 }
 
 impl Post {
-    pub(super) fn new(device: &wgpu::Device) -> Self {
+    /// The passes of a device where 4× MSAA works when `msaa`.
+    pub(super) fn new(device: &wgpu::Device, msaa: bool) -> Self {
         let float = wgpu::TextureSampleType::Float { filterable: false };
         let tonemap_layout = gpu::layout(device, "tonemap_layout", &[gpu::texture_entry(0, float)]);
         let depth_resolve_layout = gpu::layout(
@@ -116,16 +119,18 @@ impl Post {
                 count: None,
             }],
         );
-        let depth_resolve = FullscreenPipeline {
-            label: "depth_resolve",
-            source: include_str!("../shaders/depth_resolve.wgsl"),
-            fragment_entry: "fs_depth_resolve",
-            groups: &[Some(&depth_resolve_layout)],
-            targets: &[],
-            writes_depth: true,
-            constants: &[],
-        }
-        .build(device);
+        let depth_resolve = msaa.then(|| {
+            FullscreenPipeline {
+                label: "depth_resolve",
+                source: include_str!("../shaders/depth_resolve.wgsl"),
+                fragment_entry: "fs_depth_resolve",
+                groups: &[Some(&depth_resolve_layout)],
+                targets: &[],
+                writes_depth: true,
+                constants: &[],
+            }
+            .build(device)
+        });
         Self {
             tonemap_layout,
             tonemap: HashMap::new(),

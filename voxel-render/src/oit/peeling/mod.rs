@@ -15,7 +15,8 @@
 //! Early exit and adaptive layer count: an occlusion query counts the samples each front
 //! peel wrote. Results come back a frame later without stalling; the next frame runs only
 //! as many iterations as were non-empty, plus one that probes for more (never more than
-//! N/2). A frame with no translucent chunk in view records nothing at all.
+//! N/2). A frame with no translucent chunk in view records nothing at all. In a browser's
+//! WebGPU (no occlusion queries there through wgpu) every frame runs all N/2.
 //!
 //! Peel to convergence (exact): front peels only, each followed by reading its occlusion
 //! count (a stall per layer), until a pass writes nothing, at most [`MAX_PEEL_LAYERS`]
@@ -25,6 +26,7 @@ use crate::context::Capabilities;
 use crate::gpu::{
     self, ChunkPipeline, Depth, DepthMode, FullscreenPipeline, Pass, SidedPipeline, Target,
 };
+use crate::ladder::Need;
 use crate::oit::{
     OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -173,6 +175,9 @@ pub(crate) struct Peeling {
     counts: QueryReadback,
     /// Dual mode: iterations to run this frame (adaptive).
     iterations: u32,
+    /// Whether the device counts samples for the adaptation (not in a browser's WebGPU,
+    /// [`Capabilities::occlusion_queries`]): without, every frame runs all iterations.
+    adaptive: bool,
     report: PeelReport,
     /// Copies the opaque depth into the limits.
     depth_copy: gpu::DepthCopy,
@@ -196,6 +201,14 @@ impl TechniqueKind for Peeling {
 
     fn is_exact(technique: Technique) -> bool {
         technique == Technique::PeelReference
+    }
+
+    /// Peeling to convergence waits for each layer's occlusion count before the next.
+    fn needs(technique: Technique, _: &OitConfig, _: &Capabilities) -> Vec<Need> {
+        match technique {
+            Technique::PeelReference => vec![Need::WaitForGpu],
+            _ => Vec::new(),
+        }
     }
 
     fn key(technique: Technique, config: &OitConfig, _: &Capabilities) -> PeelMode {
@@ -298,6 +311,7 @@ impl TechniqueKind for Peeling {
                 max_iterations,
             ),
             iterations: max_iterations,
+            adaptive: setup.ctx.caps.occlusion_queries(),
             report: PeelReport::default(),
             depth_copy: gpu::DepthCopy::new(&setup.ctx),
         })
@@ -483,12 +497,13 @@ impl Peeling {
             .record(encoder, frame.depth, &t.back[1], timing, frame.timer);
     }
 
-    /// Front peel of iteration `i` into slot `i % 2`, with `limits`, then under-blends it.
+    /// Front peel of iteration `i` into slot `i % 2`, with `limits` (its samples counted
+    /// into query `i` when `count`), then under-blends it.
     fn front_iteration(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         frame: &TranslucentFrame<'_>,
-        i: u32,
+        (i, count): (u32, bool),
         limits: &Limits,
     ) {
         let t = &self.targets;
@@ -503,7 +518,7 @@ impl Peeling {
             false,
             Depth::Load(&t.front[cur].view),
             limits,
-            Some(i),
+            count.then_some(i),
         );
         Self::blend_pass(
             encoder,
@@ -544,7 +559,7 @@ impl Peeling {
         let t = &self.targets;
         for i in 0..self.iterations {
             let cur = (i % 2) as usize;
-            self.front_iteration(encoder, frame, i, &t.front_limits[cur]);
+            self.front_iteration(encoder, frame, (i, self.adaptive), &t.front_limits[cur]);
             self.peel_pass(
                 encoder,
                 frame,
@@ -568,7 +583,9 @@ impl Peeling {
             &frame.target.view,
             &t.front_acc_group,
         );
-        self.counts.copy(encoder, 0..self.iterations);
+        if self.adaptive {
+            self.counts.copy(encoder, 0..self.iterations);
+        }
         Ok(())
     }
 
@@ -583,7 +600,8 @@ impl Peeling {
         let mut truncated = true;
         for i in 0..MAX_PEEL_LAYERS {
             let cur = (i % 2) as usize;
-            self.front_iteration(encoder, frame, i, &self.targets.converge_limits[cur]);
+            let limits = &self.targets.converge_limits[cur];
+            self.front_iteration(encoder, frame, (i, true), limits);
             // Wait for this pass's count: zero means every layer has been peeled.
             self.counts.copy(encoder, i..i + 1);
             gpu::flush(ctx, encoder)?;

@@ -156,12 +156,14 @@ fn build_entries() -> [wgpu::BindGroupLayoutEntry; 5] {
 }
 
 /// The fragment stage writes the heads, nodes and counters (storage buffers, atomics), and
-/// reads the opaque depth while it is the pass's read-only depth attachment.
+/// reads the opaque depth while it is the pass's read-only depth attachment; the frame
+/// waits for the counters to learn whether every fragment fitted.
 fn reference_needs() -> Vec<Need> {
     vec![
         Need::Downlevel(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE),
         Need::Limit(Limit::StorageBuffersPerStage, 3),
         Need::Downlevel(wgpu::DownlevelFlags::READ_ONLY_DEPTH_STENCIL),
+        Need::WaitForGpu,
     ]
 }
 

@@ -28,7 +28,8 @@
 
 pub(crate) mod interleave;
 
-use std::time::Instant;
+// std's Instant panics in a browser; web_time's is std's elsewhere.
+use web_time::Instant;
 
 use voxel_core::ChunkPos;
 use voxel_mesh::PackedQuad;

@@ -1,9 +1,13 @@
 // Screen-door transparency (Mulder, Groen & van Wijk 1998): the technique's own group 2 (appended to
 // common.wgsl and the constant BAYER_OFFSETS made in Rust).
 
-// The packed 32-bit shading state (`StippleParams` in mod.rs, checked equal by a test).
+// The packed 32-bit shading state (`StippleParams` in mod.rs, checked equal by a test),
+// padded to the 16 bytes WebGL2 binds.
 struct StippleParams {
     shading_state: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
 
 @group(2) @binding(0) var<uniform> params: StippleParams;

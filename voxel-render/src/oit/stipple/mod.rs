@@ -67,12 +67,19 @@ impl StippleSettings {
     }
 }
 
-/// The technique's uniform (`StippleParams` in `dither.wgsl`).
+/// The technique's uniform (`StippleParams` in `dither.wgsl`), 16 bytes: WebGL2 binds
+/// no uniform of another size (wgpu's `BUFFER_BINDINGS_NOT_16_BYTE_ALIGNED`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub(crate) struct StippleParams {
     /// [`ShadingState::pack`].
     pub shading_state: u32,
+    /// Zeros, to 16 bytes (a uniform's array would be 16 bytes an element).
+    pub pad0: u32,
+    /// Zero.
+    pub pad1: u32,
+    /// Zero.
+    pub pad2: u32,
 }
 
 /// The stipple shader: the Bayer offsets from Rust, the shared code, the screen door.
@@ -195,6 +202,7 @@ impl TranslucentTechnique for Stipple {
     ) -> Result<()> {
         let params = StippleParams {
             shading_state: config.stipple.shading_state().pack(),
+            ..StippleParams::default()
         };
         view.write(&self.params, 0, bytemuck::bytes_of(&params));
         Ok(())
@@ -279,7 +287,12 @@ mod tests {
         assert_layout::<StippleParams>(
             &parse(&stipple_wgsl()),
             "StippleParams",
-            &[field!(StippleParams, shading_state)],
+            &[
+                field!(StippleParams, shading_state),
+                field!(StippleParams, pad0),
+                field!(StippleParams, pad1),
+                field!(StippleParams, pad2),
+            ],
         );
     }
 }

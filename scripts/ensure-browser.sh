@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Makes sure what the browser test and `web.sh build` need is present: Chromium (Debian's
+# `chromium`, which runs headless with WebGPU on SwiftShader and WebGL2 on ANGLE), the
+# wasm32-unknown-unknown target and wasm-bindgen's CLI at exactly the version of
+# wasm-bindgen in Cargo.lock. Installs what is missing (Chromium with apt-get when running
+# as root on Debian/Ubuntu; otherwise says what to install and fails). Sourced by web.sh
+# and test.sh.
+
+# The version of a package in Cargo.lock.
+locked_version() {
+    awk -v name="$1" '$0 == "name = \"" name "\"" { getline; gsub(/version = |"/, ""); print; exit }' Cargo.lock
+}
+
+# Chromium's binary (Debian's `chromium`, or `chromium-browser`), or nothing.
+chromium_binary() {
+    command -v chromium || command -v chromium-browser || true
+}
+
+ensure_chromium() {
+    if [ -n "$(chromium_binary)" ]; then
+        return 0
+    fi
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+        echo "installing chromium with apt-get" >&2
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium >/dev/null
+    else
+        echo "error: missing chromium; install with: sudo apt-get install -y chromium" >&2
+        return 1
+    fi
+}
+
+ensure_wasm_tools() {
+    if ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown; then
+        echo "installing the wasm32-unknown-unknown target with rustup" >&2
+        rustup target add wasm32-unknown-unknown
+    fi
+    local want
+    want="$(locked_version wasm-bindgen)"
+    if [ -z "$want" ]; then
+        echo "error: no wasm-bindgen in Cargo.lock" >&2
+        return 1
+    fi
+    local have
+    have="$(wasm-bindgen --version 2>/dev/null | awk '{ print $2 }')"
+    if [ "$have" != "$want" ]; then
+        echo "installing wasm-bindgen-cli $want with cargo install (was: ${have:-none})" >&2
+        # Not --locked: the CLI's own lock file may name dependency versions a registry
+        # mirror does not have yet (webpki-roots here); the CLI's version is what must match.
+        cargo install --quiet wasm-bindgen-cli --version "=$want"
+    fi
+}

@@ -1,0 +1,46 @@
+//! The voxel OIT renderer in a web page: the default terrain with its water, a technique
+//! picker listing what the device runs, and a fly camera, on WebGPU where the browser has
+//! it and WebGL2 otherwise (`bash scripts/web.sh build`, then `serve`; docs/browser.md).
+//!
+//! What the page shows is built here on every target, so that the browser test
+//! (`tests/browser.rs`) renders the same world from the same camera natively:
+//!
+//! - [`scene`]: the default scene (the lab's: a greenhouse on the shore, the sea through its
+//!   glass) with a radius of terrain to load.
+//! - [`fly`]: the fly camera (WASD, Space and Shift, mouse drag).
+//! - [`check`]: what the test page reports for each technique, and the size and frames it
+//!   renders them with.
+//!
+//! The page itself (wasm32 only) is `page`: it picks the backend, builds the world and
+//! draws it every animation frame; with `?test=1` it renders every technique into a texture
+//! and posts each picture (or its refusal) to the server that served it.
+
+#![warn(missing_docs)]
+
+pub mod check;
+pub mod fly;
+pub mod scene;
+
+#[cfg(target_arch = "wasm32")]
+mod page;
+
+/// What can go wrong building the page's scene.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The world generator or the world.
+    #[error("world: {0}")]
+    World(#[from] voxel_core::Error),
+    /// The renderer (a bad camera among others).
+    #[error("renderer: {0}")]
+    Render(#[from] voxel_render::Error),
+    /// The terrain of `seed` has no glass structure near the origin to look at.
+    #[error("seed {seed}: no glass structure within 768 blocks of the origin")]
+    NoGlassStructure {
+        /// The seed.
+        seed: u32,
+    },
+}
+
+/// `Result` with this crate's [`Error`].
+pub type Result<T, E = Error> = std::result::Result<T, E>;
