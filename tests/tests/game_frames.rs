@@ -27,9 +27,9 @@ fn game_frames() -> Vec<std::path::PathBuf> {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| {
-            p.file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(|n| n.starts_with("game_") && n.ends_with(".toml"))
+            p.file_name().and_then(|n| n.to_str()).is_some_and(|n| {
+                (n.starts_with("game_") || n == "particles_over_water.toml") && n.ends_with(".toml")
+            })
         })
         .collect();
     files.sort();

@@ -63,9 +63,8 @@ mod wgsl_layout;
 pub use camera::Camera;
 pub use chunks::DrawMode;
 pub use context::{
-    Capabilities, GpuContext, LimitsPreset, WANTED_FEATURES, device_descriptor, instance_descriptor,
-    instance_flags, request_device,
-    request_device_with,
+    Capabilities, GpuContext, LimitsPreset, WANTED_FEATURES, device_descriptor,
+    instance_descriptor, instance_flags, request_device, request_device_with,
 };
 pub use error::{Error, Result};
 pub use fetch::QuadFetch;

@@ -132,14 +132,26 @@ impl RayMarcher {
                 continue;
             }
             // An edge is where the surfaces change: another plane or block type met or
-            // ended on (the signature), not another block of the same type in the same plane
-            // (with flat textures and the same light, a far floor's blocks, which a pixel's
-            // ring spans under water and far away, draw as one surface).
+            // ended on (the signature), or another block of the same plane shaded otherwise;
+            // not another block of the same type in the same plane shaded alike (with flat
+            // textures, a far floor's blocks, which a pixel's ring spans under water and
+            // far away, draw as one surface).
             let plane = |s: Option<Surface>| s.map(|s| s.plane());
+            // The shading of a face's corners (ambient occlusion): where two faces of one
+            // plane shade differently, the rasteriser's interpolation decides too.
+            let corners = |s: Option<Surface>| {
+                s.filter(|s| self.class(s.id) != RenderClass::Translucent)
+                    .map(|s| {
+                        [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+                            .map(|(u, v)| self.ao(s.block, s.face, u, v, 1.0).to_bits())
+                    })
+            };
             let mut seam = false;
             let near_edge = ring(i).any(|r| {
                 seam |= r.layer_faces != ray.layer_faces[i];
-                r.signature != ray.signature[i] || plane(r.end) != plane(ray.end[i])
+                r.signature != ray.signature[i]
+                    || plane(r.end) != plane(ray.end[i])
+                    || (r.end != ray.end[i] && corners(r.end) != corners(ray.end[i]))
             });
             if near_edge {
                 c.differing_on_edges += 1;
