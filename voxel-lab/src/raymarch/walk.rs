@@ -290,7 +290,7 @@ impl RayMarcher {
             }
             if ended {
                 let color = if w.want_color {
-                    self.lit(surface, p, a, w)
+                    self.lit(surface, p, a, w.light, w.shading)
                 } else {
                     [0.0; 3]
                 };
@@ -431,7 +431,7 @@ impl Walker<'_> {
             return;
         }
         if self.want_color {
-            let c = m.lit(s, p, a, self);
+            let c = m.lit(s, p, a, self.light, self.shading);
             self.layers.push([c[0], c[1], c[2], a[3].clamp(0.0, 1.0)]);
         }
     }
