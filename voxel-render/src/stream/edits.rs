@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use voxel_core::{BlockId, CHUNK_SIZE, Chunk, ChunkPos, WorldPos};
+use voxel_core::{BlockId, Chunk, ChunkPos, WorldPos};
 
 use super::ChunkStreamer;
 use super::local::{local_index, local_of};

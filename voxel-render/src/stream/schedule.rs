@@ -6,7 +6,6 @@ use std::collections::VecDeque;
 
 use glam::DVec3;
 use voxel_core::{BlockId, CHUNK_SIZE, ChunkPos, Neighbourhood};
-use voxel_mesh::ChunkMeshes;
 
 use super::jobs::Done;
 use super::slot::{Ready, Slot, State};
