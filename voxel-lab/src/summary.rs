@@ -110,9 +110,9 @@ pub struct ReferenceCheck {
     pub scene: String,
     /// Largest channel difference between the A-buffer and peel-to-convergence pictures.
     pub max_abs_err: u32,
-    /// Pixels where the two GPU methods differ by more than
-    /// [`GPU_AGREEMENT`](crate::eval::GPU_AGREEMENT) and the ray march does not side with
-    /// the A-buffer ([`crate::eval::unsettled_pixels`]).
+    /// Pixels where the two GPU methods differ by more than 2/255 (`eval::GPU_AGREEMENT`)
+    /// and the ray march does not side with the A-buffer (`eval::unsettled_pixels`, which
+    /// lies above this module).
     pub unsettled: usize,
     /// Whether the reference counts as exact: the A-buffer lost nothing and capped no
     /// pixel visibly, the CPU ray march ([`crate::raymarch`]), which shares no mesh and
