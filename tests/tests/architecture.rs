@@ -389,8 +389,9 @@ fn sibling_uses(
 ) -> std::collections::BTreeMap<String, Vec<(String, String)>> {
     use std::collections::{BTreeMap, BTreeSet};
     let modules: Vec<Vec<String>> = files.iter().map(|(rel, _)| module_of(rel)).collect();
-    // Children and root imports of each module folder.
-    let mut folders: BTreeMap<Vec<String>, (Vec<String>, Vec<(String, String)>)> = BTreeMap::new();
+    // Children and root imports (item, child) of each module folder.
+    type Folder = (Vec<String>, Vec<(String, String)>);
+    let mut folders: BTreeMap<Vec<String>, Folder> = BTreeMap::new();
     for (rel, text) in files {
         if rel == "lib.rs" || rel.ends_with("/mod.rs") {
             let folder = module_of(rel);
