@@ -74,8 +74,8 @@ fn limits_preset(s: &str) -> Result<voxel_render::LimitsPreset> {
 enum Command {
     /// The interactive window (scripted with --frames for tests and screenshots).
     Window(WindowArgs),
-    /// Every technique rendered for the default scene, and a quick speed/accuracy
-    /// evaluation of the suite with its chart.
+    /// Every technique rendered for the default scene, and a speed/accuracy chart of a few
+    /// suite scenes at a small size (--full: of the whole suite).
     Showcase(ShowcaseArgs),
     /// Generates and meshes a world, prints what it holds and how long it took.
     Stats(StatsArgs),
@@ -294,7 +294,27 @@ struct ShowcaseArgs {
     /// Picture size.
     #[arg(long, value_parser = size, default_value = "1280x720")]
     size: (u32, u32),
+    /// Chart the whole suite (every scene at 480x270: many minutes on a CPU driver)
+    /// instead of a few scenes at 320x180.
+    #[arg(long)]
+    full: bool,
 }
+
+/// The suite scenes the quick chart measures: water and glass, leaves behind glass, the
+/// eye under water, a game's bubbles and fish in the sea, a corridor of stained glass, and
+/// a game's things around a glass dome on the sea floor (each a few seconds at
+/// [`QUICK_SIZE`] on a CPU driver, every one scored there; `deep_stack` alone takes
+/// minutes).
+const QUICK_SCENES: [&str; 6] = [
+    "water_through_glass",
+    "leaves_behind_glass",
+    "under_water",
+    "game_sea",
+    "stained_glass_corridor",
+    "game_base",
+];
+/// Picture size of the quick chart.
+const QUICK_SIZE: (u32, u32) = (320, 180);
 
 #[derive(Args, Debug)]
 struct StatsArgs {
@@ -415,6 +435,7 @@ fn main() {
                 ShowcaseArgs {
                     out: "out".into(),
                     size: (1280, 720),
+                    full: false,
                 },
                 &device,
             )
@@ -869,10 +890,30 @@ fn window(a: WindowArgs, device: DeviceArgs) -> Result<()> {
     })
 }
 
-/// Without a display: every technique's picture of the default scene, and a quick
-/// evaluation of the suite with its speed/accuracy chart.
+/// Without a display: every technique's picture of the default scene, then the
+/// speed/accuracy chart of [`QUICK_SCENES`] at [`QUICK_SIZE`] (with `full`, of the whole
+/// suite at 480x270), each with a progress bar.
 fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()> {
     writable_dir(&a.out)?;
+    let suite = scene_paths(&[])?;
+    let suite_len = suite.len();
+    let scenes = if a.full {
+        suite
+    } else {
+        QUICK_SCENES
+            .iter()
+            .map(|name| {
+                suite
+                    .iter()
+                    .find(|p| p.file_stem().is_some_and(|s| s == *name))
+                    .cloned()
+                    .ok_or_else(|| Error::NoSuchScene {
+                        path: PathBuf::from("scenes").join(format!("{name}.toml")),
+                    })
+            })
+            .collect::<Result<Vec<_>>>()?
+    };
+    let start = Instant::now();
     let (w, h) = a.size;
     let ctx = device.context()?;
     println!("adapter: {}", ctx.caps.adapter_name);
@@ -884,9 +925,16 @@ fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()> {
     };
     let mut renderer = headless::renderer_for(&ctx, &scene, config)?;
     let target = headless::Offscreen::new(&ctx, w, h);
+    println!(
+        "every technique's picture of the default scene ({w}x{h}) into {}:",
+        a.out.display()
+    );
+    let mut progress = voxel_lab::progress::Progress::new(Technique::ALL.len());
+    let mut wrote = Vec::new();
     for t in Technique::ALL {
         if let Err(e) = renderer.set_technique(t) {
-            println!("skipped {t}: {}", chain(&e));
+            progress.step(&format!("{t}: skipped"));
+            wrote.push(format!("skipped {t}: {}", chain(&e)));
             continue;
         }
         // One frame to settle (adaptive peeling), one to keep.
@@ -894,21 +942,38 @@ fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()> {
         let img = headless::render_image(&ctx, &mut renderer, &target, &scene.cameras[0])?;
         let path = a.out.join(format!("{}.png", t.name()));
         img.save_png(&path)?;
-        println!("wrote {}", path.display());
+        progress.step(t.name());
+        wrote.push(format!("wrote {}", path.display()));
+    }
+    progress.finish();
+    for line in wrote {
+        println!("{line}");
     }
     let eval_out = a.out.join("eval");
+    let size = if a.full { (480, 270) } else { QUICK_SIZE };
+    println!(
+        "the speed/accuracy chart: {} scenes x {} techniques at {}x{} against the exact reference:",
+        scenes.len(),
+        Technique::ALL.len(),
+        size.0,
+        size.1
+    );
     let opts = EvalOptions {
-        scenes: scene_paths(&[])?,
+        scenes,
         techniques: Technique::ALL.to_vec(),
         weights: Vec::new(),
-        size: Some((480, 270)),
+        size: Some(size),
         frames: 3,
         warmup: 1,
         out: eval_out.clone(),
         stability: false,
         flicker_frames: 0,
         sweep_points: 0,
-        command: "demo showcase".into(),
+        command: if a.full {
+            "demo showcase --full".into()
+        } else {
+            "demo showcase".into()
+        },
         heatmap_width: Some(240),
         random: None,
     };
@@ -920,5 +985,11 @@ fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()> {
         eval_out.join("speed_vs_accuracy.png").display()
     );
     println!("report: {}", eval_out.join("report.md").display());
+    println!("took {:.0} s", start.elapsed().as_secs_f64());
+    if !a.full {
+        println!(
+            "the whole suite ({suite_len} scenes at 480x270, many minutes): bash scripts/run.sh showcase --full (or demo eval, docs/lab.md)"
+        );
+    }
     Ok(())
 }

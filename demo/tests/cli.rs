@@ -95,12 +95,21 @@ fn an_output_that_cannot_be_written_is_refused_before_rendering() {
         &["eval", "--out", under_file.to_str().unwrap()],
         &["is a file"],
     );
+    fails_saying(
+        &["showcase", "--full", "--out", under_file.to_str().unwrap()],
+        &["is a file"],
+    );
     let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
 fn help_comes_from_clap_for_every_command() {
-    for args in [&["--help"][..], &["eval", "--help"], &["render", "--help"]] {
+    for args in [
+        &["--help"][..],
+        &["eval", "--help"],
+        &["render", "--help"],
+        &["showcase", "--help"],
+    ] {
         let out = demo(args);
         assert!(out.status.success(), "{args:?}");
         let text = String::from_utf8_lossy(&out.stdout);
@@ -111,6 +120,8 @@ fn help_comes_from_clap_for_every_command() {
         text.contains("techniques: opaque-only, wboit-mrt"),
         "{text}"
     );
+    let text = String::from_utf8_lossy(&demo(&["showcase", "--help"]).stdout).into_owned();
+    assert!(text.contains("--full"), "{text}");
 }
 
 #[test]
@@ -426,4 +437,55 @@ fn a_bare_vox_model_renders_from_its_default_camera() {
     let share = model_px as f64 / f64::from(img.width * img.height);
     assert!(share > 0.08, "the model covers {share:.2} of the picture");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The showcase (what `bash scripts/run.sh` runs without a display): every technique's
+/// picture of the default scene, then the chart of a few suite scenes, and where the whole
+/// suite is (on lavapipe; skipped loudly without an adapter unless `CI` is set).
+#[test]
+fn the_showcase_draws_every_technique_and_a_small_chart() {
+    if voxel_render::GpuContext::headless(wgpu::Backends::VULKAN).is_err() {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "CI is set but no Vulkan adapter"
+        );
+        eprintln!("\n!!!! SKIPPING: no Vulkan adapter !!!!\n");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("demo-cli-showcase-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = demo(&[
+        "showcase",
+        "--size",
+        "160x90",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    for t in voxel_render::Technique::ALL {
+        let img = voxel_render::Image::load_png(&dir.join(format!("{}.png", t.name()))).unwrap();
+        assert_eq!((img.width, img.height), (160, 90), "{}", t.name());
+    }
+    assert!(dir.join("eval/speed_vs_accuracy.png").is_file());
+    let summary = std::fs::read_to_string(dir.join("eval/summary.json")).unwrap();
+    let records: Vec<serde_json::Value> = serde_json::from_str(&summary).unwrap();
+    let mut scenes: Vec<&str> = records
+        .iter()
+        .map(|r| r["scene"].as_str().unwrap())
+        .collect();
+    scenes.dedup();
+    assert_eq!(scenes.len(), 6, "a few scenes, not the suite: {scenes:?}");
+    assert!(
+        records
+            .iter()
+            .all(|r| r["width"] == 320 && r["height"] == 180),
+        "at a small size"
+    );
+    assert!(stdout.contains("showcase --full"), "{stdout}");
+    let _ = std::fs::remove_dir_all(dir);
 }

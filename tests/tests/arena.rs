@@ -282,8 +282,9 @@ fn a_mesh_over_the_storage_binding_is_an_error() {
     assert_eq!(stats.translucent_quads, PAGE_QUADS);
 }
 
-/// 2000 chunks uploaded and removed, 20 rounds, with and without frames between: once no
-/// frame is in flight, no page is held with no chunk (the documented bound: 0 bytes).
+/// 2000 chunks uploaded and removed, 6 rounds, with and without frames between (each
+/// round's chunks overlap the last's by all but 50): once no frame is in flight, no page
+/// is held with no chunk (the documented bound: 0 bytes), and every round peaks alike.
 #[test]
 fn empty_pages_are_given_back() {
     let Some(ctx) = gpu() else { return };
@@ -314,7 +315,7 @@ fn empty_pages_are_given_back() {
     .unwrap();
     let target = Offscreen::new(&ctx, SIZE.0, SIZE.1);
     let mut peak = Vec::new();
-    for round in 0..20 {
+    for round in 0..6 {
         let positions: Vec<ChunkPos> = (0..2000)
             .map(|i| ChunkPos::new(i % 50, 0, i / 50 + round))
             .collect();

@@ -125,8 +125,12 @@ fn with(scene: &Scene, content: Content) -> Scene {
 }
 
 fn render(scene: &Scene, config: RendererConfig) -> Image {
-    let ctx = gpu().expect("GPU");
-    tests::render_with(&ctx, scene, config)
+    // One device per test (each runs on a thread of its own): a new device for every
+    // picture cost more than the picture.
+    thread_local! {
+        static CTX: voxel_render::GpuContext = gpu().expect("GPU");
+    }
+    CTX.with(|ctx| tests::render_with(ctx, scene, config))
 }
 
 /// The largest channel difference of each pixel, in 1/255 steps.
@@ -161,6 +165,16 @@ fn every_technique_composes_game_objects_with_water_and_glass() {
     let dir = out_dir("game");
     let mut failures = Vec::new();
     let mut report = String::new();
+    let techniques: Vec<Technique> = Technique::ALL
+        .into_iter()
+        .filter(|t| *t != Technique::OpaqueOnly && *t != Technique::Reference)
+        .collect();
+    // The pool without the game's object, drawn once: the same for every case.
+    let ref_without = render(&base, refc.clone());
+    let withouts: Vec<Image> = techniques
+        .iter()
+        .map(|&t| render(&base, technique_config(t, W, H)))
+        .collect();
     for (name, content, exact_sorted, nearest) in cases() {
         let scene = with(&base, content);
         let reference = render(&scene, refc.clone());
@@ -168,7 +182,6 @@ fn every_technique_composes_game_objects_with_water_and_glass() {
             .save_png(&dir.join(format!("{name}_reference.png")))
             .unwrap();
         // The object's footprint: where it changes the reference.
-        let ref_without = render(&base, refc.clone());
         let footprint: Vec<bool> = pixel_diffs(&reference, &ref_without)
             .iter()
             .map(|&d| d > 2)
@@ -178,19 +191,14 @@ fn every_technique_composes_game_objects_with_water_and_glass() {
             area > 30,
             "{name}: the object covers {area} px of the reference"
         );
-        for t in Technique::ALL {
-            if t == Technique::OpaqueOnly || t == Technique::Reference {
-                continue;
-            }
-            let config = technique_config(t, W, H);
-            let img = render(&scene, config.clone());
+        for (&t, without) in techniques.iter().zip(&withouts) {
+            let img = render(&scene, technique_config(t, W, H));
             img.save_png(&dir.join(format!("{name}_{}.png", t.name())))
                 .unwrap();
-            let without = render(&base, config);
             let d = diff(&img, &reference);
             let err = pixel_diffs(&img, &reference);
-            let err_without = pixel_diffs(&without, &reference);
-            let drawn = pixel_diffs(&img, &without)
+            let err_without = pixel_diffs(without, &reference);
+            let drawn = pixel_diffs(&img, without)
                 .iter()
                 .zip(&footprint)
                 .filter(|(d, m)| **m && **d > 2)

@@ -14,9 +14,7 @@
 //! `cargo bench -p voxel-lab --bench object_order` (`ORDER_VD=8,16` and
 //! `ORDER_OBJECTS=1000,10000` choose rows).
 
-use std::fmt::Write as _;
 use std::ops::Range;
-use std::path::Path;
 use std::sync::Arc;
 use std::time::Instant;
 use voxel_lab::Result;
@@ -24,11 +22,17 @@ use voxel_lab::Result;
 use glam::DVec3;
 use voxel_core::{BlockId, BlockRegistry, Chunk, ChunkPos, World, blocks};
 use voxel_lab::headless::{self, Offscreen};
-use voxel_mesh::mesh_chunks;
+
 use voxel_render::stages::{GameFrame, Stages};
 use voxel_render::{
-    Camera, GameStages, GpuContext, NoGame, Renderer, RendererConfig, Technique, TranslucentObject,
+    Camera, GameStages, GpuContext, NoGame, Renderer, Technique, TranslucentObject,
 };
+
+#[path = "common/report.rs"]
+mod report;
+#[path = "common/setup.rs"]
+mod setup;
+use report::Report;
 
 const W: u32 = 640;
 const H: u32 = 360;
@@ -93,17 +97,7 @@ fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Renderer>
             positions.extend([floor, water]);
         }
     }
-    let mut config = RendererConfig {
-        width: W,
-        height: H,
-        ..RendererConfig::default()
-    };
-    config.oit.technique = technique;
-    let mut renderer = Renderer::new(ctx, &registry, config)?;
-    for (pos, meshes) in mesh_chunks(&world, &positions)? {
-        renderer.upload_chunk(pos, &meshes)?;
-    }
-    Ok(renderer)
+    setup::renderer_of(ctx, &world, &positions, technique, (W, H))
 }
 
 fn camera(vd: i32) -> Result<Camera> {
@@ -116,13 +110,7 @@ fn camera(vd: i32) -> Result<Camera> {
 
 /// `n` objects in the water in front of the camera, within the view distance.
 fn objects(n: usize, vd: i32) -> Vec<TranslucentObject> {
-    let mut seed = 0x9e37_79b9_7f4a_7c15u64 ^ n as u64;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = report::numbers(0x9e37_79b9_7f4a_7c15u64 ^ n as u64);
     let reach = f64::from(vd) * 32.0;
     (0..n)
         .map(|i| {
@@ -223,24 +211,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let ctx = headless::context()?;
     let vds = list("ORDER_VD", &[8, 16, 32]);
     let counts = list("ORDER_OBJECTS", &[1_000, 2_000, 10_000, 100_000]);
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "# cargo bench -p voxel-lab --bench object_order ({}; {} cores, load average {})\n",
-        ctx.caps.adapter_name,
-        std::thread::available_parallelism().map_or(0, |n| n.get()),
-        std::fs::read_to_string("/proc/loadavg")
-            .unwrap_or_default()
-            .split_whitespace()
-            .next()
-            .unwrap_or("?")
-    );
-    let _ = writeln!(
-        out,
-        "| VD | translucent chunks in view | objects | order, sorted-quads ms | order, sorted ms | plain depth sort ms | sorted-quads / plain | render CPU ms (sorted-quads) |"
-    );
-    let _ = writeln!(out, "|---:|---:|---:|---:|---:|---:|---:|---:|");
-    print!("{out}");
+    let mut out = Report::new("object_order", &ctx.caps.adapter_name, "");
+    out.line("| VD | translucent chunks in view | objects | order, sorted-quads ms | order, sorted ms | plain depth sort ms | sorted-quads / plain | render CPU ms (sorted-quads) |");
+    out.line("|---:|---:|---:|---:|---:|---:|---:|---:|");
     for &vd in &vds {
         let vd = vd as i32;
         let camera = camera(vd)?;
@@ -259,17 +232,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let stats = quads.render_and_submit(&target.view, &camera, &mut NoGame)?;
                 stats.meshes_drawn[2]
             };
-            let row = format!(
+            out.line(&format!(
                 "| {vd} | {visible} | {n} | {q:.3} | {s:.3} | {plain:.3} | {:.2} | {cpu:.3} |",
                 q / plain
-            );
-            println!("{row}");
-            out += &row;
-            out += "\n";
+            ));
         }
     }
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/object-order.md");
-    voxel_render::readback::write_file(&path, out.as_bytes())?;
-    println!("wrote {}", path.display());
+    out.write("object-order.md")?;
     Ok(())
 }

@@ -14,8 +14,6 @@
 //! `results/switch-bench.md`); asserts nothing about time.
 //! `cargo bench -p voxel-lab --bench switch`.
 
-use std::fmt::Write as _;
-use std::path::Path;
 use std::time::Instant;
 use voxel_lab::Result;
 
@@ -26,7 +24,10 @@ use voxel_render::{Camera, GpuContext, Renderer, Technique, low_level};
 
 #[path = "common/record_world.rs"]
 mod record_world;
+#[path = "common/report.rs"]
+mod report;
 use record_world::{H, W, camera, renderer};
+use report::Report;
 
 /// A frame of `technique`: its CPU ms, and the pipelines the renderer built in it.
 fn frame(
@@ -44,13 +45,7 @@ fn frame(
 
 /// The game's things: bubbles rising ahead of the camera, and a glass crate.
 fn content(cam: &Camera) -> Content {
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut next = report::numbers(0x2545_f491_4f6c_dd1d);
     let ahead = cam.eye + cam.unit_forward() * 30.0;
     Content {
         particles: (0..2000)
@@ -95,28 +90,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for _ in 0..3 {
         frame(&ctx, &mut r, &mut game, &target, &cam)?;
     }
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "# cargo bench -p voxel-lab --bench switch ({}; {} cores, load average {}); view distance {vd}, {} chunks\n",
-        ctx.caps.adapter_name,
-        std::thread::available_parallelism().map_or(0, |n| n.get()),
-        std::fs::read_to_string("/proc/loadavg")
-            .unwrap_or_default()
-            .split_whitespace()
-            .next()
-            .unwrap_or("?"),
-        voxel_render::low_level::chunks(&r).len(),
-    );
-    let _ = writeln!(
-        out,
+    let chunks = voxel_render::low_level::chunks(&r).len();
+    let detail = format!("; view distance {vd}, {chunks} chunks");
+    let mut out = Report::new("switch", &ctx.caps.adapter_name, &detail);
+    out.line(&format!(
         "Every real-time technique and the game's pipelines for it built at loading time: {loading:.0} ms.\n"
-    );
-    let _ = writeln!(
-        out,
-        "| switch to | first frame CPU ms | pipelines built in it | steady frame CPU ms | first / steady |\n|---|---:|---:|---:|---:|"
-    );
-    print!("{out}");
+    ));
+    out.line("| switch to | first frame CPU ms | pipelines built in it | steady frame CPU ms | first / steady |\n|---|---:|---:|---:|---:|");
     for t in Technique::REAL_TIME.into_iter().skip(1).chain([first]) {
         r.set_technique(t)?;
         let (ms, built) = frame(&ctx, &mut r, &mut game, &target, &cam)?;
@@ -125,16 +105,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect::<Result<_, _>>()?;
         steady.sort_by(f64::total_cmp);
         let median = steady[steady.len() / 2];
-        let row = format!(
+        out.line(&format!(
             "| `{t}` | {ms:.3} | {built} | {median:.3} | {:.2} |",
             ms / median
-        );
-        println!("{row}");
-        out += &row;
-        out += "\n";
+        ));
     }
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/switch-bench.md");
-    voxel_render::readback::write_file(&path, out.as_bytes())?;
-    println!("wrote {}", path.display());
+    out.write("switch-bench.md")?;
     Ok(())
 }

@@ -10,6 +10,15 @@ use std::sync::Once;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+/// Writes `$path.png` and `$path.svg` of `$size`, both drawn by `$body` on `$root`.
+macro_rules! png_and_svg {
+    ($path:expr, $size:expr, |$root:ident| $body:expr) => {{
+        fonts();
+        draw_png(&$path.with_extension("png"), $size, |$root| $body)?;
+        draw_svg(&$path.with_extension("svg"), $size, |$root| $body)
+    }};
+}
+
 /// A named set of points.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Series {
@@ -111,13 +120,9 @@ pub fn speed_vs_accuracy(
     per_scene: &[Series],
     means: &[Series],
 ) -> Result<()> {
-    fonts();
-    draw_png(&path.with_extension("png"), (1000, 640), |root| {
-        scatter(root, title, per_scene, means)
-    })?;
-    draw_svg(&path.with_extension("svg"), (1000, 640), |root| {
-        scatter(root, title, per_scene, means)
-    })
+    png_and_svg!(path, (1000, 640), |root| scatter(
+        root, title, per_scene, means
+    ))
 }
 
 /// Draws with `f` into a bitmap in memory and writes it to `path` as a PNG, in one
@@ -155,6 +160,58 @@ fn draw_svg(
     crate::files::write_file(path, text.as_bytes())
 }
 
+/// Log scales on both axes.
+type LogLog = Cartesian2d<LogCoord<f64>, LogCoord<f64>>;
+
+/// The frame of a speed/accuracy chart on a white `root`: log GPU ms across (`x_desc`),
+/// log mean FLIP up to `y1` (below [`FLIP_FLOOR`] drawn there), axes and mesh drawn.
+fn flip_chart<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    x_desc: &str,
+    (x0, x1): (f64, f64),
+    y1: f64,
+) -> Result<ChartContext<'a, DB, LogLog>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d((x0..x1).log_scale(), (FLIP_FLOOR / 1.5..y1).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc("mean FLIP against the exact reference (log; 0 drawn at 1e-4)")
+        .label_style(("sans-serif", 14))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
+}
+
+/// Draws the legend of `chart` at `position` in `font_size` on white, framed.
+fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    font_size: u32,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font(("sans-serif", font_size))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)
+}
+
 fn scatter<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
@@ -164,7 +221,6 @@ fn scatter<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(err)?;
     let floor = |(x, y): (f64, f64)| (x, y.max(FLIP_FLOOR));
     let all = || {
         per_scene
@@ -173,22 +229,10 @@ where
             .flat_map(|s| s.points.iter().copied())
             .map(floor)
     };
-    let (x0, x1) = range(all().map(|p| p.0), true);
+    let x = range(all().map(|p| p.0), true);
     let (_, y1) = range(all().map(|p| p.1), true);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(14)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d((x0..x1).log_scale(), (FLIP_FLOOR / 1.5..y1).log_scale())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("GPU ms per frame for the translucent work (log scale)")
-        .y_desc("mean FLIP against the exact reference (log; 0 drawn at 1e-4)")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
+    let x_desc = "GPU ms per frame for the translucent work (log scale)";
+    let mut chart = flip_chart(&root, title, x_desc, x, y1)?;
     for (i, s) in per_scene.iter().enumerate() {
         let c = color(i);
         chart
@@ -221,14 +265,7 @@ where
         .map_err(err)?
         .label("Pareto front (suite means)")
         .legend(|(x, y)| PathElement::new(vec![(x - 10, y), (x + 10, y)], BLACK.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 14))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight, 14)?;
     root.present().map_err(err)
 }
 
@@ -252,14 +289,10 @@ pub fn line_chart(
     log_x: bool,
     series: &[Series],
 ) -> Result<()> {
-    fonts();
     let axes = (x_desc, y_desc);
-    draw_png(&path.with_extension("png"), (900, 560), |root| {
-        lines(root, title, axes, log_x, series)
-    })?;
-    draw_svg(&path.with_extension("svg"), (900, 560), |root| {
-        lines(root, title, axes, log_x, series)
-    })
+    png_and_svg!(path, (900, 560), |root| lines(
+        root, title, axes, log_x, series
+    ))
 }
 
 fn lines<DB: DrawingBackend>(
@@ -310,14 +343,7 @@ where
                         .map_err(err)?;
                 }
             }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .label_font(("sans-serif", 13))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(err)?;
+            legend(&mut chart, SeriesLabelPosition::UpperLeft, 13)?;
         }};
     }
     if log_x {
@@ -339,13 +365,9 @@ where
 
 /// One bar per name. Writes `path.png` and `path.svg`.
 pub fn bars(path: &Path, title: &str, y_desc: &str, values: &[(String, f64)]) -> Result<()> {
-    fonts();
-    draw_png(&path.with_extension("png"), (900, 520), |root| {
-        bar_body(root, title, y_desc, values)
-    })?;
-    draw_svg(&path.with_extension("svg"), (900, 520), |root| {
-        bar_body(root, title, y_desc, values)
-    })
+    png_and_svg!(path, (900, 520), |root| bar_body(
+        root, title, y_desc, values
+    ))
 }
 
 fn bar_body<DB: DrawingBackend>(
@@ -406,13 +428,7 @@ pub struct Spread {
 /// medians and bars (whiskers) from p10 to p90 of each. Log axes; FLIP below
 /// [`FLIP_FLOOR`] is drawn there. Writes `path.png` and `path.svg`.
 pub fn speed_vs_accuracy_spread(path: &Path, title: &str, spreads: &[Spread]) -> Result<()> {
-    fonts();
-    draw_png(&path.with_extension("png"), (1000, 640), |root| {
-        spread_body(root, title, spreads)
-    })?;
-    draw_svg(&path.with_extension("svg"), (1000, 640), |root| {
-        spread_body(root, title, spreads)
-    })
+    png_and_svg!(path, (1000, 640), |root| spread_body(root, title, spreads))
 }
 
 fn spread_body<DB: DrawingBackend>(
@@ -423,24 +439,12 @@ fn spread_body<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(err)?;
     let fy = |y: f64| y.max(FLIP_FLOOR);
-    let (x0, x1) = range(spreads.iter().flat_map(|s| s.x), true);
+    let x = range(spreads.iter().flat_map(|s| s.x), true);
     let (_, y1) = range(spreads.iter().flat_map(|s| s.y.map(fy)), true);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(14)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d((x0..x1).log_scale(), (FLIP_FLOOR / 1.5..y1).log_scale())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("GPU ms per frame for the translucent work (log; bars p10 to p90, marker at the median)")
-        .y_desc("mean FLIP against the exact reference (log; 0 drawn at 1e-4)")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(err)?;
+    let x_desc =
+        "GPU ms per frame for the translucent work (log; bars p10 to p90, marker at the median)";
+    let mut chart = flip_chart(&root, title, x_desc, x, y1)?;
     for (i, s) in spreads.iter().enumerate() {
         let c = color(i);
         let (mx, my) = (s.x[1], fy(s.y[1]));
@@ -457,14 +461,7 @@ where
             .label(s.name.clone())
             .legend(move |(x, y)| Circle::new((x, y), 6, c.filled()));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 14))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
+    legend(&mut chart, SeriesLabelPosition::UpperRight, 14)?;
     root.present().map_err(err)
 }
 
@@ -476,16 +473,16 @@ pub fn histograms(
     bins: &[String],
     series: &[(String, Vec<usize>)],
 ) -> Result<()> {
-    fonts();
     let cols = 3usize;
     let rows = series.len().div_ceil(cols).max(1);
     let size = (1100, 60 + 260 * rows as u32);
-    draw_png(&path.with_extension("png"), size, |root| {
-        histogram_body(root, title, bins, series, (rows, cols))
-    })?;
-    draw_svg(&path.with_extension("svg"), size, |root| {
-        histogram_body(root, title, bins, series, (rows, cols))
-    })
+    png_and_svg!(path, size, |root| histogram_body(
+        root,
+        title,
+        bins,
+        series,
+        (rows, cols)
+    ))
 }
 
 fn histogram_body<DB: DrawingBackend>(

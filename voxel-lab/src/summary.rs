@@ -114,11 +114,18 @@ pub struct ReferenceCheck {
     pub scene: String,
     /// Largest channel difference between the A-buffer and peel-to-convergence pictures.
     pub max_abs_err: u32,
+    /// Pixels where the two GPU methods differ by more than 2/255 (`eval::GPU_AGREEMENT`)
+    /// and the ray march does not side with the A-buffer (`eval::unsettled_pixels`, which
+    /// lies above this module).
+    pub unsettled: usize,
     /// Whether the reference counts as exact: the A-buffer lost nothing and capped no
-    /// pixel visibly, and the CPU ray march ([`crate::raymarch`]), which shares no mesh and
+    /// pixel visibly, the CPU ray march ([`crate::raymarch`]), which shares no mesh and
     /// no rasteriser with it, agrees with it (flat textures) on every pixel off geometric
-    /// edges and finds no crack. The ray march settles scenes where the two GPU methods
-    /// disagree (peeling keeps one of two fragments of equal depth).
+    /// edges and finds no crack, and wherever the two GPU methods differ by more than
+    /// 2/255 the ray march sides with the A-buffer (`unsettled` is 0). The ray march
+    /// decides where the GPU methods disagree (peeling keeps one of two fragments of equal
+    /// depth); a disagreement it cannot decide (on an edge or a seam) leaves the scene
+    /// unscored.
     pub exact: bool,
     /// The ray march against the A-buffer, both with flat textures.
     pub raymarch: RayMarchSummary,

@@ -12,16 +12,14 @@
 //! custom_stage.png [--technique sorted-quads]`.
 
 use std::ops::Range;
-use std::sync::Arc;
 
 use glam::{DQuat, DVec3};
-use voxel_core::{BlockRegistry, World, WorldPos, blocks};
 use voxel_render::stages::{
     DEPTH_COMPARE, GameFrame, GameStages, OIT_GROUP, Stages, TranslucentContract, TranslucentObject,
 };
-use voxel_render::{
-    Camera, DEPTH_FORMAT, GpuContext, Renderer, RendererConfig, SCENE_FORMAT, Technique,
-};
+use voxel_render::{DEPTH_FORMAT, GpuContext, Renderer, SCENE_FORMAT};
+
+mod common;
 
 const SHADER: &str = include_str!("custom_stage.wgsl");
 const TRANSLUCENT_ENTRY: &str = "
@@ -153,31 +151,25 @@ impl Game {
     /// The world at `t` seconds: the crate bobbing, the cube turning, the bubbles rising.
     fn update(&mut self, t: f64) {
         let crate_box = Thing {
-            center: DVec3::new(-3.0, 0.1 + 0.08 * (t * 1.7).sin(), 1.0),
+            center: common::crate_center(t),
             half: DVec3::new(1.0, 0.6, 1.0),
             rotation: DQuat::from_rotation_y(0.3),
             particle: false,
             color: [0.35, 0.18, 0.07, 1.0],
         };
+        let (center, rotation) = common::cube_pose(t);
         let cube = Thing {
-            center: DVec3::new(2.5, 0.2 * (t * 0.9).sin(), -1.0),
+            center,
             half: DVec3::splat(1.2),
-            rotation: DQuat::from_euler(glam::EulerRot::YXZ, t * 0.7, 0.6, 0.2),
+            rotation,
             particle: false,
             color: [0.1, 0.7, 0.25, 0.5],
         };
-        let bubbles = (0..1000u32).map(|i| {
-            // A fixed scatter (a hash of the index) and a rise that wraps at the surface.
-            let h = |k: u64| {
-                let mut z = (u64::from(i) << 8 | k).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-                z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-                z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-                (z ^ (z >> 31)) as f64 / u64::MAX as f64
-            };
-            let rise = (h(1) * 6.0 + t * (0.5 + h(2))).rem_euclid(6.0);
+        let bubbles = (0..1000u64).map(|i| {
+            let (center, half) = common::bubble(i, t);
             Thing {
-                center: DVec3::new(h(3) * 10.0 - 5.0, rise - 6.0, h(4) * 8.0 - 4.0),
-                half: DVec3::splat(0.08 + 0.1 * h(5)),
+                center,
+                half: DVec3::splat(half),
                 rotation: DQuat::IDENTITY,
                 particle: true,
                 color: [0.85, 0.92, 1.0, 0.45],
@@ -383,74 +375,12 @@ fn pipeline(
     })
 }
 
-/// A pool of water on sand, walled with stone, a glass wall across one end.
-fn pool_world() -> Result<World, voxel_core::Error> {
-    let mut world = World::new(Arc::new(BlockRegistry::default()));
-    let fill = |w: &mut World, a: [i32; 3], b: [i32; 3], id| {
-        w.fill_box(
-            WorldPos::new(a[0], a[1], a[2]),
-            WorldPos::new(b[0], b[1], b[2]),
-            id,
-        )
-    };
-    fill(&mut world, [-10, -8, -10], [10, -8, 10], blocks::SAND)?;
-    fill(&mut world, [-11, -8, -11], [11, 0, -11], blocks::STONE)?;
-    fill(&mut world, [-11, -8, -11], [-11, 0, 11], blocks::STONE)?;
-    fill(&mut world, [11, -8, -11], [11, 0, 11], blocks::STONE)?;
-    fill(&mut world, [-10, -7, -10], [10, -1, 10], blocks::WATER)?;
-    fill(&mut world, [-10, 0, -10], [10, 3, -10], blocks::GLASS)?;
-    Ok(world)
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().collect();
-    let arg = |name: &str| {
-        args.iter()
-            .position(|a| a == name)
-            .and_then(|i| args.get(i + 1).cloned())
-    };
-    let frames: u32 = arg("--frames").map_or(Ok(60), |v| v.parse())?;
-    let out = arg("--out").unwrap_or_else(|| "custom_stage.png".into());
-    let technique = match arg("--technique") {
-        Some(name) => Technique::from_name(&name)?,
-        None => Technique::WboitMrt,
-    };
-
-    // The game's own GPU objects.
-    let instance = wgpu::Instance::new(voxel_render::instance_descriptor(wgpu::Backends::all()));
-    let adapter = pollster::block_on(instance.request_adapter(&Default::default()))?;
-    let (device, queue) = pollster::block_on(voxel_render::request_device(&adapter))?;
-    let ctx = GpuContext::from_device(&adapter, device, queue);
-
-    let mut world = pool_world()?;
-    let (width, height) = (640, 360);
-    let mut config = RendererConfig {
-        width,
-        height,
-        ..RendererConfig::default()
-    };
-    config.oit.technique = technique;
-    let mut renderer = Renderer::new(&ctx, world.registry(), config)?;
-    for (pos, meshes) in voxel_mesh::mesh_dirty(&mut world)? {
-        renderer.upload_chunk(pos, &meshes)?;
-    }
-    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
-    let output = voxel_render::stages::target(
-        &ctx.device,
-        "game_output",
-        wgpu::TextureFormat::Rgba8UnormSrgb,
-        usage,
-        (width, height),
-    );
+    let args = common::Args::parse("custom_stage.png")?;
+    let ctx = common::game_device()?;
+    let (mut renderer, output, camera) = common::pool(&ctx, args.technique)?;
     let mut game = Game::new(&ctx.device);
-    let camera = Camera::look_at(
-        DVec3::new(1.0, 7.0, 17.0),
-        DVec3::new(0.0, -2.0, -2.0),
-        70.0,
-        0.1,
-        300.0,
-    )?;
-    for frame in 0..frames.max(1) {
+    for frame in 0..args.frames {
         game.update(f64::from(frame) / 30.0);
         // After a technique switch (or a setting its pipelines depend on) the contract's
         // id changes and the game builds new translucent pipelines.
@@ -459,16 +389,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         renderer.render(&mut encoder, &output.view, &camera, &mut game)?;
         ctx.queue.submit([encoder.finish()]);
     }
-    let rgba = voxel_render::readback::read_texture(&ctx, &output.texture, 4)?;
-    voxel_render::Image {
-        width,
-        height,
-        rgba,
-    }
-    .save_png(std::path::Path::new(&out))?;
-    println!(
-        "wrote {out}: {frames} frames of {} with a crate, a glass cube and 1000 bubbles",
-        technique.name()
-    );
+    common::save(&ctx, &output, &args, "with the game's own shaders")?;
     Ok(())
 }

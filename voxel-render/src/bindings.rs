@@ -58,7 +58,17 @@ pub(crate) fn scene_volume_wgsl(group: u32) -> String {
              // The opaque depth at pixel `xy` (the exact references' volume depth).\n\
              fn opaque_depth_at(xy: vec2<f32>) -> f32 {{\n    \
              let uv = depth_uv(xy, textureDimensions(volume_depth));\n    \
-             return textureSampleLevel(volume_depth, depth_sampler, uv, 0.0).x;\n}}\n\n"
+             return textureSampleLevel(volume_depth, depth_sampler, uv, 0.0).x;\n}}\n\n\
+             @group({group}) @binding(12) var volume_far: texture_2d<f32>;\n\n\
+             // Where a medium still open after the last fragment (at window depth `last`)\n\
+             // ends at pixel `xy`: the nearest back face of a volume behind it (the exact\n\
+             // references' exit pass, its quads grown: a sliver between two merged quads\n\
+             // leaves no way out open), or the opaque surface.\n\
+             fn walk_end(xy: vec2<f32>, last: f32) -> f32 {{\n    \
+             let opaque = opaque_depth_at(xy);\n    \
+             let uv = depth_uv(xy, textureDimensions(volume_far));\n    \
+             let exit = textureSampleLevel(volume_far, depth_sampler, uv, 0.0).x;\n    \
+             return select(opaque, exit, exit < last && exit > opaque);\n}}\n\n"
         )
         + VOLUME_WGSL
 }
@@ -154,6 +164,8 @@ pub(crate) const MEDIA_EYE: u32 = 1;
 /// holds where volumes end, `volume_entry` and `entry_look` the nearest entry into one,
 /// `volume_entry2` and `entry2_look` the nearest entry beyond where that one ends,
 /// `volume_far` the farthest back face of one beyond that, `opaque_copy` the opaque depth.
+/// (With [`MEDIA_WALK`], `volume_far` holds the nearest back face of a volume, its quads
+/// grown, where an open medium ends: `walk_end`.)
 pub(crate) const MEDIA_VOLUMES: u32 = 2;
 /// [`FrameUniforms::volumes`], exact references: they walk the media from the eye along
 /// their sorted fragments; `volume_depth` holds the opaque depth.

@@ -189,6 +189,13 @@ impl ChunkPipeline<'_> {
         self.build_with(device, false, None)
     }
 
+    /// Creates the pipeline drawing both sides of every face, the quads grown against
+    /// T-junction cracks: a depth pass of where paths end, which a sliver between two
+    /// merged quads must not leave open.
+    pub(crate) fn build_two_sided_solid(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        self.build_with(device, true, None)
+    }
+
     /// Creates both variants of a translucent pipeline (see [`SidedPipeline`]).
     pub(crate) fn build_sided(&self, device: &wgpu::Device) -> SidedPipeline {
         SidedPipeline {

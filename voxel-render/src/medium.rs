@@ -187,7 +187,7 @@ impl MediumPass {
             depth: DepthMode::Write,
             samples: 1,
         }
-        .build_two_sided(device);
+        .build_two_sided_solid(device);
         let volume_far = ChunkPipeline {
             label: "volume_far",
             module: &exit_module,
@@ -197,7 +197,7 @@ impl MediumPass {
             depth: DepthMode::WriteFarthest,
             samples: 1,
         }
-        .build_two_sided(device);
+        .build_two_sided_solid(device);
         let volume_entry2 = ChunkPipeline {
             label: "volume_entry2",
             module: &exit_module,

@@ -35,9 +35,11 @@
 //! transform and the first model of a shape are used. Hidden transforms and hidden layers
 //! are left out, as MagicaVoxel shows them.
 //!
-//! The reader is in `read` (chunks and bytes), the scene graph in `scene` (transforms,
-//! groups, shapes, layers), the import into a [`World`](crate::World) in `import`.
+//! The bounded byte reader is in `bytes`, the chunks in `read`, the scene graph in `scene`
+//! (transforms, groups, shapes, layers), the import into a [`World`](crate::World) in
+//! `import`.
 
+mod bytes;
 mod error;
 mod import;
 mod read;

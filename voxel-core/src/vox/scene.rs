@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use super::read::Reader;
+use super::bytes::Reader;
 use super::{VoxError, VoxFile};
 
 /// A rotation of the scene graph: a signed permutation, `(R v)[r] = sign[r] · v[axis[r]]`.

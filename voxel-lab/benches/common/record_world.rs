@@ -10,8 +10,11 @@ use voxel_lab::Result;
 use glam::DVec3;
 use rayon::prelude::*;
 use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator, World};
-use voxel_mesh::mesh_chunks;
-use voxel_render::{Camera, GpuContext, Renderer, RendererConfig, Technique};
+
+use voxel_render::{Camera, GpuContext, Renderer, Technique};
+
+#[path = "setup.rs"]
+mod setup;
 
 pub const SEED: u32 = 1;
 pub const W: u32 = 640;
@@ -48,17 +51,7 @@ pub fn renderer(ctx: &GpuContext, vd: i32, technique: Technique) -> Result<Rende
     for (p, c) in chunks {
         world.insert_chunk(p, c)?;
     }
-    let mut config = RendererConfig {
-        width: W,
-        height: H,
-        ..RendererConfig::default()
-    };
-    config.oit.technique = technique;
-    let mut renderer = Renderer::new(ctx, &registry, config)?;
-    for (pos, meshes) in mesh_chunks(&world, &positions)? {
-        renderer.upload_chunk(pos, &meshes)?;
-    }
-    Ok(renderer)
+    setup::renderer_of(ctx, &world, &positions, technique, (W, H))
 }
 
 /// The camera of view distance `vd`.

@@ -5,7 +5,6 @@ use glam::DVec3;
 use voxel_core::RenderClass;
 use voxel_render::Camera;
 
-use super::walk::Walker;
 use super::{RayMarcher, Shading, Surface};
 use crate::content::{face_light, particle_light};
 
@@ -28,11 +27,18 @@ pub(super) fn output(x: f64) -> u8 {
 }
 
 impl RayMarcher {
-    /// The lit colour of `surface` at point `p` with albedo `a`.
-    pub(super) fn lit(&self, surface: Surface, p: DVec3, a: [f64; 4], w: &Walker<'_>) -> [f64; 3] {
+    /// The lit colour of `surface` at point `p` with albedo `a`, under `light`.
+    pub(super) fn lit(
+        &self,
+        surface: Surface,
+        p: DVec3,
+        a: [f64; 4],
+        light: &Light,
+        shading: &Shading,
+    ) -> [f64; 3] {
         let face = surface.face;
         let n = face.normal();
-        let light = w.light.on(DVec3::from(n.map(f64::from)));
+        let light = light.on(DVec3::from(n.map(f64::from)));
         let translucent = self.class(surface.id) == RenderClass::Translucent;
         let shade = if translucent {
             1.0
@@ -41,7 +47,7 @@ impl RayMarcher {
             let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
             let s = (p[ua] - surface.block[ua] as f64).clamp(0.0, 1.0);
             let t = (p[va] - surface.block[va] as f64).clamp(0.0, 1.0);
-            self.ao(surface.block, face, s, t, f64::from(w.shading.ao_strength))
+            self.ao(surface.block, face, s, t, f64::from(shading.ao_strength))
         };
         [
             a[0] * light * shade,

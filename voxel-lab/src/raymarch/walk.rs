@@ -281,7 +281,7 @@ impl RayMarcher {
             let a = self.albedo(x.to, front_face, u, v, w.shading.texturing);
             if cb == RenderClass::Opaque || a[3] >= CUTOUT_ALPHA_TEST {
                 let color = if w.want_color {
-                    self.lit(surface, p, a, w)
+                    self.lit(surface, p, a, w.light, w.shading)
                 } else {
                     [0.0; 3]
                 };
@@ -436,7 +436,7 @@ impl Walker<'_> {
             return;
         }
         if self.want_color {
-            let c = m.lit(s, p, a, self);
+            let c = m.lit(s, p, a, self.light, self.shading);
             self.layers.push([c[0], c[1], c[2], a[3].clamp(0.0, 1.0)]);
         }
     }

@@ -8,8 +8,7 @@ use serde::Deserialize;
 use toml::Spanned;
 use voxel_core::{BlockDef, BlockImage, BlockRegistry, FaceImages, Pattern, RenderClass};
 
-use super::format::{exact, exact_opt};
-use super::parse::at_line;
+use super::fields::{at_line, exact, exact_opt};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -5,8 +5,8 @@ use crate::Result;
 use glam::DVec3;
 use voxel_render::low_level::WORLD_EXTENT;
 
+use super::fields::at_line;
 use super::format::SceneFile;
-use super::parse::at_line;
 use crate::content::rotation;
 use voxel_render::content::{Content, Entity, MAX_EMISSIVE, Particle};
 

@@ -4,29 +4,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::blocks::BlockDefFile;
-
-/// A fixed-length array in a scene file: exactly `N` values (serde's arrays take the first
-/// `N` of a longer list and ignore the rest).
-pub(super) fn exact<'de, D, T, const N: usize>(d: D) -> Result<[T; N], D::Error>
-where
-    D: serde::Deserializer<'de>,
-    T: Deserialize<'de>,
-{
-    let v = Vec::<T>::deserialize(d)?;
-    let n = v.len();
-    v.try_into().map_err(|_| {
-        serde::de::Error::invalid_length(n, &format!("an array of length {N}").as_str())
-    })
-}
-
-/// [`exact`] for an optional array.
-pub(super) fn exact_opt<'de, D, T, const N: usize>(d: D) -> Result<Option<[T; N]>, D::Error>
-where
-    D: serde::Deserializer<'de>,
-    T: Deserialize<'de>,
-{
-    exact(d).map(Some)
-}
+use super::fields::{exact, exact_opt};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -73,6 +73,7 @@ use crate::{Error, Result};
 
 mod blocks;
 mod content;
+mod fields;
 mod format;
 mod parse;
 #[cfg(test)]

@@ -16,6 +16,7 @@ use voxel_render::Camera;
 
 use super::blocks::{block_def, class_named};
 use super::content::content_of;
+use super::fields::at_line;
 use super::format::{BoxDef, PaletteDef, SceneFile};
 use super::{Scene, fill_box, framing_camera, model_name};
 
@@ -29,13 +30,6 @@ const MAX_BOX_BLOCKS: i128 = 20_000_000;
 /// costs up to about 40 KiB, so 20 M blocks in a row (625 000 chunks) would take tens of
 /// GiB. 16 384 chunks hold a 4096 × 4096 floor.
 const MAX_BOX_CHUNKS: i128 = 16_384;
-
-/// The scene error `message` at the line of the byte offset `at` of `text` (it reads
-/// `LINE: message`).
-pub(super) fn at_line(text: &str, at: usize, message: impl std::fmt::Display) -> Error {
-    let line = text[..at.min(text.len())].matches('\n').count() + 1;
-    Error::scene(Some(line), message)
-}
 
 /// The `table.key` written on the line holding byte `at` (the key before `=`, the table
 /// from the nearest header above), for error messages.

@@ -1,30 +1,12 @@
-//! A frame's draw commands: the indirect commands, the runs per page, the draw lists of
-//! the passes and the builder that fills them.
-
-use bytemuck::{Pod, Zeroable};
+//! A frame's draws: the runs of commands per page, the draw lists of the passes and the
+//! builder that fills them with [`DrawCommand`]s.
 
 #[cfg(doc)]
 use super::Culled;
 use super::DrawMode;
+use super::command::DrawCommand;
 use super::store::ChunkStore;
-#[cfg(doc)]
-use crate::QuadFetch;
 use crate::arena::Alloc;
-
-/// One draw command, as `multi_draw_indirect` reads it with [`QuadFetch::Storage`] (with
-/// [`QuadFetch::Instanced`] each is a direct draw of its own).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
-pub(crate) struct DrawCommand {
-    /// Vertices: 6 per quad.
-    pub vertex_count: u32,
-    /// Always 1.
-    pub instance_count: u32,
-    /// The mesh's first quad in its page, times 6.
-    pub first_vertex: u32,
-    /// The chunk's slot.
-    pub first_instance: u32,
-}
 
 /// A run of commands drawing from one page.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

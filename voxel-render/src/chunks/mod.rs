@@ -18,6 +18,7 @@
 //! ([`crate::layers`]) are summed up at the upload and kept with the region's records, so
 //! that the culling hands them over in its walk when asked to.
 
+mod command;
 mod cull;
 mod draws;
 mod gpu_chunk;

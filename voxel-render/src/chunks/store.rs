@@ -6,8 +6,8 @@ use std::sync::Arc;
 use voxel_core::ChunkPos;
 use voxel_mesh::{ChunkMeshes, PackedQuad};
 
+use super::command::DrawCommand;
 use super::cull::{Culled, FarEntry, Frustum, NearEntry, Regions, near_key};
-use super::draws::DrawCommand;
 use super::gpu_chunk::{GpuChunk, distinct_planes, layers_bounds};
 use super::{MeshKind, PosMap};
 use crate::arena::{Alloc, ArenaStats, QuadArena};

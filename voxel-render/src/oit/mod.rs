@@ -14,6 +14,7 @@ pub(crate) mod peeling;
 pub(crate) mod reference;
 pub(crate) mod sorted;
 pub(crate) mod stipple;
+mod sums;
 pub(crate) mod wboit;
 
 use std::fmt;

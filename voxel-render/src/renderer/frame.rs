@@ -323,6 +323,13 @@ impl Renderer {
             self.medium
                 .volume_depth_pass(encoder, &t.depth, &t.volume_depth, exits, timer);
         }
+        if media == MEDIA_WALK {
+            // Where a medium still open after the references' last fragment ends: the
+            // nearest back face of a volume, quads grown (`walk_end` in `bindings.rs`).
+            let exits = Some((&t.far_scene_group, &draws, translucent));
+            self.medium
+                .volume_depth_pass(encoder, &t.depth, &t.volume_far, exits, timer);
+        }
         if media == MEDIA_VOLUMES {
             self.medium.volume_entry_pass(
                 encoder,

@@ -5,9 +5,10 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use voxel_core::{BlockId, CHUNK_SIZE, Chunk, ChunkPos, WorldPos};
+use voxel_core::{BlockId, Chunk, ChunkPos, WorldPos};
 
 use super::ChunkStreamer;
+use super::local::{local_index, local_of};
 use super::slot::State;
 use super::source::generate_checked;
 use crate::{Error, Result};
@@ -23,22 +24,8 @@ pub const EDIT_BYTES: usize = 20;
 /// chunk with one edit, over 10 000 chunks.
 pub const EDITED_CHUNK_BYTES: usize = 160;
 
-/// The edits of one chunk: in-chunk index ([`local_index`]) → block.
+/// The edits of one chunk: in-chunk index (`local_index`) → block.
 pub(super) type ChunkEdits = Arc<BTreeMap<u16, BlockId>>;
-
-/// The index of a block within its chunk (x fastest), as the edit lists key it.
-fn local_index([x, y, z]: [usize; 3]) -> u16 {
-    (x + CHUNK_SIZE * (y + CHUNK_SIZE * z)) as u16
-}
-
-pub(super) fn local_of(index: u16) -> [usize; 3] {
-    let i = usize::from(index);
-    [
-        i % CHUNK_SIZE,
-        (i / CHUNK_SIZE) % CHUNK_SIZE,
-        i / (CHUNK_SIZE * CHUNK_SIZE),
-    ]
-}
 
 impl ChunkStreamer {
     /// Bytes counted for the edits kept (see [`ChunkStreamer::memory_bytes`]).

@@ -9,8 +9,7 @@ use voxel_core::{BlockRegistry, Chunk, ChunkPos, Neighbourhood};
 use voxel_mesh::{ChunkMeshes, Mesher};
 
 use super::ChunkStreamer;
-use super::schedule::Ready;
-use super::slot::{Slot, State};
+use super::slot::{Ready, Slot, State};
 use super::source::generate_checked;
 
 /// What a job sends back to the streamer.

@@ -79,6 +79,7 @@
 mod config;
 mod edits;
 mod jobs;
+mod local;
 mod schedule;
 mod slot;
 mod source;
@@ -102,8 +103,8 @@ pub use source::{ChunkSink, ChunkSource};
 
 use edits::ChunkEdits;
 use jobs::Done;
-use schedule::{Ready, distance2, within};
-use slot::Slot;
+use schedule::{distance2, within};
+use slot::{Ready, Slot};
 
 /// Loads, meshes, uploads and unloads the chunks around an eye (see the module docs).
 pub struct ChunkStreamer {

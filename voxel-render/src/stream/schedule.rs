@@ -6,10 +6,9 @@ use std::collections::VecDeque;
 
 use glam::DVec3;
 use voxel_core::{BlockId, CHUNK_SIZE, ChunkPos, Neighbourhood};
-use voxel_mesh::ChunkMeshes;
 
 use super::jobs::Done;
-use super::slot::{Slot, State};
+use super::slot::{Ready, Slot, State};
 use super::{ChunkSink, ChunkStreamer};
 use crate::{Error, Result};
 
@@ -35,32 +34,6 @@ pub struct StreamFrame {
     /// The positions uploaded (or dropped from the sink, their meshes empty) in this
     /// update, in order: what a game mirrors (its own per-chunk data, a minimap).
     pub uploaded: Vec<ChunkPos>,
-}
-
-/// A finished mesh waiting for its upload, nearest first.
-pub(super) struct Ready {
-    pub(super) distance: i64,
-    pub(super) pos: ChunkPos,
-    pub(super) version: u64,
-    pub(super) meshes: ChunkMeshes,
-}
-
-impl PartialEq for Ready {
-    fn eq(&self, other: &Self) -> bool {
-        (self.distance, self.pos) == (other.distance, other.pos)
-    }
-}
-impl Eq for Ready {}
-impl PartialOrd for Ready {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Ready {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        // BinaryHeap pops the largest: the nearest must compare largest.
-        (other.distance, other.pos).cmp(&(self.distance, self.pos))
-    }
 }
 
 /// Squared horizontal and vertical distance of an offset, for ordering and ranges.

@@ -1,4 +1,8 @@
-//! How far along each position is: its [`State`] and the [`Slot`] that holds it.
+//! How far along each position is: its [`State`], the [`Slot`] that holds it, and a
+//! finished mesh waiting for its upload ([`Ready`]).
+
+use voxel_core::ChunkPos;
+use voxel_mesh::ChunkMeshes;
 
 /// How far along a position is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,5 +63,31 @@ impl Slot {
     /// stay resident.
     pub(super) fn needs_neighbours(&self) -> bool {
         self.uploaded || matches!(self.state, State::Meshing | State::Ready)
+    }
+}
+
+/// A finished mesh waiting for its upload, nearest first.
+pub(super) struct Ready {
+    pub(super) distance: i64,
+    pub(super) pos: ChunkPos,
+    pub(super) version: u64,
+    pub(super) meshes: ChunkMeshes,
+}
+
+impl PartialEq for Ready {
+    fn eq(&self, other: &Self) -> bool {
+        (self.distance, self.pos) == (other.distance, other.pos)
+    }
+}
+impl Eq for Ready {}
+impl PartialOrd for Ready {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Ready {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        // BinaryHeap pops the largest: the nearest must compare largest.
+        (other.distance, other.pos).cmp(&(self.distance, self.pos))
     }
 }

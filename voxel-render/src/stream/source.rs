@@ -7,7 +7,7 @@ use std::panic::AssertUnwindSafe;
 use voxel_core::{BlockId, BlockRegistry, Chunk, ChunkPos, TerrainGenerator, World};
 use voxel_mesh::ChunkMeshes;
 
-use super::edits::local_of;
+use super::local::local_of;
 use crate::{Renderer, Result};
 
 /// Where chunks come from. Called on rayon's workers, any number at once.

@@ -25,8 +25,9 @@ use wgpu::util::DeviceExt;
 
 use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, Pass, SidedPipeline};
+use crate::gpu::{self, Depth, Pass, SidedPipeline};
 use crate::ladder::Need;
+use crate::oit::sums;
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -278,25 +279,8 @@ fn group_entries(resolve: bool) -> Vec<wgpu::BindGroupLayoutEntry> {
     entries
 }
 
-const ADDITIVE: wgpu::BlendState = wgpu::BlendState {
-    color: wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    },
-    alpha: wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    },
-};
-
 fn additive_target(format: wgpu::TextureFormat) -> Option<wgpu::ColorTargetState> {
-    Some(wgpu::ColorTargetState {
-        format,
-        blend: Some(ADDITIVE),
-        write_mask: wgpu::ColorWrites::ALL,
-    })
+    sums::blended(format, sums::ADDITIVE)
 }
 
 /// The size-dependent targets and the groups that read them.
@@ -379,16 +363,9 @@ impl TechniqueKind for Mboit {
         );
         let chunk = |label, resolve: bool, layout: &wgpu::BindGroupLayout, targets: &[_]| {
             let module = gpu::shader(device, label, &[&mboit_wgsl(resolve)]);
-            ChunkPipeline {
-                label,
-                module: &module,
-                fragment_entry: if resolve { "fs_resolve" } else { "fs_moments" },
-                groups: &setup.layouts.with(&[layout]),
-                targets,
-                depth: gpu::DepthMode::ReadOnly,
-                samples: 1,
-            }
-            .build_sided(device)
+            let entry = if resolve { "fs_resolve" } else { "fs_moments" };
+            let groups = setup.layouts.with(&[layout]);
+            sums::chunk_pass(device, label, &module, entry, &groups, targets)
         };
         let moments = chunk(
             "mboit_moments",
@@ -438,16 +415,14 @@ impl Mboit {
         single: bool,
         size: (u32, u32),
     ) -> Targets {
-        use wgpu::TextureUsages as U;
-        let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC;
         let (b0_format, moments_format) = moment_formats(single);
-        let b0 = gpu::target(device, "mboit_b0", b0_format, usage, size);
-        let moments = gpu::target(device, "mboit_moments", moments_format, usage, size);
-        let accumulation = gpu::target(
+        let [b0, moments, accumulation] = sums::targets(
             device,
-            "mboit_accumulation",
-            ACCUMULATION_FORMAT,
-            usage,
+            [
+                ("mboit_b0", b0_format),
+                ("mboit_moments", moments_format),
+                ("mboit_accumulation", ACCUMULATION_FORMAT),
+            ],
             size,
         );
         let resolve_group = gpu::bind_group(

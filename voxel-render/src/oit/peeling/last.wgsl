@@ -17,5 +17,5 @@ fn fs_last_volume(in: FullscreenOut) -> @location(0) vec4<f32> {
     if medium.a <= 0.0 {
         discard;
     }
-    return medium_segment(medium, ray_length(in.clip.xy, start, opaque_depth_at(in.clip.xy)));
+    return medium_segment(medium, ray_length(in.clip.xy, start, walk_end(in.clip.xy, start)));
 }

@@ -78,7 +78,7 @@ fn fs_resolve(in: FullscreenOut) -> @location(0) vec4<f32> {
         last = node.depth;
     }
     if medium.a > 0.0 {
-        let segment = medium_segment(medium, ray_length(in.clip.xy, last, opaque_depth_at(in.clip.xy)));
+        let segment = medium_segment(medium, ray_length(in.clip.xy, last, walk_end(in.clip.xy, last)));
         acc += (1.0 - acc.a) * segment;
     }
     if total > MAX_LAYERS {

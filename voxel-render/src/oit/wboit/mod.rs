@@ -41,8 +41,9 @@ use wgpu::util::DeviceExt;
 
 use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, Pass, SidedPipeline, Target};
+use crate::gpu::{self, Depth, Pass, SidedPipeline, Target};
 use crate::ladder::Need;
+use crate::oit::sums;
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -228,19 +229,6 @@ fn game_output(accumulation: bool, revealage: bool) -> String {
     )
 }
 
-const ADDITIVE: wgpu::BlendState = wgpu::BlendState {
-    color: wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    },
-    alpha: wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::One,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    },
-};
-
 const MULTIPLY_ONE_MINUS_SRC: wgpu::BlendState = wgpu::BlendState {
     color: wgpu::BlendComponent {
         src_factor: wgpu::BlendFactor::Zero,
@@ -293,16 +281,7 @@ impl AccumulateBuilder {
         );
         let groups = self.layouts.with(&[&self.params_layout]);
         let chunk = |label, fragment_entry, targets: &[Option<wgpu::ColorTargetState>]| {
-            ChunkPipeline {
-                label,
-                module: &module,
-                fragment_entry,
-                groups: &groups,
-                targets,
-                depth: gpu::DepthMode::ReadOnly,
-                samples: 1,
-            }
-            .build_sided(device)
+            sums::chunk_pass(device, label, &module, fragment_entry, &groups, targets)
         };
         let [accum, reveal] = &self.targets;
         if self.two_pass {
@@ -413,15 +392,8 @@ impl TechniqueKind for Wboit {
             &params_layout,
             &[params.as_entire_binding()],
         );
-        let target = |format, blend| {
-            Some(wgpu::ColorTargetState {
-                format,
-                blend: Some(blend),
-                write_mask: wgpu::ColorWrites::ALL,
-            })
-        };
-        let accum_target = target(accum_format, ADDITIVE);
-        let reveal_target = target(REVEALAGE_FORMAT, MULTIPLY_ONE_MINUS_SRC);
+        let accum_target = sums::blended(accum_format, sums::ADDITIVE);
+        let reveal_target = sums::blended(REVEALAGE_FORMAT, MULTIPLY_ONE_MINUS_SRC);
         let builder = AccumulateBuilder {
             two_pass: technique == Technique::WboitTwoPass,
             layouts: setup.layouts.clone(),
@@ -460,10 +432,14 @@ impl Wboit {
         accum_format: wgpu::TextureFormat,
         size: (u32, u32),
     ) -> Targets {
-        use wgpu::TextureUsages as U;
-        let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC;
-        let accumulation = gpu::target(device, "wboit_accumulation", accum_format, usage, size);
-        let revealage = gpu::target(device, "wboit_revealage", REVEALAGE_FORMAT, usage, size);
+        let [accumulation, revealage] = sums::targets(
+            device,
+            [
+                ("wboit_accumulation", accum_format),
+                ("wboit_revealage", REVEALAGE_FORMAT),
+            ],
+            size,
+        );
         let composite_group = gpu::texture_group(
             device,
             "wboit_composite",

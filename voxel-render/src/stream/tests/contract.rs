@@ -110,9 +110,41 @@ impl ChunkSource for TestSource {
 struct Truth {
     failing: bool,
     edits: HashMap<ChunkPos, Vec<([usize; 3], BlockId)>>,
+    /// The chunks and fresh meshes made so far, kept until the next edit: every check
+    /// after a settle reads most of them again.
+    chunks: std::cell::RefCell<HashMap<ChunkPos, Chunk>>,
+    meshes: std::cell::RefCell<HashMap<ChunkPos, ChunkMeshes>>,
 }
 
 impl Truth {
+    fn new(failing: bool) -> Self {
+        Self {
+            failing,
+            edits: HashMap::new(),
+            chunks: Default::default(),
+            meshes: Default::default(),
+        }
+    }
+
+    /// The chunk at `pos`, made once until an edit.
+    fn cached(&self, pos: ChunkPos) -> Chunk {
+        self.chunks
+            .borrow_mut()
+            .entry(pos)
+            .or_insert_with(|| self.chunk(pos))
+            .clone()
+    }
+
+    /// A fresh mesh of `pos` (`fresh_mesh`), made once until an edit.
+    fn fresh_mesh(&self, pos: ChunkPos) -> ChunkMeshes {
+        if let Some(m) = self.meshes.borrow().get(&pos) {
+            return m.clone();
+        }
+        let m = fresh_mesh(pos, &|p| Some(self.cached(p)));
+        self.meshes.borrow_mut().insert(pos, m.clone());
+        m
+    }
+
     fn chunk(&self, pos: ChunkPos) -> Chunk {
         if kind_of(pos, self.failing) != Kind::Blocks {
             return Chunk::default();
@@ -130,6 +162,8 @@ impl Truth {
     }
 
     fn edit(&mut self, pos: WorldPos, id: BlockId) {
+        self.chunks.get_mut().clear();
+        self.meshes.get_mut().clear();
         let (c, local) = pos.split();
         self.edits.entry(c).or_default().push((local, id));
     }
@@ -205,19 +239,9 @@ fn check_against_truth(
     what: &str,
 ) {
     let centre = ChunkStreamer::centre_of(eye).unwrap();
-    let cache: std::cell::RefCell<HashMap<ChunkPos, Chunk>> = Default::default();
-    let chunk_at = |p: ChunkPos| -> Option<Chunk> {
-        Some(
-            cache
-                .borrow_mut()
-                .entry(p)
-                .or_insert_with(|| truth.chunk(p))
-                .clone(),
-        )
-    };
     for (&pos, meshes) in &sink.held {
         assert!(s.keeps(pos, centre), "{what}: {pos:?} past the margin");
-        let fresh = fresh_mesh(pos, &chunk_at);
+        let fresh = truth.fresh_mesh(pos);
         assert!(
             *meshes == fresh,
             "{what}: {pos:?} drawn with {} quads, a fresh mesh of the true world has {}",
@@ -228,7 +252,7 @@ fn check_against_truth(
     for o in &s.offsets {
         let pos = ChunkPos::new(centre.x + o[0], centre.y + o[1], centre.z + o[2]);
         if !sink.held.contains_key(&pos) {
-            let fresh = fresh_mesh(pos, &chunk_at);
+            let fresh = truth.fresh_mesh(pos);
             assert!(
                 fresh.is_empty(),
                 "{what}: {pos:?} within the view distance not drawn ({} quads)",
@@ -240,19 +264,39 @@ fn check_against_truth(
         }
     }
     for (pos, c) in s.world().iter() {
-        let t = chunk_at(pos).unwrap_or_default();
-        for z in 0..CHUNK_SIZE {
-            for y in 0..CHUNK_SIZE {
-                for x in 0..CHUNK_SIZE {
-                    assert_eq!(
-                        c.get(x, y, z).unwrap(),
-                        t.get(x, y, z).unwrap(),
-                        "{what}: resident block {x},{y},{z} of {pos:?}"
-                    );
-                }
-            }
+        let t = truth.cached(pos);
+        if same_blocks(c, &t) {
+            continue;
+        }
+        // Every block, in `to_dense`'s order: y fastest, then z, then x.
+        let (have, want) = (c.to_dense(), t.to_dense());
+        if let Some(i) = (0..have.len()).find(|&i| have[i] != want[i]) {
+            let (x, y, z) = (
+                i / CHUNK_SIZE / CHUNK_SIZE,
+                i % CHUNK_SIZE,
+                i / CHUNK_SIZE % CHUNK_SIZE,
+            );
+            panic!(
+                "{what}: resident block {x},{y},{z} of {pos:?} is {:?}, the true world's {:?}",
+                have[i], want[i]
+            );
         }
     }
+}
+
+/// Whether `a` and `b` hold the same blocks, in whatever form each is stored: as many
+/// blocks of each type, at the same places (air is what the other types leave).
+fn same_blocks(a: &Chunk, b: &Chunk) -> bool {
+    let palette = |c: &Chunk| {
+        let mut p: Vec<(BlockId, usize)> = c.palette().filter(|e| e.1 > 0).collect();
+        p.sort_unstable_by_key(|e| e.0.0);
+        p
+    };
+    let pa = palette(a);
+    pa == palette(b)
+        && pa
+            .iter()
+            .all(|&(id, _)| id == BlockId::AIR || a.occupancy(id) == b.occupancy(id))
 }
 
 /// For a source that answers differently each call there is no true world beyond what
@@ -332,10 +376,7 @@ fn random_sequences_hold_the_truth_once_idle() {
             changing: changing.then(|| std::sync::atomic::AtomicU64::new(0)),
         };
         let mut s = ChunkStreamer::new(registry(), source, config).unwrap();
-        let mut truth = Truth {
-            failing,
-            edits: HashMap::new(),
-        };
+        let mut truth = Truth::new(failing);
         let mut sink = Holder::default();
         let mut failed = HashSet::new();
         let home = DVec3::new(5.0, 10.0, 5.0);
@@ -464,10 +505,7 @@ fn deterministic(view_distance: u32, hysteresis: u32) -> (ChunkStreamer, Truth) 
         changing: None,
     };
     let s = ChunkStreamer::new(registry(), source, config).unwrap();
-    let truth = Truth {
-        failing: false,
-        edits: HashMap::new(),
-    };
+    let truth = Truth::new(false);
     (s, truth)
 }
 
@@ -828,4 +866,41 @@ fn far_edits_are_kept_within_the_bound() {
         blocks::GLASS
     );
     assert!(sink.held.contains_key(&c));
+}
+
+/// The oracle's block comparison: the same blocks in another form are the same, one block
+/// moved or changed is not.
+#[test]
+fn same_blocks_compares_every_block_in_any_form() {
+    // A chunk of boxes of several types.
+    let a = (0..100)
+        .map(|x| blocks_of(ChunkPos::new(x, 0, 0), 7))
+        .find(|c| c.palette_len() > 2)
+        .unwrap();
+    let mut packed = a.clone();
+    packed.pack();
+    assert!(same_blocks(&a, &packed) && same_blocks(&packed, &a));
+    let mut changed = packed.clone();
+    let old = changed.get(0, 0, 0).unwrap();
+    let other = if old == blocks::STONE {
+        blocks::GLASS
+    } else {
+        blocks::STONE
+    };
+    changed.set(0, 0, 0, other).unwrap();
+    assert!(!same_blocks(&a, &changed));
+    // The same counts at other places.
+    let mut moved = Chunk::default();
+    moved.set(1, 0, 0, blocks::STONE).unwrap();
+    let mut here = Chunk::default();
+    here.set(0, 0, 0, blocks::STONE).unwrap();
+    assert!(!same_blocks(&here, &moved));
+    assert!(same_blocks(
+        &Chunk::uniform(blocks::WATER),
+        &Chunk::uniform(blocks::WATER)
+    ));
+    assert!(!same_blocks(
+        &Chunk::uniform(blocks::WATER),
+        &Chunk::default()
+    ));
 }
