@@ -15,6 +15,8 @@ use voxel_core::World;
 use voxel_mesh::{Mesher, UV_AXES};
 use voxel_render::{Camera, Image};
 
+use crate::overlaps::Pair;
+
 /// A pixel centre closer than this to a quad edge (in pixels) is an edge pixel: 16 times
 /// the 1/256-pixel snapping of the rasterizer, which leaves room for the f32 vertex
 /// transform.
@@ -129,9 +131,9 @@ fn ray_segment(d: DVec3, a: DVec3, b: DVec3) -> Option<(f64, f64)> {
 }
 
 /// Where an exact order's error against the reference stands: the largest channel error
-/// over the pixels off translucent quad edges and off `overlaps` (pixels showing two of a
-/// game's objects that interpenetrate, [`crate::overlaps`]), and how many pixels off by
-/// more than 1/255 lie on an edge and on such objects (an edge first).
+/// over the pixels off translucent quad edges and off pixels showing two of a game's
+/// objects that interpenetrate or nearly touch ([`crate::overlaps`]), and how many pixels
+/// off by more than 1/255 lie on each (an edge first).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct OffEdges {
     /// The largest channel error elsewhere (1/255).
@@ -140,13 +142,19 @@ pub struct OffEdges {
     pub on_edges: u32,
     /// Pixels off by more than 1/255 on interpenetrating objects.
     pub on_overlaps: u32,
+    /// Pixels off by more than 1/255 on objects near each other (their bounding balls meet,
+    /// their solids do not: the centre order can be wrong there).
+    pub on_near: u32,
+    /// Pixels off by more than 8/255 elsewhere (the order of quads and planes is wrong there,
+    /// or two objects' centres are).
+    pub over_8: u32,
 }
 
-/// [`OffEdges`] of `test` against `reference`, with `edges` and the mask `overlaps` (one
-/// flag a pixel, row by row; empty: none).
+/// [`OffEdges`] of `test` against `reference`, with `edges` and the objects' mask `objects`
+/// (one [`Pair`] a pixel, row by row; empty: none).
 pub fn error_off_edges(
     edges: &Edges,
-    overlaps: &[bool],
+    objects: &[Pair],
     reference: &Image,
     test: &Image,
 ) -> OffEdges {
@@ -163,16 +171,19 @@ pub fn error_off_edges(
                 continue;
             }
             classified += 1;
-            if classified <= MAX_CLASSIFIED && edges.is_edge(x, y) {
-                out.on_edges += 1;
-            } else if overlaps
+            let pair = objects
                 .get((y * reference.width + x) as usize)
                 .copied()
-                .unwrap_or(false)
-            {
+                .unwrap_or(Pair::None);
+            if classified <= MAX_CLASSIFIED && edges.is_edge(x, y) {
+                out.on_edges += 1;
+            } else if pair == Pair::Interpenetrating {
                 out.on_overlaps += 1;
+            } else if pair == Pair::Near {
+                out.on_near += 1;
             } else {
                 out.max = out.max.max(err);
+                out.over_8 += u32::from(err > 8);
             }
         }
     }

@@ -428,7 +428,7 @@ fn scene_records(
             let drawn = renderer.drawn_camera(&camera);
             let e = quad_edges.get_or_insert_with(|| Edges::new(&scene.world, &drawn, size));
             let o = overlaps
-                .get_or_insert_with(|| crate::overlaps::overlap_mask(&scene.content, &drawn, size));
+                .get_or_insert_with(|| crate::overlaps::object_mask(&scene.content, &drawn, size));
             edges::error_off_edges(e, o, &reference.image, &m.image)
         });
         records.push(Record {
@@ -456,6 +456,7 @@ fn scene_records(
             max_abs_err_off_edges: off_edges.map(|e| e.max),
             edge_px: off_edges.map(|e| e.on_edges),
             overlap_px: off_edges.map(|e| e.on_overlaps),
+            near_px: off_edges.map(|e| e.on_near),
             heatmap,
         });
     }

@@ -6,7 +6,10 @@
 //! Two translucent things interpenetrate when their solids intersect: boxes (entities, at
 //! any angle) by the separating-axis test of Gottschalk, Lin & Manocha (1996), a particle
 //! (a camera-facing square, a box of no depth) likewise. A pixel counts when its centre ray
-//! meets both of an intersecting pair.
+//! meets both of an intersecting pair. Apart from those, two things whose bounding balls
+//! meet are *near*: their solids do not touch, but the sorted techniques order them by their
+//! centres, which can be wrong where they overlap on screen (a bubble just under a turned
+//! fish, seen from above); the lab counts their pixels apart too.
 
 use glam::DVec3;
 use voxel_render::Camera;
@@ -136,10 +139,26 @@ fn solids(content: &Content, camera: &Camera) -> Vec<Solid> {
 /// The pairs of `solids` that intersect (particles, which all face one way, are never a
 /// pair among themselves: parallel squares meet only in their plane).
 fn intersecting(solids: &[Solid], particles: usize) -> Vec<(usize, usize)> {
+    pairs(solids, particles, intersect)
+}
+
+/// The pairs of `solids` (an entity and anything) whose bounding balls meet though the
+/// solids do not.
+fn near(solids: &[Solid], particles: usize) -> Vec<(usize, usize)> {
+    pairs(solids, particles, |a, b| {
+        a.center.distance(b.center) <= a.radius() + b.radius() && !intersect(a, b)
+    })
+}
+
+fn pairs(
+    solids: &[Solid],
+    particles: usize,
+    meet: impl Fn(&Solid, &Solid) -> bool,
+) -> Vec<(usize, usize)> {
     let mut pairs = Vec::new();
     for j in particles..solids.len() {
         for i in 0..j {
-            if intersect(&solids[i], &solids[j]) {
+            if meet(&solids[i], &solids[j]) {
                 pairs.push((i, j));
             }
         }
@@ -147,14 +166,28 @@ fn intersecting(solids: &[Solid], particles: usize) -> Vec<(usize, usize)> {
     pairs
 }
 
-/// Per pixel of a `size` picture of `camera` (row by row): whether its centre ray meets two
-/// of the game's translucent objects that interpenetrate.
-pub fn overlap_mask(content: &Content, camera: &Camera, size: (u32, u32)) -> Vec<bool> {
+/// What a pixel shows of a game's objects: two that interpenetrate, two near each other,
+/// or neither ([`object_mask`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Pair {
+    /// No two of them at once (or two apart).
+    #[default]
+    None,
+    /// Two whose bounding balls meet though their solids do not.
+    Near,
+    /// Two whose solids intersect.
+    Interpenetrating,
+}
+
+/// Per pixel of a `size` picture of `camera` (row by row): the pair of the game's
+/// translucent objects its centre ray meets, interpenetrating ones first.
+pub fn object_mask(content: &Content, camera: &Camera, size: (u32, u32)) -> Vec<Pair> {
     let (w, h) = size;
-    let mut mask = vec![false; w as usize * h as usize];
+    let mut mask = vec![Pair::None; w as usize * h as usize];
     let solids = solids(content, camera);
-    let pairs = intersecting(&solids, content.particles.len());
-    if pairs.is_empty() {
+    let n = content.particles.len();
+    let (crossing, close) = (intersecting(&solids, n), near(&solids, n));
+    if crossing.is_empty() && close.is_empty() {
         return mask;
     }
     let f = camera.unit_forward();
@@ -173,10 +206,26 @@ pub fn overlap_mask(content: &Content, camera: &Camera, size: (u32, u32)) -> Vec
             let ny = 1.0 - (f64::from(y) + 0.5) / f64::from(h) * 2.0;
             let dir = f + right * (nx * tan_x) + up * (ny * tan_y);
             let hits = |k: usize| solids[k].hit(camera.eye, dir);
-            mask[(y * w + x) as usize] = pairs.iter().any(|&(i, j)| hits(i) && hits(j));
+            let both = |pairs: &[(usize, usize)]| pairs.iter().any(|&(i, j)| hits(i) && hits(j));
+            mask[(y * w + x) as usize] = if both(&crossing) {
+                Pair::Interpenetrating
+            } else if both(&close) {
+                Pair::Near
+            } else {
+                Pair::None
+            };
         }
     }
     mask
+}
+
+/// Per pixel of a `size` picture of `camera` (row by row): whether its centre ray meets two
+/// of the game's translucent objects that interpenetrate.
+pub fn overlap_mask(content: &Content, camera: &Camera, size: (u32, u32)) -> Vec<bool> {
+    object_mask(content, camera, size)
+        .into_iter()
+        .map(|p| p == Pair::Interpenetrating)
+        .collect()
 }
 
 #[cfg(test)]

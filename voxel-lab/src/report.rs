@@ -21,9 +21,9 @@ fn row(r: &Record) -> String {
         .map_or(String::new(), |s| format!(" (objects {s:.3})"));
     // An exact order's error where the order alone decides: off quad edges and off a
     // game's objects that interpenetrate (pixels off by more than 1/255 there, counted).
-    let off = match (r.max_abs_err_off_edges, r.edge_px, r.overlap_px) {
-        (Some(m), Some(e), Some(o)) if e > 0 || o > 0 || m != r.max_abs_err => {
-            format!(" ({m} off {e} edge and {o} overlap px)")
+    let off = match (r.max_abs_err_off_edges, r.edge_px, r.overlap_px, r.near_px) {
+        (Some(m), Some(e), Some(o), Some(n)) if e > 0 || o > 0 || n > 0 || m != r.max_abs_err => {
+            format!(" ({m} off {e} edge, {o} overlap and {n} near-pair px)")
         }
         _ => String::new(),
     };

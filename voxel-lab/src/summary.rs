@@ -94,14 +94,18 @@ pub struct Record {
     /// `sorted-quads`: quads in those cycles.
     pub quads_in_cycles: Option<u32>,
     /// The sorted techniques: the largest channel error over the pixels off translucent
-    /// quad edges ([`crate::edges`]) and off a game's objects that interpenetrate
-    /// ([`crate::overlaps`]), where the order alone decides the colour.
+    /// quad edges ([`crate::edges`]) and off a game's objects that interpenetrate or nearly
+    /// touch ([`crate::overlaps`]), where the order of quads and planes decides the colour.
     pub max_abs_err_off_edges: Option<u32>,
     /// The sorted techniques: pixels off by more than 1/255 that lie on a quad edge.
     pub edge_px: Option<u32>,
     /// The sorted techniques: pixels off by more than 1/255 that show two of a game's
     /// objects that interpenetrate (no order of whole objects is right there).
     pub overlap_px: Option<u32>,
+    /// The sorted techniques: pixels off by more than 1/255 that show two of a game's
+    /// objects near each other (bounding balls meeting, solids apart), whose centres order
+    /// them.
+    pub near_px: Option<u32>,
     /// The FLIP heat map, relative to the output folder (empty when not saved: random
     /// scenes save none).
     pub heatmap: String,

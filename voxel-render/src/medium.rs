@@ -17,36 +17,41 @@
 //! ([`voxel_core::BlockDef::absorption`]; the built-in water's 16 blocks dim as much as
 //! one water surface, [`voxel_core::WATER_ABSORPTION`]) is a volume: along a path of `d`
 //! blocks inside it, what lies beyond keeps `exp(−σ d)` of its light and takes the
-//! block's colour, lit like a face turned to the sky, for the rest. Seen from outside, every
-//! technique composes an entry face together with the volume behind it down to where it
-//! ends (`translucent_color` in `common.wgsl`): the first back face of a volume in front of
-//! the opaque surface, or that surface (`volume_depth`, a copy of the opaque depth and a
-//! depth pass of the volumes' back faces, `volume_exit.wgsl`, made only when a volume is in
-//! view). That is exact for one volume along the ray with nothing translucent inside it
-//! (a lake over its ground, a pool seen through its side), the common case; translucent
-//! things inside a volume get the whole path in front of them. The exact references (the
-//! A-buffer and peeling to convergence) split the path at every surface instead, with the
-//! opaque depth alone. A block type without absorption (glass) is a thin surface.
+//! block's colour, lit like a face turned to the sky, for the rest. A block type without
+//! absorption (glass) is a thin surface seen from outside; inside one the eye sees the fog
+//! every translucent block had before volumes existed: 16 blocks of it dim as much as one of
+//! its surfaces ([`voxel_core::BlockDef::eye_absorption`]), so that a game's own water keeps
+//! its look without being made a volume.
 //!
-//! **Fog.** Inside a volume, the way from the eye to the medium's first surface (or to the
-//! opaque surface behind it, whichever is nearer) is the same absorption: fog of the
-//! block's colour over the composited picture, opaque and translucent alike, the same for
-//! every technique. Inside a thin surface's block the fog is what every translucent block
-//! had before volumes existed: 16 blocks of it dim as much as one of its surfaces
-//! ([`voxel_core::BlockDef::eye_absorption`]), so that a game's own water keeps its look
-//! without being made a volume.
+//! **The path, for the real-time techniques** (`shaders/path.wgsl`). Per pixel the frame
+//! knows three stretches of medium along the ray: the eye's own medium up to its boundary;
+//! the nearest volume entered beyond it (`volume_entry` and its look, a depth pass of the
+//! volumes' front faces) up to where volumes end (`volume_depth`: the nearest back face of a
+//! volume, or the opaque surface); and the nearest volume entered beyond that end
+//! (`volume_entry2`) up to the farthest back face of a volume beyond it (`volume_far`) or the
+//! opaque surface. The exit passes draw the quads grown (a sliver where merged quads meet
+//! must not leave a way out open). A full-screen media pass lays the whole path over the
+//! opaque picture before the technique draws; every translucent fragment takes the part of
+//! the path in front of it (`fogged`), so that the blend of the layers in order is the path
+//! split at every layer, for any number of things inside the water. The passes run only when
+//! a volume is in view or the eye is in an absorbing medium.
 //!
-//! **How.** With the eye inside a medium, a frame adds two passes: a depth pass over the
-//! visible translucent meshes that keeps, per pixel, the nearest surface of the medium's
-//! type (both sides) in front of the opaque depth; and the fog. The technique draws both
-//! sides of translucent faces (its two-sided pipeline variant) and each fragment asks
-//! `counts()` in `common.wgsl`: front faces count; a back face counts when it is of the
-//! medium's type, not an interface, and at exactly that first depth (positions are
-//! `@invariant`, so the depths are bit-identical). No quad is added: the cost is paid only
-//! under water. A face of the medium toward a cutout block lies in the plane of that block's
-//! face; where the cutout texel is solid the boundary pass leaves the tie to the opaque
-//! surface (within 1/16384 of its depth), as an opaque block hides the medium's face: the
-//! passage ends there, fogged; through a hole in the texel the face is the way out.
+//! **The exact references** walk the media from the eye along their sorted fragments and need
+//! only the opaque depth, plus (grown) the nearest back face of a volume, where a medium
+//! still open after their last fragment ends.
+//!
+//! **The boundary.** With the eye inside a medium, a depth pass over the visible translucent
+//! meshes keeps, per pixel, the nearest surface of the medium's type (both sides) in front
+//! of the opaque depth. The technique draws both sides of translucent faces (its two-sided
+//! pipeline variant) and each fragment asks `counts()` in `common.wgsl`: front faces count; a
+//! back face counts when it is of the medium's type, not an interface, and at exactly that
+//! first depth (positions are `@invariant`, so the depths are bit-identical). No quad is
+//! added: the cost is paid only under water. A face of the medium toward a cutout block
+//! lies in the plane of that block's face; where the cutout texel is solid the boundary pass
+//! leaves the tie to the opaque surface (within 1/16384 of its depth), as an opaque block
+//! hides the medium's face: the passage ends there; through a hole in the texel the face is
+//! the way out. A waterlogged block holds its medium (the mesher draws no face of the medium
+//! toward it).
 //!
 //! **Crossing a surface.** The near plane would cut away a translucent face closer to the
 //! eye than it (the surface the eye is passing through), so that a band of the picture
@@ -103,7 +108,7 @@ pub(crate) fn looks(registry: &BlockRegistry) -> Vec<Option<MediumLook>> {
         .collect()
 }
 
-/// The medium shaders: the boundary pass (after the shared chunk code) and the fog.
+/// The boundary pass's shader (after the shared chunk code).
 pub(crate) fn boundary_wgsl() -> String {
     crate::bindings::common_wgsl() + include_str!("shaders/medium_boundary.wgsl")
 }

@@ -227,6 +227,7 @@ impl Renderer {
                 keys: self.culled.translucent_keys(),
                 positions: self.culled.translucent_positions(),
             };
+            self.interleaver.look(camera.unit_forward());
             self.interleaver.order(
                 game.translucent_objects(),
                 camera.eye,

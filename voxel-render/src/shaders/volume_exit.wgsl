@@ -12,7 +12,8 @@ fn fs_volume_exit(in: VsOut, @builtin(front_facing) front: bool) {
     if front || medium_look(in.block).a <= 0.0 {
         discard;
     }
-    if frame.medium != NO_MEDIUM && in.clip.z >= boundary_depth(in.clip.xy) {
+    // At the boundary within rounding: the quads here are grown, the boundary's are not.
+    if frame.medium != NO_MEDIUM && in.clip.z >= boundary_depth(in.clip.xy) * (1.0 - PATH_TIE) {
         discard;
     }
 }
@@ -42,7 +43,8 @@ fn fs_volume_far(in: VsOut, @builtin(front_facing) front: bool) {
         || in.clip.z >= depth_at(volume_entry2, in.clip.xy) {
         discard;
     }
-    if frame.medium != NO_MEDIUM && in.clip.z >= boundary_depth(in.clip.xy) {
+    // At the boundary within rounding: the quads here are grown, the boundary's are not.
+    if frame.medium != NO_MEDIUM && in.clip.z >= boundary_depth(in.clip.xy) * (1.0 - PATH_TIE) {
         discard;
     }
 }

@@ -78,11 +78,6 @@ const CLIP_PLANES: usize = 6;
 // A part lies between at most two cuts an axis.
 const _: () = assert!(CLIP_PLANES >= 2 * 3);
 
-/// A fragment within this share of its view depth of a clip plane lies in it
-/// (`clip.wgsl`): far above what reconstructing its position from the depth errs by (about
-/// 1e-6 of it in 32-bit floats), far below what a player sees (1 mm at 10 blocks).
-const CLIP_EPSILON: f32 = 1e-4;
-
 /// One clip as `clip.wgsl` reads it (`OitClip`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -115,12 +110,10 @@ impl ClipUniform {
     }
 }
 
-/// The clip WGSL of a game's prelude (`clip.wgsl`, after its constant).
+/// The clip WGSL of a game's prelude (`clip.wgsl`; the prelude declares
+/// `OIT_OBJECT_DEPTH_BIAS`).
 fn clip_wgsl() -> String {
-    gpu::WgslConsts::default()
-        .f32("OIT_CLIP_EPSILON", CLIP_EPSILON)
-        .finish()
-        + include_str!("clip.wgsl")
+    include_str!("clip.wgsl").to_owned()
 }
 
 /// The blending pipeline, and for `sorted-quads` each chunk's exact order.
@@ -331,7 +324,7 @@ mod clip_tests {
     fn the_clip_uniform_is_laid_out_as_its_wgsl() {
         use crate::wgsl_layout::{assert_layout, field};
         let module = crate::wgsl_layout::parse(
-            &("struct Frame { viewport: vec2<f32> };\n@group(0) @binding(0) var<uniform> frame: Frame;\n".to_owned()
+            &("const OIT_OBJECT_DEPTH_BIAS: f32 = 0.0;\nstruct Frame { viewport: vec2<f32> };\n@group(0) @binding(0) var<uniform> frame: Frame;\n".to_owned()
                 + &clip_wgsl()),
         );
         assert_layout::<ClipUniform>(

@@ -581,6 +581,10 @@ pub(crate) struct Interleaver {
     boxes: Vec<(DVec3, DVec3)>,
     /// The distinct clips of the parts (0: none).
     clips: Vec<Clip>,
+    /// The view direction (unit; zero: order by distance from the eye instead): objects at
+    /// one place go farthest first along it, the order that is exact for particles, which
+    /// all face the camera (parallel squares are ordered by their planes).
+    forward: DVec3,
     /// The parts' objects in draw order, their parts in that order, and where runs of them
     /// are drawn.
     order: Vec<u32>,
@@ -655,6 +659,20 @@ impl Interleaver {
         self.run(objects.len(), ball, eye, chunks, two_sided, split_quads);
     }
 
+    /// Orders objects at one place farthest first along the unit view direction `forward`
+    /// from now on (before: by distance from the eye).
+    pub(crate) fn look(&mut self, forward: DVec3) {
+        self.forward = forward;
+    }
+
+    /// The key that orders a part centred at `c` farthest first at its place.
+    fn key(&self, c: DVec3, eye: DVec3) -> u32 {
+        if self.forward == DVec3::ZERO {
+            return farthest_key(c.distance_squared(eye));
+        }
+        farthest_key((c - eye).dot(self.forward).max(0.0))
+    }
+
     /// The last order: the objects in draw order (an object cut into parts once per part),
     /// where runs of them are drawn, and the clips the runs name ([`Split::clip`]; 0 none).
     pub(crate) fn result(&self) -> (&[u32], &[Split], &[Clip]) {
@@ -710,13 +728,13 @@ impl Interleaver {
             if inside && !split_quads {
                 // The eye is inside it (a volume seen from within, whose far faces are drawn):
                 // after every chunk, as what lies nearest.
-                self.push(whole, (last, 0), farthest_key(o2));
+                self.push(whole, (last, 0), self.key(b.center, eye));
                 continue;
             }
             self.crossings.clear();
             let at = self.place(&frame, b, split_quads);
             if self.crossings.is_empty() {
-                self.push(whole, at, farthest_key(o2));
+                self.push(whole, at, self.key(b.center, eye));
                 continue;
             }
             self.split(&frame, whole, &[], 0);
@@ -859,8 +877,8 @@ impl Interleaver {
                 continue;
             }
             let clip = self.clip_id(clip);
-            let o2 = center.distance_squared(eye);
-            self.push(Part { clip, ..part }, at, farthest_key(o2));
+            let key = self.key(center, eye);
+            self.push(Part { clip, ..part }, at, key);
         }
         self.crossings = crossings;
     }
@@ -1008,10 +1026,11 @@ impl Interleaver {
     }
 }
 
-/// A key that orders squared distances `o2` farthest first: the bits of the 32-bit float
-/// order like the number (enough to tell objects apart at one place: 24 bits of mantissa).
-fn farthest_key(o2: f64) -> u32 {
-    !(o2 as f32).to_bits()
+/// A key that orders non-negative distances (or their squares) farthest first: the bits of
+/// the 32-bit float order like the number (enough to tell objects apart at one place: 24
+/// bits of mantissa).
+fn farthest_key(d: f64) -> u32 {
+    !(d as f32).to_bits()
 }
 
 /// Sorts `(key, value)` pairs by key, stably, in three passes of eleven bits (Bevy sorts
