@@ -416,3 +416,67 @@ fn a_games_own_water_keeps_its_look() {
         );
     }
 }
+
+/// Dense volumes (absorption 0.3 to 1 a block): a thing just under the surface of a pool of
+/// slime, seen from above and from inside the slime. The real-time techniques see each
+/// fragment through its own path (nothing is divided by a transmittance that reaches 1e-7
+/// here), so the thing neither vanishes nor glows: within 2/255 of the A-buffer.
+#[test]
+fn a_thing_in_a_dense_volume_is_seen_through_its_own_path() {
+    use voxel_render::content::{Content, Entity};
+    let Some(ctx) = gpu() else { return };
+    for absorption in [0.3f32, 1.0] {
+        let mut registry = BlockRegistry::default();
+        let slime = registry
+            .register(BlockDef::new("dense_slime", [90, 200, 70], 0.5).with_absorption(absorption))
+            .unwrap();
+        let mut world = World::new(Arc::new(registry));
+        voxel_lab::scene::fill_box(&mut world, [-16, -17, -16], [15, -17, 15], SAND).unwrap();
+        voxel_lab::scene::fill_box(&mut world, [-16, -16, -16], [15, -1, 15], slime).unwrap();
+        let entity = |y: f64| Entity {
+            center: DVec3::new(0.5, y, -2.0),
+            half_extents: [1.5, 0.2, 1.5],
+            rotation: glam::DQuat::from_rotation_y(0.4),
+            color: [230, 60, 40],
+            opacity: 0.7,
+            emissive: 0.0,
+        };
+        let content = Content {
+            particles: Vec::new(),
+            entities: vec![entity(-0.6), entity(-3.0)],
+        };
+        for (eye, target) in [
+            ([0.5, 5.0, 6.0], [0.5, -2.0, -2.0]),
+            ([0.5, -1.5, 3.0], [0.5, -3.0, -2.0]),
+        ] {
+            let mut scene = tests::scene("dense", world.clone(), eye, target);
+            scene.content = content.clone();
+            let reference = render_with(&ctx, &scene, config(Technique::Reference));
+            let bare = render_with(
+                &ctx,
+                &Scene {
+                    content: Content::default(),
+                    ..scene.clone()
+                },
+                config(Technique::Reference),
+            );
+            assert!(
+                diff(&reference, &bare).over_one > 100,
+                "absorption {absorption}, eye {eye:?}: the things are seen"
+            );
+            for t in [
+                Technique::SortedQuads,
+                Technique::Sorted,
+                Technique::DepthPeeling,
+            ] {
+                let img = render_with(&ctx, &scene, config(t));
+                assert_close(
+                    &format!("dense_{absorption}_{}_{t}", eye[1]),
+                    &img,
+                    &reference,
+                    2,
+                );
+            }
+        }
+    }
+}

@@ -382,7 +382,7 @@ fn the_page_draws_like_native_on_webgpu_and_webgl2() {
                 Kind::Refused => {
                     // `Error::Unsupported`, and only for what the device does not run.
                     assert!(
-                        text.starts_with("unsupported by this adapter: "),
+                        text.starts_with("not supported on this device: "),
                         "{backend}: {t} refused with another error: {text}"
                     );
                     assert!(
