@@ -273,72 +273,6 @@ impl Sorted {
     }
 }
 
-#[cfg(test)]
-mod clip_tests {
-    use super::*;
-    use crate::stages::ClipPlane;
-
-    /// A clip plane in clip space gives, at a point's normalised device position, its
-    /// signed distance from the plane over its view depth: what `clip.wgsl` compares.
-    #[test]
-    fn clip_planes_measure_the_distance_to_the_plane_over_the_view_depth() {
-        let eye = glam::DVec3::new(1000.25, 64.5, -3000.75);
-        let camera = crate::Camera::look_at(
-            eye,
-            eye + glam::DVec3::new(3.0, -1.0, -8.0),
-            70.0,
-            0.1,
-            500.0,
-        )
-        .expect("a valid camera");
-        let view_proj = camera.view_proj(16.0 / 9.0);
-        for (axis, at) in [(1usize, 64.0), (0, 1003.0), (2, -3010.0)] {
-            let eye_side = if eye[axis] >= at { 1.0 } else { -1.0 };
-            let clip = vec![ClipPlane {
-                axis,
-                at,
-                eye_side,
-                far: false,
-            }];
-            let u = ClipUniform::new(&clip, view_proj, eye);
-            assert_eq!(u.count, 1);
-            let plane = glam::Vec4::from_array(u.planes[0]);
-            for k in 0..50 {
-                let t = f64::from(k) / 50.0;
-                let p = eye
-                    + glam::DVec3::new(3.0 + 4.0 * t, -1.0 - 2.0 * t, -8.0 + t) * (1.0 + 5.0 * t);
-                let rel = (p - eye).as_vec3();
-                let c = view_proj * rel.extend(1.0);
-                let ndc = glam::Vec4::new(c.x / c.w, c.y / c.w, c.z / c.w, 1.0);
-                let want = (p[axis] - at) * eye_side;
-                let got = f64::from(plane.dot(ndc)) * f64::from(c.w);
-                assert!(
-                    (got - want).abs() < 1e-3 * (1.0 + want.abs()),
-                    "axis {axis}: {got} against {want}"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn the_clip_uniform_is_laid_out_as_its_wgsl() {
-        use crate::wgsl_layout::{assert_layout, field};
-        let module = crate::wgsl_layout::parse(
-            &("const OIT_OBJECT_DEPTH_BIAS: f32 = 0.0;\nstruct Frame { viewport: vec2<f32> };\n@group(0) @binding(0) var<uniform> frame: Frame;\n".to_owned()
-                + &clip_wgsl()),
-        );
-        assert_layout::<ClipUniform>(
-            &module,
-            "OitClip",
-            &[
-                field!(ClipUniform, planes),
-                field!(ClipUniform, count),
-                field!(ClipUniform, far),
-            ],
-        );
-    }
-}
-
 impl TranslucentTechnique for Sorted {
     fn resize(&mut self, _: &GpuContext, _: u32, _: u32) -> Result<()> {
         Ok(())
@@ -494,5 +428,71 @@ impl TranslucentTechnique for Sorted {
             sort: self.sort_quads.then_some(self.report),
             ..TechniqueReport::default()
         }
+    }
+}
+
+#[cfg(test)]
+mod clip_tests {
+    use super::*;
+    use crate::stages::ClipPlane;
+
+    /// A clip plane in clip space gives, at a point's normalised device position, its
+    /// signed distance from the plane over its view depth: what `clip.wgsl` compares.
+    #[test]
+    fn clip_planes_measure_the_distance_to_the_plane_over_the_view_depth() {
+        let eye = glam::DVec3::new(1000.25, 64.5, -3000.75);
+        let camera = crate::Camera::look_at(
+            eye,
+            eye + glam::DVec3::new(3.0, -1.0, -8.0),
+            70.0,
+            0.1,
+            500.0,
+        )
+        .expect("a valid camera");
+        let view_proj = camera.view_proj(16.0 / 9.0);
+        for (axis, at) in [(1usize, 64.0), (0, 1003.0), (2, -3010.0)] {
+            let eye_side = if eye[axis] >= at { 1.0 } else { -1.0 };
+            let clip = vec![ClipPlane {
+                axis,
+                at,
+                eye_side,
+                far: false,
+            }];
+            let u = ClipUniform::new(&clip, view_proj, eye);
+            assert_eq!(u.count, 1);
+            let plane = glam::Vec4::from_array(u.planes[0]);
+            for k in 0..50 {
+                let t = f64::from(k) / 50.0;
+                let p = eye
+                    + glam::DVec3::new(3.0 + 4.0 * t, -1.0 - 2.0 * t, -8.0 + t) * (1.0 + 5.0 * t);
+                let rel = (p - eye).as_vec3();
+                let c = view_proj * rel.extend(1.0);
+                let ndc = glam::Vec4::new(c.x / c.w, c.y / c.w, c.z / c.w, 1.0);
+                let want = (p[axis] - at) * eye_side;
+                let got = f64::from(plane.dot(ndc)) * f64::from(c.w);
+                assert!(
+                    (got - want).abs() < 1e-3 * (1.0 + want.abs()),
+                    "axis {axis}: {got} against {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_clip_uniform_is_laid_out_as_its_wgsl() {
+        use crate::wgsl_layout::{assert_layout, field};
+        let module = crate::wgsl_layout::parse(
+            &("const OIT_OBJECT_DEPTH_BIAS: f32 = 0.0;\nstruct Frame { viewport: vec2<f32> };\n@group(0) @binding(0) var<uniform> frame: Frame;\n".to_owned()
+                + &clip_wgsl()),
+        );
+        assert_layout::<ClipUniform>(
+            &module,
+            "OitClip",
+            &[
+                field!(ClipUniform, planes),
+                field!(ClipUniform, count),
+                field!(ClipUniform, far),
+            ],
+        );
     }
 }
