@@ -337,6 +337,16 @@ fn shadow_misses(b: Ball, eye: DVec3, axis: usize, (lo, hi): (DVec3, DVec3)) -> 
         return false;
     }
     let [u, v] = [(axis + 1) % 3, (axis + 2) % 3];
+    // The centre's shadow on the rectangle: the box's meets it (most objects under a
+    // surface that spans the chunk), without the corners.
+    let t = to_plane / (b.center[axis] - eye[axis]);
+    let inside = |a: usize| {
+        let p = eye[a] + (b.center[a] - eye[a]) * t;
+        p >= lo[a] && p <= hi[a]
+    };
+    if inside(u) && inside(v) {
+        return false;
+    }
     let (mut smin, mut smax) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for k in 0..8 {
         let corner = DVec3::new(
