@@ -396,6 +396,17 @@ struct EvalArgs {
     /// Width of the saved heat maps (downscaled; default full size), 16 to 8192.
     #[arg(long, value_parser = clap::value_parser!(u32).range(i64::from(voxel_lab::limits::MIN_HEATMAP_WIDTH)..=i64::from(voxel_lab::limits::MAX_SIDE)))]
     heatmap_width: Option<u32>,
+    /// Skip FLIP (the lab's dearest step per run at large sizes): no mean FLIP, no heat
+    /// maps; the other errors (largest, share of pixels off) stay.
+    #[arg(long)]
+    no_flip: bool,
+    /// Save no heat maps or reference pictures.
+    #[arg(long)]
+    no_heatmaps: bool,
+    /// Width of the CPU ray march checking each scene's reference (default: the run's
+    /// size; 0: none, the two GPU exact methods then vouch for each other), 0 to 8192.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(voxel_lab::limits::MAX_SIDE)))]
+    raymarch_width: Option<u32>,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
@@ -729,6 +740,11 @@ fn eval(a: EvalArgs, device: &headless::Device) -> Result<()> {
             .join(" "),
         heatmap_width: a.heatmap_width,
         random,
+        checks: voxel_lab::summary::Checks {
+            flip: !a.no_flip,
+            heatmaps: !a.no_heatmaps,
+            raymarch_width: a.raymarch_width,
+        },
     };
     // Before the GPU: a broken scene or an option past its cap is the first thing said.
     opts.validate()?;
@@ -911,6 +927,7 @@ fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()> {
         command: "demo showcase".into(),
         heatmap_width: Some(240),
         random: None,
+        checks: Default::default(),
     };
     let summary = voxel_lab::evaluate(&ctx, &opts)?;
     println!(

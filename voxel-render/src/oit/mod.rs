@@ -461,7 +461,7 @@ pub(crate) struct TranslucentFrame<'a> {
 impl TranslucentFrame<'_> {
     /// Records the draws of every visible translucent mesh (group 0 and each chunk's
     /// group 1 set here; the pipeline and groups from 2 on set by the caller).
-    pub(crate) fn draw_chunks(&self, pass: &mut wgpu::RenderPass<'_>) {
+    pub(crate) fn draw_chunks(&self, pass: &mut crate::gpu::CountedPass<'_, '_>) {
         pass.set_bind_group(0, self.scene, &[]);
         self.draws.draw(self.chunks, pass);
     }

@@ -556,7 +556,7 @@ impl TranslucentTechnique for Mboit {
             );
             (g, [moments, resolve])
         });
-        let draw = |pass: &mut wgpu::RenderPass<'_>,
+        let draw = |pass: &mut crate::gpu::CountedPass<'_, '_>,
                     pipeline: &SidedPipeline,
                     group: &wgpu::BindGroup,
                     variant: usize| {
@@ -579,19 +579,18 @@ impl TranslucentTechnique for Mboit {
         let colors = [gpu::clear(&t.accumulation.view, wgpu::Color::TRANSPARENT)];
         Pass::new("mboit_resolve", GpuPass::Translucent, &colors)
             .depth(depth)
+            .reads(&[&t.b0.view, &t.moments.view])
             .record(encoder, frame.timer, |pass| {
                 draw(pass, &self.resolve, &t.resolve_group, 1);
             });
         let colors = [gpu::load(&frame.target.view)];
-        Pass::new("mboit_composite", GpuPass::Composite, &colors).record(
-            encoder,
-            frame.timer,
-            |pass| {
+        Pass::new("mboit_composite", GpuPass::Composite, &colors)
+            .reads(&[&t.accumulation.view, &t.b0.view])
+            .record(encoder, frame.timer, |pass| {
                 pass.set_pipeline(&self.composite);
                 pass.set_bind_group(0, &t.composite_group, &[]);
-                pass.draw(0..3, 0..1);
-            },
-        );
+                pass.draw_full_screen();
+            });
         Ok(())
     }
 

@@ -68,6 +68,9 @@ struct ChunkOrder {
     order: QuadOrder,
     /// The region the GPU order is exact for (`None`: sort again on the next frame).
     sorted_for: Option<RegionKey>,
+    /// The chunk's order stamp when this order was written
+    /// (`GpuChunk::order_stamp`): another one means the GPU draws another order now.
+    stamp: u64,
     /// Cycles of the last sort.
     cycles: (u32, u32),
 }
@@ -199,7 +202,7 @@ impl Sorted {
         let Some(chunk) = chunks.get(pos) else {
             return (false, false);
         };
-        let generation = chunk.generation();
+        let (generation, stamp) = (chunk.generation(), chunk.order_stamp());
         let built = self
             .orders
             .get(&pos)
@@ -212,6 +215,7 @@ impl Sorted {
                     generation,
                     order,
                     sorted_for: None,
+                    stamp: 0,
                     cycles: (0, 0),
                 },
             );
@@ -223,7 +227,7 @@ impl Sorted {
         let o = pos.origin();
         let local = [0, 1, 2].map(|k| eye[k] - o[k] as f64);
         let key = entry.order.region_key(local);
-        if entry.sorted_for == Some(key) {
+        if entry.sorted_for == Some(key) && entry.stamp == stamp {
             return (built, false);
         }
         let stats = entry.order.sort_into(local, &mut self.scratch);
@@ -232,6 +236,7 @@ impl Sorted {
         entry.sorted_for = stats.is_exact_in_region().then_some(key);
         entry.cycles = (stats.cycles, stats.quads_in_cycles);
         chunks.reorder_translucent(ctx, pos, std::mem::take(&mut self.scratch));
+        entry.stamp = chunks.get(pos).map_or(0, |c| c.order_stamp());
         (built, true)
     }
 }
@@ -263,6 +268,7 @@ impl Sorted {
         }
         // A buffer of the frame's own: a frame recorded before the last one is submitted
         // keeps its clips.
+        crate::cost::created_buffer();
         let buffer = ctx
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -276,6 +282,167 @@ impl Sorted {
             size: wgpu::BufferSize::new(std::mem::size_of::<ClipUniform>() as u64),
         });
         game_group(&ctx.device, "sorted_game", &self.game_layout, game, &[clip])
+    }
+}
+
+impl TranslucentTechnique for Sorted {
+    fn resize(&mut self, _: &GpuContext, _: u32, _: u32) -> Result<()> {
+        Ok(())
+    }
+
+    /// Sorted-quads: builds the order structure of every chunk with translucent quads that
+    /// has none (or one of an older mesh), so that the first frame only sorts.
+    fn warm(&mut self, chunks: &ChunkStore) {
+        if !self.sort_quads {
+            return;
+        }
+        for chunk in chunks.iter() {
+            let quads = chunk.translucent_quads();
+            if quads.is_empty() {
+                continue;
+            }
+            let (pos, generation) = (chunk.pos(), chunk.generation());
+            if self
+                .orders
+                .get(&pos)
+                .is_some_and(|o| o.generation == generation)
+            {
+                continue;
+            }
+            self.orders.insert(
+                pos,
+                ChunkOrder {
+                    generation,
+                    order: QuadOrder::new(quads),
+                    sorted_for: None,
+                    stamp: 0,
+                    cycles: (0, 0),
+                },
+            );
+        }
+    }
+
+    /// Sorted-quads: sorts the visible chunks whose region key changed since their last
+    /// sort, building the order structure of newly visible or remeshed chunks first.
+    fn prepare(
+        &mut self,
+        ctx: &GpuContext,
+        _config: &OitConfig,
+        chunks: &mut ChunkStore,
+        view: &FrameView<'_>,
+    ) -> Result<()> {
+        if !self.sort_quads {
+            // The mesher's order, whatever a technique drew before.
+            chunks.restore_mesher_order();
+            return Ok(());
+        }
+        let start = Instant::now();
+        let mut report = SortReport::default();
+        for &pos in view.translucent {
+            let (built, sorted) = self.sort_chunk(ctx, chunks, pos, view.camera.eye);
+            report.chunks_built += usize::from(built);
+            report.chunks_resorted += usize::from(sorted);
+            if let Some(o) = self.orders.get(&pos) {
+                report.cycles += o.cycles.0;
+                report.quads_in_cycles += o.cycles.1;
+            }
+        }
+        // Forget chunks that were removed or remeshed since (kept bounded by the store).
+        if self.orders.len() > 2 * chunks.len() + 64 {
+            self.orders
+                .retain(|pos, o| chunks.get(*pos).map(|c| c.generation()) == Some(o.generation));
+        }
+        report.ms = start.elapsed().as_secs_f64() * 1e3;
+        self.report = report;
+        Ok(())
+    }
+
+    fn render(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &TranslucentFrame<'_>,
+    ) -> Result<()> {
+        let colors = [gpu::load(&frame.target.view)];
+        let pipeline = self.pipeline.get(frame.two_sided);
+        let group = frame.game.map(|g| self.game_group(ctx, g));
+        let stride = self.clip_stride;
+        Pass::new("sorted", GpuPass::Translucent, &colors)
+            .depth(Depth::ReadOnly(&frame.depth.view))
+            .record(encoder, frame.timer, |pass| {
+                pass.set_pipeline(pipeline);
+                let (Some(game), Some(group)) = (frame.game, &group) else {
+                    frame.draw_chunks(pass);
+                    return;
+                };
+                // The objects where `interleave` put them (before a chunk, or among its
+                // quads), each run with its clip, then the rest.
+                pass.set_bind_group(0, frame.scene, &[]);
+                let draws = frame.draws;
+                let objects = |pass: &mut crate::gpu::CountedPass<'_, '_>, range, clip: u32| {
+                    let offset = (u64::from(clip) * stride) as u32;
+                    game.draw_offsets(pass, 0, group, &[offset], range);
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, frame.scene, &[]);
+                };
+                // Chunks before `chunk` are drawn, and quads `..quad` of it.
+                let (mut next, mut chunk, mut quad) = (0, 0usize, 0u32);
+                for split in game.splits {
+                    let c = split.chunk as usize;
+                    if c > chunk {
+                        if quad > 0 {
+                            draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
+                            chunk += 1;
+                        }
+                        draws.draw_range(frame.chunks, chunk..c, pass);
+                        (chunk, quad) = (c, 0);
+                    }
+                    if split.quad > quad {
+                        draws.draw_quads(frame.chunks, c, quad..split.quad, pass);
+                        quad = split.quad;
+                    }
+                    let end = split.end as usize;
+                    if end > next {
+                        objects(pass, next..end, split.clip);
+                        next = end;
+                    }
+                }
+                if quad > 0 {
+                    draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
+                    chunk += 1;
+                }
+                draws.draw_range(frame.chunks, chunk..usize::MAX, pass);
+                // A game that orders nothing (no objects declared) draws everything here.
+                if next < game.objects || game.objects == 0 {
+                    objects(pass, next..game.objects, 0);
+                }
+            });
+        Ok(())
+    }
+
+    fn variants(&self) -> Vec<TranslucentVariant> {
+        vec![TranslucentVariant {
+            name: "sorted",
+            wgsl: game_prelude(
+                &clip_wgsl(),
+                "struct OitOutput {\n    @location(0) color: vec4<f32>,\n};\n\n\
+                 // Blended SrcAlpha, OneMinusSrcAlpha over what is behind, outside the\n\
+                 // part being drawn discarded.\n\
+                 fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
+                 if oit_clipped(position) {\n        discard;\n    }\n    \
+                 return OitOutput(fogged(position.xy, position.z, color));\n}\n",
+            ),
+            targets: vec![gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
+            depth_stencil: gpu::depth_state(DepthMode::ReadOnly),
+            layout: self.game_layout.clone(),
+        }]
+    }
+
+    fn report(&self) -> TechniqueReport {
+        TechniqueReport {
+            sort: self.sort_quads.then_some(self.report),
+            ..TechniqueReport::default()
+        }
     }
 }
 
@@ -342,163 +509,5 @@ mod clip_tests {
                 field!(ClipUniform, far),
             ],
         );
-    }
-}
-
-impl TranslucentTechnique for Sorted {
-    fn resize(&mut self, _: &GpuContext, _: u32, _: u32) -> Result<()> {
-        Ok(())
-    }
-
-    /// Sorted-quads: builds the order structure of every chunk with translucent quads that
-    /// has none (or one of an older mesh), so that the first frame only sorts.
-    fn warm(&mut self, chunks: &ChunkStore) {
-        if !self.sort_quads {
-            return;
-        }
-        for chunk in chunks.iter() {
-            let quads = chunk.translucent_quads();
-            if quads.is_empty() {
-                continue;
-            }
-            let (pos, generation) = (chunk.pos(), chunk.generation());
-            if self
-                .orders
-                .get(&pos)
-                .is_some_and(|o| o.generation == generation)
-            {
-                continue;
-            }
-            self.orders.insert(
-                pos,
-                ChunkOrder {
-                    generation,
-                    order: QuadOrder::new(quads),
-                    sorted_for: None,
-                    cycles: (0, 0),
-                },
-            );
-        }
-    }
-
-    /// Sorted-quads: sorts the visible chunks whose region key changed since their last
-    /// sort, building the order structure of newly visible or remeshed chunks first.
-    fn prepare(
-        &mut self,
-        ctx: &GpuContext,
-        _config: &OitConfig,
-        chunks: &mut ChunkStore,
-        view: &FrameView<'_>,
-    ) -> Result<()> {
-        if !self.sort_quads {
-            return Ok(());
-        }
-        let start = Instant::now();
-        let mut report = SortReport::default();
-        for &pos in view.translucent {
-            let (built, sorted) = self.sort_chunk(ctx, chunks, pos, view.camera.eye);
-            report.chunks_built += usize::from(built);
-            report.chunks_resorted += usize::from(sorted);
-            if let Some(o) = self.orders.get(&pos) {
-                report.cycles += o.cycles.0;
-                report.quads_in_cycles += o.cycles.1;
-            }
-        }
-        // Forget chunks that were removed or remeshed since (kept bounded by the store).
-        if self.orders.len() > 2 * chunks.len() + 64 {
-            self.orders
-                .retain(|pos, o| chunks.get(*pos).map(|c| c.generation()) == Some(o.generation));
-        }
-        report.ms = start.elapsed().as_secs_f64() * 1e3;
-        self.report = report;
-        Ok(())
-    }
-
-    fn render(
-        &mut self,
-        ctx: &GpuContext,
-        encoder: &mut wgpu::CommandEncoder,
-        frame: &TranslucentFrame<'_>,
-    ) -> Result<()> {
-        let colors = [gpu::load(&frame.target.view)];
-        let pipeline = self.pipeline.get(frame.two_sided);
-        let group = frame.game.map(|g| self.game_group(ctx, g));
-        let stride = self.clip_stride;
-        Pass::new("sorted", GpuPass::Translucent, &colors)
-            .depth(Depth::ReadOnly(&frame.depth.view))
-            .record(encoder, frame.timer, |pass| {
-                pass.set_pipeline(pipeline);
-                let (Some(game), Some(group)) = (frame.game, &group) else {
-                    frame.draw_chunks(pass);
-                    return;
-                };
-                // The objects where `interleave` put them (before a chunk, or among its
-                // quads), each run with its clip, then the rest.
-                pass.set_bind_group(0, frame.scene, &[]);
-                let draws = frame.draws;
-                let objects = |pass: &mut wgpu::RenderPass<'_>, range, clip: u32| {
-                    let offset = (u64::from(clip) * stride) as u32;
-                    game.draw_offsets(pass, 0, group, &[offset], range);
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, frame.scene, &[]);
-                };
-                // Chunks before `chunk` are drawn, and quads `..quad` of it.
-                let (mut next, mut chunk, mut quad) = (0, 0usize, 0u32);
-                for split in game.splits {
-                    let c = split.chunk as usize;
-                    if c > chunk {
-                        if quad > 0 {
-                            draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
-                            chunk += 1;
-                        }
-                        draws.draw_range(frame.chunks, chunk..c, pass);
-                        (chunk, quad) = (c, 0);
-                    }
-                    if split.quad > quad {
-                        draws.draw_quads(frame.chunks, c, quad..split.quad, pass);
-                        quad = split.quad;
-                    }
-                    let end = split.end as usize;
-                    if end > next {
-                        objects(pass, next..end, split.clip);
-                        next = end;
-                    }
-                }
-                if quad > 0 {
-                    draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
-                    chunk += 1;
-                }
-                draws.draw_range(frame.chunks, chunk..usize::MAX, pass);
-                // A game that orders nothing (no objects declared) draws everything here.
-                if next < game.objects || game.objects == 0 {
-                    objects(pass, next..game.objects, 0);
-                }
-            });
-        Ok(())
-    }
-
-    fn variants(&self) -> Vec<TranslucentVariant> {
-        vec![TranslucentVariant {
-            name: "sorted",
-            wgsl: game_prelude(
-                &clip_wgsl(),
-                "struct OitOutput {\n    @location(0) color: vec4<f32>,\n};\n\n\
-                 // Blended SrcAlpha, OneMinusSrcAlpha over what is behind, outside the\n\
-                 // part being drawn discarded.\n\
-                 fn oit_output(position: vec4<f32>, color: vec4<f32>) -> OitOutput {\n    \
-                 if oit_clipped(position) {\n        discard;\n    }\n    \
-                 return OitOutput(fogged(position.xy, position.z, color));\n}\n",
-            ),
-            targets: vec![gpu::scene_target(Some(wgpu::BlendState::ALPHA_BLENDING))],
-            depth_stencil: gpu::depth_state(DepthMode::ReadOnly),
-            layout: self.game_layout.clone(),
-        }]
-    }
-
-    fn report(&self) -> TechniqueReport {
-        TechniqueReport {
-            sort: self.sort_quads.then_some(self.report),
-            ..TechniqueReport::default()
-        }
     }
 }

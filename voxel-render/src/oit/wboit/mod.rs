@@ -594,7 +594,9 @@ impl TranslucentTechnique for Wboit {
             )
         });
         // Chunks, then the game's geometry in its pipeline for this pass.
-        let draw = |pass: &mut wgpu::RenderPass<'_>, pipeline: &SidedPipeline, variant: usize| {
+        let draw = |pass: &mut crate::gpu::CountedPass<'_, '_>,
+                    pipeline: &SidedPipeline,
+                    variant: usize| {
             pass.set_pipeline(pipeline.get(frame.two_sided));
             pass.set_bind_group(2, &self.params_group, &[]);
             frame.draw_chunks(pass);
@@ -653,18 +655,16 @@ impl TranslucentTechnique for Wboit {
             return Ok(());
         }
         let colors = [gpu::load(&frame.target.view)];
-        Pass::new("wboit_composite", GpuPass::Composite, &colors).record(
-            encoder,
-            frame.timer,
-            |pass| {
+        Pass::new("wboit_composite", GpuPass::Composite, &colors)
+            .reads(&[accum, reveal])
+            .record(encoder, frame.timer, |pass| {
                 pass.set_pipeline(&self.composite);
                 pass.set_bind_group(0, &t.composite_group, &[]);
                 if let Some([x, y, w, h]) = rect {
                     pass.set_scissor_rect(x, y, w, h);
                 }
-                pass.draw(0..3, 0..1);
-            },
-        );
+                pass.draw_full_screen();
+            });
         Ok(())
     }
 

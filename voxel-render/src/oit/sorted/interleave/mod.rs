@@ -765,7 +765,7 @@ impl Interleaver {
         let b = whole.ball;
         let c = b.center;
         let mut crossings = std::mem::take(&mut self.crossings);
-        crossings.sort_by(|x, y| (x.0, x.1.to_bits(), x.2).cmp(&(y.0, y.1.to_bits(), y.2)));
+        crossings.sort_by_key(|x| (x.0, x.1.to_bits(), x.2));
         // A plane of quads that is also a chunk border is cut as a plane of quads.
         crossings.dedup_by(|x, y| (x.0, x.1) == (y.0, y.1));
         crossings.sort_by(|x, y| (c[x.0] - x.1).abs().total_cmp(&(c[y.0] - y.1).abs()));
