@@ -36,7 +36,7 @@ use voxel_mesh::order::{QuadOrder, RegionKey};
 
 use crate::chunks::{ChunkStore, PosMap};
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, Pass, SidedPipeline};
+use crate::gpu::{self, ChunkPipeline, CountedPass, Depth, DepthMode, Pass, SidedPipeline};
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -379,11 +379,18 @@ impl TranslucentTechnique for Sorted {
                 // quads), each run with its clip, then the rest.
                 pass.set_bind_group(0, frame.scene, &[]);
                 let draws = frame.draws;
-                let objects = |pass: &mut crate::gpu::CountedPass<'_, '_>, range, clip: u32| {
+                let objects = |pass: &mut CountedPass<'_, '_>, range, clip: u32| {
                     let offset = (u64::from(clip) * stride) as u32;
                     game.draw_offsets(pass, 0, group, &[offset], range);
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, frame.scene, &[]);
+                };
+                // The game's draws change the pipeline and group 0: set again before the
+                // next chunk quads, not between two runs of objects.
+                let lost = std::cell::Cell::new(false);
+                let chunk_state = |pass: &mut CountedPass<'_, '_>| {
+                    if lost.replace(false) {
+                        pass.set_pipeline(pipeline);
+                        pass.set_bind_group(0, frame.scene, &[]);
+                    }
                 };
                 // Chunks before `chunk` are drawn, and quads `..quad` of it.
                 let (mut next, mut chunk, mut quad) = (0, 0usize, 0u32);
@@ -391,22 +398,29 @@ impl TranslucentTechnique for Sorted {
                     let c = split.chunk as usize;
                     if c > chunk {
                         if quad > 0 {
+                            chunk_state(pass);
                             draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
                             chunk += 1;
                         }
-                        draws.draw_range(frame.chunks, chunk..c, pass);
+                        if chunk < c {
+                            chunk_state(pass);
+                            draws.draw_range(frame.chunks, chunk..c, pass);
+                        }
                         (chunk, quad) = (c, 0);
                     }
                     if split.quad > quad {
+                        chunk_state(pass);
                         draws.draw_quads(frame.chunks, c, quad..split.quad, pass);
                         quad = split.quad;
                     }
                     let end = split.end as usize;
                     if end > next {
                         objects(pass, next..end, split.clip);
+                        lost.set(true);
                         next = end;
                     }
                 }
+                chunk_state(pass);
                 if quad > 0 {
                     draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
                     chunk += 1;
