@@ -275,6 +275,14 @@ pub fn write(out: &Path, summary: &Summary, opts: &EvalOptions) -> Result<()> {
          % px off: pixels whose largest channel differs from the exact reference by more than 1/255.\n",
         opts.command, summary.adapter, size.0, size.1, opts.frames, opts.warmup
     );
+    if !summary.skipped.is_empty() {
+        let _ = writeln!(
+            s,
+            "**Time budget spent**: {} scenes left out ({}).\n",
+            summary.skipped.len(),
+            summary.skipped.join(", ")
+        );
+    }
     section(&mut s, summary, true);
     crate::files::write_file(&out.join("costs.md"), s.as_bytes())
 }

@@ -231,6 +231,14 @@ fn header(s: &mut String, summary: &Summary, opts: &EvalOptions) {
         .first()
         .map_or((0, 0), |r| (r.width, r.height));
     let _ = writeln!(s, "# Transparency techniques: speed and accuracy\n");
+    if !summary.skipped.is_empty() {
+        let _ = writeln!(
+            s,
+            "**Time budget spent**: {} scenes left out ({}).\n",
+            summary.skipped.len(),
+            summary.skipped.join(", ")
+        );
+    }
     let _ = writeln!(
         s,
         "Made by `{}` on **{}**, {}×{} pixels, median of {} timed frames after {} warm-up frames, {} scenes.\n",

@@ -50,7 +50,7 @@ pub struct EvalOptions {
 
 /// The lab's own work per scene and per run, which a quick check can cut: each is on by
 /// default.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Checks {
     /// Mean FLIP per run (NVIDIA's perceptual difference, on the CPU: the lab's dearest
     /// step per run at large sizes). Off: `flip_mean` is `null` (NaN) and no heat map is
@@ -63,6 +63,10 @@ pub struct Checks {
     /// methods agree within 2/255 and the A-buffer capped nothing visibly). The ray
     /// march is the dearest step per scene.
     pub raymarch_width: Option<u32>,
+    /// Wall-clock seconds after which no further scene is started (`None`: no limit): a
+    /// check on a machine lent for minutes ends with the scenes done written out, those
+    /// left named in the report.
+    pub time_budget: Option<f64>,
 }
 
 impl Default for Checks {
@@ -71,6 +75,7 @@ impl Default for Checks {
             flip: true,
             heatmaps: true,
             raymarch_width: None,
+            time_budget: None,
         }
     }
 }
@@ -351,6 +356,9 @@ pub struct Summary {
     pub reference_checks: Vec<ReferenceCheck>,
     /// Random scenes: what each holds, in scene order (empty for scene files).
     pub features: Vec<SceneFeatures>,
+    /// Scenes left out because the run's time budget was spent
+    /// ([`Checks::time_budget`]).
+    pub skipped: Vec<String>,
 }
 
 /// What a random scene holds.

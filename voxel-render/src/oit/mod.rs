@@ -902,10 +902,7 @@ impl ScreenCover {
                 self.0 = None;
                 return;
             }
-            let p = glam::Vec2::new(
-                (clip.x / clip.w + 1.0) * 0.5,
-                (1.0 - clip.y / clip.w) * 0.5,
-            );
+            let p = glam::Vec2::new((clip.x / clip.w + 1.0) * 0.5, (1.0 - clip.y / clip.w) * 0.5);
             min = min.min(p);
             max = max.max(p);
         }
@@ -930,10 +927,7 @@ impl ScreenCover {
         };
         let (mut lo, mut hi) = (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY);
         for o in objects {
-            let half = o
-                .half_extents
-                .unwrap_or(glam::DVec3::splat(o.radius))
-                .abs();
+            let half = o.half_extents.unwrap_or(glam::DVec3::splat(o.radius)).abs();
             lo = lo.min(o.center - half);
             hi = hi.max(o.center + half);
         }
