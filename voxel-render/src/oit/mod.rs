@@ -898,7 +898,7 @@ impl ScreenCover {
             let clip = view_proj * (corner - eye).as_vec3().extend(1.0);
             // Clip w is the view depth; a corner at or behind the eye's plane reaches
             // everywhere on screen.
-            if !(clip.w > 1e-3) || !clip.is_finite() {
+            if clip.w.partial_cmp(&1e-3) != Some(std::cmp::Ordering::Greater) || !clip.is_finite() {
                 self.0 = None;
                 return;
             }
