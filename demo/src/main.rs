@@ -227,6 +227,16 @@ fn random_seed(s: &str) -> Result<u64> {
     })
 }
 
+fn time_budget(s: &str) -> Result<f64> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(Error::NotA {
+            value: s.to_owned(),
+            what: "a time budget: a number of seconds above 0".into(),
+        }),
+    }
+}
+
 fn technique(s: &str) -> Result<Technique> {
     Ok(Technique::from_name(s)?)
 }
@@ -416,6 +426,21 @@ struct EvalArgs {
     /// Width of the saved heat maps (downscaled; default full size), 16 to 8192.
     #[arg(long, value_parser = clap::value_parser!(u32).range(i64::from(voxel_lab::limits::MIN_HEATMAP_WIDTH)..=i64::from(voxel_lab::limits::MAX_SIDE)))]
     heatmap_width: Option<u32>,
+    /// Skip FLIP (the lab's dearest step per run at large sizes): no mean FLIP, no heat
+    /// maps; the other errors (largest, share of pixels off) stay.
+    #[arg(long)]
+    no_flip: bool,
+    /// Save no heat maps or reference pictures.
+    #[arg(long)]
+    no_heatmaps: bool,
+    /// Width of the CPU ray march checking each scene's reference (default: the run's
+    /// size; 0: none, the two GPU exact methods then vouch for each other), 0 to 8192.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(voxel_lab::limits::MAX_SIDE)))]
+    raymarch_width: Option<u32>,
+    /// Start no scene after this many seconds (the scenes done are written out, those
+    /// left named in the report).
+    #[arg(long, value_name = "SECONDS", value_parser = time_budget)]
+    time_budget: Option<f64>,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
@@ -750,6 +775,12 @@ fn eval(a: EvalArgs, device: &headless::Device) -> Result<()> {
             .join(" "),
         heatmap_width: a.heatmap_width,
         random,
+        checks: voxel_lab::summary::Checks {
+            flip: !a.no_flip,
+            heatmaps: !a.no_heatmaps,
+            raymarch_width: a.raymarch_width,
+            time_budget: a.time_budget,
+        },
     };
     // Before the GPU: a broken scene or an option past its cap is the first thing said.
     opts.validate()?;
@@ -976,6 +1007,7 @@ fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()> {
         },
         heatmap_width: Some(240),
         random: None,
+        checks: Default::default(),
     };
     let summary = voxel_lab::evaluate(&ctx, &opts)?;
     println!(

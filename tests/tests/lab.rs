@@ -31,6 +31,7 @@ fn small_eval_of_the_suite() {
         command: "cargo test -p tests --test lab".into(),
         heatmap_width: Some(48),
         random: None,
+        checks: Default::default(),
     };
 
     let summary = voxel_lab::evaluate(&ctx, &opts).unwrap();

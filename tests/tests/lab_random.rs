@@ -51,6 +51,7 @@ fn options(out: PathBuf, scenes: Vec<PathBuf>, random: Option<RandomSet>) -> Eva
         command: "cargo test -p tests --test lab_random".into(),
         heatmap_width: None,
         random,
+        checks: Default::default(),
     }
 }
 

@@ -482,6 +482,7 @@ fn the_lab_evaluates_the_vox_scenes_and_the_exact_references_agree() {
         command: "cargo test -p tests --test vox".into(),
         heatmap_width: None,
         random: None,
+        checks: Default::default(),
     };
     let summary = voxel_lab::evaluate(&ctx, &opts).unwrap();
     assert_eq!(summary.reference_checks.len(), scenes.len());

@@ -5,8 +5,10 @@ use crate::{Error, Result};
 
 use std::path::Path;
 
+use voxel_render::low_level::{self, FrameCost};
 use voxel_render::{
-    Camera, FrameStats, GpuContext, Image, OitConfig, RendererConfig, Technique, WeightFunction,
+    Camera, FrameStats, GpuContext, GpuTimes, Image, OitConfig, RendererConfig, Technique,
+    WeightFunction,
 };
 
 use crate::edges::{self, Edges};
@@ -16,7 +18,8 @@ use crate::progress::Progress;
 use crate::raymarch;
 use crate::scene::Scene;
 use crate::summary::{
-    EvalOptions, RayMarchSummary, Record, ReferenceCheck, SceneFeatures, Summary,
+    Checks, CostRecord, EvalOptions, RayMarchSummary, Record, ReferenceCheck, SceneFeatures,
+    Summary,
 };
 
 /// A renderer for measurements, sized `size`.
@@ -44,6 +47,9 @@ pub struct Measured {
     pub nan_px: usize,
     /// Stats of the last frame.
     pub stats: FrameStats,
+    /// What the technique's frame asked of the GPU, counted in one more frame after the
+    /// timed ones (`None` when the frame could not be counted).
+    pub cost: Option<FrameCost>,
 }
 
 fn median(mut v: Vec<f64>) -> Option<f64> {
@@ -69,9 +75,8 @@ pub fn measure(
     let mut gpu = Vec::new();
     let mut cpu = Vec::new();
     let mut sort = Vec::new();
-    let mut stats = FrameStats::default();
     for i in 0..warmup + frames.max(1) {
-        stats = renderer.render_and_submit(&target.view, camera)?;
+        let stats = renderer.render_and_submit(&target.view, camera)?;
         let times = renderer.gpu_times_blocking();
         if i >= warmup {
             cpu.push(stats.cpu_ms);
@@ -81,6 +86,112 @@ pub fn measure(
             }
         }
     }
+    finish(ctx, renderer, target, camera, gpu, cpu, sort)
+}
+
+/// Rounds the timed frames of [`measure_runs`] are spread over (at most).
+const ROUNDS: usize = 3;
+
+/// Wall-clock time the warm-up of [`measure_runs`] lasts at least: a GPU that idled while
+/// the CPU worked (building the renderer, the last scene's checks) raises its clocks over
+/// some tens of milliseconds of work.
+const WARM_UP: std::time::Duration = std::time::Duration::from_millis(250);
+
+/// Warm-up rounds of [`measure_runs`] at most.
+const MAX_WARM_UP_ROUNDS: usize = 64;
+
+/// Measures every configuration of `configs` on one scene, as [`measure`] does each, with
+/// the real-time ones timed in turns: all of them built first; `warmup` rounds of one
+/// frame each (and more until [`WARM_UP`] has passed, so that the GPU's clocks have risen);
+/// then the timed frames in up to [`ROUNDS`] rounds, each run's block of them after one
+/// untimed frame that settles its switch (sorted-quads sorts again after `sorted` drew the
+/// mesher's order). Whatever the GPU's state does over the scene (clocks, memory freed
+/// before) then weighs on every technique alike. Each run's picture and counted frame
+/// follow its last block. The exact techniques (which wait for the GPU inside a frame)
+/// are measured alone afterwards.
+pub fn measure_runs(
+    ctx: &GpuContext,
+    renderer: &mut SceneRenderer,
+    target: &Offscreen,
+    camera: &Camera,
+    configs: &[OitConfig],
+    warmup: usize,
+    frames: usize,
+) -> Result<Vec<Measured>> {
+    let real: Vec<usize> = (0..configs.len())
+        .filter(|&i| !configs[i].technique.stalls())
+        .collect();
+    let mut out: Vec<Option<Measured>> = (0..configs.len()).map(|_| None).collect();
+    for &i in &real {
+        renderer.prebuild_technique(configs[i].technique)?;
+    }
+    let frame = |renderer: &mut SceneRenderer, i: usize| -> Result<(FrameStats, GpuTimes)> {
+        renderer.set_oit_config(configs[i].clone())?;
+        let stats = renderer.render_and_submit(&target.view, camera)?;
+        Ok((stats, renderer.gpu_times_blocking()))
+    };
+    let start = std::time::Instant::now();
+    let mut round = 0;
+    while !real.is_empty()
+        && (round < warmup || (start.elapsed() < WARM_UP && round < MAX_WARM_UP_ROUNDS))
+    {
+        for &i in &real {
+            frame(renderer, i)?;
+        }
+        round += 1;
+    }
+    let frames = frames.max(1);
+    let rounds = frames.min(ROUNDS);
+    let mut timed: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = vec![Default::default(); configs.len()];
+    for r in 0..rounds {
+        let block = frames / rounds + usize::from(r < frames % rounds);
+        for &i in &real {
+            // The switch settles.
+            frame(renderer, i)?;
+            for _ in 0..block {
+                let (stats, times) = frame(renderer, i)?;
+                let (g, c, s) = &mut timed[i];
+                if !times.is_empty() {
+                    g.push(times.translucent_work());
+                }
+                c.push(stats.cpu_ms);
+                s.push(stats.game_sort_ms);
+            }
+            if r + 1 == rounds {
+                let (g, c, s) = std::mem::take(&mut timed[i]);
+                out[i] = Some(finish(ctx, renderer, target, camera, g, c, s)?);
+            }
+        }
+    }
+    for &i in &real {
+        renderer.release_technique(configs[i].technique);
+    }
+    for (i, config) in configs.iter().enumerate() {
+        if out[i].is_none() {
+            out[i] = Some(measure(
+                ctx, renderer, target, camera, config, warmup, frames,
+            )?);
+        }
+    }
+    Ok(out.into_iter().flatten().collect())
+}
+
+/// A counted frame of the technique in force, its picture and HDR colour, with the
+/// timings gathered before.
+fn finish(
+    ctx: &GpuContext,
+    renderer: &mut SceneRenderer,
+    target: &Offscreen,
+    camera: &Camera,
+    gpu: Vec<f64>,
+    cpu: Vec<f64>,
+    sort: Vec<f64>,
+) -> Result<Measured> {
+    // Counted in a frame of its own: its queries stay out of the timed frames. The picture
+    // is the same (a still camera).
+    low_level::count_next_frame(renderer);
+    let stats = renderer.render_and_submit(&target.view, camera)?;
+    let cost = low_level::frame_cost(renderer)?;
     let image = target.read(ctx)?;
     let hdr = read_hdr(ctx, renderer.scene_color())?;
     Ok(Measured {
@@ -90,6 +201,7 @@ pub fn measure(
         game_sort_ms: median(sort).unwrap_or(0.0),
         nan_px: metrics::non_finite_pixels(&hdr),
         stats,
+        cost,
     })
 }
 
@@ -128,7 +240,8 @@ pub struct Reference {
 }
 
 /// Renders `camera` of `renderer`'s scene with both exact methods and checks them against
-/// each other and against the CPU ray march of `world`.
+/// each other and against the CPU ray march of `world` (at the size `checks` asks for;
+/// none when it asks for none).
 pub fn reference(
     ctx: &GpuContext,
     renderer: &mut SceneRenderer,
@@ -136,7 +249,8 @@ pub fn reference(
     camera: &Camera,
     scene: &Scene,
     name: &str,
-) -> Result<(Reference, RayMarchCheck)> {
+    checks: &Checks,
+) -> Result<(Reference, Option<RayMarchCheck>)> {
     let weight = default_weight();
     let abuffer = measure(
         ctx,
@@ -156,10 +270,47 @@ pub fn reference(
         0,
         1,
     )?;
-    let agreement = metrics::compare(&abuffer.image, &peel.image).0.max_abs_err;
+    let agreement = metrics::compare_without_flip(&abuffer.image, &peel.image).max_abs_err;
     let r = abuffer.stats.technique.reference.unwrap_or_default();
     let peeled = peel.stats.technique.peeling.unwrap_or_default();
-    let size = renderer.size();
+    let size = match checks.raymarch_width {
+        None => Some(renderer.size()),
+        Some(0) => None,
+        Some(w) => {
+            let (fw, fh) = renderer.size();
+            // The run's aspect at `w` pixels wide (never wider than the run).
+            let w = w.min(fw);
+            Some((
+                w,
+                (u64::from(fh) * u64::from(w) / u64::from(fw)).max(1) as u32,
+            ))
+        }
+    };
+    let Some(size) = size else {
+        // No ray march: the two GPU methods, which share the mesh and the rasteriser,
+        // vouch for each other alone.
+        let agrees = agreement <= u32::from(GPU_AGREEMENT);
+        // Nothing sides with either picture: every pixel they differ at past the
+        // agreement is unsettled (the peeled picture stands in for the ray march).
+        let unsettled = unsettled_pixels(&abuffer.image, &peel.image, &peel.image, &abuffer.image);
+        return Ok((
+            Reference {
+                image: abuffer.image,
+                check: ReferenceCheck {
+                    scene: name.to_owned(),
+                    max_abs_err: agreement,
+                    unsettled,
+                    exact: agrees && r.exact(),
+                    raymarch: RayMarchSummary::default(),
+                    lost_fragments: r.lost_fragments,
+                    capped_pixels: r.capped_pixels,
+                    capped_visible_pixels: r.capped_visible_pixels,
+                    depth_complexity: peeled.layers.unwrap_or(0),
+                },
+            },
+            None,
+        ));
+    };
     let ray = raymarch_check(ctx, scene, camera, size)?;
     let c = &ray.comparison;
     let raymarch = RayMarchSummary {
@@ -197,7 +348,7 @@ pub fn reference(
                 depth_complexity: peeled.layers.unwrap_or(0),
             },
         },
-        ray,
+        Some(ray),
     ))
 }
 
@@ -377,14 +528,32 @@ fn scene_records(
     let camera = scene.cameras[0];
     let dir = opts.out.join("heatmaps");
 
+    // The techniques first, before the exact references fill the GPU's memory (the
+    // A-buffer of a deep stack at 1080p takes gigabytes) and the ray march leaves it idle.
+    let runs = runs(opts);
+    progress.step(&format!("{stem}: {} runs in rounds", runs.len()));
+    let configs: Vec<OitConfig> = runs.iter().map(|(_, c)| c.clone()).collect();
+    let measured = measure_runs(
+        ctx,
+        &mut renderer,
+        &target,
+        &camera,
+        &configs,
+        opts.warmup,
+        opts.frames,
+    )?;
+
     progress.step(&format!("{stem}: exact references and the ray march"));
-    let (reference, ray) = reference(ctx, &mut renderer, &target, &camera, scene, &stem)?;
+    let checks = &opts.checks;
+    let heatmaps = heatmaps && checks.heatmaps && checks.flip;
+    let (reference, ray) = reference(ctx, &mut renderer, &target, &camera, scene, &stem, checks)?;
     if heatmaps {
-        for (image, what) in [
-            (&reference.image, "reference"),
-            (&ray.ray.image, "raymarch_flat"),
-            (&ray.gpu, "reference_flat"),
-        ] {
+        let mut pictures = vec![(&reference.image, "reference")];
+        if let Some(ray) = &ray {
+            pictures.push((&ray.ray.image, "raymarch_flat"));
+            pictures.push((&ray.gpu, "reference_flat"));
+        }
+        for (image, what) in pictures {
             save(
                 &thumbnail(image, opts.heatmap_width),
                 &dir.join(format!("{stem}__{what}.png")),
@@ -395,24 +564,24 @@ fn scene_records(
     let mut records = Vec::new();
     let mut quad_edges = None;
     let mut overlaps = None;
-    for (name, config) in runs(opts) {
+    for ((name, config), m) in runs.into_iter().zip(measured) {
         progress.step(&format!("{stem}: {name}"));
-        let m = measure(
-            ctx,
-            &mut renderer,
-            &target,
-            &camera,
-            &config,
-            opts.warmup,
-            opts.frames,
-        )?;
-        let (metrics, heat) = metrics::compare(&reference.image, &m.image);
-        let heatmap = if heatmaps {
-            let file = format!("{stem}__{}.png", name.replace('/', "_"));
-            save(&thumbnail(&heat, opts.heatmap_width), &dir.join(&file))?;
-            format!("heatmaps/{file}")
+        let (metrics, heat) = if checks.flip {
+            let (m, heat) = metrics::compare(&reference.image, &m.image);
+            (m, Some(heat))
         } else {
-            String::new()
+            (
+                metrics::compare_without_flip(&reference.image, &m.image),
+                None,
+            )
+        };
+        let heatmap = match heat.filter(|_| heatmaps) {
+            Some(heat) => {
+                let file = format!("{stem}__{}.png", name.replace('/', "_"));
+                save(&thumbnail(&heat, opts.heatmap_width), &dir.join(&file))?;
+                format!("heatmaps/{file}")
+            }
+            None => String::new(),
         };
         let Metrics {
             rmse,
@@ -458,6 +627,7 @@ fn scene_records(
             overlap_px: off_edges.map(|e| e.on_overlaps),
             near_px: off_edges.map(|e| e.on_near),
             heatmap,
+            cost: m.cost.as_ref().map(CostRecord::of),
         });
     }
     Ok((records, reference.check))
@@ -480,7 +650,24 @@ pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary> {
     let mut records = Vec::new();
     let mut checks = Vec::new();
     let mut features = Vec::new();
+    let mut skipped = Vec::new();
+    let start = std::time::Instant::now();
     for i in 0..count {
+        if opts
+            .checks
+            .time_budget
+            .is_some_and(|b| start.elapsed().as_secs_f64() > b)
+        {
+            skipped.extend((i..count).map(|j| match opts.random {
+                Some(set) => set.scene(j, opts.size.unwrap_or(DEFAULT_SIZE)).name,
+                None => opts.scenes[j].display().to_string(),
+            }));
+            log::warn!(
+                "time budget spent after {i} of {count} scenes: {} left out",
+                count - i
+            );
+            break;
+        }
         let (r, check) = match opts.random {
             Some(set) => {
                 // Parsed from its text like a scene file, so that the text replays it.
@@ -516,6 +703,7 @@ pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary> {
     }
     progress.finish();
     Ok(Summary {
+        skipped,
         adapter: ctx.caps.adapter_name.clone(),
         records,
         reference_checks: checks,

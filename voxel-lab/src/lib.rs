@@ -13,7 +13,8 @@
 //! - the runs, which use the model: [`eval`] (every scene × technique against the
 //!   reference), [`stability`] (sweeps and flicker);
 //! - the report, which reads what the runs produced: [`distribution`] (errors over random
-//!   scenes, where each technique fails), [`charts`], [`report`];
+//!   scenes, where each technique fails), [`charts`], [`costs`] (what each technique asked
+//!   of the GPU), [`report`];
 //! - [`evaluate`] here, which runs everything and writes every file;
 //! - [`stream`]: the streaming flight (`demo stream`), which draws its own chart;
 //! - [`gallery`]: one scene under every technique with its error maps (`demo gallery`);
@@ -24,6 +25,7 @@
 pub mod backends;
 pub mod charts;
 pub mod content;
+pub mod costs;
 pub mod distribution;
 pub mod edges;
 pub mod error;
@@ -59,7 +61,8 @@ pub fn chain(e: &dyn std::error::Error) -> String {
 
 /// Runs the evaluation `opts` asks for and writes every file into `opts.out`:
 /// `summary.json`, `reference_checks.json`, heat maps, the speed-against-accuracy chart,
-/// the stability sweeps (when asked) and `report.md`. On random scenes
+/// the stability sweeps (when asked), `report.md` and `costs.md` (what each technique's
+/// frame asked of the GPU, [`costs`]). On random scenes
 /// ([`EvalOptions::random`]) no heat maps, but `distribution.json`, `scenes.json`,
 /// `worst/` and the distribution charts.
 ///
@@ -84,7 +87,12 @@ pub fn evaluate(ctx: &voxel_render::GpuContext, opts: &EvalOptions) -> Result<Su
             distribution::write_worst(out, *set, d, opts)?;
             report::random_charts(out, &summary, d, opts)?;
         }
-        None => report::chart(out, &summary, opts)?,
+        // Without FLIP there is no accuracy axis to chart.
+        None if opts.checks.flip => report::chart(out, &summary, opts)?,
+        None => {}
+    }
+    if distribution.is_none() {
+        costs::write(out, &summary, opts)?;
     }
     let stability = if opts.stability {
         let st = stability::run(ctx, opts)?;

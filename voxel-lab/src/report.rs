@@ -210,6 +210,7 @@ pub fn write(
     suite_means(&mut s, summary);
     winners(&mut s, summary);
     weights(&mut s, summary);
+    costs(&mut s, summary);
     per_scene(&mut s, summary, opts);
     reference_checks(&mut s, summary);
     if let Some(st) = stability {
@@ -230,6 +231,14 @@ fn header(s: &mut String, summary: &Summary, opts: &EvalOptions) {
         .first()
         .map_or((0, 0), |r| (r.width, r.height));
     let _ = writeln!(s, "# Transparency techniques: speed and accuracy\n");
+    if !summary.skipped.is_empty() {
+        let _ = writeln!(
+            s,
+            "**Time budget spent**: {} scenes left out ({}).\n",
+            summary.skipped.len(),
+            summary.skipped.join(", ")
+        );
+    }
     let _ = writeln!(
         s,
         "Made by `{}` on **{}**, {}×{} pixels, median of {} timed frames after {} warm-up frames, {} scenes.\n",
@@ -277,7 +286,14 @@ fn header(s: &mut String, summary: &Summary, opts: &EvalOptions) {
          `sorted-quads` and `depth-peeling` are exact for one volume along a ray (things inside it included), and \
          a volume behind another is approximate in every real-time technique (docs/techniques.md, Volumes).\n"
     );
-    let _ = writeln!(s, "![speed against accuracy](speed_vs_accuracy.png)\n");
+    if opts.checks.flip {
+        let _ = writeln!(s, "![speed against accuracy](speed_vs_accuracy.png)\n");
+    } else {
+        let _ = writeln!(
+            s,
+            "FLIP was not computed (`--no-flip`): its columns read NaN, and there is no chart.\n"
+        );
+    }
 }
 
 fn suite_means(s: &mut String, summary: &Summary) {
@@ -307,6 +323,17 @@ fn suite_means(s: &mut String, summary: &Summary) {
             mean.rmse
         );
     }
+}
+
+fn costs(s: &mut String, summary: &Summary) {
+    if summary.records.iter().all(|r| r.cost.is_none()) {
+        return;
+    }
+    let _ = writeln!(
+        s,
+        "## GPU cost (counters)\n\nEvery scene × technique in [costs.md](costs.md).\n"
+    );
+    crate::costs::section(s, summary, false);
 }
 
 fn winners(s: &mut String, summary: &Summary) {

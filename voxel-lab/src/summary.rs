@@ -43,6 +43,41 @@ pub struct EvalOptions {
     /// per scene; `distribution.json`, `scenes.json`, `worst/` and the distribution
     /// charts besides the usual files.
     pub random: Option<RandomSet>,
+    /// What a run spends its time on besides the techniques' frames: FLIP, heat maps, the
+    /// ray march.
+    pub checks: Checks,
+}
+
+/// The lab's own work per scene and per run, which a quick check can cut: each is on by
+/// default.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Checks {
+    /// Mean FLIP per run (NVIDIA's perceptual difference, on the CPU: the lab's dearest
+    /// step per run at large sizes). Off: `flip_mean` is `null` (NaN) and no heat map is
+    /// made.
+    pub flip: bool,
+    /// FLIP heat maps and the reference pictures saved per scene.
+    pub heatmaps: bool,
+    /// Width of the CPU ray march that checks each scene's reference (`None`: the run's
+    /// size; `Some(0)`: no ray march, the reference counts as exact where the two GPU
+    /// methods agree within 2/255 and the A-buffer capped nothing visibly). The ray
+    /// march is the dearest step per scene.
+    pub raymarch_width: Option<u32>,
+    /// Wall-clock seconds after which no further scene is started (`None`: no limit): a
+    /// check on a machine lent for minutes ends with the scenes done written out, those
+    /// left named in the report.
+    pub time_budget: Option<f64>,
+}
+
+impl Default for Checks {
+    fn default() -> Self {
+        Self {
+            flip: true,
+            heatmaps: true,
+            raymarch_width: None,
+            time_budget: None,
+        }
+    }
 }
 
 /// One scene × technique measurement (the keys of `summary.json`).
@@ -109,6 +144,163 @@ pub struct Record {
     /// The FLIP heat map, relative to the output folder (empty when not saved: random
     /// scenes save none).
     pub heatmap: String,
+    /// What the technique's frame asked of the GPU, counted in one frame after the timed
+    /// ones (`null` where the frame could not be counted).
+    pub cost: Option<CostRecord>,
+}
+
+/// What one frame asked of the GPU ([`voxel_render::low_level::FrameCost`]): sums over
+/// the translucent work, the media passes and the whole frame, and each pass.
+#[derive(Clone, Debug, Serialize)]
+pub struct CostRecord {
+    /// The technique's passes and composites (what `gpu_ms` times).
+    pub translucent: CostSums,
+    /// The passes of the media (the eye's medium and volumes in view), before the
+    /// technique draws.
+    pub media: CostSums,
+    /// Every pass of the frame.
+    pub frame: CostSums,
+    /// Buffer copies of the frame's own writes (uniforms, draw commands, re-sorted quads).
+    pub uploads: u32,
+    /// Their bytes.
+    pub upload_bytes: u64,
+    /// Buffers created while the frame was recorded.
+    pub buffers_created: u32,
+    /// Bind groups created while the frame was recorded.
+    pub bind_groups_created: u32,
+    /// Every pass, in order.
+    pub passes: Vec<PassRecord>,
+}
+
+/// Sums over a set of passes ([`voxel_render::low_level::CostTotals`]).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct CostSums {
+    /// Render passes.
+    pub passes: u32,
+    /// Texture copies.
+    pub copies: u32,
+    /// Passes that drew a full-screen triangle.
+    pub full_screen_passes: u32,
+    /// Draw commands recorded.
+    pub draw_calls: u32,
+    /// Draws issued (each command of a multi-draw).
+    pub draws: u32,
+    /// Pipeline changes.
+    pub pipelines: u32,
+    /// Bind group and vertex buffer changes.
+    pub bind_groups: u32,
+    /// Calls into the game's own drawing.
+    pub game_calls: u32,
+    /// Bytes of targets cleared.
+    pub clear_bytes: u64,
+    /// Fragments shaded (`null`: not measured).
+    pub fragments: Option<u64>,
+    /// Samples written or blended.
+    pub samples: Option<u64>,
+    /// Bytes written into targets, clears and copies included.
+    pub bytes_written: Option<u64>,
+    /// Bytes read from targets and the textures the passes declare.
+    pub bytes_read: Option<u64>,
+    /// Fragments shaded per pixel of the frame.
+    pub fragments_per_pixel: Option<f64>,
+}
+
+impl CostSums {
+    fn of(t: &voxel_render::low_level::CostTotals, pixels: u64) -> Self {
+        Self {
+            passes: t.passes,
+            copies: t.copies,
+            full_screen_passes: t.full_screen_passes,
+            draw_calls: t.draw_calls,
+            draws: t.draws,
+            pipelines: t.pipelines,
+            bind_groups: t.bind_groups,
+            game_calls: t.game_calls,
+            clear_bytes: t.clear_bytes,
+            fragments: t.fragments,
+            samples: t.samples,
+            bytes_written: t.bytes_written,
+            bytes_read: t.bytes_read,
+            fragments_per_pixel: t.fragments.map(|f| f as f64 / pixels.max(1) as f64),
+        }
+    }
+
+    /// Bytes written and read together (`None`: not measured).
+    pub fn bytes(&self) -> Option<u64> {
+        Some(self.bytes_written? + self.bytes_read?)
+    }
+}
+
+/// One pass of a counted frame ([`voxel_render::low_level::PassCost`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct PassRecord {
+    /// Its label.
+    pub label: String,
+    /// The kind of GPU work it counts as (`untimed` for none).
+    pub kind: String,
+    /// Draw commands recorded.
+    pub draw_calls: u32,
+    /// Draws issued.
+    pub draws: u32,
+    /// Pipeline changes.
+    pub pipelines: u32,
+    /// Bind group and vertex buffer changes.
+    pub bind_groups: u32,
+    /// Calls into the game's own drawing.
+    pub game_calls: u32,
+    /// Full-screen triangles drawn.
+    pub full_screen_draws: u32,
+    /// Bytes of attachments cleared.
+    pub clear_bytes: u64,
+    /// Bytes a texture copy moved (0: a render pass).
+    pub copy_bytes: u64,
+    /// Fragments shaded.
+    pub fragments: Option<u64>,
+    /// Samples written or blended.
+    pub samples: Option<u64>,
+    /// Bytes written.
+    pub bytes_written: Option<u64>,
+    /// Bytes read.
+    pub bytes_read: Option<u64>,
+}
+
+impl CostRecord {
+    /// The record of `cost`.
+    pub fn of(cost: &voxel_render::low_level::FrameCost) -> Self {
+        let px = cost.pixels;
+        Self {
+            translucent: CostSums::of(&cost.translucent(), px),
+            media: CostSums::of(&cost.of_kind(voxel_render::GpuPass::Medium), px),
+            frame: CostSums::of(&cost.all(), px),
+            uploads: cost.uploads,
+            upload_bytes: cost.upload_bytes,
+            buffers_created: cost.buffers_created,
+            bind_groups_created: cost.bind_groups_created,
+            passes: cost
+                .passes
+                .iter()
+                .map(|p| PassRecord {
+                    label: p.label.clone(),
+                    kind: p
+                        .kind
+                        .map_or("untimed", voxel_render::GpuPass::name)
+                        .to_owned(),
+                    draw_calls: p.draw_calls,
+                    draws: p.draws,
+                    pipelines: p.pipelines,
+                    bind_groups: p.bind_groups,
+                    game_calls: p.game_calls,
+                    full_screen_draws: p.full_screen_draws,
+                    clear_bytes: p.clear_bytes,
+                    copy_bytes: p.copy_bytes,
+                    fragments: p.fragments,
+                    samples: p.samples,
+                    bytes_written: p.bytes_written(),
+                    bytes_read: p.bytes_read(),
+                })
+                .collect(),
+        }
+    }
 }
 
 /// The exact methods against each other, per scene.
@@ -175,6 +367,9 @@ pub struct Summary {
     pub reference_checks: Vec<ReferenceCheck>,
     /// Random scenes: what each holds, in scene order (empty for scene files).
     pub features: Vec<SceneFeatures>,
+    /// Scenes left out because the run's time budget was spent
+    /// ([`Checks::time_budget`]).
+    pub skipped: Vec<String>,
 }
 
 /// What a random scene holds.

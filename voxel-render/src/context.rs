@@ -184,12 +184,14 @@ pub struct GpuContext {
 }
 
 /// Optional features the renderer uses when the adapter has them (GPU timings, one
-/// indirect draw per page, 32-bit float moments for MBOIT). A game that requests its own
+/// indirect draw per page, 32-bit float moments for MBOIT, the fragments a counted
+/// frame's passes shade: `low_level::count_next_frame`). A game that requests its own
 /// device asks for `adapter.features() & WANTED_FEATURES` besides its own, or builds the
 /// whole request with [`device_descriptor`]; without them the renderer falls back (logged).
 pub const WANTED_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
     .union(wgpu::Features::INDIRECT_FIRST_INSTANCE)
-    .union(wgpu::Features::FLOAT32_BLENDABLE);
+    .union(wgpu::Features::FLOAT32_BLENDABLE)
+    .union(wgpu::Features::PIPELINE_STATISTICS_QUERY);
 
 impl GpuContext {
     /// Wraps a device the embedding game already owns. `adapter` is the one it came from

@@ -2,6 +2,7 @@
 //! pipeline builders for chunk quads and fullscreen triangles, render targets, and one
 //! helper that records a render pass with its attachments and timing.
 
+use crate::cost;
 use crate::fetch::QuadFetch;
 use crate::timing::{GpuPass, Timer};
 use crate::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
@@ -439,6 +440,7 @@ pub fn bind_group(
             resource: r.clone(),
         })
         .collect();
+    cost::created_bind_group();
     device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some(label),
         layout,
@@ -604,10 +606,16 @@ pub struct Pass<'a> {
     pub timing: Option<GpuPass>,
     /// Occlusion queries the pass writes to.
     pub occlusion: Option<&'a wgpu::QuerySet>,
+    /// Whether its pipelines blend into the colour attachments (each written sample then
+    /// reads the texel too): what a counted frame's bytes assume ([`crate::cost`]).
+    pub blends: bool,
+    /// Textures each fragment reads once (a composite's sums, a copy's source), for a
+    /// counted frame's bytes.
+    pub reads: &'a [&'a wgpu::TextureView],
 }
 
 impl<'a> Pass<'a> {
-    /// A timed pass into `colors` without depth.
+    /// A timed pass into `colors` without depth, blending.
     pub fn new(
         label: &'a str,
         timing: GpuPass,
@@ -619,6 +627,8 @@ impl<'a> Pass<'a> {
             depth: Depth::None,
             timing: Some(timing),
             occlusion: None,
+            blends: true,
+            reads: &[],
         }
     }
 
@@ -627,18 +637,81 @@ impl<'a> Pass<'a> {
         Self { depth, ..self }
     }
 
+    /// The same pass writing its colour attachments without blending.
+    pub(crate) fn opaque(self) -> Self {
+        Self {
+            blends: false,
+            ..self
+        }
+    }
+
+    /// The same pass with each fragment reading `textures` once.
+    pub(crate) fn reads(self, textures: &'a [&'a wgpu::TextureView]) -> Self {
+        Self {
+            reads: textures,
+            ..self
+        }
+    }
+
+    /// What the pass's attachments cost per sample, and its clears ([`crate::cost`]).
+    fn shape(&self) -> cost::PassShape {
+        let mut shape = cost::PassShape::default();
+        for c in self.colors.iter().flatten() {
+            let t = c.view.texture();
+            shape.size = (t.width(), t.height());
+            let bytes = cost::texel_bytes(t.format());
+            shape.write_bytes += bytes;
+            if self.blends {
+                shape.read_bytes += bytes;
+            }
+            if matches!(c.ops.load, wgpu::LoadOp::Clear(_)) {
+                shape.clear_bytes += cost::texture_bytes(t);
+            }
+        }
+        let depth = match self.depth {
+            Depth::None => None,
+            Depth::ReadOnly(v) => Some((v, false, false)),
+            Depth::Load(v) => Some((v, true, false)),
+            Depth::Clear(v, _) => Some((v, true, true)),
+        };
+        if let Some((view, writes, clears)) = depth {
+            let t = view.texture();
+            shape.size = (t.width(), t.height());
+            let bytes = cost::texel_bytes(t.format());
+            shape.read_bytes += bytes;
+            if writes {
+                shape.write_bytes += bytes;
+            }
+            if clears {
+                shape.clear_bytes += cost::texture_bytes(t);
+            }
+        }
+        shape.texture_bytes = self
+            .reads
+            .iter()
+            .map(|v| cost::texel_bytes(v.texture().format()))
+            .sum();
+        shape
+    }
+
     /// Records the pass into `encoder` (timed by `timer` when given): `body` sets
-    /// pipelines and draws.
+    /// pipelines and draws. In a counted frame ([`crate::cost`]) what `body` records is
+    /// counted, and the pass's fragments and samples are measured where the device can.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         timer: Option<&Timer>,
-        body: impl FnOnce(&mut wgpu::RenderPass<'_>),
+        body: impl FnOnce(&mut CountedPass<'_, '_>),
     ) {
         let query = self
             .timing
             .zip(timer)
             .map(|(pass, t)| t.begin(pass, encoder));
+        let counted = cost::counting().then(|| self.shape());
+        let slots = counted.and_then(|shape| {
+            cost::begin_pass(self.label, self.timing, shape, self.occlusion.is_some())
+        });
+        let own_occlusion = slots.as_ref().and_then(|s| s.occlusion.as_ref());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(self.label),
@@ -647,14 +720,107 @@ impl<'a> Pass<'a> {
                 timestamp_writes: query
                     .as_ref()
                     .and_then(|q| q.render_pass_timestamp_writes()),
-                occlusion_query_set: self.occlusion,
+                occlusion_query_set: self.occlusion.or(own_occlusion),
                 multiview_mask: None,
             });
-            body(&mut pass);
+            if let Some(s) = &slots {
+                if let Some(stats) = &s.statistics {
+                    pass.begin_pipeline_statistics_query(stats, s.index);
+                }
+                if own_occlusion.is_some() {
+                    pass.begin_occlusion_query(s.index);
+                }
+            }
+            body(&mut CountedPass { raw: &mut pass });
+            if let Some(s) = &slots {
+                if own_occlusion.is_some() {
+                    pass.end_occlusion_query();
+                }
+                if s.statistics.is_some() {
+                    pass.end_pipeline_statistics_query();
+                }
+            }
+        }
+        if counted.is_some() {
+            cost::end_pass();
         }
         if let (Some(q), Some(t)) = (query, timer) {
             t.end(encoder, q);
         }
+    }
+}
+
+/// A render pass being recorded by [`Pass::record`]: the commands the renderer records
+/// go through it, so that a counted frame counts them ([`crate::cost`]); it derefs to the
+/// `wgpu::RenderPass` for everything else.
+#[derive(Debug)]
+pub struct CountedPass<'p, 'e> {
+    raw: &'p mut wgpu::RenderPass<'e>,
+}
+
+impl<'e> CountedPass<'_, 'e> {
+    /// `RenderPass::set_pipeline`.
+    pub fn set_pipeline(&mut self, pipeline: &wgpu::RenderPipeline) {
+        cost::set_pipeline(pipeline);
+        self.raw.set_pipeline(pipeline);
+    }
+
+    /// `RenderPass::set_bind_group`.
+    pub fn set_bind_group(&mut self, index: u32, group: &wgpu::BindGroup, offsets: &[u32]) {
+        cost::set_bind_group(index, Some(group), offsets);
+        self.raw.set_bind_group(index, group, offsets);
+    }
+
+    /// `RenderPass::set_vertex_buffer`.
+    pub fn set_vertex_buffer(&mut self, slot: u32, slice: wgpu::BufferSlice<'_>) {
+        cost::set_vertex_buffer();
+        self.raw.set_vertex_buffer(slot, slice);
+    }
+
+    /// `RenderPass::set_scissor_rect`.
+    pub fn set_scissor_rect(&mut self, x: u32, y: u32, width: u32, height: u32) {
+        cost::scissor(u64::from(width) * u64::from(height));
+        self.raw.set_scissor_rect(x, y, width, height);
+    }
+
+    /// `RenderPass::draw`.
+    pub fn draw(&mut self, vertices: std::ops::Range<u32>, instances: std::ops::Range<u32>) {
+        cost::draw(1, 1);
+        self.raw.draw(vertices, instances);
+    }
+
+    /// Draws the full-screen triangle of `fullscreen.wgsl` (three vertices, one instance).
+    pub fn draw_full_screen(&mut self) {
+        cost::full_screen();
+        self.raw.draw(0..3, 0..1);
+    }
+
+    /// `RenderPass::multi_draw_indirect`: one call, `count` draws.
+    pub fn multi_draw_indirect(&mut self, buffer: &wgpu::Buffer, offset: u64, count: u32) {
+        cost::draw(1, count);
+        self.raw.multi_draw_indirect(buffer, offset, count);
+    }
+
+    /// Hands the raw pass to a game's own drawing ([`crate::stages::GameStages`]): counted
+    /// as one call into the game; what it sets is unknown afterwards.
+    pub fn game<R>(&mut self, f: impl FnOnce(&mut wgpu::RenderPass<'e>) -> R) -> R {
+        cost::game_call();
+        let r = f(self.raw);
+        cost::game_call_done();
+        r
+    }
+}
+
+impl<'e> std::ops::Deref for CountedPass<'_, 'e> {
+    type Target = wgpu::RenderPass<'e>;
+    fn deref(&self) -> &Self::Target {
+        self.raw
+    }
+}
+
+impl std::ops::DerefMut for CountedPass<'_, '_> {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        self.raw
     }
 }
 
@@ -804,6 +970,11 @@ impl DepthCopy {
                 dst.texture.as_image_copy(),
                 src.texture.size(),
             );
+            cost::copied(
+                "depth_copy",
+                Some(timing),
+                cost::texture_bytes(&src.texture),
+            );
             return;
         };
         let group = bind_group(
@@ -817,10 +988,11 @@ impl DepthCopy {
         );
         Pass::new("depth_copy", timing, &[])
             .depth(Depth::Clear(&dst.view, 0.0))
+            .reads(&[&src.view])
             .record(encoder, timer, |pass| {
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &group, &[]);
-                pass.draw(0..3, 0..1);
+                pass.draw_full_screen();
             });
     }
 }

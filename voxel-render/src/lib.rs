@@ -25,7 +25,7 @@
 //!
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `ladder`
 //! (what each pass needs of a device), `camera`, `readback`, `submission`, `timing`,
-//! `fetch` (how quads reach the vertex shader) → `gpu` (pass and pipeline plumbing) →
+//! `cost` (what a frame asks of the GPU, counted), `fetch` (how quads reach the vertex shader) → `gpu` (pass and pipeline plumbing) →
 //! `bindings` (what every chunk pipeline binds), `textures`, `arena` (the quad arena),
 //! `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
 //! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` →
@@ -41,6 +41,7 @@ mod camera;
 mod chunks;
 pub mod content;
 mod context;
+mod cost;
 mod error;
 mod fetch;
 mod gpu;

@@ -8,7 +8,8 @@ pub use crate::arena::QUAD_BYTES;
 pub use crate::bindings::{AO_DEPTH, OPAQUE_EXPANSION_PX, TONEMAP_SHOULDER};
 pub use crate::camera::{MAX_FAR, MAX_FOV_DEG, MIN_FOV_DEG, MIN_NEAR, WORLD_EXTENT};
 pub use crate::chunks::{ChunkStore, GpuChunk, MeshKind};
-pub use crate::gpu::{Pass, clear, pipelines_built};
+pub use crate::cost::{CostTotals, FrameCost, PassCost};
+pub use crate::gpu::{CountedPass, Pass, clear, pipelines_built};
 pub use crate::ladder::{Limit, Need, check};
 pub use crate::oit::moments::single_precision;
 pub use crate::oit::peeling::MAX_PEEL_LAYERS;
@@ -26,6 +27,23 @@ pub use crate::stream::{EDIT_BYTES, EDITED_CHUNK_BYTES, MAX_VIEW_DISTANCE};
 /// their generations).
 pub fn chunks(renderer: &crate::Renderer) -> &ChunkStore {
     renderer.chunks()
+}
+
+/// Counts what the next frame of `renderer` asks of the GPU (`crate::cost`): per pass
+/// its draw calls, pipeline and bind-group changes, full-screen draws and clears, and,
+/// where the device has occlusion and pipeline-statistics queries and the technique does
+/// not submit inside its frame, the fragments it shades and the samples it writes (from
+/// which the bytes of targets written and read follow). Read it with [`frame_cost`] once
+/// the frame is submitted. Frames not counted pay one thread-local look-up per command.
+pub fn count_next_frame(renderer: &mut crate::Renderer) {
+    renderer.count_next_frame();
+}
+
+/// What the last frame counted with [`count_next_frame`] asked of the GPU, once its
+/// encoder is submitted (waits for its query results); `None` when no frame was counted
+/// since the last call.
+pub fn frame_cost(renderer: &mut crate::Renderer) -> crate::Result<Option<FrameCost>> {
+    renderer.frame_cost()
 }
 
 /// The transparency manager of `renderer`: the technique's configuration, how many times

@@ -408,7 +408,7 @@ impl MediumPass {
         Pass::new("media", GpuPass::Medium, &colors).record(encoder, timer, |pass| {
             pass.set_pipeline(&self.media);
             pass.set_bind_group(0, scene, &[]);
-            pass.draw(0..3, 0..1);
+            pass.draw_full_screen();
         });
     }
 }

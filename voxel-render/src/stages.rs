@@ -746,32 +746,32 @@ impl GameDraw<'_> {
     /// Draws the objects `range` in pass `variant`, with `group` bound at [`OIT_GROUP`].
     pub(crate) fn draw(
         &self,
-        pass: &mut wgpu::RenderPass<'_>,
+        pass: &mut crate::gpu::CountedPass<'_, '_>,
         variant: usize,
         group: &wgpu::BindGroup,
         range: Range<usize>,
     ) {
         pass.set_bind_group(OIT_GROUP, group, &[]);
-        self.stages.translucent(pass, self.frame, variant, range);
+        pass.game(|raw| self.stages.translucent(raw, self.frame, variant, range));
     }
 
     /// Like [`GameDraw::draw`], with dynamic `offsets` for the group.
     pub(crate) fn draw_offsets(
         &self,
-        pass: &mut wgpu::RenderPass<'_>,
+        pass: &mut crate::gpu::CountedPass<'_, '_>,
         variant: usize,
         group: &wgpu::BindGroup,
         offsets: &[u32],
         range: Range<usize>,
     ) {
         pass.set_bind_group(OIT_GROUP, group, offsets);
-        self.stages.translucent(pass, self.frame, variant, range);
+        pass.game(|raw| self.stages.translucent(raw, self.frame, variant, range));
     }
 
     /// Draws every object in pass `variant`.
     pub(crate) fn draw_all(
         &self,
-        pass: &mut wgpu::RenderPass<'_>,
+        pass: &mut crate::gpu::CountedPass<'_, '_>,
         variant: usize,
         group: &wgpu::BindGroup,
     ) {

@@ -146,6 +146,12 @@ impl FrameWrites {
             .push((target.clone(), offset, at, data.len() as u64));
     }
 
+    /// The copies waiting to be recorded, and their bytes.
+    pub(crate) fn pending(&self) -> (u32, u64) {
+        let bytes = self.copies.iter().map(|c| c.3).sum();
+        (self.copies.len() as u32, bytes)
+    }
+
     /// Moves `other`'s writes after this one's.
     pub(crate) fn append(&mut self, other: &mut FrameWrites) {
         let base = self.bytes.len() as u64;

@@ -63,7 +63,7 @@ pub(crate) struct FrameDraws<'a> {
 
 impl FrameDraws<'_> {
     /// Records the draws of `list` (pipeline and group 0 already set; group 1 set here).
-    pub(crate) fn draw(&self, list: &DrawList, pass: &mut wgpu::RenderPass<'_>) {
+    pub(crate) fn draw(&self, list: &DrawList, pass: &mut crate::gpu::CountedPass<'_, '_>) {
         self.draw_range(list, 0..list.meshes, pass);
     }
 
@@ -72,7 +72,7 @@ impl FrameDraws<'_> {
         &self,
         list: &DrawList,
         range: std::ops::Range<usize>,
-        pass: &mut wgpu::RenderPass<'_>,
+        pass: &mut crate::gpu::CountedPass<'_, '_>,
     ) {
         let Some(base) = list.runs.first().map(|r| r.first as usize) else {
             return;
@@ -115,7 +115,7 @@ impl FrameDraws<'_> {
         list: &DrawList,
         index: usize,
         quads: std::ops::Range<u32>,
-        pass: &mut wgpu::RenderPass<'_>,
+        pass: &mut crate::gpu::CountedPass<'_, '_>,
     ) {
         let Some(base) = list.runs.first().map(|r| r.first as usize) else {
             return;

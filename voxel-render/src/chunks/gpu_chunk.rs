@@ -26,6 +26,13 @@ pub struct GpuChunk {
     pub(super) volume: bool,
     /// Changes with every upload of the chunk.
     pub(super) generation: u64,
+    /// The mesher's order of the translucent quads while the GPU draws them in another
+    /// (`None`: the GPU holds the mesher's order).
+    pub(super) mesher_order: Option<Vec<PackedQuad>>,
+    /// Changes whenever the GPU order of the translucent quads is written (an upload, a
+    /// re-sort, the mesher's order restored): what a technique that wrote an order checks
+    /// its order is still the one drawn.
+    pub(super) order_stamp: u64,
 }
 
 impl GpuChunk {
@@ -78,6 +85,11 @@ impl GpuChunk {
     /// the store.
     pub fn generation(&self) -> u64 {
         self.generation
+    }
+
+    /// Changes whenever the GPU order of the translucent quads is written.
+    pub(crate) fn order_stamp(&self) -> u64 {
+        self.order_stamp
     }
 }
 

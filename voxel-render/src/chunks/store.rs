@@ -38,6 +38,9 @@ pub struct ChunkStore {
     regions: Regions,
     pub(super) indirect: wgpu::Buffer,
     next_generation: u64,
+    /// Whether a chunk may hold its translucent quads in an order other than the mesher's
+    /// ([`ChunkStore::reorder_translucent`]).
+    reordered: bool,
     /// Whether a frame's draw lists hold places that its submit has not yet drawn (from
     /// [`ChunkStore::lists_built`] to [`ChunkStore::frame_submitted`]).
     in_flight: bool,
@@ -85,6 +88,7 @@ impl ChunkStore {
             regions: Regions::default(),
             indirect,
             next_generation: 1,
+            reordered: false,
             in_flight: false,
             retired: Vec::new(),
             retired_slots: Vec::new(),
@@ -148,7 +152,7 @@ impl ChunkStore {
     /// Sets what draws from page `page` read: its group 1, or with
     /// [`QuadFetch::Instanced`] the page as vertex buffer 0 (the group goes with each
     /// draw). `false` for a page given back.
-    pub(super) fn bind_page(&self, page: u32, pass: &mut wgpu::RenderPass<'_>) -> bool {
+    pub(super) fn bind_page(&self, page: u32, pass: &mut crate::gpu::CountedPass<'_, '_>) -> bool {
         let (Some(Some(group)), Some(buffer)) = (
             self.groups.get(page as usize),
             self.arena.page(page as usize),
@@ -169,7 +173,7 @@ impl ChunkStore {
         page: u32,
         c: &DrawCommand,
         quads: std::ops::Range<u32>,
-        pass: &mut wgpu::RenderPass<'_>,
+        pass: &mut crate::gpu::CountedPass<'_, '_>,
     ) {
         let slot = c.first_instance;
         let first = c.first_vertex / 6 + quads.start;
@@ -354,6 +358,8 @@ impl ChunkStore {
                 self.volume_blocks.get(block).copied().unwrap_or(false)
             }),
             generation: self.next_generation,
+            mesher_order: None,
+            order_stamp: self.next_generation,
         });
         self.next_generation += 1;
         Ok(())
@@ -451,8 +457,39 @@ impl ChunkStore {
         {
             self.arena
                 .write(&mut Upload::Frame(&mut self.writes), a, &quads);
-            c.translucent = quads;
+            let old = std::mem::replace(&mut c.translucent, quads);
+            if c.mesher_order.is_none() {
+                c.mesher_order = Some(old);
+            }
+            self.reordered = true;
+            c.order_stamp = self.next_generation;
+            self.next_generation += 1;
         }
+    }
+
+    /// Puts every chunk's translucent quads back in the mesher's order (in the frame being
+    /// recorded), where a technique re-sorted them: what a technique that draws the
+    /// mesher's order (`sorted`) draws then does not depend on the techniques before it.
+    /// Costs nothing when no chunk was re-sorted.
+    pub(crate) fn restore_mesher_order(&mut self) {
+        if !self.reordered {
+            return;
+        }
+        for c in self.slots.iter_mut().flatten() {
+            let Some(quads) = c.mesher_order.take() else {
+                continue;
+            };
+            if let Some(a) = c.meshes[MeshKind::Translucent as usize]
+                && quads.len() == a.quads as usize
+            {
+                self.arena
+                    .write(&mut Upload::Frame(&mut self.writes), a, &quads);
+                c.translucent = quads;
+                c.order_stamp = self.next_generation;
+                self.next_generation += 1;
+            }
+        }
+        self.reordered = false;
     }
 
     /// Sets a chunk's whole-chunk opacity (fade-in): at the next submit, or `in_frame` in

@@ -267,8 +267,14 @@ impl Instances {
             };
             if bound != Some(page) {
                 match (&p.group, fetch) {
-                    (Some(group), QuadFetch::Storage) => pass.set_bind_group(1, group, &[]),
-                    _ => pass.set_vertex_buffer(0, p.buffer.slice(..)),
+                    (Some(group), QuadFetch::Storage) => {
+                        crate::cost::set_bind_group(1, Some(group), &[]);
+                        pass.set_bind_group(1, group, &[]);
+                    }
+                    _ => {
+                        crate::cost::set_vertex_buffer();
+                        pass.set_vertex_buffer(0, p.buffer.slice(..));
+                    }
                 }
                 bound = Some(page);
             }
@@ -279,6 +285,7 @@ impl Instances {
             } else {
                 BOX_VERTICES
             };
+            crate::cost::draw(1, 1);
             pass.draw(0..vertices, (i - base) as u32..(j - base) as u32);
             i = j;
         }
@@ -677,6 +684,7 @@ impl ContentStages {
 
     /// Binds what every draw of its pipelines reads besides the instances.
     fn bind_view(&self, pass: &mut wgpu::RenderPass<'_>) {
+        crate::cost::set_bind_group(0, Some(&self.view_group), &[]);
         pass.set_bind_group(0, &self.view_group, &[]);
     }
 }
@@ -806,6 +814,7 @@ impl GameStages for ContentStages {
         let Some((_, pipeline)) = &self.opaque_pipeline else {
             return;
         };
+        crate::cost::set_pipeline(pipeline);
         pass.set_pipeline(pipeline);
         self.bind_view(pass);
         self.opaque
@@ -829,6 +838,7 @@ impl GameStages for ContentStages {
         if objects.start >= objects.end.min(self.translucent.count) {
             return;
         }
+        crate::cost::set_pipeline(pipeline);
         pass.set_pipeline(pipeline);
         self.bind_view(pass);
         self.translucent

@@ -462,7 +462,7 @@ pub(crate) struct TranslucentFrame<'a> {
 impl TranslucentFrame<'_> {
     /// Records the draws of every visible translucent mesh (group 0 and each chunk's
     /// group 1 set here; the pipeline and groups from 2 on set by the caller).
-    pub(crate) fn draw_chunks(&self, pass: &mut wgpu::RenderPass<'_>) {
+    pub(crate) fn draw_chunks(&self, pass: &mut crate::gpu::CountedPass<'_, '_>) {
         pass.set_bind_group(0, self.scene, &[]);
         self.draws.draw(self.chunks, pass);
     }
@@ -854,4 +854,114 @@ impl OitManager {
             None => Ok(()),
         }
     }
+}
+
+/// Where a composite draws: the screen rectangle (0 to 1, y down) that translucent things
+/// may cover, grown as more are added; `None` stands for the whole screen. A full-screen
+/// composite discards every pixel no translucent fragment reached, so a scissor around the
+/// rest leaves the picture as it is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ScreenCover(pub Option<[glam::Vec2; 2]>);
+
+impl ScreenCover {
+    /// Nothing covered yet.
+    pub(crate) fn none() -> Self {
+        Self(Some([glam::Vec2::INFINITY, glam::Vec2::NEG_INFINITY]))
+    }
+
+    /// The rectangle `min`–`max` added.
+    pub(crate) fn add_rect(&mut self, [min, max]: [glam::Vec2; 2]) {
+        if let Some([lo, hi]) = &mut self.0 {
+            *lo = lo.min(min);
+            *hi = hi.max(max);
+        }
+    }
+
+    /// The box `lo`–`hi` (world blocks) seen through `view_proj` (camera-relative, from
+    /// `eye`) added: the rectangle around its corners' projections; the whole screen when
+    /// a corner lies at or behind the eye's plane, or is not finite.
+    pub(crate) fn add_box(
+        &mut self,
+        (lo, hi): (glam::DVec3, glam::DVec3),
+        view_proj: Mat4,
+        eye: glam::DVec3,
+    ) {
+        if self.0.is_none() {
+            return;
+        }
+        let (mut min, mut max) = (glam::Vec2::INFINITY, glam::Vec2::NEG_INFINITY);
+        for i in 0..8 {
+            let corner = glam::DVec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let clip = view_proj * (corner - eye).as_vec3().extend(1.0);
+            // Clip w is the view depth; a corner at or behind the eye's plane reaches
+            // everywhere on screen.
+            if clip.w.partial_cmp(&1e-3) != Some(std::cmp::Ordering::Greater) || !clip.is_finite() {
+                self.0 = None;
+                return;
+            }
+            let p = glam::Vec2::new((clip.x / clip.w + 1.0) * 0.5, (1.0 - clip.y / clip.w) * 0.5);
+            min = min.min(p);
+            max = max.max(p);
+        }
+        self.add_rect([min, max]);
+    }
+
+    /// A game's objects added (`None`: it draws translucent geometry it does not declare,
+    /// which may lie anywhere): the box around all of them (each object's box, or its
+    /// ball's).
+    pub(crate) fn add_objects(
+        &mut self,
+        objects: Option<&[TranslucentObject]>,
+        view_proj: Mat4,
+        eye: glam::DVec3,
+    ) {
+        let Some(objects) = objects.filter(|o| !o.is_empty()) else {
+            if objects.is_some() {
+                // Drawn but not declared.
+                self.0 = None;
+            }
+            return;
+        };
+        let (mut lo, mut hi) = (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY);
+        for o in objects {
+            let half = o.half_extents.unwrap_or(glam::DVec3::splat(o.radius)).abs();
+            lo = lo.min(o.center - half);
+            hi = hi.max(o.center + half);
+        }
+        self.add_box((lo, hi), view_proj, eye);
+    }
+
+    /// The pixels `[x, y, width, height]` of a `size` target it covers, grown by a pixel
+    /// (the rasteriser's vertex snapping, and a projection on the CPU in f32 against the
+    /// shader's); zero size when nothing is covered, `None` for the whole screen.
+    pub(crate) fn pixels(&self, size: (u32, u32)) -> Option<[u32; 4]> {
+        self.0.map(|[min, max]| pixel_rect(min, max, size))
+    }
+}
+
+/// The pixels `[x, y, width, height]` of a `size` target around the screen rectangle
+/// `min`–`max` (0 to 1, y down), grown by a pixel (the rasteriser's vertex snapping, and
+/// a projection on the CPU in f32 against the shader's); zero size when it is empty or
+/// off screen.
+pub(crate) fn pixel_rect(
+    min: glam::Vec2,
+    max: glam::Vec2,
+    (width, height): (u32, u32),
+) -> [u32; 4] {
+    let size = glam::Vec2::new(width as f32, height as f32);
+    let lo = (min * size - 1.0).floor().clamp(glam::Vec2::ZERO, size);
+    let hi = (max * size + 1.0).ceil().clamp(glam::Vec2::ZERO, size);
+    if !(lo.x < hi.x && lo.y < hi.y) {
+        return [0; 4];
+    }
+    [
+        lo.x as u32,
+        lo.y as u32,
+        (hi.x - lo.x) as u32,
+        (hi.y - lo.y) as u32,
+    ]
 }

@@ -95,6 +95,22 @@ impl Renderer {
         camera: &Camera,
         game: &mut dyn GameStages,
     ) -> Result<FrameStats> {
+        let frame = self.render_frame(encoder, output, camera, game);
+        if frame.is_err() {
+            // A frame that failed is not counted ([`crate::cost`]).
+            drop(crate::cost::end_frame());
+        }
+        frame
+    }
+
+    /// [`Renderer::render`], counted when a frame is armed ([`crate::cost`]).
+    fn render_frame(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        output: &wgpu::TextureView,
+        camera: &Camera,
+        game: &mut dyn GameStages,
+    ) -> Result<FrameStats> {
         self.ctx.check_device()?;
         camera.validate()?;
         // The output's format (its tonemap pipeline made the first time), checked with it.
@@ -139,6 +155,8 @@ impl Renderer {
             self.config.output_format = format;
         }
         let start = Instant::now();
+        // Counting starts after the output's check, whose pass is never submitted.
+        self.begin_cost();
         let ctx = &self.ctx;
         let timed = self
             .timer
@@ -290,6 +308,11 @@ impl Renderer {
         }
         // Every write of the frame, in its encoder before its first pass.
         writes.append(self.chunks.writes());
+        let (copies, bytes) = writes.pending();
+        if copies > 0 {
+            crate::cost::uploaded(copies, bytes);
+            crate::cost::created_buffer();
+        }
         let recorded = writes.record(&self.ctx.device, encoder);
         self.writes = writes;
         recorded?;
@@ -405,14 +428,17 @@ impl Renderer {
             let colors = [gpu::load(&t.color.view)];
             Pass::new("game_hdr_overlay", GpuPass::Game, &colors)
                 .depth(Depth::ReadOnly(&t.depth.view))
-                .record(encoder, timer, |pass| game.hdr_overlay(pass, &game_frame));
+                .record(encoder, timer, |pass| {
+                    pass.game(|raw| game.hdr_overlay(raw, &game_frame))
+                });
             self.ctx.check_device()?;
         }
         self.tonemap(encoder, output, timer);
         if stages.overlay {
             let colors = [gpu::load(output)];
-            Pass::new("game_overlay", GpuPass::Game, &colors)
-                .record(encoder, timer, |pass| game.overlay(pass, &game_frame));
+            Pass::new("game_overlay", GpuPass::Game, &colors).record(encoder, timer, |pass| {
+                pass.game(|raw| game.overlay(raw, &game_frame))
+            });
             self.ctx.check_device()?;
         }
         let stats = FrameStats {
@@ -427,6 +453,7 @@ impl Renderer {
         if timed && let Some(t) = &mut self.timer {
             t.end_frame(&self.ctx, encoder);
         }
+        self.end_cost(encoder);
         self.submissions.attach(&self.ctx, encoder);
         self.last_encoder = Some(encoder_key(encoder));
         Ok(FrameStats {
@@ -702,8 +729,11 @@ impl Renderer {
             };
             Pass::new(label, kind, &colors)
                 .depth(depth)
+                .opaque()
                 .record(encoder, timer, |pass| match (kind, game) {
-                    (GpuPass::Game, Some((game, frame))) => game.opaque(pass, frame),
+                    (GpuPass::Game, Some((game, frame))) => {
+                        pass.game(|raw| game.opaque(raw, frame))
+                    }
                     _ => {
                         let (pipeline, list) = if first {
                             (&self.opaque, opaque)
@@ -722,7 +752,7 @@ impl Renderer {
                 .record(encoder, timer, |pass| {
                     pass.set_pipeline(resolve);
                     pass.set_bind_group(0, group, &[]);
-                    pass.draw(0..3, 0..1);
+                    pass.draw_full_screen();
                 });
         }
     }
@@ -737,10 +767,14 @@ impl Renderer {
             return;
         };
         let colors = [gpu::load(output)];
-        Pass::new("tonemap", GpuPass::Tonemap, &colors).record(encoder, timer, |pass| {
+        let reads = [&self.targets.color.view];
+        let tonemap = Pass::new("tonemap", GpuPass::Tonemap, &colors)
+            .opaque()
+            .reads(&reads);
+        tonemap.record(encoder, timer, |pass| {
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &self.targets.tonemap_group, &[]);
-            pass.draw(0..3, 0..1);
+            pass.draw_full_screen();
         });
     }
 }

@@ -17,6 +17,7 @@ use wgpu::util::DeviceExt;
 
 use crate::bindings::{FrameUniforms, SharedLayouts, common_wgsl};
 use crate::chunks::{ChunkStore, Culled, DrawBuilder, DrawMode, PosMap};
+use crate::cost::{CostQueries, FrameCost};
 use crate::error::scoped;
 use crate::fetch::{QuadFetch, TableTexture};
 use crate::gpu::{self, ChunkPipeline, DepthMode};
@@ -110,6 +111,19 @@ pub struct Renderer {
     writes: FrameWrites,
     /// The encoder the last frame ended in (`frame::encoder_key`).
     last_encoder: Option<u64>,
+    /// What the next frame's cost is counted with ([`crate::cost`]), once asked for.
+    cost: CostCounting,
+}
+
+/// Counting what frames ask of the GPU ([`crate::cost`]): armed for one frame at a time.
+#[derive(Debug, Default)]
+pub(crate) struct CostCounting {
+    /// The next frame is counted.
+    armed: bool,
+    /// The query sets, made the first time a frame is counted.
+    queries: Option<CostQueries>,
+    /// The last counted frame: what was counted, each pass's query slot, slots used.
+    counted: Option<(FrameCost, Vec<Option<u32>>, u32)>,
 }
 
 impl Renderer {
@@ -253,6 +267,7 @@ impl Renderer {
             checked_view: None,
             writes: FrameWrites::default(),
             last_encoder: None,
+            cost: CostCounting::default(),
             config,
         })
     }
@@ -531,6 +546,70 @@ impl Renderer {
         let times = timer.read_blocking(&ctx, || self.settle_submission());
         self.timer = Some(timer);
         times
+    }
+
+    /// Counts what the next frame asks of the GPU ([`crate::cost`]): its passes' draws,
+    /// state changes and clears, and, where the device has the queries and the technique
+    /// never submits inside its frame, their fragments and samples. Read with
+    /// [`Renderer::frame_cost`] once that frame is submitted.
+    pub(crate) fn count_next_frame(&mut self) {
+        self.cost.armed = true;
+    }
+
+    /// What the last counted frame asked of the GPU ([`Renderer::count_next_frame`]),
+    /// waiting for its query results (its encoder must have been submitted); `None` when
+    /// no frame was counted since the last call.
+    pub(crate) fn frame_cost(&mut self) -> Result<Option<FrameCost>> {
+        let Some((mut cost, slots, used)) = self.cost.counted.take() else {
+            return Ok(None);
+        };
+        if let Some(queries) = &self.cost.queries
+            && cost.measured
+        {
+            self.ctx.check_device()?;
+            let results = queries.read(&self.ctx, used)?;
+            crate::cost::fill(&mut cost, &slots, &results);
+        }
+        Ok(Some(cost))
+    }
+
+    /// Starts counting the frame about to be recorded when one is armed.
+    pub(crate) fn begin_cost(&mut self) {
+        if !std::mem::take(&mut self.cost.armed) {
+            return;
+        }
+        // The exact techniques submit inside their frame and record hundreds of passes:
+        // their commands are counted, not measured.
+        let measure = !self.oit.technique().stalls();
+        if measure && self.cost.queries.is_none() {
+            let statistics = self
+                .ctx
+                .caps
+                .features
+                .contains(wgpu::Features::PIPELINE_STATISTICS_QUERY);
+            self.cost.queries = Some(CostQueries::new(&self.ctx.device, statistics));
+        }
+        let slots = self
+            .cost
+            .queries
+            .as_ref()
+            .filter(|_| measure)
+            .map(CostQueries::slots);
+        let (w, h) = self.size();
+        crate::cost::begin_frame(u64::from(w) * u64::from(h), slots);
+    }
+
+    /// Ends the counted frame, if one is: resolves its queries at the end of `encoder`.
+    pub(crate) fn end_cost(&mut self, encoder: &mut wgpu::CommandEncoder) {
+        let Some((cost, slots, used)) = crate::cost::end_frame() else {
+            return;
+        };
+        if let Some(q) = &self.cost.queries
+            && cost.measured
+        {
+            q.resolve(encoder, used);
+        }
+        self.cost.counted = Some((cost, slots, used));
     }
 
     /// What became of the last frame's encoder; a dropped one's queue writes are flushed

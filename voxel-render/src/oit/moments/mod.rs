@@ -29,8 +29,8 @@ use crate::gpu::{self, Depth, Pass, SidedPipeline};
 use crate::ladder::Need;
 use crate::oit::sums;
 use crate::oit::{
-    FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
-    TranslucentTechnique,
+    FrameView, OitConfig, ScreenCover, Setup, Technique, TechniqueKind, TechniqueReport,
+    TranslucentFrame, TranslucentTechnique,
 };
 use crate::stages::{TranslucentObject, TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
@@ -99,6 +99,10 @@ pub struct MboitReport {
     pub moments: wgpu::TextureFormat,
     /// The view depths the warp spans.
     pub depth_range: [f32; 2],
+    /// The pixels the composite covered, `[x, y, width, height]` (zero size: it was
+    /// skipped): the rectangle around the visible translucent meshes' boxes and the
+    /// game's objects; `None`: the whole screen.
+    pub composite_rect: Option<[u32; 4]>,
 }
 
 /// The technique's uniform (`MboitParams` in `moments.wgsl`).
@@ -493,9 +497,18 @@ impl TranslucentTechnique for Mboit {
         let range = depth_range(view.camera, view.layers.boxes(), view.game_objects);
         let params = MboitParams::new(range, self.bias(), config.mboit.overestimation);
         view.write(&self.params, 0, bytemuck::bytes_of(&params));
+        // The composite discards every pixel no translucent fragment reached: only the
+        // rectangle around the meshes' boxes and the game's objects is drawn.
+        let mut cover = ScreenCover::none();
+        for b in view.layers.boxes() {
+            cover.add_box(b, view.view_proj, view.camera.eye);
+        }
+        cover.add_objects(view.game_objects, view.view_proj, view.camera.eye);
+        let size = self.targets.accumulation.texture.size();
         self.report = Some(MboitReport {
             moments: self.targets.moments.texture.format(),
             depth_range: range,
+            composite_rect: cover.pixels((size.width, size.height)),
         });
         Ok(())
     }
@@ -531,7 +544,7 @@ impl TranslucentTechnique for Mboit {
             );
             (g, [moments, resolve])
         });
-        let draw = |pass: &mut wgpu::RenderPass<'_>,
+        let draw = |pass: &mut crate::gpu::CountedPass<'_, '_>,
                     pipeline: &SidedPipeline,
                     group: &wgpu::BindGroup,
                     variant: usize| {
@@ -554,19 +567,26 @@ impl TranslucentTechnique for Mboit {
         let colors = [gpu::clear(&t.accumulation.view, wgpu::Color::TRANSPARENT)];
         Pass::new("mboit_resolve", GpuPass::Translucent, &colors)
             .depth(depth)
+            .reads(&[&t.b0.view, &t.moments.view])
             .record(encoder, frame.timer, |pass| {
                 draw(pass, &self.resolve, &t.resolve_group, 1);
             });
+        let rect = self.report.and_then(|r| r.composite_rect);
+        if rect.is_some_and(|[_, _, w, h]| w == 0 || h == 0) {
+            // Nothing translucent on screen: every pixel would be discarded.
+            return Ok(());
+        }
         let colors = [gpu::load(&frame.target.view)];
-        Pass::new("mboit_composite", GpuPass::Composite, &colors).record(
-            encoder,
-            frame.timer,
-            |pass| {
+        Pass::new("mboit_composite", GpuPass::Composite, &colors)
+            .reads(&[&t.accumulation.view, &t.b0.view])
+            .record(encoder, frame.timer, |pass| {
                 pass.set_pipeline(&self.composite);
                 pass.set_bind_group(0, &t.composite_group, &[]);
-                pass.draw(0..3, 0..1);
-            },
-        );
+                if let Some([x, y, w, h]) = rect {
+                    pass.set_scissor_rect(x, y, w, h);
+                }
+                pass.draw_full_screen();
+            });
         Ok(())
     }
 

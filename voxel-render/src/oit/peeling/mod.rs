@@ -465,7 +465,7 @@ impl Peeling {
         Pass::new("peel_blend", GpuPass::Composite, &colors).record(encoder, frame.timer, |pass| {
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, group, &[]);
-            pass.draw(0..3, 0..1);
+            pass.draw_full_screen();
         });
     }
 
@@ -632,7 +632,7 @@ impl Peeling {
                     pass.set_pipeline(&self.last_volume);
                     pass.set_bind_group(0, &self.targets.last_group, &[]);
                     pass.set_bind_group(1, frame.scene, &[]);
-                    pass.draw(0..3, 0..1);
+                    pass.draw_full_screen();
                 },
             );
         }

@@ -469,7 +469,7 @@ impl Reference {
                     pass.set_pipeline(&self.resolve);
                     pass.set_bind_group(0, &b.resolve_group, &dynamic);
                     pass.set_bind_group(1, frame.scene, &[]);
-                    pass.draw(0..3, 0..1);
+                    pass.draw_full_screen();
                 },
             );
             encoder.copy_buffer_to_buffer(

@@ -37,7 +37,7 @@ use voxel_mesh::order::{QuadOrder, RegionKey};
 
 use crate::chunks::{ChunkStore, PosMap};
 use crate::context::Capabilities;
-use crate::gpu::{self, ChunkPipeline, Depth, DepthMode, Pass, SidedPipeline};
+use crate::gpu::{self, ChunkPipeline, CountedPass, Depth, DepthMode, Pass, SidedPipeline};
 use crate::oit::{
     FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
     TranslucentTechnique,
@@ -69,6 +69,9 @@ struct ChunkOrder {
     order: QuadOrder,
     /// The region the GPU order is exact for (`None`: sort again on the next frame).
     sorted_for: Option<RegionKey>,
+    /// The chunk's order stamp when this order was written
+    /// (`GpuChunk::order_stamp`): another one means the GPU draws another order now.
+    stamp: u64,
     /// Cycles of the last sort.
     cycles: (u32, u32),
 }
@@ -193,7 +196,7 @@ impl Sorted {
         let Some(chunk) = chunks.get(pos) else {
             return (false, false);
         };
-        let generation = chunk.generation();
+        let (generation, stamp) = (chunk.generation(), chunk.order_stamp());
         let built = self
             .orders
             .get(&pos)
@@ -206,6 +209,7 @@ impl Sorted {
                     generation,
                     order,
                     sorted_for: None,
+                    stamp: 0,
                     cycles: (0, 0),
                 },
             );
@@ -217,7 +221,7 @@ impl Sorted {
         let o = pos.origin();
         let local = [0, 1, 2].map(|k| eye[k] - o[k] as f64);
         let key = entry.order.region_key(local);
-        if entry.sorted_for == Some(key) {
+        if entry.sorted_for == Some(key) && entry.stamp == stamp {
             return (built, false);
         }
         let stats = entry.order.sort_into(local, &mut self.scratch);
@@ -226,6 +230,7 @@ impl Sorted {
         entry.sorted_for = stats.is_exact_in_region().then_some(key);
         entry.cycles = (stats.cycles, stats.quads_in_cycles);
         chunks.reorder_translucent(ctx, pos, std::mem::take(&mut self.scratch));
+        entry.stamp = chunks.get(pos).map_or(0, |c| c.order_stamp());
         (built, true)
     }
 }
@@ -257,6 +262,7 @@ impl Sorted {
         }
         // A buffer of the frame's own: a frame recorded before the last one is submitted
         // keeps its clips.
+        crate::cost::created_buffer();
         let buffer = ctx
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -303,6 +309,7 @@ impl TranslucentTechnique for Sorted {
                     generation,
                     order: QuadOrder::new(quads),
                     sorted_for: None,
+                    stamp: 0,
                     cycles: (0, 0),
                 },
             );
@@ -319,6 +326,8 @@ impl TranslucentTechnique for Sorted {
         view: &FrameView<'_>,
     ) -> Result<()> {
         if !self.sort_quads {
+            // The mesher's order, whatever a technique drew before.
+            chunks.restore_mesher_order();
             return Ok(());
         }
         let start = Instant::now();
@@ -364,11 +373,18 @@ impl TranslucentTechnique for Sorted {
                 // quads), each run with its clip, then the rest.
                 pass.set_bind_group(0, frame.scene, &[]);
                 let draws = frame.draws;
-                let objects = |pass: &mut wgpu::RenderPass<'_>, range, clip: u32| {
+                let objects = |pass: &mut CountedPass<'_, '_>, range, clip: u32| {
                     let offset = (u64::from(clip) * stride) as u32;
                     game.draw_offsets(pass, 0, group, &[offset], range);
-                    pass.set_pipeline(pipeline);
-                    pass.set_bind_group(0, frame.scene, &[]);
+                };
+                // The game's draws change the pipeline and group 0: set again before the
+                // next chunk quads, not between two runs of objects.
+                let lost = std::cell::Cell::new(false);
+                let chunk_state = |pass: &mut CountedPass<'_, '_>| {
+                    if lost.replace(false) {
+                        pass.set_pipeline(pipeline);
+                        pass.set_bind_group(0, frame.scene, &[]);
+                    }
                 };
                 // Chunks before `chunk` are drawn, and quads `..quad` of it.
                 let (mut next, mut chunk, mut quad) = (0, 0usize, 0u32);
@@ -376,22 +392,29 @@ impl TranslucentTechnique for Sorted {
                     let c = split.chunk as usize;
                     if c > chunk {
                         if quad > 0 {
+                            chunk_state(pass);
                             draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
                             chunk += 1;
                         }
-                        draws.draw_range(frame.chunks, chunk..c, pass);
+                        if chunk < c {
+                            chunk_state(pass);
+                            draws.draw_range(frame.chunks, chunk..c, pass);
+                        }
                         (chunk, quad) = (c, 0);
                     }
                     if split.quad > quad {
+                        chunk_state(pass);
                         draws.draw_quads(frame.chunks, c, quad..split.quad, pass);
                         quad = split.quad;
                     }
                     let end = split.end as usize;
                     if end > next {
                         objects(pass, next..end, split.clip);
+                        lost.set(true);
                         next = end;
                     }
                 }
+                chunk_state(pass);
                 if quad > 0 {
                     draws.draw_quads(frame.chunks, chunk, quad..u32::MAX, pass);
                     chunk += 1;

@@ -232,6 +232,7 @@ impl TranslucentTechnique for Stipple {
         let colors = [gpu::load(&frame.target.view)];
         Pass::new("stipple", GpuPass::Translucent, &colors)
             .depth(depth)
+            .opaque()
             .record(encoder, frame.timer, |pass| {
                 pass.set_pipeline(self.pipeline.get(frame.two_sided));
                 pass.set_bind_group(2, &self.group, &[]);

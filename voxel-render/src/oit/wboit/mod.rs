@@ -45,8 +45,8 @@ use crate::gpu::{self, Depth, Pass, SidedPipeline, Target};
 use crate::ladder::Need;
 use crate::oit::sums;
 use crate::oit::{
-    FrameView, OitConfig, Setup, Technique, TechniqueKind, TechniqueReport, TranslucentFrame,
-    TranslucentTechnique,
+    FrameView, OitConfig, ScreenCover, Setup, Technique, TechniqueKind, TechniqueReport,
+    TranslucentFrame, TranslucentTechnique,
 };
 use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
@@ -82,8 +82,9 @@ pub struct WboitSettings {
     /// maximum weight (without it, 22 such layers reach 65504).
     pub headroom: bool,
     /// With the fitted weight, composite only within the screen rectangle of the
-    /// translucent planes facing the eye (the fit projects them anyway), and not at all
-    /// when it is empty; the whole screen when a game draws translucent geometry (whose
+    /// translucent planes facing the eye (the fit projects them anyway) and the box around
+    /// the game's declared translucent objects, and not at all when it is empty; the
+    /// whole screen when a game draws translucent geometry it does not declare (whose
     /// extent the renderer does not know) or the eye is inside a medium (back faces are
     /// drawn). Outside it the composite would discard every pixel (revealage 1), so the
     /// picture is the same.
@@ -466,25 +467,6 @@ impl Wboit {
     }
 }
 
-/// The pixels `[x, y, width, height]` of a `size` target around the screen rectangle
-/// `min`–`max` (0 to 1, y down), grown by a pixel (the rasteriser's vertex snapping, and
-/// a projection on the CPU in f32 against the shader's); zero size when it is empty or
-/// off screen.
-fn pixel_rect(min: glam::Vec2, max: glam::Vec2, (width, height): (u32, u32)) -> [u32; 4] {
-    let size = glam::Vec2::new(width as f32, height as f32);
-    let lo = (min * size - 1.0).floor().clamp(glam::Vec2::ZERO, size);
-    let hi = (max * size + 1.0).ceil().clamp(glam::Vec2::ZERO, size);
-    if !(lo.x < hi.x && lo.y < hi.y) {
-        return [0; 4];
-    }
-    [
-        lo.x as u32,
-        lo.y as u32,
-        (hi.x - lo.x) as u32,
-        (hi.y - lo.y) as u32,
-    ]
-}
-
 impl TranslucentTechnique for Wboit {
     fn resize(&mut self, ctx: &GpuContext, width: u32, height: u32) -> Result<()> {
         self.targets = Self::targets(
@@ -539,11 +521,18 @@ impl TranslucentTechnique for Wboit {
         let size = (size.width, size.height);
         // The fit projected every plane drawn (front faces, with the eye in air) already;
         // other weights, and frames in a medium, composite the whole screen (projecting
-        // every chunk's box again cost more CPU time than the composite it saved).
+        // every chunk's box again cost more CPU time than the composite it saved). A
+        // game's objects add the box around them (the whole screen where it draws
+        // translucent geometry it does not declare).
         self.composite_rect = fit
             .as_ref()
             .filter(|_| settings.composite_scissor && view.camera.medium.is_none())
-            .map(|fit| pixel_rect(fit.covered[0], fit.covered[1], size));
+            .and_then(|fit| {
+                let mut cover = ScreenCover::none();
+                cover.add_rect(fit.covered);
+                cover.add_objects(view.game_objects, view.view_proj, view.camera.eye);
+                cover.pixels(size)
+            });
         self.report = Some(WboitReport {
             weight: settings.weight,
             accumulation: self.accum_format,
@@ -570,7 +559,9 @@ impl TranslucentTechnique for Wboit {
             )
         });
         // Chunks, then the game's geometry in its pipeline for this pass.
-        let draw = |pass: &mut wgpu::RenderPass<'_>, pipeline: &SidedPipeline, variant: usize| {
+        let draw = |pass: &mut crate::gpu::CountedPass<'_, '_>,
+                    pipeline: &SidedPipeline,
+                    variant: usize| {
             pass.set_pipeline(pipeline.get(frame.two_sided));
             pass.set_bind_group(2, &self.params_group, &[]);
             frame.draw_chunks(pass);
@@ -615,12 +606,7 @@ impl TranslucentTechnique for Wboit {
                 }
             }
         }
-        // A game's translucent geometry may lie anywhere: then the whole screen.
-        let rect = if frame.game.is_some() {
-            None
-        } else {
-            self.composite_rect
-        };
+        let rect = self.composite_rect;
         if let Some(report) = &mut self.report {
             report.composite_rect = rect;
         }
@@ -629,18 +615,16 @@ impl TranslucentTechnique for Wboit {
             return Ok(());
         }
         let colors = [gpu::load(&frame.target.view)];
-        Pass::new("wboit_composite", GpuPass::Composite, &colors).record(
-            encoder,
-            frame.timer,
-            |pass| {
+        Pass::new("wboit_composite", GpuPass::Composite, &colors)
+            .reads(&[accum, reveal])
+            .record(encoder, frame.timer, |pass| {
                 pass.set_pipeline(&self.composite);
                 pass.set_bind_group(0, &t.composite_group, &[]);
                 if let Some([x, y, w, h]) = rect {
                     pass.set_scissor_rect(x, y, w, h);
                 }
-                pass.draw(0..3, 0..1);
-            },
-        );
+                pass.draw_full_screen();
+            });
         Ok(())
     }
 

@@ -573,13 +573,20 @@ struct Part {
 pub(crate) struct Interleaver {
     /// The parts drawn: each object, or its pieces where it was split.
     parts: Vec<Part>,
-    /// Each part's place (chunk, quad).
+    /// Each part's place (chunk, quad): first the earliest place the fewest constraints
+    /// rule out, then the one chosen within its range (`Interleaver::gather`).
     places: Vec<(u32, u32)>,
+    /// Each part's latest place as good as its earliest (the same constraints ruled out).
+    latest: Vec<(u32, u32)>,
+    /// Room for gathering: each part's latest place as a sort key, and the part.
+    by_latest: Vec<(u64, u32)>,
     /// Each part's distance as a key that orders farthest first, and the part.
     farthest: Vec<(u32, u32)>,
     /// Room for the radix sort.
     spare: Vec<(u32, u32)>,
-    items: Vec<(u32, u32, i64)>,
+    /// The constraints of the object being placed: (chunk, quad after which it applies,
+    /// weight, the first quad of its run).
+    items: Vec<(u32, u32, i64, u32)>,
     weights: Vec<i64>,
     /// The planes an object crosses in the chunks no sound test decides: (axis, at).
     crossings: Vec<(usize, f64, bool)>,
@@ -600,6 +607,8 @@ pub(crate) struct Interleaver {
     order: Vec<u32>,
     drawn: Vec<u32>,
     splits: Vec<Split>,
+    /// Room for [`group_clips`].
+    grouped: Vec<u32>,
 }
 
 /// What [`Interleaver::place`] reads of a frame.
@@ -716,6 +725,7 @@ impl Interleaver {
         self.boxes.clear();
         self.parts.clear();
         self.places.clear();
+        self.latest.clear();
         self.farthest.clear();
         self.clips.clear();
         self.clips.push(Vec::new());
@@ -744,11 +754,12 @@ impl Interleaver {
             self.crossings.clear();
             let at = self.place(&frame, b, split_quads);
             if self.crossings.is_empty() {
-                self.push(whole, at, self.key(b.center, eye));
+                self.push_range(whole, at, self.key(b.center, eye));
                 continue;
             }
             self.split(&frame, whole, &[], 0);
         }
+        self.gather();
         let Self {
             parts,
             places,
@@ -757,9 +768,11 @@ impl Interleaver {
             order,
             drawn,
             splits,
+            grouped,
             ..
         } = self;
         order_by_place(places, farthest, spare, last, drawn);
+        group_clips(parts, places, eye, drawn, grouped);
         order.clear();
         order.extend(drawn.iter().map(|&p| parts[p as usize].object));
         splits.clear();
@@ -782,9 +795,47 @@ impl Interleaver {
 
     /// Adds a part at place `at`, with distance key `key` (`farthest_key`).
     fn push(&mut self, part: Part, at: (u32, u32), key: u32) {
+        self.push_range(part, (at, at), key);
+    }
+
+    /// Adds a part that may go anywhere from place `range.0` to `range.1` (the same
+    /// constraints ruled out at each), with distance key `key`.
+    fn push_range(&mut self, part: Part, range: ((u32, u32), (u32, u32)), key: u32) {
         self.farthest.push((key, self.parts.len() as u32));
-        self.places.push(at);
+        self.places.push(range.0);
+        self.latest.push(range.1);
         self.parts.push(part);
+    }
+
+    /// Chooses each part's place within its range so that the parts share as few places
+    /// as they can: each place is a run of the game's draws among the chunks' quads, with
+    /// a pipeline switch to the game's and back around it. The greedy choice is optimal
+    /// (stabbing intervals): by latest place, each part goes where the last run stands if
+    /// that lies in its range, else starts a new run at its latest place.
+    fn gather(&mut self) {
+        if self.places == self.latest {
+            return;
+        }
+        let key = |(c, k): (u32, u32)| u64::from(c) << 32 | u64::from(k);
+        self.by_latest.clear();
+        self.by_latest.extend(
+            self.latest
+                .iter()
+                .enumerate()
+                .map(|(i, &l)| (key(l), i as u32)),
+        );
+        self.by_latest.sort_unstable();
+        let mut run: Option<(u32, u32)> = None;
+        for &(_, i) in &self.by_latest {
+            let i = i as usize;
+            let earliest = self.places[i];
+            let at = match run {
+                Some(r) if key(r) >= key(earliest) => r,
+                _ => self.latest[i],
+            };
+            run = Some(at);
+            self.places[i] = at;
+        }
     }
 
     /// Cuts `whole` at the planes it crosses (`self.crossings`, the nearest
@@ -876,7 +927,7 @@ impl Interleaver {
             // where its own cuts left none): cut it once more.
             let again = depth + 1 < MAX_SPLIT_DEPTH && clip.len() + 2 <= 6;
             self.crossings.clear();
-            let at = self.place(frame, ball, again);
+            let range = self.place(frame, ball, again);
             let part = Part {
                 object: whole.object,
                 ball,
@@ -888,7 +939,7 @@ impl Interleaver {
             }
             let clip = self.clip_id(clip);
             let key = self.key(center, eye);
-            self.push(Part { clip, ..part }, at, key);
+            self.push_range(Part { clip, ..part }, range, key);
         }
         self.crossings = crossings;
     }
@@ -902,10 +953,11 @@ impl Interleaver {
         (self.clips.len() - 1) as u32
     }
 
-    /// The place of ball `b` in the sequence (see [`Interleaver::order`]); with `collect`,
-    /// the planes it reaches through in the chunks no sound test decides go to
-    /// `self.crossings`.
-    fn place(&mut self, f: &Frame<'_, '_>, b: Ball, collect: bool) -> (u32, u32) {
+    /// The places of ball `b` in the sequence (see [`Interleaver::order`]) that the fewest
+    /// constraints rule out: the earliest and the latest of the first range of them (the
+    /// same constraints ruled out at every place between); with `collect`, the planes it
+    /// reaches through in the chunks no sound test decides go to `self.crossings`.
+    fn place(&mut self, f: &Frame<'_, '_>, b: Ball, collect: bool) -> ((u32, u32), (u32, u32)) {
         let Self {
             items,
             weights,
@@ -940,7 +992,7 @@ impl Interleaver {
             while at < last && chunks.surfaces[at as usize].is_none() {
                 at += 1;
             }
-            return (at, 0);
+            return ((at, 0), (at, 0));
         }
         let o = b.center.distance(eye);
         // The constraints in draw order: (chunk, quad after which it applies, weight:
@@ -962,8 +1014,8 @@ impl Interleaver {
             match safe(b, o, eye, s, planes, d, range.len() > 1) {
                 // Apart on screen: any place is right.
                 [true, true] => {}
-                [true, false] => items.push((c32, 0, SOUND)),
-                [false, true] => items.push((c32, 0, -SOUND)),
+                [true, false] => items.push((c32, 0, SOUND, 0)),
+                [false, true] => items.push((c32, 0, -SOUND, 0)),
                 [false, false] if f.split_quads => {
                     let (from, to, first_box) = *fc.runs.get_or_insert_with(|| {
                         let (from, first_box) = (runs.len() as u32, boxes.len() as u32);
@@ -992,26 +1044,39 @@ impl Interleaver {
                         if w != 0 {
                             // A run weighs its count; the place after it is after its
                             // last quad.
-                            items.push((c32, k + n - 1, w * i64::from(n)));
+                            items.push((c32, k + n - 1, w * i64::from(n), k));
                         }
                         k += n;
                     }
                 }
-                [false, false] => items.push((c32, 0, if o > d[1] { -1 } else { 1 })),
+                [false, false] => items.push((c32, 0, if o > d[1] { -1 } else { 1 }, 0)),
             }
         }
         // Before everything in range, every item that must come before the object is
         // violated; passing an item changes the cost by its weight.
         let mut cost: i64 = items.iter().map(|it| it.2.max(0)).sum();
         let (mut min, mut at) = (cost, (range.start as u32, 0));
-        for &(c, k, w) in items.iter() {
+        let mut after = 0;
+        for (i, &(c, k, w, _)) in items.iter().enumerate() {
             cost -= w;
             if cost < min {
                 // Just after the item: after the whole chunk where it stood for it.
                 let whole = w.abs() == SOUND || !f.split_quads;
                 (min, at) = (cost, if whole { (c + 1, 0) } else { (c, k + 1) });
+                after = i + 1;
             }
         }
+        // The places from there on rule out as few until the first item that must come
+        // after the object (none that must come before can follow: the cost would fall
+        // below its least): just before that item, before its whole chunk where it
+        // stood for it; past the chunks in range where none follows.
+        let latest = match items[after..].iter().find(|it| it.2 < 0) {
+            Some(&(c, _, w, first)) => {
+                let whole = w.abs() == SOUND || !f.split_quads;
+                if whole { (c, 0) } else { (c, first) }
+            }
+            None => (range.end as u32, 0),
+        };
         if collect && min > 0 && !single {
             // No one place meets every chunk the object spans (a slab through a pane that
             // two chunks hold, each with its own layers): the parts in each cell meet their
@@ -1022,18 +1087,92 @@ impl Interleaver {
                 }
             }
         }
-        let (c, k) = at;
-        // After quads `..k` of chunk `c`; past the end of a chunk is before the next one.
-        let mut at = match chunks.surfaces.get(c as usize).and_then(Option::as_ref) {
-            Some(s) if k as usize >= s.quads.len() && k > 0 => (c + 1, 0),
-            _ => (c, k),
+        let place = |(c, k): (u32, u32)| {
+            // After quads `..k` of chunk `c`; past the end of a chunk is before the next
+            // one.
+            let mut at = match chunks.surfaces.get(c as usize).and_then(Option::as_ref) {
+                Some(s) if k as usize >= s.quads.len() && k > 0 => (c + 1, 0),
+                _ => (c, k),
+            };
+            // Chunks with nothing translucent draw nothing: the next one that does.
+            while at.0 < last && chunks.surfaces[at.0 as usize].is_none() {
+                at = (at.0 + 1, 0);
+            }
+            at
         };
-        // Chunks with nothing translucent draw nothing: the next one that does.
-        while at.0 < last && chunks.surfaces[at.0 as usize].is_none() {
-            at = (at.0 + 1, 0);
-        }
-        at
+        let at = place(at);
+        (at, place(latest).max(at))
     }
+}
+
+/// How many parts a part may move back over, at most, to join an earlier run of its clip
+/// ([`group_clips`]): the tests stay linear in the parts.
+const GROUP_WINDOW: usize = 64;
+
+/// Whether balls `a` and `b` may overlap as seen from `eye`: the cones from the eye around
+/// them meet (or the eye is inside one).
+fn may_overlap(a: Ball, b: Ball, eye: DVec3) -> bool {
+    let (u, v) = (a.center - eye, b.center - eye);
+    let (du, dv) = (u.length(), v.length());
+    if du <= a.radius || dv <= b.radius || !(du * dv).is_normal() {
+        return true;
+    }
+    let (sa, sb) = (a.radius / du, b.radius / dv);
+    let (ca, cb) = ((1.0 - sa * sa).sqrt(), (1.0 - sb * sb).sqrt());
+    // Two half angles past a right angle together always meet.
+    if ca * cb - sa * sb <= -1.0 {
+        return true;
+    }
+    u.dot(v) / (du * dv) >= ca * cb - sa * sb
+}
+
+/// Groups the parts at each place by clip where the picture stays the same: a part joins
+/// the last run of its clip at its place (moving back over the parts drawn since) when it
+/// overlaps none of them on screen, so that blending them in the other order changes no
+/// pixel. Each run of one clip is one draw of the game's with its own clip (and a switch of
+/// pipeline around it): parts of objects cut at a surface or a chunk border would
+/// otherwise alternate with whole objects in the farthest-first order.
+fn group_clips(
+    parts: &[Part],
+    places: &[(u32, u32)],
+    eye: DVec3,
+    drawn: &mut Vec<u32>,
+    grouped: &mut Vec<u32>,
+) {
+    if parts.iter().all(|p| p.clip == 0) {
+        return;
+    }
+    grouped.clear();
+    let mut from = 0;
+    while from < drawn.len() {
+        let place = places[drawn[from] as usize];
+        let to = from + drawn[from..].partition_point(|&i| places[i as usize] == place);
+        let start = grouped.len();
+        for &p in &drawn[from..to] {
+            let part = &parts[p as usize];
+            // The end of the last run of its clip in this place, if the part may join it.
+            let mut at = None;
+            for (back, &q) in grouped[start..].iter().enumerate().rev() {
+                if grouped.len() - start - back > GROUP_WINDOW {
+                    break;
+                }
+                let other = &parts[q as usize];
+                if other.clip == part.clip {
+                    at = Some(start + back + 1);
+                    break;
+                }
+                if may_overlap(part.ball, other.ball, eye) {
+                    break;
+                }
+            }
+            match at {
+                Some(i) if i < grouped.len() => grouped.insert(i, p),
+                _ => grouped.push(p),
+            }
+        }
+        from = to;
+    }
+    std::mem::swap(drawn, grouped);
 }
 
 /// A key that orders non-negative distances (or their squares) farthest first: the bits of

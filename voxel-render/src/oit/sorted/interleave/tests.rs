@@ -502,3 +502,60 @@ fn a_face_lying_in_a_surface_is_on_the_eyes_side_of_it() {
         assert_eq!(far, s.quad == 0 && s.chunk == 0, "{splits:?} {clips:?}");
     }
 }
+
+#[test]
+fn parts_share_the_fewest_places_their_ranges_allow() {
+    let mut o = Interleaver::default();
+    let part = |object| Part {
+        object,
+        ball: point(DVec3::ZERO),
+        clip: 0,
+    };
+    // Ranges (earliest, latest): [1,3], [2,5], [4,6], [6,6], [0,0].
+    let ranges = [
+        ((1, 0), (3, 0)),
+        ((2, 0), (5, 0)),
+        ((4, 0), (6, 0)),
+        ((6, 0), (6, 0)),
+        ((0, 0), (0, 0)),
+    ];
+    for (i, &r) in ranges.iter().enumerate() {
+        o.push_range(part(i as u32), r, 0);
+    }
+    o.gather();
+    for (p, (lo, hi)) in o.places.iter().zip(ranges) {
+        assert!(lo <= *p && *p <= hi, "{p:?} outside {lo:?}..{hi:?}");
+    }
+    let mut distinct = o.places.clone();
+    distinct.sort();
+    distinct.dedup();
+    // 0 alone; 1..3 and 2..5 share 3; 4..6 and 6 share 6: three places, the fewest.
+    assert_eq!(distinct, vec![(0, 0), (3, 0), (6, 0)]);
+}
+
+#[test]
+fn parts_of_one_clip_join_a_run_only_over_parts_they_cannot_overlap() {
+    let eye = DVec3::ZERO;
+    let ball = |x: f64| Ball::sphere(DVec3::new(x, 0.0, -10.0), 0.5);
+    // Farthest first at one place: clips 1, 0, 1, 0 and a last clip-1 part that lies on
+    // the screen where the clip-0 part before it does.
+    let parts: Vec<Part> = [(-6.0, 1), (-3.0, 0), (0.0, 1), (3.0, 0), (3.2, 1)]
+        .into_iter()
+        .enumerate()
+        .map(|(i, (x, clip))| Part {
+            object: i as u32,
+            ball: ball(x),
+            clip,
+        })
+        .collect();
+    let places = vec![(0, 0); parts.len()];
+    let (mut drawn, mut room) = ((0..parts.len() as u32).collect::<Vec<_>>(), Vec::new());
+    group_clips(&parts, &places, eye, &mut drawn, &mut room);
+    // Part 2 moves back over part 1 (apart on screen) to join part 0; part 4 stays after
+    // part 3, which it overlaps: three runs (clips 1, 0, 1) instead of five.
+    assert_eq!(drawn, vec![0, 2, 1, 3, 4]);
+    assert!(may_overlap(ball(3.0), ball(3.2), eye));
+    assert!(!may_overlap(ball(-3.0), ball(0.0), eye));
+    // The eye inside a ball: it covers everything.
+    assert!(may_overlap(Ball::sphere(DVec3::ZERO, 1.0), ball(-6.0), eye));
+}
