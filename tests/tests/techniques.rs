@@ -373,3 +373,40 @@ fn centre_sorted(ctx: &voxel_render::GpuContext, s: &Scene) -> voxel_render::Ima
     }
     frame(ctx, &mut r, &s.cameras[0])
 }
+
+#[test]
+fn a_switch_between_the_sorted_techniques_draws_each_ones_order_and_sorts_nothing_again() {
+    let Some(ctx) = gpu() else { return };
+    let scene = sheets_scene();
+    let mut r = renderer_for(&ctx, &scene, config(Technique::SortedQuads)).unwrap();
+    // Both prepared at loading time, as a game whose menu offers them does (a technique
+    // not prepared is dropped at a switch away, and its orders with it).
+    for t in [Technique::Sorted, Technique::SortedQuads] {
+        r.prebuild_technique(t).unwrap();
+    }
+    let target = Offscreen::new(&ctx, W, H);
+    let camera = scene.cameras[0];
+    let mut frame = |r: &mut voxel_lab::headless::SceneRenderer| {
+        let stats = r.render_and_submit(&target.view, &camera).unwrap();
+        (target.read(&ctx).unwrap(), stats.technique.sort)
+    };
+    let (quads, report) = frame(&mut r);
+    assert!(report.unwrap().chunks_resorted > 0, "the first frame sorts");
+    // `sorted` draws the mesher's order, as a renderer that never sorted does.
+    r.set_technique(Technique::Sorted).unwrap();
+    let (chunks_only, _) = frame(&mut r);
+    let fresh = render_with(&ctx, &scene, config(Technique::Sorted));
+    assert_close("switch_sorted", &chunks_only, &fresh, 0);
+    assert!(
+        diff(&chunks_only, &quads).max > 8,
+        "the two orders differ here"
+    );
+    // Back to `sorted-quads`: its orders are drawn again without sorting (the eye stayed).
+    r.set_technique(Technique::SortedQuads).unwrap();
+    let (again, report) = frame(&mut r);
+    assert_eq!(report.unwrap().chunks_resorted, 0, "{report:?}");
+    assert_close("switch_sorted_quads", &again, &quads, 0);
+    // And once more to `sorted`: the mesher's order again.
+    r.set_technique(Technique::Sorted).unwrap();
+    assert_close("switch_sorted_again", &frame(&mut r).0, &fresh, 0);
+}

@@ -7,7 +7,7 @@
 //!
 //! Off unless a frame is armed (`low_level::count_next_frame`); then the passes of that
 //! frame are counted on the recording thread (a renderer records on the thread that calls
-//! it, as [`crate::gpu::pipelines_built`] counts), and the query results are read back
+//! it, as `gpu::pipelines_built` counts), and the query results are read back
 //! once the frame is submitted (`low_level::frame_cost`). A frame not armed pays one
 //! thread-local look-up per recorded command.
 
@@ -30,7 +30,7 @@ pub struct PassCost {
     pub pipelines: u32,
     /// Bind group and vertex buffer changes (setting what is already bound is not one).
     pub bind_groups: u32,
-    /// Calls into a game's own drawing ([`crate::stages::GameStages`]); what a game's code
+    /// Calls into a game's own drawing (`stages::GameStages`); what a game's code
     /// records is not counted, except the ready-made content's.
     pub game_calls: u32,
     /// Full-screen triangles drawn.

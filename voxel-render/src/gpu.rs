@@ -801,7 +801,7 @@ impl<'e> CountedPass<'_, 'e> {
         self.raw.multi_draw_indirect(buffer, offset, count);
     }
 
-    /// Hands the raw pass to a game's own drawing ([`crate::stages::GameStages`]): counted
+    /// Hands the raw pass to a game's own drawing (`stages::GameStages`): counted
     /// as one call into the game; what it sets is unknown afterwards.
     pub fn game<R>(&mut self, f: impl FnOnce(&mut wgpu::RenderPass<'e>) -> R) -> R {
         cost::game_call();

@@ -29,6 +29,9 @@ pub struct GpuChunk {
     /// The mesher's order of the translucent quads while the GPU draws them in another
     /// (`None`: the GPU holds the mesher's order).
     pub(super) mesher_order: Option<Vec<PackedQuad>>,
+    /// A technique's order put aside when the mesher's was restored, with the stamp it
+    /// had: the technique draws it again without sorting ([`super::ChunkStore::reapply_order`]).
+    pub(super) set_aside: Option<(Vec<PackedQuad>, u64)>,
     /// Changes whenever the GPU order of the translucent quads is written (an upload, a
     /// re-sort, the mesher's order restored): what a technique that wrote an order checks
     /// its order is still the one drawn.

@@ -359,6 +359,7 @@ impl ChunkStore {
             }),
             generation: self.next_generation,
             mesher_order: None,
+            set_aside: None,
             order_stamp: self.next_generation,
         });
         self.next_generation += 1;
@@ -461,6 +462,7 @@ impl ChunkStore {
             if c.mesher_order.is_none() {
                 c.mesher_order = Some(old);
             }
+            c.set_aside = None;
             self.reordered = true;
             c.order_stamp = self.next_generation;
             self.next_generation += 1;
@@ -484,12 +486,40 @@ impl ChunkStore {
             {
                 self.arena
                     .write(&mut Upload::Frame(&mut self.writes), a, &quads);
-                c.translucent = quads;
+                let sorted = std::mem::replace(&mut c.translucent, quads);
+                c.set_aside = Some((sorted, c.order_stamp));
                 c.order_stamp = self.next_generation;
                 self.next_generation += 1;
             }
         }
         self.reordered = false;
+    }
+
+    /// Draws again the order a technique wrote with stamp `stamp` (in the frame being
+    /// recorded), where [`Self::restore_mesher_order`] put it aside since: an upload instead
+    /// of a sort, when a game switches back. The chunk's order stamp becomes `stamp` again
+    /// (the GPU holds that order). False when nothing with that stamp was put aside.
+    pub(crate) fn reapply_order(&mut self, pos: ChunkPos, stamp: u64) -> bool {
+        let Some(&slot) = self.by_pos.get(&pos) else {
+            return false;
+        };
+        let Some(c) = self.slots[slot as usize].as_mut() else {
+            return false;
+        };
+        let (Some(a), Some((quads, s))) =
+            (c.meshes[MeshKind::Translucent as usize], c.set_aside.take())
+        else {
+            return false;
+        };
+        if s != stamp || quads.len() != a.quads as usize {
+            return false;
+        }
+        self.arena
+            .write(&mut Upload::Frame(&mut self.writes), a, &quads);
+        c.mesher_order = Some(std::mem::replace(&mut c.translucent, quads));
+        c.order_stamp = stamp;
+        self.reordered = true;
+        true
     }
 
     /// Sets a chunk's whole-chunk opacity (fade-in): at the next submit, or `in_frame` in

@@ -221,7 +221,10 @@ impl Sorted {
         let o = pos.origin();
         let local = [0, 1, 2].map(|k| eye[k] - o[k] as f64);
         let key = entry.order.region_key(local);
-        if entry.sorted_for == Some(key) && entry.stamp == stamp {
+        if entry.sorted_for == Some(key)
+            && (entry.stamp == stamp || chunks.reapply_order(pos, entry.stamp))
+        {
+            // Still drawn, or drawn again from where `sorted` put it aside.
             return (built, false);
         }
         let stats = entry.order.sort_into(local, &mut self.scratch);
