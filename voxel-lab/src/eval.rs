@@ -363,30 +363,46 @@ pub const GPU_AGREEMENT: u8 = 2;
 /// `abuffer_flat` within 1/255 of the ray march's). Where the ray march agrees with the
 /// A-buffer it decides for it (peeling keeps one of two fragments at exactly equal depth);
 /// where it cannot (an edge or a seam passes within reach of the pixel's centre, where the
-/// rasteriser decides) nothing says which picture is right. Pictures of different sizes
-/// leave every pixel unsettled.
+/// rasteriser decides) nothing says which picture is right. A ray march smaller than the
+/// pictures (`--raymarch-width`) settles each pixel by the pixel of its own picture that
+/// covers it; pictures of other sizes (the two GPU ones apart, or the two of the ray march's
+/// check apart) leave every pixel unsettled.
 pub fn unsettled_pixels(
     abuffer: &Image,
     peeled: &Image,
     ray: &Image,
     abuffer_flat: &Image,
 ) -> usize {
-    let size = (abuffer.width, abuffer.height);
     let pixels = abuffer.rgba.len() / 4;
-    if [peeled, ray, abuffer_flat]
-        .iter()
-        .any(|i| (i.width, i.height) != size || i.rgba.len() != abuffer.rgba.len())
-    {
+    let same = |a: &Image, b: &Image| {
+        (a.width, a.height) == (b.width, b.height) && a.rgba.len() == b.rgba.len()
+    };
+    let (w, h) = (abuffer.width as usize, abuffer.height as usize);
+    if !same(abuffer, peeled) || !same(ray, abuffer_flat) || w * h != pixels || ray.width == 0 {
         return pixels;
     }
-    let differ = |a: &Image, b: &Image, i: usize| {
+    let (rw, rh) = (ray.width as usize, ray.height as usize);
+    if rw * rh != ray.rgba.len() / 4 {
+        return pixels;
+    }
+    let differ = |a: &Image, i: usize, b: &Image, j: usize| {
         (0..3)
-            .map(|c| a.rgba[i * 4 + c].abs_diff(b.rgba[i * 4 + c]))
+            .map(|c| a.rgba[i * 4 + c].abs_diff(b.rgba[j * 4 + c]))
             .max()
             .unwrap_or(0)
     };
+    // The ray march's pixel over pixel `i` of the pictures.
+    let covering = |i: usize| {
+        let (x, y) = (i % w, i / w);
+        (y * rh / h).min(rh - 1) * rw + (x * rw / w).min(rw - 1)
+    };
     (0..pixels)
-        .filter(|&i| differ(abuffer, peeled, i) > GPU_AGREEMENT && differ(ray, abuffer_flat, i) > 1)
+        .filter(|&i| {
+            differ(abuffer, i, peeled, i) > GPU_AGREEMENT && {
+                let j = covering(i);
+                differ(ray, j, abuffer_flat, j) > 1
+            }
+        })
         .count()
 }
 
@@ -745,8 +761,21 @@ mod tests {
             unsettled_pixels(&abuffer, &peeled, &abuffer_flat, &abuffer_flat),
             0
         );
-        // Pictures of another size settle nothing.
+        // GPU pictures of two sizes settle nothing.
         let small = image(&[[100, 100, 100]]);
         assert_eq!(unsettled_pixels(&abuffer, &small, &ray, &abuffer_flat), 4);
+        // A ray march of half the width: pixels 0 and 1 are settled by its pixel 0 (on the
+        // A-buffer's side), 2 and 3 by its pixel 1 (not): pixels 2 and 3 stay unsettled.
+        let ray_half = image(&[[30, 40, 50], [0, 0, 0]]);
+        let flat_half = image(&[[30, 40, 50], [9, 9, 9]]);
+        assert_eq!(
+            unsettled_pixels(&abuffer, &peeled, &ray_half, &flat_half),
+            2
+        );
+        let flat_agreeing = image(&[[30, 40, 50], [0, 0, 0]]);
+        assert_eq!(
+            unsettled_pixels(&abuffer, &peeled, &ray_half, &flat_agreeing),
+            0
+        );
     }
 }
