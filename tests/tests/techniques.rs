@@ -386,7 +386,7 @@ fn a_switch_between_the_sorted_techniques_draws_each_ones_order_and_sorts_nothin
     }
     let target = Offscreen::new(&ctx, W, H);
     let camera = scene.cameras[0];
-    let mut frame = |r: &mut voxel_lab::headless::SceneRenderer| {
+    let frame = |r: &mut voxel_lab::headless::SceneRenderer| {
         let stats = r.render_and_submit(&target.view, &camera).unwrap();
         (target.read(&ctx).unwrap(), stats.technique.sort)
     };
