@@ -102,8 +102,8 @@ const MAX_WARM_UP_ROUNDS: usize = 64;
 
 /// Measures every configuration of `configs` on one scene, as [`measure`] does each, with
 /// the real-time ones timed in turns: all of them built first; `warmup` rounds of one
-/// frame each (and more until [`WARM_UP`] has passed, so that the GPU's clocks have risen);
-/// then the timed frames in up to [`ROUNDS`] rounds, each run's block of them after one
+/// frame each (and more until `WARM_UP` has passed, so that the GPU's clocks have risen);
+/// then the timed frames in up to `ROUNDS` rounds, each run's block of them after one
 /// untimed frame that settles its switch (sorted-quads sorts again after `sorted` drew the
 /// mesher's order). Whatever the GPU's state does over the scene (clocks, memory freed
 /// before) then weighs on every technique alike. Each run's picture and counted frame

@@ -104,7 +104,7 @@ pub struct FrameCost {
     pub pixels: u64,
     /// Its render passes in the order recorded.
     pub passes: Vec<PassCost>,
-    /// Buffer copies of the frame's own writes ([`crate::submission::FrameWrites`]:
+    /// Buffer copies of the frame's own writes (`submission::FrameWrites`:
     /// uniforms, draw commands, re-sorted quads).
     pub uploads: u32,
     /// Their bytes.

@@ -607,7 +607,7 @@ pub struct Pass<'a> {
     /// Occlusion queries the pass writes to.
     pub occlusion: Option<&'a wgpu::QuerySet>,
     /// Whether its pipelines blend into the colour attachments (each written sample then
-    /// reads the texel too): what a counted frame's bytes assume ([`crate::cost`]).
+    /// reads the texel too): what a counted frame's bytes assume (`cost`).
     pub blends: bool,
     /// Textures each fragment reads once (a composite's sums, a copy's source), for a
     /// counted frame's bytes.
@@ -695,7 +695,7 @@ impl<'a> Pass<'a> {
     }
 
     /// Records the pass into `encoder` (timed by `timer` when given): `body` sets
-    /// pipelines and draws. In a counted frame ([`crate::cost`]) what `body` records is
+    /// pipelines and draws. In a counted frame (`cost`) what `body` records is
     /// counted, and the pass's fragments and samples are measured where the device can.
     pub fn record(
         &self,
@@ -751,7 +751,7 @@ impl<'a> Pass<'a> {
 }
 
 /// A render pass being recorded by [`Pass::record`]: the commands the renderer records
-/// go through it, so that a counted frame counts them ([`crate::cost`]); it derefs to the
+/// go through it, so that a counted frame counts them (`cost`); it derefs to the
 /// `wgpu::RenderPass` for everything else.
 #[derive(Debug)]
 pub struct CountedPass<'p, 'e> {
