@@ -152,6 +152,45 @@ pub fn read_texture(
     texture: &wgpu::Texture,
     bytes_per_texel: u32,
 ) -> Result<Vec<u8>> {
+    let copy = copy_texture(ctx, texture, bytes_per_texel)?;
+    let bytes = map_read(ctx, &copy.buffer)?;
+    Ok(copy.rows(&bytes))
+}
+
+/// A texture copied into a mappable buffer, the copy submitted: the first half of
+/// [`read_texture`], for a caller that maps [`TextureCopy::buffer`] itself (a web page
+/// awaits the map instead of blocking) and then takes [`TextureCopy::rows`].
+#[derive(Debug)]
+pub struct TextureCopy {
+    /// The buffer the texture was copied into (`MAP_READ`), rows padded to wgpu's
+    /// alignment.
+    pub buffer: wgpu::Buffer,
+    row: u32,
+    padded: u32,
+    height: u32,
+}
+
+impl TextureCopy {
+    /// The texels of the mapped buffer's bytes `mapped`, row padding removed:
+    /// `width * height * bytes_per_texel` bytes.
+    pub fn rows(&self, mapped: &[u8]) -> Vec<u8> {
+        let (row, padded) = (self.row as usize, self.padded as usize);
+        let mut out = Vec::with_capacity(row * self.height as usize);
+        for r in 0..self.height as usize {
+            let start = r * padded;
+            out.extend_from_slice(&mapped[start..start + row]);
+        }
+        out
+    }
+}
+
+/// Copies a whole single-sample 2D texture into a new mappable buffer and submits the copy;
+/// what [`read_texture`] checks and refuses, this does.
+pub fn copy_texture(
+    ctx: &GpuContext,
+    texture: &wgpu::Texture,
+    bytes_per_texel: u32,
+) -> Result<TextureCopy> {
     ctx.check_device()?;
     check_copyable(ctx, texture, bytes_per_texel)?;
     let (w, h) = (texture.width(), texture.height());
@@ -198,13 +237,12 @@ pub fn read_texture(
         (buffer, encoder.finish())
     })?;
     ctx.queue.submit([commands]);
-    let bytes = map_read(ctx, &buffer)?;
-    let mut out = Vec::with_capacity((row * h) as usize);
-    for r in 0..h as usize {
-        let start = r * padded as usize;
-        out.extend_from_slice(&bytes[start..start + row as usize]);
-    }
-    Ok(out)
+    Ok(TextureCopy {
+        buffer,
+        row,
+        padded,
+        height: h,
+    })
 }
 
 /// What [`read_texture`] needs of `texture`, checked before anything is recorded.

@@ -414,30 +414,9 @@ async fn draw_and_read(
 /// Reads an RGBA8 texture back without blocking (the page's thread must not): the map is
 /// awaited on the event loop, polling the device (WebGL2 maps at a poll).
 async fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>, String> {
-    let (w, h) = (texture.width(), texture.height());
-    let row = w * 4;
-    let padded =
-        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("test_readback"),
-        size: u64::from(padded) * u64::from(h),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(h),
-            },
-        },
-        texture.size(),
-    );
-    ctx.queue.submit([encoder.finish()]);
+    let copy = voxel_render::readback::copy_texture(ctx, texture, 4)
+        .map_err(|e| format!("copying the picture: {e}"))?;
+    let buffer = &copy.buffer;
     let mapped = Arc::new(Mutex::new(None));
     let done = Arc::clone(&mapped);
     buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
@@ -460,11 +439,7 @@ async fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>,
         .slice(..)
         .get_mapped_range()
         .map_err(|e| format!("reading the picture: {e}"))?;
-    let mut out = Vec::with_capacity((row * h) as usize);
-    for r in 0..h as usize {
-        let start = r * padded as usize;
-        out.extend_from_slice(&view[start..start + row as usize]);
-    }
+    let out = copy.rows(&view);
     drop(view);
     buffer.unmap();
     Ok(out)
