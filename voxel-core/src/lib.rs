@@ -23,7 +23,9 @@ pub use chunk::{
     column_index, row_index,
 };
 pub use error::{Error, Result};
-pub use terrain::{Site, SiteKind, TerrainBlocks, TerrainConfig, TerrainGenerator, TerrainRole};
+pub use terrain::{
+    Showcase, Site, SiteKind, TerrainBlocks, TerrainConfig, TerrainGenerator, TerrainRole,
+};
 pub use vox::{PaletteOverride, VoxError, VoxFile, VoxPlacement};
 pub use world::{
     ChunkPos, Face, MAX_RAY_DISTANCE, Neighbourhood, RayHit, World, WorldPos, touched_neighbours,

@@ -293,6 +293,20 @@ impl Site {
     }
 }
 
+/// The default scene ([`TerrainGenerator::showcase`]): its world and where it is seen from,
+/// world blocks.
+#[derive(Debug)]
+pub struct Showcase {
+    /// The terrain around the structure.
+    pub world: World,
+    /// The eye.
+    pub eye: [f64; 3],
+    /// The point looked at.
+    pub target: [f64; 3],
+    /// The unit horizontal direction from the structure to the sea.
+    pub water_dir: [f64; 3],
+}
+
 /// Side of the square regions that hold at most one structure each.
 const REGION: i64 = 96;
 /// Side of the square cells that hold at most one tree each.
@@ -572,6 +586,52 @@ impl TerrainGenerator {
             world.insert_chunk(p, c)?;
         }
         Ok(world)
+    }
+
+    /// The default scene's world and view, which the lab and the web page both draw: terrain
+    /// `radius` chunks each way (clamped to 1 to 16) and two chunks high around the
+    /// greenhouse nearest the origin (else the first structure near it) over the default
+    /// registry, and an eye on the land side, above the ground there, looking through the
+    /// structure at the sea. `None` where no structure lies within 768 blocks of the origin.
+    pub fn showcase(&self, radius: i32) -> crate::Result<Option<Showcase>> {
+        let radius = radius.clamp(1, 16);
+        let sites = self.sites_in(-768, -768, 768, 768);
+        let Some(site) = sites
+            .iter()
+            .filter(|s| s.kind == SiteKind::Greenhouse)
+            .min_by_key(|s| s.center[0].pow(2) + s.center[2].pow(2))
+            .or_else(|| sites.first())
+            .copied()
+        else {
+            return Ok(None);
+        };
+        let c = site.center;
+        let (cx, cz) = (c[0].div_euclid(32) as i32, c[2].div_euclid(32) as i32);
+        let world = self.generate_world(
+            Arc::new(BlockRegistry::default()),
+            ChunkPos::new(cx - radius, 0, cz - radius),
+            ChunkPos::new(cx + radius, 1, cz + radius),
+        )?;
+        // The unit horizontal direction of the water (as glam's `normalize`: times the
+        // reciprocal of the length).
+        let (wx, wz) = (f64::from(site.water_dir[0]), f64::from(site.water_dir[1]));
+        let inverse = 1.0 / (wx * wx + 0.0 * 0.0 + wz * wz).sqrt();
+        let dir = [wx * inverse, 0.0, wz * inverse];
+        let center = [c[0] as f64 + 0.5, c[1] as f64, c[2] as f64 + 0.5];
+        // Back from the structure on the land side, above the ground there.
+        let mut eye = [0, 1, 2].map(|a| center[a] - dir[a] * 18.0);
+        eye[1] += 11.0;
+        let ground = self.height_at(eye[0].floor() as i64, eye[2].floor() as i64) as f64;
+        eye[1] = eye[1].max(ground + 3.5);
+        let sea = f64::from(self.config.sea_level);
+        let mut target = [0, 1, 2].map(|a| center[a] + dir[a] * 12.0);
+        target[1] += sea - center[1] + 1.0;
+        Ok(Some(Showcase {
+            world,
+            eye,
+            target,
+            water_dir: dir,
+        }))
     }
 }
 
