@@ -453,12 +453,7 @@ impl ChunkStore {
         let Some(c) = self.slots[slot as usize].as_mut() else {
             return;
         };
-        if let Some(a) = c.meshes[MeshKind::Translucent as usize]
-            && quads.len() == a.quads as usize
-        {
-            self.arena
-                .write(&mut Upload::Frame(&mut self.writes), a, &quads);
-            let old = std::mem::replace(&mut c.translucent, quads);
+        if let Ok(old) = write_order(&self.arena, &mut self.writes, c, quads) {
             if c.mesher_order.is_none() {
                 c.mesher_order = Some(old);
             }
@@ -481,12 +476,7 @@ impl ChunkStore {
             let Some(quads) = c.mesher_order.take() else {
                 continue;
             };
-            if let Some(a) = c.meshes[MeshKind::Translucent as usize]
-                && quads.len() == a.quads as usize
-            {
-                self.arena
-                    .write(&mut Upload::Frame(&mut self.writes), a, &quads);
-                let sorted = std::mem::replace(&mut c.translucent, quads);
+            if let Ok(sorted) = write_order(&self.arena, &mut self.writes, c, quads) {
                 c.set_aside = Some((sorted, c.order_stamp));
                 c.order_stamp = self.next_generation;
                 self.next_generation += 1;
@@ -506,17 +496,16 @@ impl ChunkStore {
         let Some(c) = self.slots[slot as usize].as_mut() else {
             return false;
         };
-        let (Some(a), Some((quads, s))) =
-            (c.meshes[MeshKind::Translucent as usize], c.set_aside.take())
-        else {
+        let Some((quads, s)) = c.set_aside.take() else {
             return false;
         };
-        if s != stamp || quads.len() != a.quads as usize {
+        if s != stamp {
             return false;
         }
-        self.arena
-            .write(&mut Upload::Frame(&mut self.writes), a, &quads);
-        c.mesher_order = Some(std::mem::replace(&mut c.translucent, quads));
+        let Ok(mesher) = write_order(&self.arena, &mut self.writes, c, quads) else {
+            return false;
+        };
+        c.mesher_order = Some(mesher);
         c.order_stamp = stamp;
         self.reordered = true;
         true
@@ -651,5 +640,23 @@ impl ChunkStore {
         }
         self.remake_groups(&ctx.device);
         true
+    }
+}
+
+/// Writes `quads` (a permutation of `c`'s translucent quads) as `c`'s GPU order, in the
+/// frame being recorded (`writes`), and returns the order it replaces; gives `quads` back
+/// when the chunk's translucent mesh holds another number of quads.
+fn write_order(
+    arena: &QuadArena,
+    writes: &mut FrameWrites,
+    c: &mut GpuChunk,
+    quads: Vec<PackedQuad>,
+) -> std::result::Result<Vec<PackedQuad>, Vec<PackedQuad>> {
+    match c.meshes[MeshKind::Translucent as usize] {
+        Some(a) if quads.len() == a.quads as usize => {
+            arena.write(&mut Upload::Frame(writes), a, &quads);
+            Ok(std::mem::replace(&mut c.translucent, quads))
+        }
+        _ => Err(quads),
     }
 }
