@@ -327,17 +327,12 @@ impl MediumPass {
     ) {
         self.depth_copy
             .record(encoder, opaque_depth, opaque_copy, GpuPass::Medium, timer);
-        self.depth_copy
-            .record(encoder, opaque_depth, entry_depth, GpuPass::Medium, timer);
-        let colors = [gpu::clear(&entry_look.view, wgpu::Color::TRANSPARENT)];
-        let faces = (scene, draws, chunks);
-        nearest_faces(
+        self.entry_faces(
             encoder,
-            "volume_entry",
-            &self.volume_entry,
-            entry_depth,
-            &colors,
-            faces,
+            ("volume_entry", &self.volume_entry),
+            opaque_depth,
+            (entry_depth, entry_look),
+            (scene, draws, chunks),
             timer,
         );
     }
@@ -357,19 +352,31 @@ impl MediumPass {
         chunks: &DrawList,
         timer: Option<&Timer>,
     ) {
+        self.entry_faces(
+            encoder,
+            ("volume_entry2", &self.volume_entry2),
+            opaque_depth,
+            (entry_depth, entry_look),
+            (scene, draws, chunks),
+            timer,
+        );
+    }
+
+    /// The body of the two entry passes: `entry_depth` starts as the opaque depth, and
+    /// `pipeline` writes the nearest front face it keeps and its medium's look.
+    fn entry_faces(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        (label, pipeline): (&str, &wgpu::RenderPipeline),
+        opaque_depth: &Target,
+        (entry_depth, entry_look): (&Target, &Target),
+        faces: (&wgpu::BindGroup, &FrameDraws<'_>, &DrawList),
+        timer: Option<&Timer>,
+    ) {
         self.depth_copy
             .record(encoder, opaque_depth, entry_depth, GpuPass::Medium, timer);
         let colors = [gpu::clear(&entry_look.view, wgpu::Color::TRANSPARENT)];
-        let faces = (scene, draws, chunks);
-        nearest_faces(
-            encoder,
-            "volume_entry2",
-            &self.volume_entry2,
-            entry_depth,
-            &colors,
-            faces,
-            timer,
-        );
+        nearest_faces(encoder, label, pipeline, entry_depth, &colors, faces, timer);
     }
 
     /// Writes into `far` the farthest back face of a volume in front of the opaque surface
