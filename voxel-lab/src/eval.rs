@@ -286,52 +286,41 @@ pub fn reference(
             ))
         }
     };
-    let Some(size) = size else {
+    let (raymarch, unsettled, ray) = match size {
         // No ray march: the two GPU methods, which share the mesh and the rasteriser,
-        // vouch for each other alone.
-        let agrees = agreement <= u32::from(GPU_AGREEMENT);
-        // Nothing sides with either picture: every pixel they differ at past the
-        // agreement is unsettled (the peeled picture stands in for the ray march).
-        let unsettled = unsettled_pixels(&abuffer.image, &peel.image, &peel.image, &abuffer.image);
-        return Ok((
-            Reference {
-                image: abuffer.image,
-                check: ReferenceCheck {
-                    scene: name.to_owned(),
-                    max_abs_err: agreement,
-                    unsettled,
-                    exact: agrees && r.exact(),
-                    raymarch: RayMarchSummary::default(),
-                    lost_fragments: r.lost_fragments,
-                    capped_pixels: r.capped_pixels,
-                    capped_visible_pixels: r.capped_visible_pixels,
-                    depth_complexity: peeled.layers.unwrap_or(0),
-                },
-            },
+        // vouch for each other alone. Nothing sides with either picture: every pixel they
+        // differ at past the agreement is unsettled (the peeled picture stands in for the
+        // ray march), so the reference is exact where they agree within `GPU_AGREEMENT`.
+        None => (
+            RayMarchSummary::default(),
+            unsettled_pixels(&abuffer.image, &peel.image, &peel.image, &abuffer.image),
             None,
-        ));
+        ),
+        Some(size) => {
+            let ray = raymarch_check(ctx, scene, camera, size)?;
+            let c = &ray.comparison;
+            let raymarch = RayMarchSummary {
+                differing: c.differing,
+                max_abs_err_off_edges: c.max_abs_err_off_edges,
+                differing_on_edges: c.differing_on_edges,
+                translucent_seams: c.translucent_seams,
+                cracks: c.cracks,
+                worst: c
+                    .worst
+                    .iter()
+                    .map(|p| {
+                        format!(
+                            "pixel ({}, {}): ray march {:?}, A-buffer {:?} ({}/255), {}",
+                            p.x, p.y, p.ray, p.gpu, p.diff, p.surface
+                        )
+                    })
+                    .collect(),
+                seconds: ray.seconds,
+            };
+            let unsettled = unsettled_pixels(&abuffer.image, &peel.image, &ray.ray.image, &ray.gpu);
+            (raymarch, unsettled, Some(ray))
+        }
     };
-    let ray = raymarch_check(ctx, scene, camera, size)?;
-    let c = &ray.comparison;
-    let raymarch = RayMarchSummary {
-        differing: c.differing,
-        max_abs_err_off_edges: c.max_abs_err_off_edges,
-        differing_on_edges: c.differing_on_edges,
-        translucent_seams: c.translucent_seams,
-        cracks: c.cracks,
-        worst: c
-            .worst
-            .iter()
-            .map(|p| {
-                format!(
-                    "pixel ({}, {}): ray march {:?}, A-buffer {:?} ({}/255), {}",
-                    p.x, p.y, p.ray, p.gpu, p.diff, p.surface
-                )
-            })
-            .collect(),
-        seconds: ray.seconds,
-    };
-    let unsettled = unsettled_pixels(&abuffer.image, &peel.image, &ray.ray.image, &ray.gpu);
     let agrees = raymarch.differing == 0 && raymarch.cracks == 0 && unsettled == 0;
     Ok((
         Reference {
@@ -348,7 +337,7 @@ pub fn reference(
                 depth_complexity: peeled.layers.unwrap_or(0),
             },
         },
-        Some(ray),
+        ray,
     ))
 }
 
