@@ -42,7 +42,9 @@ ensure_wasm_tools() {
         return 1
     fi
     local have
-    have="$(wasm-bindgen --version 2>/dev/null | awk '{ print $2 }')"
+    # `|| true`: under `set -euo pipefail` (test.sh, web.sh) a missing CLI must reach the
+    # install below, not end the script with wasm-bindgen's status 127.
+    have="$( (wasm-bindgen --version 2>/dev/null || true) | awk '{ print $2 }')"
     if [ "$have" != "$want" ]; then
         echo "installing wasm-bindgen-cli $want with cargo install (was: ${have:-none})" >&2
         # Not --locked: the CLI's own lock file may name dependency versions a registry

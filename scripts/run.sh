@@ -4,6 +4,8 @@
 # Vulkan driver first when none is present (see ensure-vulkan.sh). Arguments go to the demo.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/ensure-toolchain.sh
 source scripts/ensure-vulkan.sh
+ensure_toolchain
 ensure_vulkan
 exec cargo run --release -p demo -- "$@"

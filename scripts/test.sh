@@ -5,8 +5,10 @@
 # ensure-browser.sh). One release build serves the tests, the demo and the benchmarks' peers.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/ensure-toolchain.sh
 source scripts/ensure-vulkan.sh
 source scripts/ensure-browser.sh
+ensure_toolchain
 ensure_vulkan
 ensure_chromium
 ensure_wasm_tools

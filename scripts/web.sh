@@ -7,11 +7,13 @@
 #                               (PORT=... for another port)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/ensure-toolchain.sh
 source scripts/ensure-browser.sh
 
 OUT=out/web
 
 build() {
+    ensure_toolchain
     ensure_wasm_tools
     cargo build --release --target wasm32-unknown-unknown -p voxel-web
     mkdir -p "$OUT"
