@@ -6,6 +6,8 @@
 # as root on Debian/Ubuntu; otherwise says what to install and fails). Sourced by web.sh
 # and test.sh.
 
+source "$(dirname "${BASH_SOURCE[0]}")/setup-step.sh"
+
 # The version of a package in Cargo.lock.
 locked_version() {
     awk -v name="$1" '$0 == "name = \"" name "\"" { getline; gsub(/version = |"/, ""); print; exit }' Cargo.lock
@@ -22,8 +24,10 @@ ensure_chromium() {
     fi
     if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
         echo "installing chromium with apt-get" >&2
-        apt-get update -qq
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium >/dev/null
+        local by_hand="sudo apt-get update && sudo apt-get install -y chromium"
+        setup_step chromium "$by_hand" apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive setup_step chromium "$by_hand" \
+            apt-get install -y -qq --no-install-recommends chromium >/dev/null
     else
         echo "error: missing chromium; install with: sudo apt-get install -y chromium" >&2
         return 1
@@ -33,7 +37,8 @@ ensure_chromium() {
 ensure_wasm_tools() {
     if ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknown; then
         echo "installing the wasm32-unknown-unknown target with rustup" >&2
-        rustup target add wasm32-unknown-unknown
+        setup_step "wasm32 target" "rustup target add wasm32-unknown-unknown" \
+            rustup target add wasm32-unknown-unknown
     fi
     local want
     want="$(locked_version wasm-bindgen)"
@@ -49,6 +54,7 @@ ensure_wasm_tools() {
         echo "installing wasm-bindgen-cli $want with cargo install (was: ${have:-none})" >&2
         # Not --locked: the CLI's own lock file may name dependency versions a registry
         # mirror does not have yet (webpki-roots here); the CLI's version is what must match.
-        cargo install --quiet wasm-bindgen-cli --version "=$want"
+        setup_step wasm-bindgen "cargo install wasm-bindgen-cli --version =$want" \
+            cargo install --quiet wasm-bindgen-cli --version "=$want"
     fi
 }

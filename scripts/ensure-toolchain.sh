@@ -4,6 +4,8 @@
 # target. rustup would install it on the first cargo call anyway; doing it here says so and
 # fails early with a clear message when rustup is missing. Sourced by run.sh, test.sh, web.sh.
 
+source "$(dirname "${BASH_SOURCE[0]}")/setup-step.sh"
+
 ensure_toolchain() {
     if ! command -v rustup >/dev/null; then
         echo "error: rustup not found; install Rust with https://rustup.rs (the checkout's rust-toolchain.toml names the version)" >&2
@@ -16,5 +18,6 @@ ensure_toolchain() {
     fi
     # With no argument rustup installs the toolchain the toolchain file names, with its
     # components and targets; a no-op when all are present.
-    rustup toolchain install >/dev/null
+    setup_step "Rust toolchain" "rustup toolchain install $want --component rustfmt clippy --target wasm32-unknown-unknown" \
+        rustup toolchain install >/dev/null
 }

@@ -5,9 +5,13 @@
 # run time. Installs what is missing with apt-get when running as root on Debian/Ubuntu;
 # otherwise says what to install and fails. Sourced by run.sh and test.sh.
 
+source "$(dirname "${BASH_SOURCE[0]}")/setup-step.sh"
+
+# SETUP_ROOT (default: none) is a folder the file probes look under instead of /; the setup
+# test (tests/tests/setup_scripts.rs) points it at an empty folder to play a fresh machine.
 have_vulkan_driver() {
-    compgen -G "/usr/share/vulkan/icd.d/*.json" >/dev/null ||
-        compgen -G "/etc/vulkan/icd.d/*.json" >/dev/null
+    compgen -G "${SETUP_ROOT:-}/usr/share/vulkan/icd.d/*.json" >/dev/null ||
+        compgen -G "${SETUP_ROOT:-}/etc/vulkan/icd.d/*.json" >/dev/null
 }
 
 have_lib() {
@@ -16,8 +20,8 @@ have_lib() {
 
 # Mesa's software GL driver: swrast_dri.so (or, in newer Mesa, libgallium) in a dri folder.
 have_mesa_dri() {
-    compgen -G "/usr/lib/*/dri/swrast_dri.so" >/dev/null ||
-        compgen -G "/usr/lib/dri/swrast_dri.so" >/dev/null ||
+    compgen -G "${SETUP_ROOT:-}/usr/lib/*/dri/swrast_dri.so" >/dev/null ||
+        compgen -G "${SETUP_ROOT:-}/usr/lib/dri/swrast_dri.so" >/dev/null ||
         have_lib libgallium
 }
 
@@ -34,8 +38,10 @@ ensure_vulkan() {
     if ((${#missing[@]})); then
         if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
             echo "installing ${missing[*]} with apt-get" >&2
-            apt-get update -qq
-            DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+            local by_hand="sudo apt-get update && sudo apt-get install -y ${missing[*]}"
+            setup_step "Vulkan/GL drivers" "$by_hand" apt-get update -qq
+            DEBIAN_FRONTEND=noninteractive setup_step "Vulkan/GL drivers" "$by_hand" \
+                apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
         else
             echo "error: missing ${missing[*]}; install with: sudo apt-get install -y ${missing[*]}" >&2
             return 1
