@@ -590,6 +590,16 @@ impl Gfx {
         {
             self.settings.oit.technique = *t;
         }
+        // [ and ] step through every technique, however many there are (the digits reach
+        // the first ten).
+        let step = match code {
+            KeyCode::BracketRight => Some(1),
+            KeyCode::BracketLeft => Some(Technique::ALL.len() - 1),
+            _ => None,
+        };
+        if let Some(step) = step {
+            self.settings.oit.technique = step_technique(self.settings.oit.technique, step);
+        }
         match code {
             KeyCode::F2 | KeyCode::KeyP => self.request_screenshot(),
             KeyCode::KeyH => self.settings.heatmap = !self.settings.heatmap,
@@ -961,5 +971,31 @@ impl Gfx {
         .save_png(path)?;
         self.status.message = format!("saved {}", path.display());
         Ok(())
+    }
+}
+
+/// The technique `step` places after `current` in `Technique::ALL`, wrapping around.
+fn step_technique(current: Technique, step: usize) -> Technique {
+    let all = Technique::ALL;
+    let at = all.iter().position(|t| *t == current).unwrap_or(0);
+    all[(at + step) % all.len()]
+}
+
+#[cfg(test)]
+mod key_tests {
+    use super::*;
+
+    #[test]
+    fn the_bracket_keys_reach_every_technique_and_wrap() {
+        let all = Technique::ALL;
+        let mut t = all[0];
+        let mut seen = vec![t];
+        for _ in 1..all.len() {
+            t = step_technique(t, 1);
+            seen.push(t);
+        }
+        assert_eq!(seen, all.to_vec());
+        assert_eq!(step_technique(*all.last().unwrap(), 1), all[0]);
+        assert_eq!(step_technique(all[0], all.len() - 1), *all.last().unwrap());
     }
 }

@@ -124,7 +124,10 @@ impl Gfx {
 
     fn technique_settings(&mut self, ui: &mut egui::Ui) {
         let s = &mut self.settings;
-        ui.label("Technique (keys 1-9, 0)");
+        ui.label(format!(
+            "Technique (keys 1-9, 0; [ ] step through all {})",
+            Technique::ALL.len()
+        ));
         egui::ComboBox::from_id_salt("technique")
             .selected_text(s.oit.technique.name())
             .show_ui(ui, |ui| {

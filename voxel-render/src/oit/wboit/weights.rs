@@ -1,6 +1,10 @@
-//! WBOIT weight functions, mirrored in WGSL (`accumulate.wgsl`, `weight()`): the same
-//! formulas, so that unit tests of these pin the shader's maths too (a GPU test checks the
-//! shader against this file).
+//! WBOIT weight functions: where a reader finds them, and the CPU's copy (the lab and the
+//! unit tests use it). What draws is the WGSL copy (`accumulate.wgsl`, `weight()`), the same
+//! formulas; `tests/tests/render_wboit.rs`'s `shader_weights_match_the_rust_formulas` renders
+//! every weight at three depths and fails when the two copies differ. Another weight: a
+//! variant here (with its name), its branch in `weight()` of `accumulate.wgsl`
+//! (the `WEIGHT_<NAME>` id constants are generated from this enum), and
+//! `OitConfig.wboit.weight` picks it.
 //!
 //! Inputs: `z` is the standard window depth in [0, 1] (0 at the near plane: OpenGL's
 //! `gl_FragCoord.z`, which the published weights use), `depth` the view-space distance (McGuire & Bavoil's |z|), `alpha`
