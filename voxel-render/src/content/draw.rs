@@ -410,10 +410,18 @@ impl ContentStages {
     /// Replaces what it draws (moving particles, a turning cube). The instance buffers grow
     /// when needed (to twice what is needed, at most a buffer more, so that content growing
     /// a little rebuilds nothing), over as many buffers as the device's binding size
-    /// needs. Fails, keeping what it drew, on a value outside its range
-    /// (`Error::InvalidContent`) or when the device cannot hold the instances
-    /// (`Error::Gpu`).
+    /// needs. Fails, keeping what it drew, on a `ctx` of another device than the one it
+    /// was made on (`Error::OtherDevice`, before anything is made: its buffers live on its
+    /// own device), on a value outside its range (`Error::InvalidContent`) or when the
+    /// device cannot hold the instances (`Error::Gpu`).
     pub fn set_content(&mut self, ctx: &GpuContext, content: Content) -> Result<()> {
+        if !ctx.same_device(&self.ctx) {
+            return Err(crate::Error::OtherDevice(format!(
+                "ContentStages::set_content was given a context of {}, the content was made \
+                 on {} (pass the renderer's context, Renderer::context, or a clone of it)",
+                ctx.caps.adapter_name, self.ctx.caps.adapter_name
+            )));
+        }
         content.validate()?;
         let (opaque, translucent) = counts(&content);
         if opaque > self.opaque.capacity || translucent > self.translucent.capacity {
