@@ -397,7 +397,7 @@ impl ContentStages {
         };
         let (opaque, translucent) = counts(&content);
         stages.allocate(ctx, opaque, translucent)?;
-        stages.objects = Self::objects(&content);
+        Self::objects_into(&content, &mut stages.objects);
         stages.content = content;
         Ok(stages)
     }
@@ -428,7 +428,7 @@ impl ContentStages {
             let room = |n: usize| n + n.min(self.per_page);
             self.allocate(ctx, room(opaque), room(translucent))?;
         }
-        self.objects = Self::objects(&content);
+        Self::objects_into(&content, &mut self.objects);
         self.content = content;
         Ok(())
     }
@@ -450,23 +450,28 @@ impl ContentStages {
     }
 
     /// The translucent objects in instance order before sorting: particles, then the
-    /// translucent entities.
-    fn objects(content: &Content) -> Vec<TranslucentObject> {
-        content
-            .particles
-            .iter()
-            // A square facing the camera: its corners, whichever way it turns.
-            .map(|p| {
-                TranslucentObject::ball(p.center, f64::from(p.half_size) * std::f64::consts::SQRT_2)
-            })
-            .chain(
-                content
-                    .entities
-                    .iter()
-                    .filter(|e| !e.is_opaque())
-                    .map(|e| TranslucentObject::aabb(e.center, e.world_half_extents())),
-            )
-            .collect()
+    /// translucent entities, into `objects` (its room kept from call to call).
+    fn objects_into(content: &Content, objects: &mut Vec<TranslucentObject>) {
+        objects.clear();
+        objects.extend(
+            content
+                .particles
+                .iter()
+                // A square facing the camera: its corners, whichever way it turns.
+                .map(|p| {
+                    TranslucentObject::ball(
+                        p.center,
+                        f64::from(p.half_size) * std::f64::consts::SQRT_2,
+                    )
+                })
+                .chain(
+                    content
+                        .entities
+                        .iter()
+                        .filter(|e| !e.is_opaque())
+                        .map(|e| TranslucentObject::aabb(e.center, e.world_half_extents())),
+                ),
+        );
     }
 
     /// Builds now the pipelines for `renderer`'s configuration and contract, which the
