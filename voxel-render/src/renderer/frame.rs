@@ -806,7 +806,7 @@ impl Renderer {
 /// own objects (wgpu-core then takes them for those), but an error a texture causes goes to
 /// its own device: a view of one mip level past its last is asked for, labelled to say why,
 /// inside a validation scope of the renderer's device, which catches that error only when
-/// the texture is its own (about 10 µs). Another device's error goes to that device's
+/// the texture is its own, every frame. Another device's error goes to that device's
 /// handler: wgpu's default one panics, which is caught here; a game's own handler is told
 /// of the view the label names.
 #[cfg(not(target_arch = "wasm32"))]
