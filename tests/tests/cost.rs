@@ -191,3 +191,104 @@ fn the_game_objects_of_the_sorted_order_cost_few_runs() {
         "{quads:?} against {sorted:?}"
     );
 }
+
+/// A counted frame whose encoder is not submitted yet has no cost to give: `frame_cost`
+/// is an `Error::FrameOrder` until the submit (the counted frame is kept), then the cost;
+/// one whose encoder is dropped unsubmitted ran nothing: `None`. (Before, both gave a
+/// cost read from query results the GPU never wrote.)
+#[test]
+fn an_unsubmitted_frame_has_no_cost() {
+    let Some(ctx) = gpu() else { return };
+    let scene =
+        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/deep_stack.toml"))
+            .unwrap();
+    let config = RendererConfig {
+        width: W,
+        height: H,
+        ..RendererConfig::default()
+    };
+    let mut r = renderer_for(&ctx, &scene, config).unwrap();
+    let target = Offscreen::new(&ctx, W, H);
+    let camera = scene.cameras[0];
+    r.render_and_submit(&target.view, &camera).unwrap();
+    let encoder = |ctx: &GpuContext| ctx.device.create_command_encoder(&Default::default());
+
+    // Recorded, not submitted: an error naming the submit, the frame kept.
+    low_level::count_next_frame(&mut r.renderer);
+    let mut e = encoder(&ctx);
+    r.renderer
+        .render(&mut e, &target.view, &camera, &mut voxel_render::NoGame)
+        .unwrap();
+    let err = low_level::frame_cost(&mut r.renderer).unwrap_err();
+    assert!(
+        matches!(err, voxel_render::Error::FrameOrder(_)) && err.to_string().contains("submit"),
+        "{err:?}"
+    );
+    ctx.queue.submit([e.finish()]);
+    let cost = low_level::frame_cost(&mut r.renderer).unwrap().unwrap();
+    assert!(cost.measured && fragments(&cost.all()) > 0, "{cost:?}");
+    assert!(low_level::frame_cost(&mut r.renderer).unwrap().is_none());
+
+    // Dropped unsubmitted: nothing ran, no cost; then the next counted frame has one.
+    low_level::count_next_frame(&mut r.renderer);
+    let mut e = encoder(&ctx);
+    r.renderer
+        .render(&mut e, &target.view, &camera, &mut voxel_render::NoGame)
+        .unwrap();
+    drop(e);
+    assert!(low_level::frame_cost(&mut r.renderer).unwrap().is_none());
+    // Also once a later frame has learnt of the drop.
+    low_level::count_next_frame(&mut r.renderer);
+    let mut e = encoder(&ctx);
+    r.renderer
+        .render(&mut e, &target.view, &camera, &mut voxel_render::NoGame)
+        .unwrap();
+    drop(e);
+    r.render_and_submit(&target.view, &camera).unwrap();
+    assert!(low_level::frame_cost(&mut r.renderer).unwrap().is_none());
+    low_level::count_next_frame(&mut r.renderer);
+    r.render_and_submit(&target.view, &camera).unwrap();
+    let cost = low_level::frame_cost(&mut r.renderer).unwrap().unwrap();
+    assert!(cost.measured && fragments(&cost.all()) > 0, "{cost:?}");
+}
+
+/// wgpu's GL backend answers occlusion queries with GL's `ANY_SAMPLES_PASSED_CONSERVATIVE`
+/// (1 where any sample passed) and has no pipeline statistics: a counted frame there is
+/// not measured, its fragments, samples and bytes `None` (they read 4 fragments for a
+/// frame of millions before), its commands still counted.
+#[test]
+fn gl_frames_are_counted_but_not_measured() {
+    let Some(ctx) = tests::gl() else { return };
+    let scene =
+        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/deep_stack.toml"))
+            .unwrap();
+    let config = RendererConfig {
+        width: W,
+        height: H,
+        ..RendererConfig::default()
+    };
+    let mut r = renderer_for(&ctx, &scene, config).unwrap();
+    let target = Offscreen::new(&ctx, W, H);
+    let camera = scene.cameras[0];
+    for t in [Technique::WboitMrt, Technique::SortedQuads] {
+        r.renderer.set_oit_config(OitConfig::with(t)).unwrap();
+        r.render_and_submit(&target.view, &camera).unwrap();
+        low_level::count_next_frame(&mut r.renderer);
+        r.render_and_submit(&target.view, &camera).unwrap();
+        let cost = low_level::frame_cost(&mut r.renderer).unwrap().unwrap();
+        let all = cost.all();
+        assert!(!cost.measured, "{t} on GL: {cost:?}");
+        assert_eq!(
+            (all.fragments, all.samples, all.bytes()),
+            (None, None, None),
+            "{t} on GL"
+        );
+        assert!(
+            cost.passes
+                .iter()
+                .all(|p| p.samples.is_none() && p.fragments.is_none()),
+            "{t} on GL: {cost:?}"
+        );
+        assert!(all.passes >= 2 && all.draw_calls > 0, "{t} on GL: {all:?}");
+    }
+}

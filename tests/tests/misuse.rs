@@ -293,6 +293,17 @@ fn content_stages_of_another_device_are_refused() {
         .prebuild(&mut b.renderer, Technique::Stipple)
         .unwrap_err();
     assert!(matches!(e, Error::OtherDevice(_)), "{e:?}");
+    // New content through the other device's context (more things than it has room for,
+    // so that it would make buffers there): refused before wgpu is called, where it
+    // panicked ("Cannot get non-existent resource BindGroupLayoutId"); what it drew stays.
+    let more = Content {
+        particles: vec![particle(); 64],
+        entities: vec![],
+    };
+    let e = game.set_content(&other, more.clone()).unwrap_err();
+    assert!(matches!(e, Error::OtherDevice(_)), "{e:?}");
+    assert!(e.to_string().contains("set_content"), "{e}");
+    game.set_content(&ctx, more).unwrap();
     // The renderer still draws.
     b.renderer
         .render_and_submit(&target.view, &scene.cameras[0], &mut NoGame)
@@ -347,6 +358,56 @@ fn an_output_view_of_another_device_is_refused() {
     let target = Offscreen::new(&ctx, W, H);
     r.render_and_submit(&target.view, &scene.cameras[0])
         .unwrap();
+}
+
+/// A game that makes two wgpu instances (a window's and a headless one) and hands the
+/// renderer an output view or an encoder of the other: `Error::OtherDevice` naming the
+/// instance, found before the frame is recorded, where wgpu-core panicked looking the
+/// object's id up in the renderer's instance ("Cannot get non-existent resource"); the
+/// renderer draws on afterwards.
+#[test]
+fn an_output_view_or_encoder_of_another_instance_is_refused() {
+    let (Some(ctx), Some(other)) = (gpu(), gpu()) else {
+        return;
+    };
+    let scene = scene();
+    let mut r = renderer_for(&ctx, &scene, config()).unwrap();
+    let target = Offscreen::new(&ctx, W, H);
+    r.render_and_submit(&target.view, &scene.cameras[0])
+        .unwrap();
+    let expected = target.read(&ctx).unwrap();
+    let instance_error = |e: Error| {
+        assert!(matches!(e, Error::OtherDevice(_)), "{e:?}");
+        assert!(e.to_string().contains("wgpu::Instance"), "{e}");
+    };
+
+    // Their view as the output, in the renderer's own encoder.
+    let theirs = Offscreen::new(&other, W, H);
+    let e = r
+        .renderer
+        .render_and_submit(&theirs.view, &scene.cameras[0], &mut NoGame)
+        .unwrap_err();
+    instance_error(e);
+
+    // Their encoder, the renderer's own output.
+    let mut encoder = other.device.create_command_encoder(&Default::default());
+    let e = r
+        .renderer
+        .render(&mut encoder, &target.view, &scene.cameras[0], &mut NoGame)
+        .unwrap_err();
+    instance_error(e);
+    // Nothing was recorded into it: it finishes and submits on its own device.
+    other.queue.submit([encoder.finish()]);
+    other
+        .device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .unwrap();
+
+    // The renderer draws on, the same picture.
+    r.render_and_submit(&target.view, &scene.cameras[0])
+        .unwrap();
+    let d = diff(&target.read(&ctx).unwrap(), &expected);
+    assert_eq!(d.max, 0, "{d:?}");
 }
 
 /// Brightness and sky channels above `Lighting::MAX_BRIGHTNESS` (up to `f32::MAX`) are

@@ -515,6 +515,12 @@ impl EvalOptions {
 /// Output size when neither the command nor the scene gives one.
 pub const DEFAULT_SIZE: (u32, u32) = (640, 360);
 
+/// The progress steps [`scene_records`] makes for a scene of `runs` runs: the runs
+/// measured, the exact references, then one per run compared.
+fn scene_steps(runs: usize) -> usize {
+    runs + 2
+}
+
 /// Measures every run of `opts` on `scene` (named `stem`) against its reference; with
 /// `heatmaps`, saves the reference picture and one heat map per run under
 /// `out/heatmaps/`.
@@ -651,7 +657,7 @@ pub fn run_suite(ctx: &GpuContext, opts: &EvalOptions) -> Result<Summary> {
     };
     std::fs::create_dir_all(&dir).map_err(Error::io(&dir))?;
     let count = opts.random.map_or(opts.scenes.len(), |r| r.count);
-    let mut progress = Progress::new(count * (runs(opts).len() + 1));
+    let mut progress = Progress::new(count * scene_steps(runs(opts).len()));
     let mut records = Vec::new();
     let mut checks = Vec::new();
     let mut features = Vec::new();

@@ -28,9 +28,14 @@ impl Progress {
         }
     }
 
-    /// One step done, doing `what` next.
+    /// One step done, doing `what` next. Never counts past the total: a step beyond it
+    /// (a caller that miscounted) leaves the count at the total, and is logged.
     pub fn step(&mut self, what: &str) {
-        self.bar.inc(1);
+        if self.position() >= self.total() {
+            log::debug!("progress: a step past the total {} ({what})", self.total());
+        } else {
+            self.bar.inc(1);
+        }
         self.bar.set_message(what.to_owned());
         if !self.tty {
             let (pos, len) = (self.bar.position(), self.bar.length().unwrap_or(1));
@@ -45,8 +50,33 @@ impl Progress {
         }
     }
 
+    /// Steps done.
+    pub fn position(&self) -> u64 {
+        self.bar.position()
+    }
+
+    /// The steps it counts to.
+    pub fn total(&self) -> u64 {
+        self.bar.length().unwrap_or(1)
+    }
+
     /// Clears the bar.
     pub fn finish(&self) {
         self.bar.finish_and_clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn never_counts_past_its_total() {
+        let mut p = Progress::new(2);
+        for i in 1..=4 {
+            p.step("a step");
+            assert_eq!((p.position(), p.total()), (i.min(2), 2), "step {i}");
+        }
+        assert_eq!(Progress::new(0).total(), 1);
     }
 }

@@ -129,6 +129,16 @@ impl Capabilities {
         self.backend != wgpu::Backend::BrowserWebGpu
     }
 
+    /// Whether occlusion queries count the samples that pass (what a counted frame's
+    /// samples and bytes are measured with, `low_level::count_next_frame`). Not on wgpu's
+    /// GL backend (desktop GL, GLES, WebGL2), whose occlusion queries are GL's
+    /// `ANY_SAMPLES_PASSED_CONSERVATIVE`: 1 where any sample passed, so a pass of a million
+    /// samples reads 1; nor where there are no occlusion queries at all
+    /// ([`Capabilities::occlusion_queries`]).
+    pub(crate) fn counts_samples(&self) -> bool {
+        self.occlusion_queries() && self.backend != wgpu::Backend::Gl
+    }
+
     /// Whether timestamp queries at pass boundaries are available.
     pub fn timestamps(&self) -> bool {
         self.features.contains(wgpu::Features::TIMESTAMP_QUERY)
@@ -215,12 +225,20 @@ impl GpuContext {
             };
             *flag.lock().unwrap_or_else(PoisonError::into_inner) = Some(why);
         });
-        let probe = device.create_buffer(&wgpu::BufferDescriptor {
+        let probe_desc = wgpu::BufferDescriptor {
             label: Some("device_probe"),
             size: 4,
             usage: wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
-        });
+        };
+        // wgpu-core names a buffer by an index and the count of buffers that held that
+        // index (its epoch), per instance: made and dropped PROBE_EPOCH times first, the
+        // probe's name is one that another instance's buffers hardly ever carry, so that
+        // `check_encoder` finds an encoder of another instance rather than a buffer of its.
+        for _ in 0..PROBE_EPOCH {
+            drop(device.create_buffer(&probe_desc));
+        }
+        let probe = device.create_buffer(&probe_desc);
         Self {
             device,
             queue,
@@ -254,6 +272,19 @@ impl GpuContext {
             }),
             None => Ok(()),
         }
+    }
+
+    /// An `Error::OtherDevice` when `encoder` comes from another wgpu instance than this
+    /// context's device, found before anything of a frame is recorded: an empty clear of
+    /// the context's own four-byte probe is recorded into it (nothing on the GPU), and
+    /// wgpu-core, which looks up the probe's id in the encoder's instance, panics there
+    /// ("Cannot get non-existent resource"); the panic is caught ([`guard_foreign`]).
+    /// An encoder of another device of the same instance is not found here: wgpu refuses
+    /// it when it is finished (`Renderer::render` says so).
+    pub(crate) fn check_encoder(&self, encoder: &mut wgpu::CommandEncoder) -> Result<()> {
+        guard_foreign("the command encoder", || {
+            encoder.clear_buffer(&self.probe, 0, Some(0));
+        })
     }
 
     /// Whether `other` is this context or a clone of it (the same device, made into a
@@ -327,6 +358,39 @@ impl GpuContext {
         let (device, queue) = request_device_with(&adapter, preset).await?;
         Ok(Self::from_device(&adapter, device, queue))
     }
+}
+
+/// Buffers made and dropped before a context's probe ([`GpuContext::check_encoder`]).
+const PROBE_EPOCH: u32 = 64;
+
+/// Runs `f`, which hands wgpu an object the caller was given (`what`: an output view, an
+/// encoder), turning wgpu-core's panic on an id its instance does not hold into
+/// `Error::OtherDevice`: wgpu names objects by ids that each `wgpu::Instance` counts on
+/// its own and offers no public way to ask an object's instance, so an object of another
+/// instance is found only when wgpu-core looks its id up in the wrong one ("Cannot get
+/// non-existent resource", or an id held by another object: "Cannot get …, found other
+/// resource"). Any other panic goes on. Where a foreign id happens to name an object of
+/// the same kind in this instance, wgpu-core takes that object instead and nothing is
+/// caught here (docs/limits-and-errors.md). wgpu-core's message still reaches the panic
+/// hook (stderr) before the error is returned.
+pub(crate) fn guard_foreign<T>(what: &str, f: impl FnOnce() -> T) -> Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).map_err(|payload| {
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or_default();
+        if !message.contains("Cannot get") {
+            std::panic::resume_unwind(payload);
+        }
+        let message = message.split_whitespace().collect::<Vec<_>>().join(" ");
+        Error::OtherDevice(format!(
+            "{what} (or an object it uses) comes from another wgpu::Instance than the \
+             renderer's device: wgpu-core could not find it there ({message}); make every \
+             device, texture, view and encoder a game gives the renderer through one \
+             wgpu::Instance"
+        ))
+    })
 }
 
 /// The flags every wgpu instance of this crate (and of its lab, demo, examples and tests)

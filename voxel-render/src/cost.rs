@@ -113,8 +113,10 @@ pub struct FrameCost {
     pub buffers_created: u32,
     /// Bind groups created while the frame was recorded.
     pub bind_groups_created: u32,
-    /// Whether the fragments and samples were measured (the device has the queries, and
-    /// the technique does not submit inside its frame).
+    /// Whether the fragments and samples were measured: the device has occlusion queries
+    /// that count samples (not wgpu's GL backend, whose queries say only whether any
+    /// sample passed, nor a browser's WebGPU), and the technique does not submit inside
+    /// its frame. Where not, every measured figure is `None`.
     pub measured: bool,
 }
 

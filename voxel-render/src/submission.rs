@@ -43,6 +43,8 @@ pub(crate) enum Outcome {
 struct Sentinel {
     buffer: wgpu::Buffer,
     state: Arc<AtomicU8>,
+    /// Which signal it carries ([`Submissions::attach`] counts them).
+    serial: u64,
 }
 
 /// Held by the deferred mapping's callback: a callback dropped without running means its
@@ -62,6 +64,11 @@ impl Drop for Signal {
 pub(crate) struct Submissions {
     waiting: Option<Sentinel>,
     idle: Vec<Sentinel>,
+    /// Signals attached so far.
+    serial: u64,
+    /// A signal whose outcome is kept when it is settled ([`Submissions::watch`]), and
+    /// that outcome once known.
+    watched: Option<(u64, Option<Outcome>)>,
 }
 
 impl Submissions {
@@ -85,6 +92,11 @@ impl Submissions {
             DROPPED => Outcome::Dropped,
             _ => return Outcome::Pending,
         };
+        if let Some((serial, known)) = &mut self.watched
+            && *serial == sentinel.serial
+        {
+            *known = Some(outcome);
+        }
         if let Some(sentinel) = self.waiting.take() {
             sentinel.state.store(IDLE, Ordering::Release);
             self.idle.push(sentinel);
@@ -92,12 +104,43 @@ impl Submissions {
         outcome
     }
 
-    /// Gives `encoder` a signal of its submission, unless the last frame's is still
-    /// waiting (this frame then shares its encoder, or will be learnt of with it).
-    pub(crate) fn attach(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) {
-        if self.waiting.is_some() {
-            return;
+    /// What became of the encoder that carries signal `serial` ([`Submissions::attach`]),
+    /// without settling it: `Pending` while it is neither submitted nor dropped, `Nothing`
+    /// when it was settled before it was watched ([`Submissions::watch`]).
+    pub(crate) fn outcome_of(&self, ctx: &GpuContext, serial: u64) -> Outcome {
+        if let Some((watched, Some(known))) = self.watched
+            && watched == serial
+        {
+            return known;
         }
+        let Some(sentinel) = self.waiting.as_ref().filter(|s| s.serial == serial) else {
+            return Outcome::Nothing;
+        };
+        if sentinel.state.load(Ordering::Acquire) == WAITING {
+            let _ = ctx.device.poll(wgpu::PollType::Poll);
+        }
+        match sentinel.state.load(Ordering::Acquire) {
+            MAPPED | SUBMITTED => Outcome::Submitted,
+            DROPPED => Outcome::Dropped,
+            _ => Outcome::Pending,
+        }
+    }
+
+    /// Keeps the outcome of signal `serial` when it is settled, for
+    /// [`Submissions::outcome_of`] (one signal at a time: the last counted frame's).
+    pub(crate) fn watch(&mut self, serial: u64) {
+        self.watched = Some((serial, None));
+    }
+
+    /// Gives `encoder` a signal of its submission, unless the last frame's is still
+    /// waiting (this frame then shares its encoder, or will be learnt of with it); returns
+    /// the signal's serial.
+    pub(crate) fn attach(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder) -> u64 {
+        if let Some(waiting) = &self.waiting {
+            return waiting.serial;
+        }
+        self.serial += 1;
+        let serial = self.serial;
         let sentinel = self.idle.pop().unwrap_or_else(|| Sentinel {
             buffer: ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("submission_sentinel"),
@@ -106,7 +149,9 @@ impl Submissions {
                 mapped_at_creation: false,
             }),
             state: Arc::new(AtomicU8::new(IDLE)),
+            serial,
         });
+        let sentinel = Sentinel { serial, ..sentinel };
         sentinel.state.store(WAITING, Ordering::Release);
         let signal = Signal(sentinel.state.clone());
         encoder.map_buffer_on_submit(&sentinel.buffer, wgpu::MapMode::Read, .., move |r| {
@@ -114,6 +159,7 @@ impl Submissions {
             signal.0.store(state, Ordering::Release);
         });
         self.waiting = Some(sentinel);
+        serial
     }
 }
 

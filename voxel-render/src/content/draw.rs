@@ -397,7 +397,7 @@ impl ContentStages {
         };
         let (opaque, translucent) = counts(&content);
         stages.allocate(ctx, opaque, translucent)?;
-        stages.objects = Self::objects(&content);
+        Self::objects_into(&content, &mut stages.objects);
         stages.content = content;
         Ok(stages)
     }
@@ -410,17 +410,25 @@ impl ContentStages {
     /// Replaces what it draws (moving particles, a turning cube). The instance buffers grow
     /// when needed (to twice what is needed, at most a buffer more, so that content growing
     /// a little rebuilds nothing), over as many buffers as the device's binding size
-    /// needs. Fails, keeping what it drew, on a value outside its range
-    /// (`Error::InvalidContent`) or when the device cannot hold the instances
-    /// (`Error::Gpu`).
+    /// needs. Fails, keeping what it drew, on a `ctx` of another device than the one it
+    /// was made on (`Error::OtherDevice`, before anything is made: its buffers live on its
+    /// own device), on a value outside its range (`Error::InvalidContent`) or when the
+    /// device cannot hold the instances (`Error::Gpu`).
     pub fn set_content(&mut self, ctx: &GpuContext, content: Content) -> Result<()> {
+        if !ctx.same_device(&self.ctx) {
+            return Err(crate::Error::OtherDevice(format!(
+                "ContentStages::set_content was given a context of {}, the content was made \
+                 on {} (pass the renderer's context, Renderer::context, or a clone of it)",
+                ctx.caps.adapter_name, self.ctx.caps.adapter_name
+            )));
+        }
         content.validate()?;
         let (opaque, translucent) = counts(&content);
         if opaque > self.opaque.capacity || translucent > self.translucent.capacity {
             let room = |n: usize| n + n.min(self.per_page);
             self.allocate(ctx, room(opaque), room(translucent))?;
         }
-        self.objects = Self::objects(&content);
+        Self::objects_into(&content, &mut self.objects);
         self.content = content;
         Ok(())
     }
@@ -442,23 +450,28 @@ impl ContentStages {
     }
 
     /// The translucent objects in instance order before sorting: particles, then the
-    /// translucent entities.
-    fn objects(content: &Content) -> Vec<TranslucentObject> {
-        content
-            .particles
-            .iter()
-            // A square facing the camera: its corners, whichever way it turns.
-            .map(|p| {
-                TranslucentObject::ball(p.center, f64::from(p.half_size) * std::f64::consts::SQRT_2)
-            })
-            .chain(
-                content
-                    .entities
-                    .iter()
-                    .filter(|e| !e.is_opaque())
-                    .map(|e| TranslucentObject::aabb(e.center, e.world_half_extents())),
-            )
-            .collect()
+    /// translucent entities, into `objects` (its room kept from call to call).
+    fn objects_into(content: &Content, objects: &mut Vec<TranslucentObject>) {
+        objects.clear();
+        objects.extend(
+            content
+                .particles
+                .iter()
+                // A square facing the camera: its corners, whichever way it turns.
+                .map(|p| {
+                    TranslucentObject::ball(
+                        p.center,
+                        f64::from(p.half_size) * std::f64::consts::SQRT_2,
+                    )
+                })
+                .chain(
+                    content
+                        .entities
+                        .iter()
+                        .filter(|e| !e.is_opaque())
+                        .map(|e| TranslucentObject::aabb(e.center, e.world_half_extents())),
+                ),
+        );
     }
 
     /// Builds now the pipelines for `renderer`'s configuration and contract, which the

@@ -113,7 +113,28 @@ pub struct Entity {
     pub emissive: f32,
 }
 
+impl Particle {
+    /// Whether every value is in its range (`Content::validate` names the one that is not).
+    fn in_range(&self) -> bool {
+        center_in_range(self.center)
+            && size_in_range(self.half_size)
+            && (0.0..=1.0).contains(&self.opacity)
+            && (0.0..=MAX_EMISSIVE).contains(&self.emissive)
+    }
+}
+
 impl Entity {
+    /// Whether every value is in its range (`Content::validate` names the one that is not).
+    fn in_range(&self) -> bool {
+        let q = self.rotation;
+        center_in_range(self.center)
+            && self.half_extents.iter().all(|&h| size_in_range(h))
+            && q.is_finite()
+            && (q.length() - 1.0).abs() <= 1e-3
+            && (0.0..=1.0).contains(&self.opacity)
+            && (0.0..=MAX_EMISSIVE).contains(&self.emissive)
+    }
+
     /// Whether it is drawn with the opaque geometry.
     pub fn is_opaque(&self) -> bool {
         self.opacity >= 1.0
@@ -165,6 +186,13 @@ impl Content {
     /// [`Error::InvalidContent`] naming the particle or entity, its index and the field.
     /// [`ContentStages::new`] and [`ContentStages::set_content`] check with it.
     pub fn validate(&self) -> Result<()> {
+        // Every value in range, as plain comparisons over the whole content (what a game's
+        // every `set_content` pays); the error is found and named only when one is not.
+        if self.particles.iter().all(Particle::in_range)
+            && self.entities.iter().all(Entity::in_range)
+        {
+            return Ok(());
+        }
         for (i, p) in self.particles.iter().enumerate() {
             let bad = |field, message| invalid("particle", i, field, message);
             check_center(p.center).map_err(|m| bad("center", m))?;
@@ -230,8 +258,16 @@ fn invalid(kind: &'static str, index: usize, field: &'static str, message: Strin
     }
 }
 
+fn center_in_range(c: DVec3) -> bool {
+    c.is_finite() && c.abs().max_element() < WORLD_EXTENT
+}
+
+fn size_in_range(s: f32) -> bool {
+    s > 0.0 && s <= MAX_HALF_SIZE
+}
+
 fn check_center(c: DVec3) -> std::result::Result<(), String> {
-    if !c.is_finite() || c.abs().max_element() >= WORLD_EXTENT {
+    if !center_in_range(c) {
         return Err(format!(
             "{c} is not a point of the world (finite, each coordinate within ±{WORLD_EXTENT})"
         ));
@@ -240,7 +276,7 @@ fn check_center(c: DVec3) -> std::result::Result<(), String> {
 }
 
 fn check_size(s: f32) -> std::result::Result<(), String> {
-    if !(s > 0.0 && s <= MAX_HALF_SIZE) {
+    if !size_in_range(s) {
         return Err(format!(
             "{s} is not a size above 0 and at most {MAX_HALF_SIZE} blocks"
         ));

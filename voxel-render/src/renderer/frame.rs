@@ -95,7 +95,15 @@ impl Renderer {
         camera: &Camera,
         game: &mut dyn GameStages,
     ) -> Result<FrameStats> {
-        let frame = self.render_frame(encoder, output, camera, game);
+        // Objects of another wgpu instance make wgpu-core panic when it looks their ids up
+        // (`context::guard_foreign`): the encoder and the output view are checked first,
+        // and a panic of that kind later in the frame (a game's pipeline of another
+        // instance, or an id that named an object of this one until then) is an error too,
+        // the frame abandoned.
+        let frame = crate::context::guard_foreign("an object given to the frame", || {
+            self.render_frame(encoder, output, camera, game)
+        })
+        .and_then(|frame| frame);
         if frame.is_err() {
             // A frame that failed is not counted ([`crate::cost`]).
             drop(crate::cost::end_frame());
@@ -112,6 +120,7 @@ impl Renderer {
         game: &mut dyn GameStages,
     ) -> Result<FrameStats> {
         self.ctx.check_device()?;
+        self.ctx.check_encoder(encoder)?;
         camera.validate()?;
         // The output's format (its tonemap pipeline made the first time), checked with it.
         let format = output_format(self.config.output_view_format, output.texture().format());
@@ -453,8 +462,12 @@ impl Renderer {
         if timed && let Some(t) = &mut self.timer {
             t.end_frame(&self.ctx, encoder);
         }
-        self.end_cost(encoder);
-        self.submissions.attach(&self.ctx, encoder);
+        let counted = self.end_cost(encoder);
+        let signal = self.submissions.attach(&self.ctx, encoder);
+        if counted {
+            self.cost.signal = signal;
+            self.submissions.watch(signal);
+        }
         self.last_encoder = Some(encoder_key(encoder));
         Ok(FrameStats {
             cpu_ms: start.elapsed().as_secs_f64() * 1e3,
@@ -564,6 +577,9 @@ impl Renderer {
                 t.usage()
             )));
         }
+        // Before anything compares its ids with the renderer's: ids of another instance can
+        // name the renderer's own objects.
+        check_texture_device(&self.ctx, t)?;
         if *t == self.targets.color.texture {
             return Err(Error::Output(
                 "the renderer's own scene colour texture (Renderer::scene_color): the tonemap \
@@ -578,29 +594,34 @@ impl Renderer {
             return Err(Error::Output(format!("no tonemap pipeline for {want:?}")));
         };
         let device = &self.ctx.device;
-        let checked = scoped(device, "checking the output view", || {
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("output_view_check"),
-            });
-            let color = [gpu::load(output)];
-            // One pass (about 10 µs on lavapipe): the scene depth beside the output fails
-            // on another size, the pipeline on another view format, the tonemap's group on
-            // an output it reads, a view of another device on that.
-            Pass::new("output_view_check", GpuPass::Tonemap, &color)
-                .depth(Depth::Load(&self.targets.depth.view))
-                .record(&mut encoder, None, |pass| {
-                    pass.set_pipeline(check);
-                    pass.set_bind_group(0, &self.targets.tonemap_group, &[]);
+        let checked = crate::context::guard_foreign("the output view", || {
+            scoped(device, "checking the output view", || {
+                let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("output_view_check"),
                 });
-            // Never submitted: recording and finishing are what validate.
-            drop(encoder.finish());
-        });
+                let color = [gpu::load(output)];
+                // One pass (about 10 µs on lavapipe): the scene depth beside the output fails
+                // on another size, the pipeline on another view format, the tonemap's group on
+                // an output it reads, a view of another device on that.
+                Pass::new("output_view_check", GpuPass::Tonemap, &color)
+                    .depth(Depth::Load(&self.targets.depth.view))
+                    .record(&mut encoder, None, |pass| {
+                        pass.set_pipeline(check);
+                        pass.set_bind_group(0, &self.targets.tonemap_group, &[]);
+                    });
+                // Never submitted: recording and finishing are what validate.
+                drop(encoder.finish());
+            })
+        })
+        .and_then(|checked| checked);
         if checked.is_ok() {
             self.checked_view = Some(output.clone());
         }
         checked.map_err(|e| {
             let why = match &e {
                 Error::Gpu { error, .. } => error.to_string(),
+                // Another instance's view (`context::guard_foreign`).
+                Error::OtherDevice(_) => return e,
                 other => other.to_string(),
             };
             // wgpu's `DeviceMismatch`: "Device with '…' label of TextureView … doesn't
@@ -780,6 +801,54 @@ impl Renderer {
 }
 
 /// Tells encoders apart while they live (wgpu's id; no two live encoders share one).
+/// An `Error::OtherDevice` when `texture` is not of `ctx`'s device. wgpu tells an object's
+/// device by no public means, and ids of another `wgpu::Instance` can name the renderer's
+/// own objects (wgpu-core then takes them for those), but an error a texture causes goes to
+/// its own device: a view of one mip level past its last is asked for, labelled to say why,
+/// inside a validation scope of the renderer's device, which catches that error only when
+/// the texture is its own, every frame. Another device's error goes to that device's
+/// handler: wgpu's default one panics, which is caught here; a game's own handler is told
+/// of the view the label names.
+#[cfg(not(target_arch = "wasm32"))]
+fn check_texture_device(ctx: &crate::GpuContext, texture: &wgpu::Texture) -> Result<()> {
+    let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let probed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        drop(texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some(
+                "voxel_render's check of the output's device (a view past the last mip level, \
+                 on purpose): the renderer was given a texture of another device or instance",
+            ),
+            base_mip_level: texture.mip_level_count(),
+            mip_level_count: Some(1),
+            ..Default::default()
+        }));
+    }));
+    let caught = pollster::block_on(scope.pop());
+    match probed {
+        Ok(()) if caught.is_some() => Ok(()),
+        Err(payload)
+            if !payload
+                .downcast_ref::<String>()
+                .is_some_and(|m| m.contains("wgpu error")) =>
+        {
+            std::panic::resume_unwind(payload)
+        }
+        _ => Err(Error::OtherDevice(
+            "the output view's texture is of another device than the renderer's, or of \
+             another wgpu::Instance (wgpu's error went to that device, not the renderer's); \
+             draw into a texture of the renderer's device (Renderer::context), and make every \
+             device of a game through one wgpu::Instance"
+                .into(),
+        )),
+    }
+}
+
+/// In a browser each object is the browser's own and wgpu validates devices itself.
+#[cfg(target_arch = "wasm32")]
+fn check_texture_device(_ctx: &crate::GpuContext, _texture: &wgpu::Texture) -> Result<()> {
+    Ok(())
+}
+
 fn encoder_key(encoder: &wgpu::CommandEncoder) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();

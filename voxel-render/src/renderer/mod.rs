@@ -124,6 +124,8 @@ pub(crate) struct CostCounting {
     queries: Option<CostQueries>,
     /// The last counted frame: what was counted, each pass's query slot, slots used.
     counted: Option<(FrameCost, Vec<Option<u32>>, u32)>,
+    /// The submission signal of its encoder (`submission::Submissions::attach`).
+    signal: u64,
 }
 
 impl Renderer {
@@ -557,9 +559,29 @@ impl Renderer {
     }
 
     /// What the last counted frame asked of the GPU ([`Renderer::count_next_frame`]),
-    /// waiting for its query results (its encoder must have been submitted); `None` when
-    /// no frame was counted since the last call.
+    /// waiting for its query results once its encoder is submitted; `None` when no frame
+    /// was counted since the last call, or when the counted frame's encoder was dropped
+    /// unsubmitted (nothing of it ran; it is forgotten). While that encoder is neither
+    /// submitted nor dropped: `Error::FrameOrder`, and the frame is kept for a call after
+    /// the submit.
     pub(crate) fn frame_cost(&mut self) -> Result<Option<FrameCost>> {
+        if self.cost.counted.is_none() {
+            return Ok(None);
+        }
+        match self.submissions.outcome_of(&self.ctx, self.cost.signal) {
+            Outcome::Pending => {
+                return Err(Error::FrameOrder(
+                    "the counted frame's encoder is not submitted yet: its cost is known once \
+                     the encoder is submitted (frame_cost returns it then)"
+                        .into(),
+                ));
+            }
+            Outcome::Dropped => {
+                self.cost.counted = None;
+                return Ok(None);
+            }
+            Outcome::Submitted | Outcome::Nothing => {}
+        }
         let Some((mut cost, slots, used)) = self.cost.counted.take() else {
             return Ok(None);
         };
@@ -579,8 +601,9 @@ impl Renderer {
             return;
         }
         // The exact techniques submit inside their frame and record hundreds of passes:
-        // their commands are counted, not measured.
-        let measure = !self.oit.technique().stalls();
+        // their commands are counted, not measured; nor is anything on a device whose
+        // occlusion queries do not count samples (GL's say only whether any passed).
+        let measure = !self.oit.technique().stalls() && self.ctx.caps.counts_samples();
         if measure && self.cost.queries.is_none() {
             let statistics = self
                 .ctx
@@ -600,9 +623,10 @@ impl Renderer {
     }
 
     /// Ends the counted frame, if one is: resolves its queries at the end of `encoder`.
-    pub(crate) fn end_cost(&mut self, encoder: &mut wgpu::CommandEncoder) {
+    /// Whether one was.
+    pub(crate) fn end_cost(&mut self, encoder: &mut wgpu::CommandEncoder) -> bool {
         let Some((cost, slots, used)) = crate::cost::end_frame() else {
-            return;
+            return false;
         };
         if let Some(q) = &self.cost.queries
             && cost.measured
@@ -610,6 +634,7 @@ impl Renderer {
             q.resolve(encoder, used);
         }
         self.cost.counted = Some((cost, slots, used));
+        true
     }
 
     /// What became of the last frame's encoder; a dropped one's queue writes are flushed
