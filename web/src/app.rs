@@ -227,14 +227,14 @@ impl App {
             this.gpu.ctx.device.destroy();
         }
         let f = this.frames;
-        if this.options.report && (f == REPORT_AFTER_FRAMES || f % REPORT_EVERY == 0) {
+        if this.options.report && (f == REPORT_AFTER_FRAMES || f.is_multiple_of(REPORT_EVERY)) {
             let (state, picture) = this.state();
             wasm_bindgen_futures::spawn_local(async move {
                 let _ = post("/picture", picture.as_bytes()).await;
                 let _ = post("/status", state.as_bytes()).await;
             });
         }
-        if this.frames % 60 == 0 {
+        if this.frames.is_multiple_of(60) {
             this.show_drawing();
         }
         Ok(())

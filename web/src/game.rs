@@ -18,7 +18,7 @@
 //! let streamer = ChunkStreamer::new(registry, terrain, config)?;
 //! let eye = glam::DVec3::new(0.0, 90.0, 0.0);
 //! let camera = Camera::look_at(eye, eye + glam::DVec3::new(1.0, -0.3, 0.0), 70.0, 0.1, 600.0)?;
-//! Ok(GamePage::new("my game", Blocks::Stream(streamer), camera)
+//! Ok(GamePage::new("my game", Blocks::Stream(Box::new(streamer)), camera)
 //!     .with_content(Content::default())
 //!     .on_frame(|tick, content| {
 //!         // Move the things: return the new content, or None to keep it.
@@ -40,7 +40,7 @@ pub enum Blocks {
     World(World),
     /// Chunks streamed around the eye; on wasm32 made on the page's thread within its
     /// `StreamConfig::local_budget` each frame.
-    Stream(ChunkStreamer),
+    Stream(Box<ChunkStreamer>),
 }
 
 impl Blocks {
