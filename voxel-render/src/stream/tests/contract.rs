@@ -2,6 +2,7 @@
 //! code.
 
 use super::*;
+use crate::Error;
 
 /// What a test source makes at a position.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -370,12 +371,18 @@ fn random_sequences_hold_the_truth_once_idle() {
             max_unloads: [1, 7, 256][(seq / 3 % 3) as usize],
             scan_budget: [3, 2048][(seq % 2) as usize],
             upload_budget_bytes: [64, 1 << 20][(seq / 2 % 2) as usize],
+            local_budget: std::time::Duration::from_micros([0, 300, 4000][(seq / 4 % 3) as usize]),
         };
         let source = TestSource {
             failing,
             changing: changing.then(|| std::sync::atomic::AtomicU64::new(0)),
         };
-        let mut s = ChunkStreamer::new(registry(), source, config).unwrap();
+        // One sequence in four with its jobs on the updating thread (a browser page's).
+        let mut s = if seq % 4 == 3 {
+            ChunkStreamer::new_local(registry(), source, config).unwrap()
+        } else {
+            ChunkStreamer::new(registry(), source, config).unwrap()
+        };
         let mut truth = Truth::new(failing);
         let mut sink = Holder::default();
         let mut failed = HashSet::new();
