@@ -339,8 +339,10 @@ fn a_games_own_page_builds_outside_the_workspace_and_runs() {
     }
     // The workspace's versions (wasm-bindgen's must be the CLI's); none downloaded.
     std::fs::copy(root().join("Cargo.lock"), krate.join("Cargo.lock")).unwrap();
-    let target =
-        std::env::var("CARGO_TARGET_DIR").map_or_else(|_| root().join("target"), PathBuf::from);
+    // A target folder of its own: voxel-web is a cdylib too, and built as the game's
+    // dependency (without its page) it would replace the crate's own page's
+    // voxel_web.wasm in a shared one.
+    let target = root().join("target/test-output/web-game-target");
     let out = work.join("out");
     build_page(
         Some(&krate),
