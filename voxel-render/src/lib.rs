@@ -10,7 +10,8 @@
 //! - [`Technique`] and its settings in [`OitConfig`]: how translucent water, glass and
 //!   leaves are composed, switchable at run time.
 //! - [`ChunkStreamer`]: the chunks around a moving eye, generated, meshed and uploaded on
-//!   rayon's workers (not on wasm32: a browser page has one thread).
+//!   rayon's workers (on wasm32, where a browser page has one thread, on the page's
+//!   thread within a time budget per update).
 //! - [`stages`]: the game's own geometry in the frame ([`GameStages`]), composed by every
 //!   technique, and the helpers its pipelines and overlays are built with; [`Both`] draws
 //!   two games' stages (the ready-made content and the game's own) as one.
@@ -53,7 +54,6 @@ mod oit;
 pub mod readback;
 mod renderer;
 pub mod stages;
-#[cfg(not(target_arch = "wasm32"))]
 mod stream;
 mod submission;
 pub mod textures;
@@ -78,7 +78,6 @@ pub use renderer::{FrameStats, Lighting, OUTPUT_FORMATS, Renderer, RendererConfi
 pub use stages::{
     Both, GameFrame, GameStages, NoGame, Stages, TranslucentContract, TranslucentObject,
 };
-#[cfg(not(target_arch = "wasm32"))]
 pub use stream::{ChunkSink, ChunkSource, ChunkStreamer, StreamConfig, StreamFrame};
 pub use timing::{GpuPass, GpuTimes};
 

@@ -20,7 +20,6 @@ pub use crate::oit::{
     WeightFit,
 };
 pub use crate::renderer::ChunkMemory;
-#[cfg(not(target_arch = "wasm32"))]
 pub use crate::stream::{EDIT_BYTES, EDITED_CHUNK_BYTES, MAX_VIEW_DISTANCE};
 
 /// The chunks `renderer` holds on the GPU (the store's meshes, their places in the arena and

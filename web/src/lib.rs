@@ -11,18 +11,36 @@
 //! - [`check`]: what the test page reports for each technique, and the size and frames it
 //!   renders them with.
 //!
-//! The page itself (wasm32 only) is `page`: it picks the backend, builds the world and
-//! draws it every animation frame; with `?test=1` it renders every technique into a texture
-//! and posts each picture (or its refusal) to the server that served it.
+//! - [`game`]: what a game's own page shows ([`game::GamePage`]: its blocks, a world or a
+//!   streamer, its camera, its things and what moves them), handed to `run` (wasm32)
+//!   from the game's own crate (docs/browser.md, "A game's own page").
+//!
+//! The page itself (wasm32 only) is `page`: it picks the backend (`gpu`: WebGPU, falling
+//! back to WebGL2 where WebGPU fails at any step of start-up), builds the world and draws
+//! it every animation frame (`app`: a new device and renderer after a loss, the canvas
+//! following the window); with `?test=1` it renders every technique into a texture and
+//! posts each picture (or its refusal) to the server that served it. The crate's own page
+//! is its `page` feature (on by default): a game's crate depends on this one with
+//! `default-features = false` and calls `run` from its own start function.
 
 #![warn(missing_docs)]
 
 pub mod check;
 pub mod fly;
+pub mod game;
 pub mod scene;
 
 #[cfg(target_arch = "wasm32")]
+mod app;
+#[cfg(target_arch = "wasm32")]
+mod gpu;
+#[cfg(all(target_arch = "wasm32", feature = "page"))]
+mod own;
+#[cfg(target_arch = "wasm32")]
 mod page;
+
+#[cfg(target_arch = "wasm32")]
+pub use page::run;
 
 /// What can go wrong building the page's scene.
 #[derive(Debug, thiserror::Error)]

@@ -6,19 +6,20 @@
 //! as the backend table of docs/measurements.md.
 //!
 //! The page is built first (`bash scripts/web.sh build`: wasm32, wasm-bindgen, into
-//! out/web). Without Chromium or a Vulkan adapter the test skips with a loud message,
+//! target/test-output/web-page). Without Chromium or a Vulkan adapter the test skips with a loud message,
 //! unless `CI` is set: then it fails. The pictures and `report.md` (the browser ×
 //! technique table) are written into target/test-output/browser.
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use std::collections::{BTreeMap, HashMap};
-use std::io::{BufRead, BufReader, Read, Write};
-use std::net::{TcpListener, TcpStream};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc::{Receiver, Sender, channel};
+mod common;
+
+use std::path::Path;
+use std::sync::mpsc::{Receiver, channel};
 use std::time::{Duration, Instant};
+
+use common::{Browser, Post, build_page, chromium, out_dir, root, serve, skip};
 
 use voxel_lab::metrics;
 use voxel_render::{
@@ -42,185 +43,6 @@ const RUN_TIMEOUT: Duration = Duration::from_secs(300);
 /// Fewest distinct colours of a picture that is not blank (a default-scene picture at
 /// 160×90 has thousands).
 const MIN_COLOURS: usize = 100;
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn out_dir() -> PathBuf {
-    let dir = root().join("target/test-output/browser");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Skips loudly, or fails under `CI`.
-fn skip(why: &str) {
-    if std::env::var_os("CI").is_some() {
-        panic!("CI is set but {why}");
-    }
-    eprintln!("\n!!!! SKIPPING BROWSER TEST: {why} !!!!\n");
-}
-
-/// Chromium's binary: `$CHROMIUM`, else `chromium` or `chromium-browser` on the PATH.
-fn chromium() -> Option<PathBuf> {
-    if let Some(p) = std::env::var_os("CHROMIUM") {
-        return Some(p.into());
-    }
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path)
-        .flat_map(|d| [d.join("chromium"), d.join("chromium-browser")])
-        .find(|p| p.is_file())
-}
-
-/// What the page posted.
-#[derive(Debug)]
-struct Post {
-    path: String,
-    body: Vec<u8>,
-}
-
-/// Serves `dir` (GET) and passes every POST to `posts`, on 127.0.0.1; returns the port.
-fn serve(dir: PathBuf, posts: Sender<Post>) -> u16 {
-    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
-    let port = listener.local_addr().unwrap().port();
-    std::thread::spawn(move || {
-        for stream in listener.incoming().flatten() {
-            let (dir, posts) = (dir.clone(), posts.clone());
-            std::thread::spawn(move || {
-                if let Err(e) = answer(stream, &dir, &posts) {
-                    eprintln!("test server: {e}");
-                }
-            });
-        }
-    });
-    port
-}
-
-/// One HTTP/1.1 request and its answer (the connection closed after it).
-fn answer(stream: TcpStream, dir: &Path, posts: &Sender<Post>) -> std::io::Result<()> {
-    let mut reader = BufReader::new(stream.try_clone()?);
-    let mut line = String::new();
-    reader.read_line(&mut line)?;
-    let mut parts = line.split_whitespace();
-    let (method, target) = (
-        parts.next().unwrap_or("").to_owned(),
-        parts.next().unwrap_or("/").to_owned(),
-    );
-    let mut length = 0usize;
-    loop {
-        let mut header = String::new();
-        if reader.read_line(&mut header)? == 0 || header.trim().is_empty() {
-            break;
-        }
-        if let Some((name, value)) = header.split_once(':')
-            && name.eq_ignore_ascii_case("content-length")
-        {
-            length = value.trim().parse().unwrap_or(0);
-        }
-    }
-    let mut body = vec![0; length];
-    reader.read_exact(&mut body)?;
-    let (status, kind, content) = match method.as_str() {
-        "POST" => {
-            let _ = posts.send(Post { path: target, body });
-            ("200 OK", "text/plain", Vec::new())
-        }
-        "GET" => {
-            let path = target.split('?').next().unwrap_or("/");
-            let name = match path.trim_start_matches('/') {
-                "" => "index.html",
-                n => n,
-            };
-            let kind = match name.rsplit('.').next() {
-                Some("html") => "text/html",
-                Some("js") => "text/javascript",
-                Some("wasm") => "application/wasm",
-                _ => "application/octet-stream",
-            };
-            // Only the files of the folder itself.
-            match (!name.contains(['/', '\\']) && !name.starts_with('.'))
-                .then(|| std::fs::read(dir.join(name)).ok())
-                .flatten()
-            {
-                Some(bytes) => ("200 OK", kind, bytes),
-                None => ("404 Not Found", "text/plain", b"not found".to_vec()),
-            }
-        }
-        _ => ("405 Method Not Allowed", "text/plain", Vec::new()),
-    };
-    let mut stream = stream;
-    write!(
-        stream,
-        "HTTP/1.1 {status}\r\nContent-Type: {kind}\r\nContent-Length: {}\r\nCache-Control: no-store\r\nConnection: close\r\n\r\n",
-        content.len()
-    )?;
-    stream.write_all(&content)?;
-    stream.flush()
-}
-
-/// Headless Chromium on `url`, in a fresh profile (stopped on drop). WebGPU on SwiftShader
-/// needs Chromium's Vulkan on SwiftShader too (else the canvas's swap chain has no
-/// shared-image backing and the device is lost); WebGL2 is ANGLE on SwiftShader. Without
-/// the background-networking flags Chromium keeps calling out.
-struct Browser(Child);
-
-impl Browser {
-    fn open(binary: &Path, url: &str, profile: &Path) -> Self {
-        let _ = std::fs::remove_dir_all(profile);
-        let child = Command::new(binary)
-            .args([
-                "--headless=new",
-                "--no-sandbox",
-                "--enable-unsafe-webgpu",
-                "--use-webgpu-adapter=swiftshader",
-                "--enable-features=Vulkan",
-                "--use-vulkan=swiftshader",
-                "--use-angle=swiftshader",
-                "--disable-quic",
-                "--no-first-run",
-                "--no-default-browser-check",
-                "--disable-background-networking",
-                "--disable-component-update",
-                "--disable-sync",
-                "--disable-default-apps",
-                "--disable-extensions",
-                "--enable-logging=stderr",
-            ])
-            .arg(format!("--user-data-dir={}", profile.display()))
-            .arg(url)
-            .stdin(Stdio::null())
-            .stdout(Stdio::null())
-            .stderr(Stdio::from(
-                std::fs::File::create(profile.with_extension("log")).unwrap(),
-            ))
-            .spawn()
-            .unwrap();
-        Browser(child)
-    }
-}
-
-impl Drop for Browser {
-    /// SIGTERM to the browser process alone (its GPU, renderer and utility processes end
-    /// with it), SIGKILL if it has not ended within 10 s.
-    fn drop(&mut self) {
-        let pid = self.0.id();
-        if pid > 1 {
-            let _ = Command::new("kill")
-                .args(["-s", "TERM", "--", &pid.to_string()])
-                .status();
-        }
-        let start = Instant::now();
-        while start.elapsed() < Duration::from_secs(10) {
-            if matches!(self.0.try_wait(), Ok(Some(_))) {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 /// What one backend's run gave.
 #[derive(Debug, Default)]
@@ -321,16 +143,12 @@ fn the_page_draws_like_native_on_webgpu_and_webgl2() {
     let Some(ctx) = tests::gpu() else {
         return;
     };
-    let out = out_dir();
-    let build = Command::new("bash")
-        .arg(root().join("scripts/web.sh"))
-        .arg("build")
-        .current_dir(root())
-        .status()
-        .unwrap();
-    assert!(build.success(), "bash scripts/web.sh build failed");
+    let out = out_dir("browser");
+    // The page into the target folder: nothing written into the checkout.
+    let page = root().join("target/test-output/web-page");
+    build_page(None, &page, &[]);
     let (tx, posts) = channel();
-    let port = serve(root().join("out/web"), tx);
+    let port = serve(page, tx);
     let (w, h) = TEST_SIZE;
     let mut natives: HashMap<(Technique, bool), Image> = HashMap::new();
     let mut table = format!(

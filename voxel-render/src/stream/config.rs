@@ -1,5 +1,7 @@
 //! How far and how fast the streamer works: [`StreamConfig`] and its ranges.
 
+use std::time::Duration;
+
 use crate::{Error, Result};
 
 /// The largest view distance (and vertical distance) in chunks: 64 chunks is 2048 blocks
@@ -22,8 +24,18 @@ pub struct StreamConfig {
     pub upload_budget_bytes: u64,
     /// Worker threads of the streamer's own pool, 0 to 256; 0 picks one fewer than the
     /// cores (at least 1), leaving a core to the thread that records frames. Read when
-    /// the streamer is made.
+    /// the streamer is made. Not read on wasm32 (no threads) nor by
+    /// [`ChunkStreamer::new_local`]: see [`StreamConfig::local_budget`].
+    ///
+    /// [`ChunkStreamer::new_local`]: super::ChunkStreamer::new_local
     pub threads: usize,
+    /// Where jobs run on the updating thread (wasm32, [`ChunkStreamer::new_local`]): the
+    /// time each update spends generating and meshing at most, past the job that crosses
+    /// it (at least one job runs per update), up to 1 s. Default 4 ms: a quarter of a
+    /// 60 Hz frame. Not read where worker threads do the jobs.
+    ///
+    /// [`ChunkStreamer::new_local`]: super::ChunkStreamer::new_local
+    pub local_budget: Duration,
     /// Generation and meshing jobs in flight at most (at least 1).
     pub max_jobs: usize,
     /// Chunks dropped from the sink or from memory per update at most (at least 1).
@@ -40,6 +52,7 @@ impl Default for StreamConfig {
             hysteresis: 2,
             upload_budget_bytes: 1 << 20,
             threads: 0,
+            local_budget: Duration::from_millis(4),
             max_jobs: 64,
             max_unloads: 256,
             scan_budget: 2048,
@@ -71,6 +84,12 @@ impl StreamConfig {
         }
         if self.threads > 256 {
             return bad(format!("{} threads: at most 256", self.threads));
+        }
+        if self.local_budget > Duration::from_secs(1) {
+            return bad(format!(
+                "local budget {:?}: at most 1 s per update",
+                self.local_budget
+            ));
         }
         if self.max_jobs == 0 || self.max_unloads == 0 || self.scan_budget == 0 {
             return bad("max_jobs, max_unloads and scan_budget must be at least 1".into());

@@ -4,6 +4,10 @@
 //! A [`ChunkStreamer`] owns the resident [`World`]. Each [`ChunkStreamer::update`] (once
 //! a frame, with the eye) does a bounded amount of work on the calling thread and hands
 //! the rest to its own pool ([`StreamConfig::threads`]: one thread fewer than the cores).
+//! Where there are no threads (wasm32: a browser page has one; or a streamer made with
+//! [`ChunkStreamer::new_local`]) the jobs run on the thread that calls the update, within
+//! [`StreamConfig::local_budget`] per update (at least one job), and the contract below
+//! holds the same.
 //!
 //! # The contract
 //!
@@ -71,6 +75,7 @@
 //! - `schedule`: one update ([`ChunkStreamer::update`], [`StreamFrame`]): what the
 //!   workers finished, unloads, new jobs nearest first, uploads within the budget.
 //! - `jobs`: the generation and meshing jobs the streamer's pool runs.
+//! - `pool`: where they run (worker threads, or the updating thread within a budget).
 //! - `edits`: edits of the blocks ([`ChunkStreamer::set_block`]), kept per chunk.
 //!
 //! [`Mesher::mesh`]: voxel_mesh::Mesher::mesh
@@ -80,6 +85,7 @@ mod config;
 mod edits;
 mod jobs;
 mod local;
+mod pool;
 mod schedule;
 mod slot;
 mod source;
@@ -94,7 +100,7 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 
 use voxel_core::{BlockRegistry, Chunk, ChunkPos, World};
 
-use crate::{Error, Result};
+use crate::Result;
 
 pub use config::{MAX_VIEW_DISTANCE, StreamConfig};
 pub use edits::{EDIT_BYTES, EDITED_CHUNK_BYTES};
@@ -103,13 +109,14 @@ pub use source::{ChunkSink, ChunkSource};
 
 use edits::ChunkEdits;
 use jobs::Done;
+use pool::Pool;
 use schedule::{distance2, within};
 use slot::{Ready, Slot};
 
 /// Loads, meshes, uploads and unloads the chunks around an eye (see the module docs).
 pub struct ChunkStreamer {
     config: StreamConfig,
-    pool: rayon::ThreadPool,
+    pool: Pool,
     source: Arc<dyn ChunkSource>,
     registry: Arc<BlockRegistry>,
     world: World,
@@ -157,14 +164,17 @@ impl std::fmt::Debug for ChunkStreamer {
 
 impl Drop for ChunkStreamer {
     fn drop(&mut self) {
-        // The pool finishes what is queued before its threads exit: make that nothing.
+        // The pool finishes what is queued before its threads exit: make that nothing
+        // (a local queue is dropped with the streamer).
         self.cancelled.store(true, Ordering::Relaxed);
     }
 }
 
 impl ChunkStreamer {
     /// A streamer over `registry` loading from `source`; nothing loads before the first
-    /// [`ChunkStreamer::update`]. Fails on a configuration outside its ranges.
+    /// [`ChunkStreamer::update`]. Fails on a configuration outside its ranges. Its jobs run
+    /// on a pool of [`StreamConfig::threads`] worker threads; on wasm32, which has none,
+    /// on the updating thread as with [`ChunkStreamer::new_local`].
     pub fn new(
         registry: Arc<BlockRegistry>,
         source: impl ChunkSource,
@@ -172,19 +182,34 @@ impl ChunkStreamer {
     ) -> Result<Self> {
         config.validate()?;
         source.check(&registry)?;
-        let threads = match config.threads {
-            0 => {
-                std::thread::available_parallelism().map_or(1, |n| n.get().saturating_sub(1).max(1))
-            }
-            n => n,
-        };
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .thread_name(|i| format!("chunk-streamer-{i}"))
-            .build()
-            .map_err(|e| Error::InvalidSetting(format!("the streamer's {threads} threads: {e}")))?;
+        let pool = Pool::new(config.threads)?;
+        Ok(Self::with_pool(registry, source, config, pool))
+    }
+
+    /// A streamer whose generation and meshing jobs run on the thread that calls
+    /// [`ChunkStreamer::update`], within [`StreamConfig::local_budget`] per update (at
+    /// least one job, so that a job longer than the budget still moves on), and no thread
+    /// is started: what a browser page gets (wasm32; [`ChunkStreamer::new`] makes this
+    /// there), or a game that wants its frames to do the work. `threads` is not read.
+    /// Fails as [`ChunkStreamer::new`] does.
+    pub fn new_local(
+        registry: Arc<BlockRegistry>,
+        source: impl ChunkSource,
+        config: StreamConfig,
+    ) -> Result<Self> {
+        config.validate()?;
+        source.check(&registry)?;
+        Ok(Self::with_pool(registry, source, config, Pool::local()))
+    }
+
+    fn with_pool(
+        registry: Arc<BlockRegistry>,
+        source: impl ChunkSource,
+        config: StreamConfig,
+        pool: Pool,
+    ) -> Self {
         let (tx, rx) = channel();
-        Ok(Self {
+        Self {
             pool,
             offsets: Self::offsets(&config),
             config,
@@ -204,7 +229,13 @@ impl ChunkStreamer {
             rx,
             jobs: 0,
             next_version: 0,
-        })
+        }
+    }
+
+    /// Whether its jobs run on the updating thread ([`ChunkStreamer::new_local`], and
+    /// every streamer on wasm32).
+    pub fn is_local(&self) -> bool {
+        self.pool.is_local()
     }
 
     fn offsets(config: &StreamConfig) -> Vec<[i32; 3]> {

@@ -5,7 +5,9 @@
 use std::collections::VecDeque;
 
 use glam::DVec3;
+// std's Instant panics in a browser; web_time's is std's elsewhere.
 use voxel_core::{BlockId, CHUNK_SIZE, ChunkPos, Neighbourhood};
+use web_time::Instant;
 
 use super::jobs::Done;
 use super::slot::{Ready, Slot, State};
@@ -142,9 +144,40 @@ impl ChunkStreamer {
         self.receive(centre, &mut frame);
         self.unload_some(centre, sink, &mut frame);
         self.dispatch(centre);
+        self.run_local(centre, &mut frame);
         self.upload_some(sink, &mut frame);
         frame.jobs = self.jobs;
         Ok(frame)
+    }
+
+    /// A local pool's jobs, on this thread within [`StreamConfig::local_budget`] (at least
+    /// one): when the queue runs dry, what the finished jobs made possible is queued (new
+    /// chunks meshed once their neighbours have their blocks). Nothing with worker threads.
+    ///
+    /// [`StreamConfig::local_budget`]: super::StreamConfig::local_budget
+    fn run_local(&mut self, centre: ChunkPos, frame: &mut StreamFrame) {
+        if !self.pool.is_local() {
+            return;
+        }
+        let start = Instant::now();
+        loop {
+            let job = match self.pool.pop() {
+                Some(job) => job,
+                None => {
+                    self.receive(centre, frame);
+                    self.dispatch(centre);
+                    match self.pool.pop() {
+                        Some(job) => job,
+                        None => break,
+                    }
+                }
+            };
+            job();
+            if start.elapsed() >= self.config.local_budget {
+                break;
+            }
+        }
+        self.receive(centre, frame);
     }
 
     fn receive(&mut self, centre: ChunkPos, frame: &mut StreamFrame) {

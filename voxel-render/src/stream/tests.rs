@@ -314,7 +314,16 @@ fn bad_configurations_are_errors() {
             ..StreamConfig::default()
         };
         assert!(ChunkStreamer::new(registry(), Pillars, c).is_err(), "{c:?}");
+        assert!(
+            ChunkStreamer::new_local(registry(), Pillars, c).is_err(),
+            "{c:?}"
+        );
     }
+    let c = StreamConfig {
+        local_budget: std::time::Duration::from_millis(1001),
+        ..config(2)
+    };
+    assert!(ChunkStreamer::new_local(registry(), Pillars, c).is_err());
     let mut s = ChunkStreamer::new(registry(), Pillars, config(2)).unwrap();
     assert!(s.set_view_distance(0).is_err());
     assert_eq!(s.config().view_distance, 2, "unchanged after an error");

@@ -2,6 +2,7 @@
 //! code.
 
 use super::*;
+use crate::Error;
 
 /// What a test source makes at a position.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -370,12 +371,18 @@ fn random_sequences_hold_the_truth_once_idle() {
             max_unloads: [1, 7, 256][(seq / 3 % 3) as usize],
             scan_budget: [3, 2048][(seq % 2) as usize],
             upload_budget_bytes: [64, 1 << 20][(seq / 2 % 2) as usize],
+            local_budget: std::time::Duration::from_micros([0, 300, 4000][(seq / 4 % 3) as usize]),
         };
         let source = TestSource {
             failing,
             changing: changing.then(|| std::sync::atomic::AtomicU64::new(0)),
         };
-        let mut s = ChunkStreamer::new(registry(), source, config).unwrap();
+        // One sequence in four with its jobs on the updating thread (a browser page's).
+        let mut s = if seq % 4 == 3 {
+            ChunkStreamer::new_local(registry(), source, config).unwrap()
+        } else {
+            ChunkStreamer::new(registry(), source, config).unwrap()
+        };
         let mut truth = Truth::new(failing);
         let mut sink = Holder::default();
         let mut failed = HashSet::new();
@@ -903,4 +910,88 @@ fn same_blocks_compares_every_block_in_any_form() {
         &Chunk::uniform(blocks::WATER),
         &Chunk::default()
     ));
+}
+
+/// The contract holds where the jobs run on the updating thread (a browser page's
+/// streamer, wasm32): a route of return trips and edits, each checked against the true
+/// world once idle, with no thread started.
+#[test]
+fn a_local_streamer_holds_the_truth_once_idle() {
+    let config = StreamConfig {
+        view_distance: 3,
+        vertical_distance: 1,
+        hysteresis: 1,
+        local_budget: std::time::Duration::from_millis(2),
+        ..StreamConfig::default()
+    };
+    let source = TestSource {
+        failing: true,
+        changing: None,
+    };
+    let mut s = ChunkStreamer::new_local(registry(), source, config).unwrap();
+    assert!(s.is_local());
+    let mut truth = Truth::new(true);
+    let mut sink = Holder::default();
+    let route = [
+        ChunkPos::new(0, 0, 0),
+        ChunkPos::new(2, 0, 1),
+        ChunkPos::new(9, 1, -3),
+        ChunkPos::new(0, 0, 0),
+    ];
+    let mut failed = HashSet::new();
+    for (i, &c) in route.iter().enumerate() {
+        let eye = eye_in(c);
+        let idle = run_to_idle(&mut s, eye, &mut sink, &mut failed, 10_000);
+        assert!(idle.is_some(), "stop {i}: not idle: {s:?}");
+        check_against_truth(&s, &sink, &truth, eye, &failed, &format!("stop {i}"));
+        // An edit in the eye's chunk and one at the view-distance edge.
+        for at in [
+            WorldPos::new(c.x * 32 + 3, c.y * 32 + 4, c.z * 32 + 31),
+            WorldPos::new((c.x + 3) * 32, c.y * 32 + 1, c.z * 32 + 5),
+        ] {
+            if s.set_block(at, blocks::GLASS).is_ok() {
+                truth.edit(at, blocks::GLASS);
+            }
+        }
+        let idle = run_to_idle(&mut s, eye, &mut sink, &mut failed, 10_000);
+        assert!(idle.is_some(), "stop {i} edited: not idle: {s:?}");
+        check_against_truth(&s, &sink, &truth, eye, &failed, &format!("stop {i} edited"));
+    }
+    assert!(sink.held.len() > 20, "{} chunks drawn", sink.held.len());
+}
+
+/// A local streamer's update works within its budget: with a source that takes at
+/// least 2 ms a chunk and a 5 ms budget, at most 3 chunks are made per update (the third
+/// crosses it); with no budget, exactly one job per update, so streaming still moves on.
+#[test]
+fn a_local_update_stays_within_its_budget() {
+    for (budget_ms, most) in [(5, 3), (0, 1)] {
+        let calls = Arc::new(std::sync::atomic::AtomicUsize::new(0));
+        let config = StreamConfig {
+            view_distance: 2,
+            vertical_distance: 0,
+            local_budget: std::time::Duration::from_millis(budget_ms),
+            ..StreamConfig::default()
+        };
+        let mut s = ChunkStreamer::new_local(registry(), Slow(calls.clone()), config).unwrap();
+        let mut sink = Holder::default();
+        let eye = DVec3::splat(16.0);
+        let mut updates = 0;
+        while !s.is_idle() {
+            let before = calls.load(Ordering::SeqCst);
+            s.update(eye, &mut sink).unwrap();
+            let made = calls.load(Ordering::SeqCst) - before;
+            assert!(
+                made <= most,
+                "budget {budget_ms} ms: {made} chunks in one update"
+            );
+            updates += 1;
+            assert!(updates < 10_000, "not idle: {s:?}");
+        }
+        // Every chunk within the distance and its neighbours: 13 positions (a circle of
+        // radius 2) and the rings around them, each made once.
+        let made = calls.load(Ordering::SeqCst);
+        assert!(made >= 13 * 3, "{made} chunks made");
+        assert!(updates >= made / most, "{made} chunks in {updates} updates");
+    }
 }
