@@ -62,8 +62,10 @@ build() {
             return 1
         fi
     fi
-    cargo build --release "${locked[@]}" --target wasm32-unknown-unknown \
-        --manifest-path "$crate/Cargo.toml" --lib
+    # A cdylib whatever the crate's Cargo.toml says (voxel-web is an rlib, so that a game's
+    # page that links it, built in the same target folder, never overwrites this module).
+    cargo rustc --release "${locked[@]}" --target wasm32-unknown-unknown \
+        --manifest-path "$crate/Cargo.toml" --lib --crate-type cdylib
     target="$(target_dir)"
     mkdir -p "$out"
     wasm-bindgen --target web --no-typescript --out-dir "$out" \

@@ -339,10 +339,12 @@ fn a_games_own_page_builds_outside_the_workspace_and_runs() {
     }
     // The workspace's versions (wasm-bindgen's must be the CLI's); none downloaded.
     std::fs::copy(root().join("Cargo.lock"), krate.join("Cargo.lock")).unwrap();
-    // A target folder of its own: voxel-web is a cdylib too, and built as the game's
-    // dependency (without its page) it would replace the crate's own page's
-    // voxel_web.wasm in a shared one.
-    let target = root().join("target/test-output/web-game-target");
+    // The workspace's target folder: the game's page shares the build of every dependency
+    // with the crate's own page (voxel-web is an rlib; web.sh makes each page's module a
+    // cdylib of its own name, so neither overwrites the other).
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target"));
     let out = work.join("out");
     build_page(
         Some(&krate),
