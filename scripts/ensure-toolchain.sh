@@ -19,5 +19,14 @@ ensure_toolchain() {
     # With no argument rustup installs the toolchain the toolchain file names, with its
     # components and targets; a no-op when all are present.
     setup_step "Rust toolchain" "rustup toolchain install $want --component rustfmt clippy --target wasm32-unknown-unknown" \
-        rustup toolchain install >/dev/null
+        rustup_install_quietly
+}
+
+# `rustup toolchain install`, its output shown only when it fails.
+rustup_install_quietly() {
+    local output
+    if ! output="$(rustup toolchain install 2>&1)"; then
+        echo "$output" >&2
+        return 1
+    fi
 }
