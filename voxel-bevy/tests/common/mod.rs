@@ -81,10 +81,10 @@ impl Harness {
                     ..Default::default()
                 })
                 .set(RenderPlugin {
-                    render_creation: RenderCreation::Automatic(WgpuSettings {
+                    render_creation: RenderCreation::Automatic(Box::new(WgpuSettings {
                         backends: Some(wgpu::Backends::VULKAN),
                         ..Default::default()
-                    }),
+                    })),
                     ..Default::default()
                 }),
         );
@@ -97,12 +97,14 @@ impl Harness {
         app.insert_resource(world);
         app.finish();
         app.cleanup();
-        let target = BevyImage::new_target_texture(
+        let mut target = BevyImage::new_target_texture(
             size.0,
             size.1,
             wgpu::TextureFormat::Rgba8UnormSrgb,
             None,
         );
+        // read back by the tests
+        target.texture_descriptor.usage |= wgpu::TextureUsages::COPY_SRC;
         let image = app
             .world_mut()
             .resource_mut::<Assets<BevyImage>>()
