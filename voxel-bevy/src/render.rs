@@ -43,6 +43,9 @@ struct VoxelRender {
     frames: u64,
     /// A frame is being counted (its figures are read at the next prepare).
     counting: bool,
+    /// The content last handed to the content stages (unchanged content is not uploaded
+    /// again).
+    content_drawn: Option<voxel_render::content::Content>,
 }
 
 pub(crate) fn build(app: &mut App, plugin: VoxelPlugin, chunks: ChunkQueue, reports: ReportQueue) {
@@ -114,6 +117,7 @@ fn prepare(
                 state.content = None;
                 state.technique = None;
                 state.lighting = None;
+                state.content_drawn = None;
                 let config = RendererConfig {
                     width: 64,
                     height: 64,
@@ -194,9 +198,12 @@ fn prepare(
         }
     }
     if let Some(content) = &mut state.content
-        && let Err(e) = content.set_content(&ctx, frame.content.clone())
+        && state.content_drawn.as_ref() != Some(&frame.content)
     {
-        message(reports, VoxelMessage::Error(e.to_string()));
+        match content.set_content(&ctx, frame.content.clone()) {
+            Ok(()) => state.content_drawn = Some(frame.content.clone()),
+            Err(e) => message(reports, VoxelMessage::Error(e.to_string())),
+        }
     }
     push(
         &reports.0,
