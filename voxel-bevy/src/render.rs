@@ -1,0 +1,285 @@
+//! The render world: one `voxel_render::Renderer` on Bevy's device and queue, fed with the
+//! chunks, technique, lighting and content the main world gathered, drawing each
+//! [`crate::VoxelCamera`]'s view between Bevy's opaque and transparent passes.
+
+use std::sync::Arc;
+
+use bevy::app::App;
+use bevy::core_pipeline::Core3d;
+use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
+use bevy::ecs::prelude::*;
+use bevy::render::renderer::{RenderAdapter, RenderContext, RenderDevice, RenderQueue, ViewQuery};
+use bevy::render::sync_world::MainEntity;
+use bevy::render::view::{ViewDepthStencilTexture, ViewTarget};
+use bevy::render::{Extract, ExtractSchedule, Render, RenderApp, RenderSystems};
+use voxel_core::BlockRegistry;
+use voxel_render::content::ContentStages;
+use voxel_render::{Both, GpuContext, Lighting, Renderer, RendererConfig, Technique};
+
+use crate::composite::{BevyOpaque, Composite, depth_mapping};
+use crate::{
+    ChunkOp, ChunkQueue, Report, ReportQueue, VoxelFrame, VoxelMessage, VoxelPlugin, VoxelStatus,
+    VoxelTechnique, drain, push,
+};
+
+/// The plugin's settings, in both worlds.
+#[derive(Resource, Clone, Debug)]
+pub(crate) struct PluginSettings {
+    pub(crate) far: f64,
+    pub(crate) renderer: RendererConfig,
+}
+
+/// The crate's renderer and what it draws with, in the render world.
+#[derive(Resource, Default)]
+struct VoxelRender {
+    ctx: Option<GpuContext>,
+    registry: Option<Arc<BlockRegistry>>,
+    renderer: Option<Renderer>,
+    content: Option<ContentStages>,
+    composite: Option<Composite>,
+    /// The request applied last (`None`: a new renderer applies it).
+    technique: Option<VoxelTechnique>,
+    lighting: Option<Lighting>,
+    frames: u64,
+    /// A frame is being counted (its figures are read at the next prepare).
+    counting: bool,
+    /// The content last handed to the content stages (unchanged content is not uploaded
+    /// again).
+    content_drawn: Option<voxel_render::content::Content>,
+}
+
+pub(crate) fn build(app: &mut App, plugin: VoxelPlugin, chunks: ChunkQueue, reports: ReportQueue) {
+    let settings = PluginSettings {
+        far: plugin.far,
+        renderer: plugin.renderer,
+    };
+    app.insert_resource(settings.clone());
+    let Some(render_app) = app.get_sub_app_mut(RenderApp) else {
+        return;
+    };
+    render_app
+        .insert_resource(settings)
+        .insert_resource(chunks)
+        .insert_resource(reports)
+        .init_resource::<VoxelFrame>()
+        .init_resource::<VoxelRender>()
+        .add_systems(ExtractSchedule, extract_frame)
+        .add_systems(Render, prepare.in_set(RenderSystems::Prepare))
+        .add_systems(
+            Core3d,
+            voxel_pass
+                .after(main_opaque_pass_3d)
+                .before(main_transparent_pass_3d),
+        );
+}
+
+fn extract_frame(main: Extract<Res<VoxelFrame>>, mut frame: ResMut<VoxelFrame>) {
+    frame.clone_from(&**main);
+}
+
+fn message(reports: &ReportQueue, m: VoxelMessage) {
+    match &m {
+        VoxelMessage::TechniqueChanged { requested, drawing } => {
+            log::info!("voxel-bevy: {requested:?} draws as {}", drawing.name());
+        }
+        VoxelMessage::Unsupported { requested, reason } => {
+            log::warn!("voxel-bevy: {requested:?} is not supported here: {reason}");
+        }
+        VoxelMessage::Error(e) => log::error!("voxel-bevy: {e}"),
+    }
+    push(&reports.0, Report::Message(m));
+}
+
+/// Applies the chunk changes, the technique, the lighting and the content.
+#[allow(clippy::too_many_arguments)] // a Bevy system: one parameter per resource
+fn prepare(
+    mut state: ResMut<VoxelRender>,
+    frame: Res<VoxelFrame>,
+    chunks: Res<ChunkQueue>,
+    reports: Res<ReportQueue>,
+    settings: Res<PluginSettings>,
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    adapter: Res<RenderAdapter>,
+) {
+    let state = &mut *state;
+    let ctx = state
+        .ctx
+        .get_or_insert_with(|| {
+            GpuContext::from_device(&adapter, device.wgpu_device().clone(), (**queue).clone())
+        })
+        .clone();
+    let reports = &*reports;
+    for op in drain(&chunks.0) {
+        match op {
+            ChunkOp::Reset(registry) => {
+                state.renderer = None;
+                state.content = None;
+                state.technique = None;
+                state.lighting = None;
+                state.content_drawn = None;
+                let config = RendererConfig {
+                    width: 64,
+                    height: 64,
+                    ..settings.renderer.clone()
+                };
+                match Renderer::new(&ctx, &registry, config) {
+                    Ok(r) => {
+                        match ContentStages::new(&r, Default::default()) {
+                            Ok(c) => state.content = Some(c),
+                            Err(e) => message(reports, VoxelMessage::Error(e.to_string())),
+                        }
+                        state.renderer = Some(r);
+                    }
+                    Err(e) => message(reports, VoxelMessage::Error(format!("renderer: {e}"))),
+                }
+                state.registry = Some(registry);
+            }
+            ChunkOp::Upload(pos, meshes) => {
+                if let Some(r) = &mut state.renderer
+                    && let Err(e) = r.upload_chunk(pos, &meshes)
+                {
+                    message(reports, VoxelMessage::Error(format!("chunk {pos:?}: {e}")));
+                }
+            }
+            ChunkOp::Remove(pos) => {
+                if let Some(r) = &mut state.renderer {
+                    r.remove_chunk(pos);
+                }
+            }
+        }
+    }
+    let Some(renderer) = &mut state.renderer else {
+        return;
+    };
+    let mut last_cost = None;
+    if std::mem::take(&mut state.counting) {
+        match voxel_render::low_level::frame_cost(renderer) {
+            Ok(cost) => last_cost = cost,
+            Err(e) => message(reports, VoxelMessage::Error(format!("frame cost: {e}"))),
+        }
+    }
+    if frame.count {
+        voxel_render::low_level::count_next_frame(renderer);
+        state.counting = true;
+    }
+    if state.technique != Some(frame.technique) {
+        let requested = frame.technique;
+        state.technique = Some(requested);
+        let wanted = match requested {
+            VoxelTechnique::BestAvailable => Technique::best_available(&ctx.caps),
+            VoxelTechnique::Use(t) if t.stalls() => Err(voxel_render::Error::Unsupported(format!(
+                "{} waits for the GPU inside its frame, which Bevy submits after every camera \
+                 is recorded; use one of Technique::REAL_TIME",
+                t.name()
+            ))),
+            VoxelTechnique::Use(t) => Ok(t),
+        };
+        match wanted.and_then(|t| renderer.set_technique(t)) {
+            Ok(drawing) => message(
+                reports,
+                VoxelMessage::TechniqueChanged { requested, drawing },
+            ),
+            Err(e) => message(
+                reports,
+                VoxelMessage::Unsupported {
+                    requested,
+                    reason: e.to_string(),
+                },
+            ),
+        }
+    }
+    if let Some(l) = frame.lighting
+        && state.lighting != Some(l)
+    {
+        state.lighting = Some(l);
+        if let Err(e) = renderer.set_lighting(l) {
+            message(reports, VoxelMessage::Error(format!("lighting: {e}")));
+        }
+    }
+    if let Some(content) = &mut state.content
+        && state.content_drawn.as_ref() != Some(&frame.content)
+    {
+        match content.set_content(&ctx, frame.content.clone()) {
+            Ok(()) => state.content_drawn = Some(frame.content.clone()),
+            Err(e) => message(reports, VoxelMessage::Error(e.to_string())),
+        }
+    }
+    push(
+        &reports.0,
+        Report::Status(VoxelStatus {
+            drawing: Some(renderer.config().oit.technique),
+            adapter: Some(ctx.caps.adapter_name.clone()),
+            frames: state.frames,
+            last_cost,
+        }),
+    );
+}
+
+/// Draws the world into a [`crate::VoxelCamera`]'s view, after Bevy's opaque pass.
+fn voxel_pass(
+    view: ViewQuery<(&MainEntity, &ViewTarget, &ViewDepthStencilTexture)>,
+    mut state: ResMut<VoxelRender>,
+    frame: Res<VoxelFrame>,
+    reports: Res<ReportQueue>,
+    mut render_context: RenderContext,
+) {
+    let (main, target, depth) = view.into_inner();
+    let Some(camera) = frame.cameras.get(&main.id()) else {
+        return;
+    };
+    let state = &mut *state;
+    let (Some(ctx), Some(renderer), Some(content)) =
+        (&state.ctx, &mut state.renderer, &mut state.content)
+    else {
+        return;
+    };
+    let composite = state
+        .composite
+        .get_or_insert_with(|| Composite::new(&ctx.device));
+    let color = target.main_texture();
+    let size = (color.width(), color.height());
+    if renderer.size() != size
+        && let Err(e) = renderer.resize(size.0, size.1)
+    {
+        message(&reports, VoxelMessage::Error(format!("resize: {e}")));
+        return;
+    }
+    if depth.texture().sample_count() != 1 {
+        message(
+            &reports,
+            VoxelMessage::Error("the camera's depth is multisampled: set Msaa::Off".into()),
+        );
+        return;
+    }
+    let mapping = depth_mapping(camera.near, camera.far);
+    let ldr = !matches!(
+        target.main_texture_format(),
+        wgpu::TextureFormat::Rgba16Float | wgpu::TextureFormat::Rgba32Float
+    );
+    let color_view: &wgpu::TextureView = target.main_texture_view();
+    let bevy_depth = depth
+        .texture()
+        .create_view(&wgpu::TextureViewDescriptor::default());
+    let into_world = composite.bind_group(&ctx.device, color_view, &bevy_depth, mapping, ldr);
+    let into_bevy = composite.bind_group(
+        &ctx.device,
+        color_view,
+        renderer.scene_depth_view(),
+        mapping,
+        ldr,
+    );
+    let encoder: &mut wgpu::CommandEncoder = render_context.command_encoder();
+    let mut opaque = BevyOpaque::new(composite, into_world);
+    let mut game = Both::new(&mut *content, &mut opaque);
+    match renderer.render(encoder, color_view, camera, &mut game) {
+        Ok(_) => {
+            drop(game);
+            opaque
+                .composite
+                .depth_into_bevy(encoder, &bevy_depth, &into_bevy);
+            state.frames += 1;
+        }
+        Err(e) => message(&reports, VoxelMessage::Error(format!("frame: {e}"))),
+    }
+}

@@ -1,0 +1,127 @@
+//! A headless Bevy app with `VoxelPlugin` draws suite scenes as the crate draws them on its
+//! own (same device, same camera), with every real-time technique, LDR and HDR; a
+//! technique that cannot run in Bevy's frame is reported, not a panic.
+
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+mod common;
+
+use std::path::PathBuf;
+
+use common::{Harness, have_gpu, save, share_over_one};
+use voxel_bevy::{VoxelContent, VoxelMessage, VoxelStatus, VoxelTechnique, VoxelWorld};
+use voxel_lab::scene::Scene;
+use voxel_render::Technique;
+
+fn scene(name: &str) -> Scene {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenes")
+        .join(format!("{name}.toml"));
+    Scene::load(&path).unwrap()
+}
+
+/// Renders `name` through Bevy with every real-time technique and compares each picture with
+/// the crate's own render of the plugin's camera on Bevy's device.
+fn matches_the_crate(name: &str, hdr: bool) {
+    let s = scene(name);
+    let cam = s.cameras[0];
+    let size = (160, 120);
+    let mut h = Harness::new(
+        VoxelWorld::from_world(s.world.clone()),
+        cam.eye,
+        cam.forward,
+        cam.fov_y_deg,
+        cam.near,
+        cam.far,
+        size,
+        hdr,
+    );
+    h.app.insert_resource(VoxelContent(s.content.clone()));
+    h.frames(1);
+    let ctx = h.ctx();
+    let camera = h.camera();
+    let mut reference_scene = Scene::new(name, s.world.clone(), camera);
+    reference_scene.content = s.content.clone();
+    for t in Technique::REAL_TIME {
+        h.app.insert_resource(VoxelTechnique::Use(t));
+        let bevy = h.frames(2);
+        let drawing = h.app.world().resource::<VoxelStatus>().drawing.unwrap();
+        let reference = tests::render(&ctx, &reference_scene, drawing, size.0, size.1);
+        let tag = format!("{name}-{}{}", t.name(), if hdr { "-hdr" } else { "" });
+        save(&tag, &bevy, &reference);
+        let share = share_over_one(&bevy, &reference);
+        eprintln!("{tag}: {:.4} % of pixels over 1/255", share * 100.0);
+        assert!(
+            share <= 0.001,
+            "{tag}: {:.3} % of the pixels differ by more than 1/255 ({:?})",
+            share * 100.0,
+            tests::diff(&bevy, &reference)
+        );
+        assert!(tests::distinct_colours(&bevy) > 20, "{tag}: a flat picture");
+    }
+}
+
+#[test]
+fn water_through_glass_matches_the_crate_with_every_technique() {
+    if have_gpu() {
+        matches_the_crate("water_through_glass", false);
+    }
+}
+
+#[test]
+fn under_water_matches_the_crate_with_every_technique_hdr() {
+    if have_gpu() {
+        matches_the_crate("under_water", true);
+    }
+}
+
+#[test]
+fn game_through_panes_with_content_matches_the_crate_with_every_technique() {
+    if have_gpu() {
+        matches_the_crate("game_through_panes", false);
+    }
+}
+
+#[test]
+fn a_technique_that_stalls_is_reported_and_the_previous_one_draws_on() {
+    if !have_gpu() {
+        return;
+    }
+    let s = scene("water_through_glass");
+    let cam = s.cameras[0];
+    let mut h = Harness::new(
+        VoxelWorld::from_world(s.world.clone()),
+        cam.eye,
+        cam.forward,
+        cam.fov_y_deg,
+        cam.near,
+        cam.far,
+        (96, 64),
+        false,
+    );
+    h.app
+        .insert_resource(VoxelTechnique::Use(Technique::Sorted));
+    let before = h.frames(2);
+    assert!(h.messages().iter().any(|m| matches!(
+        m,
+        VoxelMessage::TechniqueChanged {
+            drawing: Technique::Sorted,
+            ..
+        }
+    )));
+    h.app
+        .insert_resource(VoxelTechnique::Use(Technique::Reference));
+    let after = h.frames(2);
+    let messages = h.messages();
+    assert!(
+        messages.iter().any(
+            |m| matches!(m, VoxelMessage::Unsupported { reason, .. } if reason.contains("waits"))
+        ),
+        "{messages:?}"
+    );
+    assert_eq!(
+        h.app.world().resource::<VoxelStatus>().drawing,
+        Some(Technique::Sorted)
+    );
+    assert_eq!(tests::diff(&before, &after).max, 0);
+}
