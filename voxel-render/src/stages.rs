@@ -100,16 +100,19 @@ impl TranslucentObject {
 
 /// Where a run of objects is drawn: after quads `..quad` of chunk `chunk` (its position
 /// in the draw order; quad 0: before the chunk; past the last chunk: after every chunk),
-/// objects of the order up to `end`, clipped by the frame's clip `clip` (0: not clipped;
-/// the parts of an object cut at planes it reaches through), made by the sorted
-/// techniques (`oit::sorted::interleave`).
+/// the objects at positions `start..end` of the order, clipped by the frame's clip `clip`
+/// (0: not clipped; the parts of an object cut at planes it reaches through), made by the
+/// sorted techniques (`oit::sorted::interleave`). The runs are drawn in turn; each
+/// position is in one run per part of its object.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Split {
     /// The chunk, by its position in the draw order.
     pub chunk: u32,
     /// How many of its quads (in their drawn order) come before the objects.
     pub quad: u32,
-    /// The objects of the order drawn here end at this position.
+    /// The first position of the order drawn here.
+    pub start: u32,
+    /// The position after the last one drawn here.
     pub end: u32,
     /// The clip of the run's parts (an index into the frame's clips; 0: none).
     pub clip: u32,
