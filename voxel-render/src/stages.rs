@@ -168,8 +168,11 @@ pub struct GameFrame<'a> {
     /// The light's brightness, 1 by day (see `sun_dir`).
     pub brightness: f32,
     /// Sorted techniques: the game's translucent objects back to front (indices into
-    /// [`GameStages::translucent_objects`]); `None` when the technique does not sort. A
-    /// game drawing instances uploads them in this order in `prepare`.
+    /// [`GameStages::translucent_objects`], each once, never more than the objects);
+    /// `None` when the technique does not sort. A game drawing instances uploads them in
+    /// this order in `prepare`: instance buffers sized for its objects hold it. An object
+    /// `sorted-quads` cuts into parts is at its first part's position, and
+    /// [`GameStages::translucent`] draws that position once per part.
     pub order: Option<&'a [u32]>,
     /// The writes [`GameFrame::write_buffer`] gathers in `prepare`.
     pub(crate) writes: &'a GameWrites,
@@ -366,7 +369,10 @@ pub trait GameStages {
     /// Translucent geometry in one pass of the technique: set the pipeline built for
     /// `contract.variants[variant]` (group [`OIT_GROUP`] is bound) and draw the objects of
     /// `objects` — positions in `frame.order` for a sorted technique, else indices into
-    /// [`GameStages::translucent_objects`] — or everything when there are none.
+    /// [`GameStages::translucent_objects`] — or everything when there are none. A sorted
+    /// technique asks for the ranges in its draw order, not in increasing order, and may
+    /// ask for a position again (the parts of an object cut where it reaches through a
+    /// plane, each drawn with its own clip).
     fn translucent(
         &self,
         _pass: &mut wgpu::RenderPass<'_>,

@@ -1,6 +1,7 @@
 //! The sound tests against rays and hand-built chunk surfaces, and objects placed among
 //! chunks and among the quads of one chunk.
 
+use super::draw_order::may_overlap;
 use super::*;
 
 /// How a point stands against a chunk's translucent quads.
