@@ -43,7 +43,7 @@ mod place;
 mod sound;
 
 use cells::{CellIndex, KeyIndex, eye_cell};
-use draw_order::{farthest_key, group_clips, order_by_place};
+use draw_order::{Entry, farthest_key, group_clips, order_by_place};
 use sound::SeenPlane;
 #[cfg(test)]
 use sound::{SOUND, quad_side, safe, seen_planes};
@@ -168,10 +168,11 @@ pub(crate) struct Interleaver {
     latest: Vec<(u32, u32)>,
     /// Room for gathering: each part's latest place as a sort key, and the part.
     by_latest: Vec<(u64, u32)>,
-    /// Each part's distance as a key that orders farthest first, and the part.
-    farthest: Vec<(u32, u32)>,
-    /// Room for the radix sort.
-    spare: Vec<(u32, u32)>,
+    /// Each part's distance as a key that orders farthest first.
+    farthest: Vec<u32>,
+    /// Room for [`order_by_place`]'s sorts.
+    entries: Vec<Entry>,
+    spare: Vec<Entry>,
     /// The constraints of the object being placed: (chunk, quad after which it applies,
     /// weight, the first quad of its run).
     items: Vec<(u32, u32, i64, u32)>,
@@ -195,6 +196,8 @@ pub(crate) struct Interleaver {
     /// positions in `order` drawn in turn.
     order: Vec<u32>,
     drawn: Vec<u32>,
+    /// The place of each part in `drawn`.
+    drawn_at: Vec<(u32, u32)>,
     splits: Vec<Split>,
     /// Room for [`group_clips`].
     grouped: Vec<u32>,
@@ -358,16 +361,18 @@ impl Interleaver {
             parts,
             places,
             farthest,
+            entries,
             spare,
             order,
             drawn,
+            drawn_at,
             splits,
             grouped,
             position,
             ..
         } = self;
-        order_by_place(places, farthest, spare, last, drawn);
-        group_clips(parts, places, eye, drawn, grouped);
+        order_by_place(places, farthest, (entries, spare), last, drawn, drawn_at);
+        group_clips(parts, drawn_at, eye, drawn, grouped);
         // Each object once in the order, at the position of its first part drawn: a later
         // part of it draws that position again, with its own clip. So the order is never
         // longer than the objects, whatever they are cut into, and a game's instance
@@ -376,9 +381,8 @@ impl Interleaver {
         position.resize(count, u32::MAX);
         order.clear();
         splits.clear();
-        for &p in drawn.iter() {
+        for (&p, &(chunk, quad)) in drawn.iter().zip(drawn_at.iter()) {
             let part = &parts[p as usize];
-            let (chunk, quad) = places[p as usize];
             let at = &mut position[part.object as usize];
             if *at == u32::MAX {
                 *at = order.len() as u32;
@@ -408,7 +412,7 @@ impl Interleaver {
     /// Adds a part that may go anywhere from place `range.0` to `range.1` (the same
     /// constraints ruled out at each), with distance key `key`.
     fn push_range(&mut self, part: Part, range: ((u32, u32), (u32, u32)), key: u32) {
-        self.farthest.push((key, self.parts.len() as u32));
+        self.farthest.push(key);
         self.places.push(range.0);
         self.latest.push(range.1);
         self.parts.push(part);

@@ -556,7 +556,7 @@ fn parts_of_one_clip_join_a_run_only_over_parts_they_cannot_overlap() {
             clip,
         })
         .collect();
-    let places = vec![(0, 0); parts.len()];
+    let places = vec![(0u32, 0u32); parts.len()];
     let (mut drawn, mut room) = ((0..parts.len() as u32).collect::<Vec<_>>(), Vec::new());
     group_clips(&parts, &places, eye, &mut drawn, &mut room);
     // Part 2 moves back over part 1 (apart on screen) to join part 0; part 4 stays after
