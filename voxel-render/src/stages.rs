@@ -100,16 +100,19 @@ impl TranslucentObject {
 
 /// Where a run of objects is drawn: after quads `..quad` of chunk `chunk` (its position
 /// in the draw order; quad 0: before the chunk; past the last chunk: after every chunk),
-/// objects of the order up to `end`, clipped by the frame's clip `clip` (0: not clipped;
-/// the parts of an object cut at planes it reaches through), made by the sorted
-/// techniques (`oit::sorted::interleave`).
+/// the objects at positions `start..end` of the order, clipped by the frame's clip `clip`
+/// (0: not clipped; the parts of an object cut at planes it reaches through), made by the
+/// sorted techniques (`oit::sorted::interleave`). The runs are drawn in turn; each
+/// position is in one run per part of its object.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Split {
     /// The chunk, by its position in the draw order.
     pub chunk: u32,
     /// How many of its quads (in their drawn order) come before the objects.
     pub quad: u32,
-    /// The objects of the order drawn here end at this position.
+    /// The first position of the order drawn here.
+    pub start: u32,
+    /// The position after the last one drawn here.
     pub end: u32,
     /// The clip of the run's parts (an index into the frame's clips; 0: none).
     pub clip: u32,
@@ -165,8 +168,11 @@ pub struct GameFrame<'a> {
     /// The light's brightness, 1 by day (see `sun_dir`).
     pub brightness: f32,
     /// Sorted techniques: the game's translucent objects back to front (indices into
-    /// [`GameStages::translucent_objects`]); `None` when the technique does not sort. A
-    /// game drawing instances uploads them in this order in `prepare`.
+    /// [`GameStages::translucent_objects`], each once, never more than the objects);
+    /// `None` when the technique does not sort. A game drawing instances uploads them in
+    /// this order in `prepare`: instance buffers sized for its objects hold it. An object
+    /// `sorted-quads` cuts into parts is at its first part's position, and
+    /// [`GameStages::translucent`] draws that position once per part.
     pub order: Option<&'a [u32]>,
     /// The writes [`GameFrame::write_buffer`] gathers in `prepare`.
     pub(crate) writes: &'a GameWrites,
@@ -363,7 +369,10 @@ pub trait GameStages {
     /// Translucent geometry in one pass of the technique: set the pipeline built for
     /// `contract.variants[variant]` (group [`OIT_GROUP`] is bound) and draw the objects of
     /// `objects` — positions in `frame.order` for a sorted technique, else indices into
-    /// [`GameStages::translucent_objects`] — or everything when there are none.
+    /// [`GameStages::translucent_objects`] — or everything when there are none. A sorted
+    /// technique asks for the ranges in its draw order, not in increasing order, and may
+    /// ask for a position again (the parts of an object cut where it reaches through a
+    /// plane, each drawn with its own clip).
     fn translucent(
         &self,
         _pass: &mut wgpu::RenderPass<'_>,

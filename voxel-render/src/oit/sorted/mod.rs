@@ -410,11 +410,11 @@ impl TranslucentTechnique for Sorted {
                         draws.draw_quads(frame.chunks, c, quad..split.quad, pass);
                         quad = split.quad;
                     }
-                    let end = split.end as usize;
-                    if end > next {
-                        objects(pass, next..end, split.clip);
+                    let (start, end) = (split.start as usize, split.end as usize);
+                    if end > start {
+                        objects(pass, start..end, split.clip);
                         lost.set(true);
-                        next = end;
+                        next = next.max(end);
                     }
                 }
                 chunk_state(pass);

@@ -261,19 +261,16 @@ fn where_the_sound_tests_decide_the_fast_order_agrees_with_all_pairs() {
         let old = all_pairs(&balls, eye, &surfaces, two_sided, split_quads);
         let (order, splits) = interleave(&balls, eye, &seq, two_sided, split_quads);
         // The new place of each object, from the splits; an object cut into parts where it
-        // reaches through a plane (sorted-quads) is in the order once per part, and no
+        // reaches through a plane (sorted-quads) is drawn by one run per part, and no
         // single place of it is compared (the parts are tested on their own).
         let mut new = vec![(surfaces.len() as u32, 0u32); balls.len()];
         let mut parts = vec![0u32; balls.len()];
-        for &i in &order {
-            parts[i as usize] += 1;
-        }
-        let mut start = 0;
+        assert!(order.len() <= balls.len(), "each object once in the order");
         for s in &splits {
-            for &i in &order[start..s.end as usize] {
+            for &i in &order[s.start as usize..s.end as usize] {
                 new[i as usize] = (s.chunk, s.quad);
+                parts[i as usize] += 1;
             }
-            start = s.end as usize;
         }
         for (i, &b) in balls.iter().enumerate() {
             if parts[i] > 1 {

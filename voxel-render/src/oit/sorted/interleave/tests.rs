@@ -1,6 +1,7 @@
 //! The sound tests against rays and hand-built chunk surfaces, and objects placed among
 //! chunks and among the quads of one chunk.
 
+use super::draw_order::may_overlap;
 use super::*;
 
 /// How a point stands against a chunk's translucent quads.
@@ -296,15 +297,17 @@ fn objects_go_before_the_first_chunk_they_are_behind() {
     // the far water and what lies under the near water (each ball lies in one chunk
     // cell: only that cell's chunk is tested; farther chunks come before it, nearer
     // ones after), farthest first.
-    let at = |chunk, end| Split {
+    let at = |chunk, start, end| Split {
         chunk,
         quad: 0,
+        start,
         end,
         clip: 0,
     };
-    assert_eq!(splits, vec![at(0, 1), at(2, 3)]);
+    assert_eq!(splits, vec![at(0, 0, 1), at(2, 1, 3), at(3, 3, 5)]);
     assert_eq!(order[..3], [0, 1, 2]);
-    // Over the near water and by the eye: after every chunk, farthest first.
+    // Over the near water and by the eye: after every chunk (past the last), farthest
+    // first.
     assert_eq!(order[3..], [3, 4]);
 }
 
@@ -354,6 +357,7 @@ fn between_water_and_a_pane_of_one_chunk_an_object_goes_between_their_quads() {
     let want = Split {
         chunk: 0,
         quad: 1,
+        start: 0,
         end: 1,
         clip: 0,
     };
@@ -427,7 +431,10 @@ fn an_object_through_a_surface_is_cut_and_each_part_placed_on_its_side() {
         let mut orderer = Interleaver::default();
         orderer.run(1, |_| cube, eye, &seq, two_sided, true);
         let (order, splits, clips) = orderer.result();
-        assert_eq!(order, [0, 0], "two parts of object 0");
+        // Object 0 once in the order, drawn by two runs (one a part).
+        assert_eq!(order, [0]);
+        assert_eq!(splits.len(), 2, "two parts of object 0: {splits:?}");
+        assert!(splits.iter().all(|s| (s.start, s.end) == (0, 1)));
         // The part beyond the surface before its quad, the part on the eye's side after it
         // (past the chunk's last quad: after the chunk).
         let far = splits
@@ -484,7 +491,8 @@ fn a_face_lying_in_a_surface_is_on_the_eyes_side_of_it() {
         let mut orderer = Interleaver::default();
         orderer.run(1, |_| foam, eye, &seq, eye.y < 4.0, true);
         let (order, splits, clips) = orderer.result();
-        (order.len(), splits.to_vec(), clips.to_vec())
+        assert_eq!(order, [0]);
+        (splits.len(), splits.to_vec(), clips.to_vec())
     };
     // From above: wholly on the eye's side, after the surface, not cut.
     let (parts, splits, _) = place(DVec3::new(16.0, 9.0, 40.0));
@@ -548,7 +556,7 @@ fn parts_of_one_clip_join_a_run_only_over_parts_they_cannot_overlap() {
             clip,
         })
         .collect();
-    let places = vec![(0, 0); parts.len()];
+    let places = vec![(0u32, 0u32); parts.len()];
     let (mut drawn, mut room) = ((0..parts.len() as u32).collect::<Vec<_>>(), Vec::new());
     group_clips(&parts, &places, eye, &mut drawn, &mut room);
     // Part 2 moves back over part 1 (apart on screen) to join part 0; part 4 stays after
