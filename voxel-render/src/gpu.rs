@@ -532,7 +532,7 @@ pub fn load(view: &wgpu::TextureView) -> Option<wgpu::RenderPassColorAttachment<
 }
 
 /// A colour attachment cleared to `color`.
-pub fn clear(
+pub(crate) fn clear(
     view: &wgpu::TextureView,
     color: wgpu::Color,
 ) -> Option<wgpu::RenderPassColorAttachment<'_>> {
@@ -595,7 +595,7 @@ impl<'a> Depth<'a> {
 
 /// One render pass: what it draws into and how it is timed.
 #[derive(Debug)]
-pub struct Pass<'a> {
+pub(crate) struct Pass<'a> {
     /// Debug label.
     pub label: &'a str,
     /// Colour attachments ([`load`], [`clear`], `attachment`).
@@ -616,7 +616,7 @@ pub struct Pass<'a> {
 
 impl<'a> Pass<'a> {
     /// A timed pass into `colors` without depth, blending.
-    pub fn new(
+    pub(crate) fn new(
         label: &'a str,
         timing: GpuPass,
         colors: &'a [Option<wgpu::RenderPassColorAttachment<'a>>],
@@ -697,7 +697,7 @@ impl<'a> Pass<'a> {
     /// Records the pass into `encoder` (timed by `timer` when given): `body` sets
     /// pipelines and draws. In a counted frame (`cost`) what `body` records is
     /// counted, and the pass's fragments and samples are measured where the device can.
-    pub fn record(
+    pub(crate) fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         timer: Option<&Timer>,
@@ -754,56 +754,56 @@ impl<'a> Pass<'a> {
 /// go through it, so that a counted frame counts them (`cost`); it derefs to the
 /// `wgpu::RenderPass` for everything else.
 #[derive(Debug)]
-pub struct CountedPass<'p, 'e> {
+pub(crate) struct CountedPass<'p, 'e> {
     raw: &'p mut wgpu::RenderPass<'e>,
 }
 
 impl<'e> CountedPass<'_, 'e> {
     /// `RenderPass::set_pipeline`.
-    pub fn set_pipeline(&mut self, pipeline: &wgpu::RenderPipeline) {
+    pub(crate) fn set_pipeline(&mut self, pipeline: &wgpu::RenderPipeline) {
         cost::set_pipeline(pipeline);
         self.raw.set_pipeline(pipeline);
     }
 
     /// `RenderPass::set_bind_group`.
-    pub fn set_bind_group(&mut self, index: u32, group: &wgpu::BindGroup, offsets: &[u32]) {
+    pub(crate) fn set_bind_group(&mut self, index: u32, group: &wgpu::BindGroup, offsets: &[u32]) {
         cost::set_bind_group(index, Some(group), offsets);
         self.raw.set_bind_group(index, group, offsets);
     }
 
     /// `RenderPass::set_vertex_buffer`.
-    pub fn set_vertex_buffer(&mut self, slot: u32, slice: wgpu::BufferSlice<'_>) {
+    pub(crate) fn set_vertex_buffer(&mut self, slot: u32, slice: wgpu::BufferSlice<'_>) {
         cost::set_vertex_buffer();
         self.raw.set_vertex_buffer(slot, slice);
     }
 
     /// `RenderPass::set_scissor_rect`.
-    pub fn set_scissor_rect(&mut self, x: u32, y: u32, width: u32, height: u32) {
+    pub(crate) fn set_scissor_rect(&mut self, x: u32, y: u32, width: u32, height: u32) {
         cost::scissor(u64::from(width) * u64::from(height));
         self.raw.set_scissor_rect(x, y, width, height);
     }
 
     /// `RenderPass::draw`.
-    pub fn draw(&mut self, vertices: std::ops::Range<u32>, instances: std::ops::Range<u32>) {
+    pub(crate) fn draw(&mut self, vertices: std::ops::Range<u32>, instances: std::ops::Range<u32>) {
         cost::draw(1, 1);
         self.raw.draw(vertices, instances);
     }
 
     /// Draws the full-screen triangle of `fullscreen.wgsl` (three vertices, one instance).
-    pub fn draw_full_screen(&mut self) {
+    pub(crate) fn draw_full_screen(&mut self) {
         cost::full_screen();
         self.raw.draw(0..3, 0..1);
     }
 
     /// `RenderPass::multi_draw_indirect`: one call, `count` draws.
-    pub fn multi_draw_indirect(&mut self, buffer: &wgpu::Buffer, offset: u64, count: u32) {
+    pub(crate) fn multi_draw_indirect(&mut self, buffer: &wgpu::Buffer, offset: u64, count: u32) {
         cost::draw(1, count);
         self.raw.multi_draw_indirect(buffer, offset, count);
     }
 
     /// Hands the raw pass to a game's own drawing (`stages::GameStages`): counted
     /// as one call into the game; what it sets is unknown afterwards.
-    pub fn game<R>(&mut self, f: impl FnOnce(&mut wgpu::RenderPass<'e>) -> R) -> R {
+    pub(crate) fn game<R>(&mut self, f: impl FnOnce(&mut wgpu::RenderPass<'e>) -> R) -> R {
         cost::game_call();
         let r = f(self.raw);
         cost::game_call_done();

@@ -9,7 +9,7 @@ pub use crate::bindings::{AO_DEPTH, OPAQUE_EXPANSION_PX, TONEMAP_SHOULDER};
 pub use crate::camera::{MAX_FAR, MAX_FOV_DEG, MIN_FOV_DEG, MIN_NEAR, WORLD_EXTENT};
 pub use crate::chunks::{ChunkStore, GpuChunk, MeshKind};
 pub use crate::cost::{CostTotals, FrameCost, PassCost};
-pub use crate::gpu::{CountedPass, Pass, clear, pipelines_built};
+pub use crate::gpu::pipelines_built;
 pub use crate::ladder::{Limit, Need, check};
 pub use crate::oit::moments::single_precision;
 pub use crate::oit::peeling::MAX_PEEL_LAYERS;

@@ -114,7 +114,7 @@ impl GpuTimes {
 const MAX_PENDING_FRAMES: usize = 4;
 
 /// Timestamp queries around the passes of each frame, and the latest results.
-pub struct Timer {
+pub(crate) struct Timer {
     profiler: GpuProfiler,
     period: f32,
     latest: GpuTimes,

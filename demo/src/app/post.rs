@@ -1,7 +1,6 @@
 //! The demo's own passes: the blit of a finished frame to the surface and the error map
 //! against the reference, and the targets of one window size.
 
-use voxel_render::low_level::{self, Pass};
 use voxel_render::stages::{self, Target};
 
 /// The format frames are drawn in before they reach the surface.
@@ -179,16 +178,22 @@ impl Post {
         group: &wgpu::BindGroup,
         target: &wgpu::TextureView,
     ) {
-        let colors = [low_level::clear(target, wgpu::Color::BLACK)];
-        Pass {
-            timing: None,
-            ..Pass::new("demo_post", voxel_render::GpuPass::Tonemap, &colors)
-        }
-        .record(encoder, None, |pass| {
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, group, &[]);
-            pass.draw(0..3, 0..1);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("demo_post"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            ..Default::default()
         });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.draw(0..3, 0..1);
     }
 }
 

@@ -425,7 +425,7 @@ pub(crate) struct FrameView<'a> {
 
 impl FrameView<'_> {
     /// Writes `data` into `target` at `offset` in the frame being recorded.
-    pub fn write(&self, target: &wgpu::Buffer, offset: u64, data: &[u8]) {
+    pub(crate) fn write(&self, target: &wgpu::Buffer, offset: u64, data: &[u8]) {
         self.writes
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner)
