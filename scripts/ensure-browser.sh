@@ -54,7 +54,16 @@ ensure_wasm_tools() {
         echo "installing wasm-bindgen-cli $want with cargo install (was: ${have:-none})" >&2
         # Not --locked: the CLI's own lock file may name dependency versions a registry
         # mirror does not have yet (webpki-roots here); the CLI's version is what must match.
-        setup_step wasm-bindgen "cargo install wasm-bindgen-cli --version =$want" \
-            cargo install --quiet wasm-bindgen-cli --version "=$want"
+        # --force: cargo's record of what it installed can say the CLI is there when its
+        # binary is gone (deleted or moved off the PATH); then a plain install does nothing.
+        setup_step wasm-bindgen "cargo install --force wasm-bindgen-cli --version =$want" \
+            cargo install --quiet --force wasm-bindgen-cli --version "=$want"
+        have="$( (wasm-bindgen --version 2>/dev/null || true) | awk '{ print $2 }')"
+        if [ "$have" != "$want" ]; then
+            echo "error: setup step 'wasm-bindgen' installed wasm-bindgen-cli $want, but the" \
+                "wasm-bindgen on the PATH is ${have:-none}; put cargo's bin folder" \
+                "(${CARGO_HOME:-\$HOME/.cargo}/bin) first on the PATH" >&2
+            return 1
+        fi
     fi
 }

@@ -56,6 +56,8 @@ esac"#,
         "cargo",
         r#"echo "cargo $*" >> "$FAKE/log"
 [ -n "${FAIL_CARGO:-}" ] && exit 101
+# cargo's own record says the CLI is installed: it succeeds and installs nothing.
+[ -n "${CARGO_NOOP:-}" ] && exit 0
 if [ "$1" = install ]; then
     for a in "$@"; do case "$a" in =*) version="${a#=}" ;; esac; done
     printf '#!/bin/sh\necho "wasm-bindgen %s"\n' "$version" > "$FAKE/bin/wasm-bindgen"
@@ -171,7 +173,7 @@ fn a_fresh_machine_gets_every_missing_tool_and_the_script_reaches_its_end() {
         "apt-get install -y -qq --no-install-recommends mesa-vulkan-drivers libegl1 libegl-mesa0 libgles2 libgl1-mesa-dri xvfb libxkbcommon-x11-0".to_string(),
         "apt-get install -y -qq --no-install-recommends chromium".to_string(),
         "rustup target add wasm32-unknown-unknown".to_string(),
-        format!("cargo install --quiet wasm-bindgen-cli --version ={}", locked_wasm_bindgen()),
+        format!("cargo install --quiet --force wasm-bindgen-cli --version ={}", locked_wasm_bindgen()),
     ];
     for call in &expected {
         assert!(log.lines().any(|line| line == call), "no `{call}`:\n{text}");
@@ -255,9 +257,26 @@ fn a_failing_installer_names_its_step_and_what_to_run_by_hand() {
     );
     assert!(
         stderr.contains(&format!(
-            "run it by hand: cargo install wasm-bindgen-cli --version ={}",
+            "run it by hand: cargo install --force wasm-bindgen-cli --version ={}",
             locked_wasm_bindgen()
         )),
+        "{text}"
+    );
+}
+
+/// An install that succeeds but leaves no `wasm-bindgen` on the PATH (cargo's record said
+/// it was installed, or cargo's bin folder is not on the PATH) is an error naming the step,
+/// not a setup that reports success and fails later in the browser test.
+#[test]
+fn an_install_that_leaves_no_tool_on_the_path_is_an_error() {
+    let machine = FakeMachine::new("cargo-noop");
+    let output = machine.setup(&[("CARGO_NOOP", "1")]);
+    let text = report(&output, &machine.log());
+    assert!(!output.status.success(), "{text}");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("setup step 'wasm-bindgen' installed wasm-bindgen-cli")
+            && stderr.contains("on the PATH is none"),
         "{text}"
     );
 }
