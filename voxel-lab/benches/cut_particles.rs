@@ -34,7 +34,7 @@ use voxel_render::{Camera, GameStages, GpuContext, Renderer, Technique, Transluc
 mod report;
 #[path = "common/setup.rs"]
 mod setup;
-use report::Report;
+use report::{Report, list, median};
 
 const W: u32 = 640;
 const H: u32 = 360;
@@ -42,18 +42,6 @@ const WARMUP: usize = 2;
 const FRAMES: usize = 5;
 /// Half side of a particle, blocks.
 const HALF: f64 = 0.1;
-
-fn list(var: &str, default: &[usize]) -> Vec<usize> {
-    std::env::var(var)
-        .ok()
-        .map(|v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect())
-        .unwrap_or_else(|| default.to_vec())
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 /// The two glass layers over chunks x, z in -2..=1, meshed and uploaded.
 fn renderer(ctx: &GpuContext) -> Result<Renderer> {

@@ -32,7 +32,7 @@ use voxel_render::{
 mod report;
 #[path = "common/setup.rs"]
 mod setup;
-use report::Report;
+use report::{Report, list, median};
 
 const W: u32 = 640;
 const H: u32 = 360;
@@ -40,18 +40,6 @@ const WARMUP: usize = 3;
 const FRAMES: usize = 15;
 /// The sea's surface: water fills y = 0 to 23.
 const SURFACE: i32 = 24;
-
-fn list(var: &str, default: &[usize]) -> Vec<usize> {
-    std::env::var(var)
-        .ok()
-        .map(|v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect())
-        .unwrap_or_else(|| default.to_vec())
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 /// Whether column (cx, cz) holds a dome.
 fn dome(cx: i32, cz: i32) -> bool {

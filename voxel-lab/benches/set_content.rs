@@ -15,21 +15,9 @@ use voxel_render::content::{Content, ContentStages, Entity, Particle};
 
 #[path = "common/report.rs"]
 mod report;
-use report::{Report, numbers};
+use report::{Report, list, median, numbers};
 
 const ROUNDS: usize = 301;
-
-fn list(var: &str, default: &[usize]) -> Vec<usize> {
-    std::env::var(var)
-        .ok()
-        .map(|v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect())
-        .unwrap_or_else(|| default.to_vec())
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 /// `n` things: nine in ten particles (bubbles and fireflies), the rest boxes, one in
 /// three of those opaque; moved by `t`.

@@ -1,6 +1,7 @@
 //! What the benches that write a table to `results/` share: the heading that names the
 //! machine and its load, the rows printed as they come, the file written at the end, and
-//! a fixed stream of numbers to scatter things with.
+//! a fixed stream of numbers to scatter things with, the sizes a run takes from the
+//! environment and the median of timings.
 
 use std::path::Path;
 
@@ -51,4 +52,20 @@ pub fn numbers(mut seed: u64) -> impl FnMut() -> f64 {
         seed ^= seed << 17;
         (seed >> 11) as f64 / (1u64 << 53) as f64
     }
+}
+
+/// The sizes in `var` (comma-separated), or `default` (not every bench takes any).
+#[allow(dead_code)]
+pub fn list(var: &str, default: &[usize]) -> Vec<usize> {
+    std::env::var(var)
+        .ok()
+        .map(|v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect())
+        .unwrap_or_else(|| default.to_vec())
+}
+
+/// The median of `v` (sorted in place; not every bench times rounds).
+#[allow(dead_code)]
+pub fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
 }
