@@ -25,9 +25,16 @@ const TECHNIQUES: [Technique; 6] = [
     Technique::Stipple,
 ];
 
-/// Every technique of [`TECHNIQUES`] on one renderer of `scene`, each counted in its third
-/// frame (the first builds, the second settles a switch).
-fn costs(ctx: &GpuContext, scene: &str) -> HashMap<Technique, FrameCost> {
+/// A renderer of suite scene `scene` at W×H with the default settings, its target and its
+/// first camera.
+fn suite_renderer(
+    ctx: &GpuContext,
+    scene: &str,
+) -> (
+    voxel_lab::headless::SceneRenderer,
+    Offscreen,
+    voxel_render::Camera,
+) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenes")
         .join(format!("{scene}.toml"));
@@ -37,9 +44,14 @@ fn costs(ctx: &GpuContext, scene: &str) -> HashMap<Technique, FrameCost> {
         height: H,
         ..RendererConfig::default()
     };
-    let mut renderer = renderer_for(ctx, &scene, config).unwrap();
-    let target = Offscreen::new(ctx, W, H);
-    let camera = scene.cameras[0];
+    let renderer = renderer_for(ctx, &scene, config).unwrap();
+    (renderer, Offscreen::new(ctx, W, H), scene.cameras[0])
+}
+
+/// Every technique of [`TECHNIQUES`] on one renderer of `scene`, each counted in its third
+/// frame (the first builds, the second settles a switch).
+fn costs(ctx: &GpuContext, scene: &str) -> HashMap<Technique, FrameCost> {
+    let (mut renderer, target, camera) = suite_renderer(ctx, scene);
     let mut out = HashMap::new();
     for t in TECHNIQUES {
         renderer.set_oit_config(OitConfig::with(t)).unwrap();
@@ -199,17 +211,7 @@ fn the_game_objects_of_the_sorted_order_cost_few_runs() {
 #[test]
 fn an_unsubmitted_frame_has_no_cost() {
     let Some(ctx) = gpu() else { return };
-    let scene =
-        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/deep_stack.toml"))
-            .unwrap();
-    let config = RendererConfig {
-        width: W,
-        height: H,
-        ..RendererConfig::default()
-    };
-    let mut r = renderer_for(&ctx, &scene, config).unwrap();
-    let target = Offscreen::new(&ctx, W, H);
-    let camera = scene.cameras[0];
+    let (mut r, target, camera) = suite_renderer(&ctx, "deep_stack");
     r.render_and_submit(&target.view, &camera).unwrap();
     let encoder = |ctx: &GpuContext| ctx.device.create_command_encoder(&Default::default());
 
@@ -259,17 +261,7 @@ fn an_unsubmitted_frame_has_no_cost() {
 #[test]
 fn gl_frames_are_counted_but_not_measured() {
     let Some(ctx) = tests::gl() else { return };
-    let scene =
-        Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/deep_stack.toml"))
-            .unwrap();
-    let config = RendererConfig {
-        width: W,
-        height: H,
-        ..RendererConfig::default()
-    };
-    let mut r = renderer_for(&ctx, &scene, config).unwrap();
-    let target = Offscreen::new(&ctx, W, H);
-    let camera = scene.cameras[0];
+    let (mut r, target, camera) = suite_renderer(&ctx, "deep_stack");
     for t in [Technique::WboitMrt, Technique::SortedQuads] {
         r.renderer.set_oit_config(OitConfig::with(t)).unwrap();
         r.render_and_submit(&target.view, &camera).unwrap();
