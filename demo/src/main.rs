@@ -51,7 +51,7 @@ impl DeviceArgs {
 }
 
 fn quad_fetch(s: &str) -> Result<voxel_render::QuadFetch> {
-    Ok(voxel_render::QuadFetch::from_name(s)?)
+    Ok(s.parse::<voxel_render::QuadFetch>()?)
 }
 
 /// An hour of the day, 0 to 24.
@@ -67,7 +67,7 @@ fn hour(s: &str) -> Result<f32> {
 }
 
 fn limits_preset(s: &str) -> Result<voxel_render::LimitsPreset> {
-    Ok(voxel_render::LimitsPreset::from_name(s)?)
+    Ok(s.parse::<voxel_render::LimitsPreset>()?)
 }
 
 #[derive(Subcommand, Debug)]
@@ -238,11 +238,11 @@ fn time_budget(s: &str) -> Result<f64> {
 }
 
 fn technique(s: &str) -> Result<Technique> {
-    Ok(Technique::from_name(s)?)
+    Ok(s.parse::<Technique>()?)
 }
 
 fn weight(s: &str) -> Result<WeightFunction> {
-    Ok(WeightFunction::from_name(s)?)
+    Ok(s.parse::<WeightFunction>()?)
 }
 
 fn bayer(s: &str) -> Result<BayerSize> {

@@ -275,10 +275,10 @@ fn hundreds_of_timed_passes_keep_every_pass_timed() {
 
 #[test]
 fn unknown_names_list_the_known_ones() {
-    let e = Technique::from_name("wboit").unwrap_err();
+    let e = "wboit".parse::<Technique>().unwrap_err();
     assert!(matches!(e, voxel_render::Error::UnknownName { .. }));
     assert!(e.to_string().contains("wboit-mrt") && e.to_string().contains("peel-reference"));
-    let e = voxel_render::WeightFunction::from_name("x").unwrap_err();
+    let e = "x".parse::<voxel_render::WeightFunction>().unwrap_err();
     assert!(e.to_string().contains("fitted"), "{e}");
     let e = voxel_render::BayerSize::from_side(3).unwrap_err();
     assert!(e.to_string().contains("16"), "{e}");

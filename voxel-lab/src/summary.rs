@@ -458,7 +458,8 @@ impl Summary {
 /// techniques that draw: not an exact method, not `opaque-only`.
 pub fn is_real_time(run: &str) -> bool {
     let name = run.split('/').next().unwrap_or(run);
-    Technique::from_name(name).is_ok_and(|t| t.draws() && !t.is_exact())
+    name.parse::<Technique>()
+        .is_ok_and(|t| t.draws() && !t.is_exact())
 }
 
 /// Writes `value` as pretty JSON.

@@ -309,7 +309,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frames: u32 = arg("--frames").map_or(Ok(30), |v| v.parse())?;
     let out = arg("--out").unwrap_or_else(|| "night_lake.png".into());
     let technique = match arg("--technique") {
-        Some(name) => Technique::from_name(&name)?,
+        Some(name) => name.parse::<Technique>()?,
         None => Technique::SortedQuads,
     };
     let limits = match arg("--limits").as_deref() {

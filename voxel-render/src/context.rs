@@ -35,7 +35,7 @@ impl Capabilities {
     /// Reads the capabilities of `adapter` for a device created with `features` and
     /// `limits`. On desktop GL older than 4.0 storage buffers and textures count as absent
     /// whatever the driver's extensions say, and on desktop GL older than 4.2 that reports
-    /// compute shaders the world cannot be drawn ([`Capabilities::shader_bindings`]).
+    /// compute shaders the world cannot be drawn ([`Need::ShaderBindings`](crate::low_level::Need) fails).
     pub fn new(adapter: &wgpu::Adapter, features: wgpu::Features, limits: wgpu::Limits) -> Self {
         let info = adapter.get_info();
         let mut limits = limits;
@@ -118,7 +118,7 @@ impl Capabilities {
     /// NVIDIA lists on its 3.3 context): wgpu 30 then expects the slots written in the
     /// shaders, which its translator writes from GLSL 4.20 only, and every resource lands
     /// on slot 0. Nothing can be drawn right there; the renderer refuses such a device.
-    pub fn shader_bindings(&self) -> bool {
+    pub(crate) fn shader_bindings(&self) -> bool {
         self.shader_bindings
     }
 
@@ -448,14 +448,6 @@ impl LimitsPreset {
         }
     }
 
-    /// Parses a command-line name; the error lists the known names.
-    pub fn from_name(name: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|p| p.name() == name)
-            .ok_or_else(|| Error::unknown_name("limits preset", name, Self::ALL.map(Self::name)))
-    }
-
     /// The limits and features to request of `adapter`.
     pub(crate) fn request(self, adapter: &wgpu::Adapter) -> (wgpu::Limits, wgpu::Features) {
         match self {
@@ -500,6 +492,15 @@ pub fn device_descriptor(
         experimental_features: wgpu::ExperimentalFeatures::disabled(),
         memory_hints: wgpu::MemoryHints::Performance,
         trace: wgpu::Trace::Off,
+    }
+}
+
+/// Parses a command-line name (what `name` gives); the error lists the known names.
+impl std::str::FromStr for LimitsPreset {
+    type Err = Error;
+
+    fn from_str(name: &str) -> Result<Self> {
+        crate::error::parse_name("limits preset", name, &Self::ALL, Self::name)
     }
 }
 

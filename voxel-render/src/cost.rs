@@ -86,12 +86,12 @@ impl PassCost {
     }
 
     /// Whether it drew a full-screen triangle.
-    pub fn is_full_screen(&self) -> bool {
+    pub(crate) fn is_full_screen(&self) -> bool {
         self.full_screen_draws > 0
     }
 
     /// Whether it is a texture copy rather than a render pass.
-    pub fn is_copy(&self) -> bool {
+    pub(crate) fn is_copy(&self) -> bool {
         self.copy_bytes > 0
     }
 }
@@ -122,7 +122,7 @@ pub struct FrameCost {
 
 impl FrameCost {
     /// The sums over the passes `which` selects.
-    pub fn totals(&self, which: impl Fn(&PassCost) -> bool) -> CostTotals {
+    pub(crate) fn totals(&self, which: impl Fn(&PassCost) -> bool) -> CostTotals {
         let mut t = CostTotals {
             fragments: self.measured.then_some(0),
             samples: self.measured.then_some(0),

@@ -221,6 +221,20 @@ impl Error {
     }
 }
 
+/// The one of `all` whose `name_of` is `name` (what the named enums' `FromStr` does); the
+/// error lists the known names.
+pub(crate) fn parse_name<T: Copy>(
+    kind: &'static str,
+    name: &str,
+    all: &[T],
+    name_of: fn(T) -> &'static str,
+) -> Result<T> {
+    all.iter()
+        .copied()
+        .find(|&t| name_of(t) == name)
+        .ok_or_else(|| Error::unknown_name(kind, name, all.iter().map(|&t| name_of(t))))
+}
+
 /// Runs `f` inside a wgpu validation and out-of-memory error scope, so that what wgpu
 /// would report to the device's uncaptured-error handler (a panic by default) comes back
 /// as an [`Error::Gpu`] instead.

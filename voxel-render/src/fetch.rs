@@ -50,14 +50,6 @@ impl QuadFetch {
         }
     }
 
-    /// Parses a command-line name; the error lists the known names.
-    pub fn from_name(name: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|f| f.name() == name)
-            .ok_or_else(|| Error::unknown_name("quad fetch", name, Self::ALL.map(Self::name)))
-    }
-
     /// What the world's chunk pipelines need of the device when they fetch quads this way.
     pub(crate) fn needs(self) -> Vec<Need> {
         match self {
@@ -393,6 +385,15 @@ pub(crate) fn table_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
+/// Parses a command-line name (what `name` gives); the error lists the known names.
+impl std::str::FromStr for QuadFetch {
+    type Err = Error;
+
+    fn from_str(name: &str) -> Result<Self> {
+        crate::error::parse_name("quad fetch", name, &Self::ALL, Self::name)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -412,8 +413,8 @@ mod tests {
     #[test]
     fn names_round_trip() {
         for f in QuadFetch::ALL {
-            assert_eq!(QuadFetch::from_name(f.name()).unwrap(), f);
+            assert_eq!(f.name().parse::<QuadFetch>().unwrap(), f);
         }
-        assert!(QuadFetch::from_name("texture").is_err());
+        assert!("texture".parse::<QuadFetch>().is_err());
     }
 }

@@ -98,7 +98,7 @@ pub enum Need {
     /// A colour format that can be rendered to with blending.
     BlendableTarget(wgpu::TextureFormat),
     /// Each buffer and texture bound where the shaders declare it (not so on desktop GL
-    /// below 4.2 that reports compute shaders: [`Capabilities::shader_bindings`]).
+    /// below 4.2 that reports compute shaders).
     ShaderBindings,
     /// Waiting for the GPU within a frame, for a result the frame goes on with (the
     /// exact references' counts): not in a browser, whose page runs on one thread that

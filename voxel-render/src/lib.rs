@@ -35,6 +35,7 @@
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
 #![warn(missing_docs)]
+#![warn(unreachable_pub)]
 
 mod arena;
 mod bindings;
@@ -70,15 +71,21 @@ pub use context::{
 pub use error::{Error, Result};
 pub use fetch::QuadFetch;
 pub use oit::{
-    BayerSize, MboitSettings, OitConfig, PeelingSettings, StippleSettings, Technique,
-    WboitSettings, WeightFunction,
+    OitConfig, Technique, moments::MboitSettings, peeling::PeelingSettings,
+    stipple::StippleSettings, stipple::bayer::BayerSize, wboit::WboitSettings,
+    wboit::weights::WeightFunction,
 };
 pub use readback::Image;
-pub use renderer::{FrameStats, Lighting, OUTPUT_FORMATS, Renderer, RendererConfig};
+pub use renderer::{
+    FrameStats, Renderer, config::Lighting, config::OUTPUT_FORMATS, config::RendererConfig,
+};
 pub use stages::{
     Both, GameFrame, GameStages, NoGame, Stages, TranslucentContract, TranslucentObject,
 };
-pub use stream::{ChunkSink, ChunkSource, ChunkStreamer, StreamConfig, StreamFrame};
+pub use stream::{
+    ChunkStreamer, config::StreamConfig, schedule::StreamFrame, source::ChunkSink,
+    source::ChunkSource,
+};
 pub use timing::{GpuPass, GpuTimes};
 
 /// Depth format of every pass: 32-bit float, reverse-Z (1 near, 0 far).

@@ -7,7 +7,7 @@
 pub use crate::arena::QUAD_BYTES;
 pub use crate::bindings::{AO_DEPTH, OPAQUE_EXPANSION_PX, TONEMAP_SHOULDER};
 pub use crate::camera::{MAX_FAR, MAX_FOV_DEG, MIN_FOV_DEG, MIN_NEAR, WORLD_EXTENT};
-pub use crate::chunks::{ChunkStore, GpuChunk, MeshKind};
+pub use crate::chunks::{MeshKind, gpu_chunk::GpuChunk, store::ChunkStore};
 pub use crate::cost::{CostTotals, FrameCost, PassCost};
 pub use crate::gpu::pipelines_built;
 pub use crate::ladder::{Limit, Need, check};
@@ -16,11 +16,11 @@ pub use crate::oit::peeling::MAX_PEEL_LAYERS;
 pub use crate::oit::stipple::bayer::bayer;
 pub use crate::oit::wboit::{HEADROOM_SCALE, REVEALAGE_FORMAT, RGBA8_SCALE};
 pub use crate::oit::{
-    MboitReport, OitManager, PeelReport, ReferenceReport, SortReport, TechniqueReport, WboitReport,
-    WeightFit,
+    OitManager, TechniqueReport, moments::MboitReport, peeling::PeelReport,
+    reference::ReferenceReport, sorted::SortReport, wboit::WboitReport, wboit::fit::WeightFit,
 };
 pub use crate::renderer::ChunkMemory;
-pub use crate::stream::{EDIT_BYTES, EDITED_CHUNK_BYTES, MAX_VIEW_DISTANCE};
+pub use crate::stream::{config::MAX_VIEW_DISTANCE, edits::EDIT_BYTES, edits::EDITED_CHUNK_BYTES};
 
 /// The chunks `renderer` holds on the GPU (the store's meshes, their places in the arena and
 /// their generations).

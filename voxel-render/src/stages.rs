@@ -497,11 +497,6 @@ impl<A: GameStages, B: GameStages> Both<A, B> {
         }
     }
 
-    /// The two parts.
-    pub fn into_parts(self) -> (A, B) {
-        (self.first, self.second)
-    }
-
     fn part(&self, k: usize) -> &dyn GameStages {
         if k == 0 { &self.first } else { &self.second }
     }

@@ -237,12 +237,13 @@ impl TextureSet {
     }
 
     /// Number of layers.
-    pub fn layer_count(&self) -> usize {
+    pub(crate) fn layer_count(&self) -> usize {
         self.layers.len()
     }
 
     /// Level 0 of layer `i`: sRGB colour and alpha, rows top to bottom.
-    pub fn layer(&self, i: usize) -> &[[u8; 4]] {
+    #[cfg(test)]
+    pub(crate) fn layer(&self, i: usize) -> &[[u8; 4]] {
         &self.layers[i]
     }
 

@@ -465,7 +465,7 @@ fn listeners(app: &Rc<RefCell<App>>) -> Result<(), String> {
     listen(&select, "change", {
         let (app, select) = (Rc::clone(app), select.clone());
         move |_: web_sys::Event| {
-            let Ok(t) = Technique::from_name(&select.value()) else {
+            let Ok(t) = select.value().parse::<Technique>() else {
                 return;
             };
             let mut app = app.borrow_mut();

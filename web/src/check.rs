@@ -71,7 +71,7 @@ pub fn report_path(report: &Report) -> String {
 pub fn parse_report_path(path: &str) -> Option<Report> {
     let rest = path.strip_prefix("/technique/")?;
     let (name, query) = rest.split_once('?')?;
-    let technique = Technique::from_name(name).ok()?;
+    let technique = name.parse::<Technique>().ok()?;
     let (mut kind, mut drew, mut single) = (None, None, false);
     for pair in query.split('&') {
         match pair.split_once('=')? {
@@ -80,7 +80,7 @@ pub fn parse_report_path(path: &str) -> Option<Report> {
                     .into_iter()
                     .find(|x| x.name() == k);
             }
-            ("drew", d) => drew = Some(Technique::from_name(d).ok()?),
+            ("drew", d) => drew = Some(d.parse::<Technique>().ok()?),
             ("single", s) => single = s == "1",
             _ => return None,
         }

@@ -70,7 +70,7 @@ impl Options {
         };
         let technique = params
             .get("technique")
-            .map(|t| Technique::from_name(&t).map_err(|e| e.to_string()))
+            .map(|t| t.parse::<Technique>().map_err(|e| e.to_string()))
             .transpose()?;
         let lose_after = params
             .get("lose")

@@ -180,7 +180,7 @@ fn the_page_draws_like_native_on_webgpu_and_webgl2() {
         };
         let supported: Vec<Technique> = field("supported: ")
             .split(',')
-            .map(|t| Technique::from_name(t).unwrap())
+            .map(|t| t.parse::<Technique>().unwrap())
             .collect();
         table += &format!(
             "| {browser} | adapter: {}; {} | | | |\n",

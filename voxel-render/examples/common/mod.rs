@@ -31,7 +31,7 @@ impl Args {
             frames: arg("--frames").map_or(Ok(60), |v| v.parse())?.max(1),
             out: arg("--out").unwrap_or_else(|| out.into()),
             technique: match arg("--technique") {
-                Some(name) => Technique::from_name(&name)?,
+                Some(name) => name.parse::<Technique>()?,
                 None => Technique::WboitMrt,
             },
         })

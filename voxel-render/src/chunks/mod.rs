@@ -21,8 +21,8 @@
 mod command;
 mod cull;
 mod draws;
-mod gpu_chunk;
-mod store;
+pub(crate) mod gpu_chunk;
+pub(crate) mod store;
 #[cfg(test)]
 mod tests;
 
@@ -32,9 +32,9 @@ use std::hash::{BuildHasherDefault, Hasher};
 pub(crate) use cull::Culled;
 pub(crate) use cull::Frustum;
 pub(crate) use draws::{DrawBuilder, DrawList, FrameDraws};
-pub use gpu_chunk::GpuChunk;
+pub(crate) use gpu_chunk::GpuChunk;
 pub(crate) use gpu_chunk::Surfaces;
-pub use store::ChunkStore;
+pub(crate) use store::ChunkStore;
 
 /// A fast hasher for small keys of integers (chunk positions): a multiply-rotate per word
 /// and a final mix, instead of SipHash (the store and the techniques look chunks up by

@@ -34,13 +34,12 @@ use crate::stages::{GameDraw, TranslucentContract, TranslucentObject, Translucen
 use crate::timing::Timer;
 use crate::{Camera, Error, GpuContext, Result};
 
-pub use moments::{MboitReport, MboitSettings};
-pub use peeling::{PeelReport, PeelingSettings};
-pub use reference::ReferenceReport;
-pub use sorted::SortReport;
-pub use stipple::{BayerSize, StippleSettings};
-pub use wboit::weights::{WeightFit, WeightFunction};
-pub use wboit::{WboitReport, WboitSettings};
+pub(crate) use moments::{MboitReport, MboitSettings};
+pub(crate) use peeling::{PeelReport, PeelingSettings};
+pub(crate) use reference::ReferenceReport;
+pub(crate) use sorted::SortReport;
+pub(crate) use stipple::StippleSettings;
+pub(crate) use wboit::{WboitReport, WboitSettings};
 
 /// Declares [`Technique`] from the list of techniques: variant, command-line name, and the
 /// type (implementing [`TechniqueKind`]) that draws it.
@@ -262,14 +261,6 @@ impl Technique {
             Some(t) => Ok(t),
             None => Self::LOW_END.check(&config, caps).map(|()| Self::LOW_END),
         }
-    }
-
-    /// Parses a command-line name; the error lists the known names.
-    pub fn from_name(name: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|t| t.name() == name)
-            .ok_or_else(|| Error::unknown_name("technique", name, Self::ALL.map(Self::name)))
     }
 }
 
@@ -964,4 +955,13 @@ pub(crate) fn pixel_rect(
         (hi.x - lo.x) as u32,
         (hi.y - lo.y) as u32,
     ]
+}
+
+/// Parses a command-line name (what `name` gives); the error lists the known names.
+impl std::str::FromStr for Technique {
+    type Err = Error;
+
+    fn from_str(name: &str) -> Result<Self> {
+        crate::error::parse_name("technique", name, &Self::ALL, Self::name)
+    }
 }

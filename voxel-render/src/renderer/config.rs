@@ -127,7 +127,7 @@ pub struct Lighting {
     pub sun_dir: [f32; 3],
     /// Ambient share of the lighting, 0 to 1.
     pub ambient: f32,
-    /// How bright the light is (1 by day, [`Lighting::MOONLIGHT`] at night), from 0 to
+    /// How bright the light is (1 by day, 0.12 at night in [`Lighting::daytime`]), from 0 to
     /// [`Lighting::MAX_BRIGHTNESS`].
     pub brightness: f32,
     /// Sky colour (linear), what the background is cleared to, each channel from 0 to
@@ -137,11 +137,11 @@ pub struct Lighting {
 
 impl Lighting {
     /// The hour the sun rises in [`Lighting::daytime`].
-    pub const SUNRISE: f32 = 6.0;
+    pub(crate) const SUNRISE: f32 = 6.0;
     /// The hour the sun sets in [`Lighting::daytime`].
-    pub const SUNSET: f32 = 18.0;
+    pub(crate) const SUNSET: f32 = 18.0;
     /// The brightness of moonlight (night in [`Lighting::daytime`]), a share of daylight.
-    pub const MOONLIGHT: f32 = 0.12;
+    pub(crate) const MOONLIGHT: f32 = 0.12;
     /// The largest brightness, and sky channel, a renderer takes: a larger one (up to
     /// `f32::MAX`) is an `Error::InvalidSetting`. The scene colour is half floats
     /// ([`crate::SCENE_FORMAT`], largest finite value 65 504), where a GPU makes a larger
@@ -164,12 +164,12 @@ impl Lighting {
     }
 
     /// The lighting at `hour` of a 24-hour day (any finite hour, taken modulo 24; NaN or
-    /// infinite: noon). Day, [`Lighting::SUNRISE`] to [`Lighting::SUNSET`]: the sun rises
+    /// infinite: noon). Day, 6 h to 18 h: the sun rises
     /// in the east (+x), stands highest in the south (+z) at noon and sets in the west;
     /// the ambient share falls from 0.45 at noon to 0.2 at the horizon, and the sky turns
     /// from light blue to a dusk orange. Night, from an hour after sunset to an hour before
     /// sunrise: the moon crosses the sky on the sun's path, its light
-    /// [`Lighting::MOONLIGHT`] bright, more of it ambient (0.5), under a dark blue sky.
+    /// 0.12 bright, more of it ambient (0.5), under a dark blue sky.
     /// Twilight, the hour between: day and night blended, so that a clock running
     /// through the day changes the light smoothly. A model for a time-of-day control, not
     /// an atmosphere.

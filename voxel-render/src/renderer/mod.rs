@@ -3,7 +3,7 @@
 //! depth-tested read-only against the opaque depth), composite over the opaque colour,
 //! tonemap to the output format.
 
-mod config;
+pub(crate) mod config;
 mod frame;
 mod targets;
 #[cfg(test)]
@@ -30,7 +30,7 @@ use crate::textures::BlockTextures;
 use crate::timing::{GpuTimes, Timer};
 use crate::{Error, GpuContext, Result};
 
-pub use config::{Lighting, OUTPUT_FORMATS, RendererConfig};
+pub(crate) use config::{Lighting, OUTPUT_FORMATS, RendererConfig};
 use config::{check_ao_strength, check_lighting, check_output_format, check_size};
 use targets::{MSAA_SAMPLES, Post, SceneResources, SceneTargets};
 

@@ -81,14 +81,14 @@
 //! [`Mesher::mesh`]: voxel_mesh::Mesher::mesh
 //! [`Renderer`]: crate::Renderer
 
-mod config;
-mod edits;
+pub(crate) mod config;
+pub(crate) mod edits;
 mod jobs;
 mod local;
 mod pool;
-mod schedule;
+pub(crate) mod schedule;
 mod slot;
-mod source;
+pub(crate) mod source;
 
 #[cfg(test)]
 mod tests;
@@ -102,10 +102,8 @@ use voxel_core::{BlockRegistry, Chunk, ChunkPos, World};
 
 use crate::Result;
 
-pub use config::{MAX_VIEW_DISTANCE, StreamConfig};
-pub use edits::{EDIT_BYTES, EDITED_CHUNK_BYTES};
-pub use schedule::StreamFrame;
-pub use source::{ChunkSink, ChunkSource};
+pub(crate) use config::StreamConfig;
+pub(crate) use source::{ChunkSink, ChunkSource};
 
 use edits::ChunkEdits;
 use jobs::Done;
@@ -230,12 +228,6 @@ impl ChunkStreamer {
             jobs: 0,
             next_version: 0,
         }
-    }
-
-    /// Whether its jobs run on the updating thread ([`ChunkStreamer::new_local`], and
-    /// every streamer on wasm32).
-    pub fn is_local(&self) -> bool {
-        self.pool.is_local()
     }
 
     fn offsets(config: &StreamConfig) -> Vec<[i32; 3]> {

@@ -1,4 +1,6 @@
-use super::schedule::offset;
+use super::config::MAX_VIEW_DISTANCE;
+use super::edits::{EDIT_BYTES, EDITED_CHUNK_BYTES};
+use super::schedule::{StreamFrame, offset};
 use super::*;
 use glam::DVec3;
 use std::collections::HashSet;

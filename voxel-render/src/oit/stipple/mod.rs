@@ -24,7 +24,7 @@ use crate::stages::{TranslucentVariant, game_group, game_layout, game_prelude};
 use crate::timing::GpuPass;
 use crate::{Error, GpuContext, Result};
 
-pub use bayer::BayerSize;
+pub(crate) use bayer::BayerSize;
 pub(crate) use bayer::ShadingState;
 
 /// Settings of stipple. Every field has a reasoned default.

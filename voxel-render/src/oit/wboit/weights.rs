@@ -13,7 +13,7 @@
 //! translucent layers in view ([`WeightFit`]).
 
 pub(crate) use super::fit::MAX_FITTED_DEPTH;
-pub use super::fit::WeightFit;
+pub(crate) use super::fit::WeightFit;
 use crate::{Error, Result};
 
 /// A weight function.
@@ -73,14 +73,6 @@ impl WeightFunction {
         }
     }
 
-    /// Parses a command-line name; the error lists the known names.
-    pub fn from_name(name: &str) -> Result<Self> {
-        Self::ALL
-            .into_iter()
-            .find(|w| w.name() == name)
-            .ok_or_else(|| Error::unknown_name("weight", name, Self::ALL.map(Self::name)))
-    }
-
     /// The id the shader switches on (`WEIGHT_<NAME>` constants, generated from this).
     pub(crate) fn id(self) -> u32 {
         self as u32
@@ -120,6 +112,15 @@ impl WeightFunction {
             WeightFunction::McGuire10 => alpha * (3e3 * cube(1.0 - z)).max(1e-2),
             WeightFunction::Fitted => 3e3 * (-fit.optical_depth_at(screen, d)).exp(),
         }
+    }
+}
+
+/// Parses a command-line name (what `name` gives); the error lists the known names.
+impl std::str::FromStr for WeightFunction {
+    type Err = Error;
+
+    fn from_str(name: &str) -> Result<Self> {
+        crate::error::parse_name("weight", name, &Self::ALL, Self::name)
     }
 }
 
@@ -263,10 +264,11 @@ mod tests {
     #[test]
     fn names_round_trip() {
         for w in WeightFunction::ALL {
-            assert_eq!(WeightFunction::from_name(w.name()).unwrap(), w);
+            assert_eq!(w.name().parse::<WeightFunction>().unwrap(), w);
         }
         assert!(
-            WeightFunction::from_name("eq11")
+            "eq11"
+                .parse::<WeightFunction>()
                 .unwrap_err()
                 .to_string()
                 .contains("eq10")

@@ -929,7 +929,7 @@ fn a_local_streamer_holds_the_truth_once_idle() {
         changing: None,
     };
     let mut s = ChunkStreamer::new_local(registry(), source, config).unwrap();
-    assert!(s.is_local());
+    assert!(s.pool.is_local(), "jobs run on the updating thread");
     let mut truth = Truth::new(true);
     let mut sink = Holder::default();
     let route = [
