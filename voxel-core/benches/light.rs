@@ -131,4 +131,26 @@ fn main() {
         summary(&format!("{name} removed"), &mut remove);
         summary(&format!("{name} placed or removed"), &mut both);
     }
+
+    // Streaming: a chunk unlit and unloaded, then loaded and lit again (its neighbours
+    // lit), a chunk at a time over every chunk of the world.
+    let positions: Vec<ChunkPos> = {
+        let mut p: Vec<ChunkPos> = world.iter().map(|(p, _)| p).collect();
+        p.sort_unstable();
+        p
+    };
+    let (mut unlit, mut lit) = (Vec::new(), Vec::new());
+    for p in positions {
+        let t = Instant::now();
+        field.remove_chunk(&world, p).expect("same registry");
+        unlit.push(t.elapsed());
+        let chunk = world.remove_chunk(p).expect("loaded");
+        world.insert_chunk(p, chunk).expect("valid chunk");
+        let t = Instant::now();
+        field.add_chunk(&world, p).expect("same registry");
+        lit.push(t.elapsed());
+    }
+    summary("chunk unlit (remove_chunk)", &mut unlit);
+    summary("chunk lit (add_chunk)", &mut lit);
+    assert_eq!(field.len(), chunks, "every chunk lit again");
 }

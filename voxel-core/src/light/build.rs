@@ -86,7 +86,7 @@ impl LightField {
 
     /// Writes the sources of a chunk's cells (beam levels, emission) into `cells` and
     /// carries `beam` and the kinds above each column through it.
-    fn fill_chunk(
+    pub(super) fn fill_chunk(
         &self,
         chunk: Option<&Chunk>,
         beam: &mut [[f32; 3]; CHUNK_AREA],
@@ -116,7 +116,7 @@ impl LightField {
 
     /// Adds to `seeds` (per channel) the cells of chunk `c` whose level can raise a
     /// neighbour's: more than the falloff above it.
-    fn seeds_of(&self, c: u32, seeds: &mut [Vec<Cell>; 6]) {
+    pub(super) fn seeds_of(&self, c: u32, seeds: &mut [Vec<Cell>; 6]) {
         let e = &self.entries[c as usize];
         let layer = |c: u32, y: usize| self.entries[c as usize].light.uniform_layer(y);
         let cell = |(c, l): Cell| self.entries[c as usize].light.levels(l);

@@ -3,7 +3,7 @@
 
 use super::LightField;
 use super::engine::{Cell, Engine, NONE, Scratch, level};
-use super::store::{Beam, Local, local};
+use super::store::{Beam, LightChunk, Local, local};
 use crate::{
     BlockId, CHUNK_AREA, CHUNK_SIZE, CHUNK_VOLUME, ChunkPos, Error, Result, World, WorldPos,
 };
@@ -61,6 +61,7 @@ impl LightField {
             &mut engine,
             &[(ci, local(x, y, z))],
             &sky,
+            &NO_FLOOD,
             &mut self.scratch,
         );
         Ok(old)
@@ -90,9 +91,36 @@ impl LightField {
             // Its old bottom blocks are gone: what the beam below was is unknown.
             sky.extend((0..CHUNK_VOLUME).map(|l| (below[0], l as Local)));
         }
-        let all: Vec<Cell> = (0..CHUNK_VOLUME).map(|l| (ci, l as Local)).collect();
+        if replaced {
+            // Its old light may have gone anywhere from any of its cells.
+            let all: Vec<Cell> = (0..CHUNK_VOLUME).map(|l| (ci, l as Local)).collect();
+            let mut engine = Engine::new(&mut self.entries, &self.props, world);
+            run(&mut engine, &all, &sky, &NO_FLOOD, &mut self.scratch);
+            return Ok(true);
+        }
+        // Dark, and nothing came through it: its sources as a full light writes them,
+        // then a flood from its cells that can raise a neighbour and from the cells
+        // around it.
+        let mut beam = [[0.0; 3]; CHUNK_AREA];
+        let mut kinds = [0; CHUNK_AREA];
+        {
+            let engine = Engine::new(&mut self.entries, &self.props, world);
+            for col in 0..CHUNK_AREA {
+                beam[col] = engine.entries[ci as usize].beam_in.get(col);
+                kinds[col] = engine.props_of(engine.above(ci, col)).kind;
+            }
+        }
+        let mut cells = vec![[0; 6]; CHUNK_VOLUME];
+        self.fill_chunk(world.chunk(pos), &mut beam, &mut kinds, &mut cells);
+        self.entries[ci as usize].light = LightChunk::from_cells(&cells);
+        let mut flood: [Vec<Cell>; 6] = Default::default();
+        self.seeds_of(ci, &mut flood);
+        let around = self.around(ci);
+        for f in &mut flood {
+            f.extend_from_slice(&around);
+        }
         let mut engine = Engine::new(&mut self.entries, &self.props, world);
-        run(&mut engine, &all, &sky, &mut self.scratch);
+        run(&mut engine, &[], &sky, &flood, &mut self.scratch);
         Ok(true)
     }
 
@@ -126,10 +154,10 @@ impl LightField {
                 sky.extend((0..CHUNK_VOLUME).map(|l| (top, l as Local)));
             }
         }
-        let all: Vec<Cell> = (0..CHUNK_VOLUME).map(|l| (ci, l as Local)).collect();
         let mut engine = Engine::new(&mut self.entries, &self.props, world);
         engine.dead = ci;
-        run(&mut engine, &all, &sky, &mut self.scratch);
+        // Light that came through it left it by its border.
+        run(&mut engine, &border(ci), &sky, &NO_FLOOD, &mut self.scratch);
         // Take it out; the last entry takes its index.
         self.index.remove(&pos);
         if self
@@ -240,14 +268,65 @@ fn quantize(w: [[f32; 3]; CHUNK_SIZE]) -> ColumnLevels {
     w.map(|b| b.map(level))
 }
 
+impl LightField {
+    /// The cells of the lit chunks around chunk `c` that touch it.
+    fn around(&self, c: u32) -> Vec<Cell> {
+        let mut out = Vec::with_capacity(6 * CHUNK_AREA);
+        for (d, &n) in self.entries[c as usize].neigh.iter().enumerate() {
+            if n == NONE {
+                continue;
+            }
+            // The layer of `n` facing `c`: its low side when `n` lies on the positive side.
+            let axis = d / 2;
+            let fixed = if d % 2 == 0 { 0 } else { CHUNK_SIZE - 1 };
+            for a in 0..CHUNK_SIZE {
+                for b in 0..CHUNK_SIZE {
+                    let p = match axis {
+                        0 => [fixed, a, b],
+                        1 => [a, fixed, b],
+                        _ => [a, b, fixed],
+                    };
+                    out.push((n, local(p[0], p[1], p[2])));
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The cells on the six sides of chunk `c`.
+fn border(c: u32) -> Vec<Cell> {
+    let mut out = Vec::with_capacity(6 * CHUNK_AREA);
+    for x in 0..CHUNK_SIZE {
+        for y in 0..CHUNK_SIZE {
+            for z in 0..CHUNK_SIZE {
+                let edge = [x, y, z].iter().any(|&v| v == 0 || v == CHUNK_SIZE - 1);
+                if edge {
+                    out.push((c, local(x, y, z)));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// No cells to flood from besides the update's own.
+const NO_FLOOD: [&[Cell]; 6] = [&[]; 6];
+
 /// Updates the six channels for a change at `seeds` (every channel) and `sky` (cells whose
-/// beam changed).
-fn run(engine: &mut Engine<'_>, seeds: &[Cell], sky: &[Cell], scratch: &mut Scratch) {
+/// beam changed), then floods each channel from `flood` too.
+fn run<F: AsRef<[Cell]>>(
+    engine: &mut Engine<'_>,
+    seeds: &[Cell],
+    sky: &[Cell],
+    flood: &[F; 6],
+    scratch: &mut Scratch,
+) {
     let mut both = Vec::with_capacity(seeds.len() + sky.len());
     both.extend_from_slice(seeds);
     both.extend_from_slice(sky);
-    for ch in 0..6 {
+    for (ch, flood) in flood.iter().enumerate() {
         let s = if ch < 3 { &both[..] } else { seeds };
-        engine.update(ch, s, scratch);
+        engine.update(ch, s, flood.as_ref(), scratch);
     }
 }

@@ -2,6 +2,7 @@
 //! filters (increase), and its removal and refill after a change, one channel at a time.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use super::props::{ONE, Props};
 use super::store::{Beam, LightChunk, Local, local};
@@ -34,7 +35,7 @@ pub(super) struct Engine<'a> {
     props: &'a [Props],
     world: &'a World,
     blocks: Vec<Option<Option<&'a Chunk>>>,
-    beams: HashMap<Cell, [[u8; 3]; CHUNK_SIZE]>,
+    beams: HashMap<Cell, [[u8; 3]; CHUNK_SIZE], BuildHasherDefault<CellHasher>>,
     /// A chunk being unlit: its cells are cleared but never refilled.
     pub dead: u32,
 }
@@ -47,7 +48,7 @@ impl<'a> Engine<'a> {
             props,
             world,
             blocks: vec![None; n],
-            beams: HashMap::new(),
+            beams: HashMap::default(),
             dead: NONE,
         }
     }
@@ -164,22 +165,30 @@ impl<'a> Engine<'a> {
             if v <= LIGHT_FALLOFF {
                 continue;
             }
-            let kind = self.props_at(cell.0, cell.1).kind;
+            // Filters only lower a level: a neighbour at `v − falloff` or above cannot
+            // rise, and needs no block looked up.
+            let upper = v - LIGHT_FALLOFF;
+            let mut kind = None;
             for dir in 0..6 {
                 let Some(n) = self.step(cell.0, cell.1, dir) else {
                     continue;
                 };
+                let now = self.get(n, ch);
+                if now >= upper {
+                    continue;
+                }
                 let p = self.props_at(n.0, n.1);
                 if !p.open {
                     continue;
                 }
+                let kind = *kind.get_or_insert_with(|| self.props_at(cell.0, cell.1).kind);
                 let f = if p.kind == kind {
                     p.within_fx[ch % 3]
                 } else {
                     p.enter_fx[ch % 3]
                 };
                 let cand = filtered(v, f).saturating_sub(LIGHT_FALLOFF);
-                if cand > self.get(n, ch) {
+                if cand > now {
                     self.set(n, ch, cand);
                     queue.push(n);
                 }
@@ -191,7 +200,8 @@ impl<'a> Engine<'a> {
     /// Clears channel `ch` at `seeds` and at every cell whose level may have come through
     /// them (a level at most the falloff below a cleared neighbour's: filters only lower
     /// it), then refills what was cleared from the cells around it and from sources.
-    pub fn update(&mut self, ch: usize, seeds: &[Cell], scratch: &mut Scratch) {
+    /// Then floods from `flood` too (cells set to their sources by the caller).
+    pub fn update(&mut self, ch: usize, seeds: &[Cell], flood: &[Cell], scratch: &mut Scratch) {
         let Scratch {
             stack,
             cleared,
@@ -209,7 +219,7 @@ impl<'a> Engine<'a> {
                     continue;
                 };
                 let v = self.get(n, ch);
-                if v == 0 {
+                if v == 0 || n.0 == self.dead {
                     continue;
                 }
                 if u16::from(v) + u16::from(LIGHT_FALLOFF) <= u16::from(old) {
@@ -221,17 +231,32 @@ impl<'a> Engine<'a> {
                 }
             }
         }
-        for &c in cleared.iter() {
+        // Sources first, then only those that can raise a neighbour flood (a chunk lit
+        // whole would otherwise push every cell of it).
+        cleared.retain(|&c| {
             if c.0 == self.dead {
-                continue;
+                return false;
             }
             let s = self.source(c, ch);
-            if s > self.get(c, ch) {
+            let raised = s > self.get(c, ch);
+            if raised {
                 self.set(c, ch, s);
+            }
+            raised && s > LIGHT_FALLOFF
+        });
+        for &c in cleared.iter() {
+            let v = self.get(c, ch);
+            let lower = |n: Option<Cell>| {
+                n.is_some_and(|n| {
+                    u16::from(self.get(n, ch)) + u16::from(LIGHT_FALLOFF) < u16::from(v)
+                })
+            };
+            if (0..6).any(|dir| lower(self.step(c.0, c.1, dir))) {
                 queue.push(c);
             }
         }
         cleared.clear();
+        queue.extend_from_slice(flood);
         self.increase(ch, queue);
     }
 }
@@ -278,5 +303,30 @@ pub(super) fn step(entries: &[Entry], c: u32, l: Local, dir: usize) -> Option<Ce
     } else {
         let n = entries[c as usize].neigh[dir];
         (n != NONE).then(|| (n, moved(far)))
+    }
+}
+
+/// A multiplicative hash of a cell's two numbers: the beam cache is looked up once per
+/// cleared cell and sky channel, where SipHash would cost more than the walk it saves.
+#[derive(Default)]
+pub(super) struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_u16(&mut self, v: u16) {
+        self.write_u64(u64::from(v));
+    }
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
     }
 }

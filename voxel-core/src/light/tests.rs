@@ -485,6 +485,19 @@ fn chunks_lit_as_they_stream_equal_a_full_light() {
         );
     }
     assert!(!f.remove_chunk(&w, ChunkPos::new(0, 1, 0)).unwrap());
+    // A chunk replaced in place (its old light and bottom blocks gone) is relit.
+    let mut hollow = w.chunk(ChunkPos::new(1, 1, 0)).unwrap().clone();
+    hollow
+        .fill_box([0, 0, 0], [31, 20, 31], BlockId::AIR)
+        .unwrap();
+    hollow.set(5, 5, 5, light_blocks::LAVA).unwrap();
+    w.insert_chunk(ChunkPos::new(1, 1, 0), hollow).unwrap();
+    assert!(f.add_chunk(&w, ChunkPos::new(1, 1, 0)).unwrap());
+    assert_same(
+        &all_levels(&f, &w),
+        &all_levels(&LightField::new(&w), &w),
+        "replaced",
+    );
     // A chunk high above with a gap between: its shade falls through the gap.
     let high = ChunkPos::new(1, 3, 1);
     w.insert_chunk(high, crate::Chunk::uniform(blocks::STONE))
