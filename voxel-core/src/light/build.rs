@@ -38,6 +38,7 @@ impl LightField {
     /// Lights every loaded chunk of `world`, replacing what was lit.
     pub(super) fn light_all(&mut self, world: &World) {
         self.entries.clear();
+        self.changed.clear();
         self.index.clear();
         self.columns.clear();
         let mut positions: Vec<ChunkPos> = world.iter().map(|(p, _)| p).collect();
@@ -82,6 +83,7 @@ impl LightField {
         }
         // Cells stay in the form the flood wrote them in; compact once.
         self.compact();
+        self.changed.extend(positions);
     }
 
     /// Writes the sources of a chunk's cells (beam levels, emission) into `cells` and

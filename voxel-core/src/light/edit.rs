@@ -1,6 +1,8 @@
 //! Incremental updates: an edited block, a chunk lit as it streams in, a chunk unlit as it
 //! goes.
 
+use std::collections::HashSet;
+
 use super::LightField;
 use super::engine::{Cell, Engine, NONE, Scratch, level};
 use super::store::{Beam, LightChunk, Local, local};
@@ -63,6 +65,7 @@ impl LightField {
             &sky,
             &NO_FLOOD,
             &mut self.scratch,
+            &mut self.changed,
         );
         Ok(old)
     }
@@ -95,7 +98,14 @@ impl LightField {
             // Its old light may have gone anywhere from any of its cells.
             let all: Vec<Cell> = (0..CHUNK_VOLUME).map(|l| (ci, l as Local)).collect();
             let mut engine = Engine::new(&mut self.entries, &self.props, world);
-            run(&mut engine, &all, &sky, &NO_FLOOD, &mut self.scratch);
+            run(
+                &mut engine,
+                &all,
+                &sky,
+                &NO_FLOOD,
+                &mut self.scratch,
+                &mut self.changed,
+            );
             return Ok(true);
         }
         // Dark, and nothing came through it: its sources as a full light writes them,
@@ -120,7 +130,15 @@ impl LightField {
             f.extend_from_slice(&around);
         }
         let mut engine = Engine::new(&mut self.entries, &self.props, world);
-        run(&mut engine, &[], &sky, &flood, &mut self.scratch);
+        run(
+            &mut engine,
+            &[],
+            &sky,
+            &flood,
+            &mut self.scratch,
+            &mut self.changed,
+        );
+        self.changed.insert(pos);
         Ok(true)
     }
 
@@ -157,7 +175,14 @@ impl LightField {
         let mut engine = Engine::new(&mut self.entries, &self.props, world);
         engine.dead = ci;
         // Light that came through it left it by its border.
-        run(&mut engine, &border(ci), &sky, &NO_FLOOD, &mut self.scratch);
+        run(
+            &mut engine,
+            &border(ci),
+            &sky,
+            &NO_FLOOD,
+            &mut self.scratch,
+            &mut self.changed,
+        );
         // Take it out; the last entry takes its index.
         self.index.remove(&pos);
         if self
@@ -321,6 +346,7 @@ fn run<F: AsRef<[Cell]>>(
     sky: &[Cell],
     flood: &[F; 6],
     scratch: &mut Scratch,
+    changed: &mut HashSet<ChunkPos>,
 ) {
     let mut both = Vec::with_capacity(seeds.len() + sky.len());
     both.extend_from_slice(seeds);
@@ -328,5 +354,10 @@ fn run<F: AsRef<[Cell]>>(
     for (ch, flood) in flood.iter().enumerate() {
         let s = if ch < 3 { &both[..] } else { seeds };
         engine.update(ch, s, flood.as_ref(), scratch);
+    }
+    for &c in &engine.touched {
+        if c != engine.dead {
+            changed.insert(engine.entries[c as usize].pos);
+        }
     }
 }

@@ -38,6 +38,8 @@ pub(super) struct Engine<'a> {
     beams: HashMap<Cell, [[u8; 3]; CHUNK_SIZE], BuildHasherDefault<CellHasher>>,
     /// A chunk being unlit: its cells are cleared but never refilled.
     pub dead: u32,
+    /// The chunks whose light changed.
+    pub touched: Vec<u32>,
 }
 
 impl<'a> Engine<'a> {
@@ -50,6 +52,7 @@ impl<'a> Engine<'a> {
             blocks: vec![None; n],
             beams: HashMap::default(),
             dead: NONE,
+            touched: Vec::new(),
         }
     }
 
@@ -100,7 +103,13 @@ impl<'a> Engine<'a> {
 
     #[inline]
     fn set(&mut self, (c, l): Cell, ch: usize, v: u8) {
+        if self.get((c, l), ch) == v {
+            return;
+        }
         self.entries[c as usize].light.set_channel(l, ch, v);
+        if self.touched.last() != Some(&c) && !self.touched.contains(&c) {
+            self.touched.push(c);
+        }
     }
 
     /// The block above the top of chunk `c` at column `col` as light sees it: air where

@@ -59,7 +59,7 @@ mod store;
 #[cfg(test)]
 mod tests;
 
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeSet, HashMap, HashSet};
 use std::sync::Arc;
 
 pub use store::{Light, LightChunk};
@@ -115,6 +115,8 @@ pub struct LightField {
     columns: HashMap<[i32; 2], BTreeSet<i32>>,
     /// Queues the updates reuse.
     scratch: engine::Scratch,
+    /// Chunks whose light changed since [`LightField::take_changed`].
+    changed: HashSet<ChunkPos>,
 }
 
 impl LightField {
@@ -127,6 +129,7 @@ impl LightField {
             index: HashMap::new(),
             columns: HashMap::new(),
             scratch: engine::Scratch::default(),
+            changed: HashSet::new(),
         }
     }
 
@@ -173,6 +176,16 @@ impl LightField {
                 e.light.memory_bytes() + e.beam_in.memory_bytes() + std::mem::size_of::<Entry>()
             })
             .sum()
+    }
+
+    /// The lit chunks whose light changed since the last call (every chunk lit by
+    /// [`LightField::new`] or [`LightField::add_chunk`], every chunk where an edit or a
+    /// chunk unlit wrote a level, if only to clear and refill it), sorted: what a lit mesh must be rebuilt for (with the
+    /// neighbours whose border vertices read them).
+    pub fn take_changed(&mut self) -> Vec<ChunkPos> {
+        let mut v: Vec<_> = self.changed.drain().collect();
+        v.sort_unstable();
+        v
     }
 
     /// Turns layers whose blocks all hold the same light back into 6 bytes (edits leave

@@ -339,8 +339,14 @@ fn light_is_continuous_across_chunk_borders() {
     fill(&mut w, [-40, 50, -40], [70, 50, 70], blocks::STONE);
     fill(&mut w, [-40, 0, -40], [70, 0, 70], blocks::STONE);
     // One torch on the corner of four chunks, one in the middle of a chunk.
-    w.set_block(WorldPos::new(0, 5, 0), TORCH).unwrap();
-    let f = LightField::new(&w);
+    let mut f = LightField::new(&w);
+    f.take_changed();
+    w.set_block_lit(&mut f, WorldPos::new(0, 5, 0), TORCH)
+        .unwrap();
+    let around: Vec<_> = [[-1, -1], [-1, 0], [0, -1], [0, 0]]
+        .map(|[x, z]| ChunkPos::new(x, 0, z))
+        .into();
+    assert_eq!(f.take_changed(), around, "the four chunks the torch lights");
     let mut g = world();
     load(&mut g, [-1, 0, -1], [1, 1, 1]);
     fill(&mut g, [-40, 50, -40], [70, 50, 70], blocks::STONE);
@@ -370,9 +376,12 @@ fn removing_a_torch_restores_darkness() {
     fill(&mut w, [1, 1, 1], [19, 19, 19], BlockId::AIR);
     let mut f = LightField::new(&w);
     let dark = all_levels(&f, &w);
+    assert_eq!(f.take_changed(), vec![ChunkPos::new(0, 0, 0)]);
     w.set_block_lit(&mut f, WorldPos::new(10, 10, 10), TORCH)
         .unwrap();
     assert_eq!(at(&f, [10, 12, 10]).block, [223, 138, 58]);
+    assert_eq!(f.take_changed(), vec![ChunkPos::new(0, 0, 0)]);
+    assert!(f.take_changed().is_empty());
     assert_same(
         &all_levels(&f, &w),
         &all_levels(&LightField::new(&w), &w),
