@@ -273,6 +273,11 @@ pub struct BlockDef {
     /// not drawn (the volume goes on through it), its holes show the medium, and an eye in
     /// it is in the medium. `None` (the default): it stands in air.
     pub medium: Option<BlockId>,
+    /// The light the block gives out (torch, lava, glowing glass): the block light level
+    /// of its own cell per channel, linear RGB from 0 to 255, falling
+    /// [`crate::LIGHT_FALLOFF`] a block from there (255 lights 15 blocks around it); see
+    /// [`crate::LightField`]. `[0, 0, 0]` (the default): it gives none.
+    pub emission: [u8; 3],
 }
 
 /// The built-in water's absorption per block: 16 blocks of it dim what lies behind as
@@ -319,6 +324,7 @@ impl BlockDef {
             images: FaceImages::default(),
             absorption: 0.0,
             medium: None,
+            emission: [0; 3],
         }
     }
 
@@ -356,6 +362,7 @@ impl BlockDef {
             images: FaceImages::default(),
             absorption: 0.0,
             medium: None,
+            emission: [0; 3],
         }
     }
 
@@ -373,6 +380,11 @@ impl BlockDef {
     /// [`BlockDef::absorption`]).
     pub fn with_absorption(self, absorption: f32) -> Self {
         Self { absorption, ..self }
+    }
+
+    /// The same block giving out light `emission` (see [`BlockDef::emission`]).
+    pub fn emitting(self, emission: [u8; 3]) -> Self {
+        Self { emission, ..self }
     }
 
     /// The same (cutout) block standing in `medium` (see [`BlockDef::medium`]).
@@ -468,6 +480,7 @@ impl BlockRegistry {
             images: FaceImages::default(),
             absorption: 0.0,
             medium: None,
+            emission: [0; 3],
         };
         Self {
             by_name: HashMap::from([(air.name.clone(), BlockId::AIR)]),

@@ -56,6 +56,10 @@ pub enum Error {
     /// maximum distance that is negative, not a number, or beyond the limit.
     #[error("invalid ray: {0}")]
     InvalidRay(String),
+    /// A light field used with a world over another block registry than the one it was
+    /// built for.
+    #[error("the light field was built for another block registry than this world's")]
+    LightRegistry,
     /// A MagicaVoxel file that cannot be imported: which file, and what is wrong with it.
     #[error("{file}: {error}")]
     Vox {

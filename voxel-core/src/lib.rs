@@ -10,6 +10,7 @@
 mod block;
 mod chunk;
 mod error;
+mod light;
 mod terrain;
 pub mod vox;
 mod world;
@@ -23,6 +24,7 @@ pub use chunk::{
     column_index, row_index,
 };
 pub use error::{Error, Result};
+pub use light::{LIGHT_FALLOFF, Light, LightChunk, LightField, light_blocks};
 pub use terrain::{
     Showcase, Site, SiteKind, TerrainBlocks, TerrainConfig, TerrainGenerator, TerrainRole,
 };
