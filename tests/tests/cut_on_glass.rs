@@ -1,11 +1,12 @@
-//! Issue 52's G1 cases as far as they were rebuilt here: a game's flat things lying on
-//! glass under another glass layer (one across chunk borders, cut there), and particles
-//! between two glass layers (`scenes/regressions/foam_on_glass_under_glass.toml`,
-//! `particles_between_glass.toml`): `sorted-quads` within 1/255 of the A-buffer reference
-//! off quad edges (where the rasteriser decides, not the order), as `depth-peeling` is.
-//! These scenes are exact before and after the change that added them: the issue's own
-//! `foam_on_glass_big*` scenes were not at hand, and what made them 20–22/255 off is not
-//! known. On lavapipe, as CI runs it.
+//! Issue 52's G1 cases: a game's flat things lying on glass under another glass layer (one
+//! across chunk borders, cut there), and particles between two glass layers
+//! (`scenes/regressions/foam_on_glass_under_glass.toml`, `particles_between_glass.toml`,
+//! exact before and after the fix), and two scenes the search below found
+//! (`foam_on_glass_big_side.toml`, `foam_on_glass_big_chunks.toml`: big things, the layers'
+//! sides in view, 71/255 and 24/255 off on 28 % and 1.6 % of the picture before the fix):
+//! `sorted-quads` within 1/255 of the A-buffer reference off quad edges (where the
+//! rasteriser decides, not the order) and object overlaps, as `depth-peeling` is. On
+//! lavapipe, as CI runs it.
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
