@@ -108,7 +108,7 @@ pub(crate) struct ChunkSequence<'a> {
 struct ChunkFacts {
     distances: [f64; 3],
     planes: Option<(u32, u32)>,
-    /// The runs, and where the boxes of its planes' quads start.
+    /// The runs, and where the boxes of its runs' quads start.
     runs: Option<(u32, u32, u32)>,
 }
 
@@ -183,7 +183,7 @@ pub(crate) struct Interleaver {
     facts: Vec<ChunkFacts>,
     seen: Vec<SeenPlane>,
     runs: Vec<(u32, u32)>,
-    /// Per chunk that needs them, the box of each plane's quads, world blocks.
+    /// Per chunk that needs them, the box of each run's quads, world blocks.
     boxes: Vec<(DVec3, DVec3)>,
     /// The distinct clips of the parts (0: none), and by hash the indices of the others.
     clips: Vec<Clip>,

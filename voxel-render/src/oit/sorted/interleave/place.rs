@@ -8,6 +8,9 @@ use super::cells::cells_and_keys;
 use super::sound::{SOUND, plane_runs, plane_weight, safe, seen_planes, shadow_misses, touch};
 use super::{Ball, Clip, ClipPlane, Frame, Interleaver, MAX_SPLIT_DEPTH, MAX_SPLIT_PLANES, Part};
 
+/// A plane's weight in [`Interleaver::place`] where the eye does not see it.
+const UNSEEN: i64 = i64::MIN;
+
 impl Interleaver {
     /// Cuts `whole` at the planes it crosses (`self.crossings`, the nearest
     /// [`MAX_SPLIT_PLANES`] to its centre) into the parts between them, and places each.
@@ -219,28 +222,43 @@ impl Interleaver {
                         (from, runs.len() as u32, first_box)
                     });
                     let runs = &runs[from as usize..to as usize];
+                    // Each seen plane's weight (`UNSEEN`: a plane not seen, which orders
+                    // nothing).
                     weights.clear();
-                    weights.resize(s.planes.len(), 0);
+                    weights.resize(s.planes.len(), UNSEEN);
                     for pl in planes.iter() {
-                        let quads = boxes[(first_box + pl.index) as usize];
-                        // A plane whose quads the object cannot overlap on screen orders
-                        // nothing (the top of a glass wall above a fish behind it).
-                        if shadow_misses(b, eye, pl.axis, quads) {
-                            continue;
-                        }
-                        let w = plane_weight(b, pl);
-                        weights[pl.index as usize] = w;
-                        if w == 0 && collect {
-                            crossings.push((pl.axis, pl.at, false));
-                        }
+                        weights[pl.index as usize] = plane_weight(b, pl);
                     }
+                    let origin = DVec3::from(s.origin);
                     let mut k = 0u32;
-                    for &(p, n) in runs.iter() {
+                    for (r, &(p, n)) in runs.iter().enumerate() {
                         let w = weights[p as usize];
-                        if w != 0 {
-                            // A run weighs its count; the place after it is after its
-                            // last quad.
-                            items.push((c32, k + n - 1, w * i64::from(n), k));
+                        let (face, at) = s.planes[p as usize];
+                        let axis = face.axis();
+                        // A run whose quads the object cannot overlap on screen orders
+                        // nothing (the top of a glass wall above a fish behind it; the side
+                        // of a floor below a thing lying on it, in the plane of the side of
+                        // a layer above): its box first, then, where that meets the
+                        // object's shadow, its quads one by one.
+                        let meets =
+                            |(lo, hi): (DVec3, DVec3)| !shadow_misses(b, eye, axis, (lo, hi));
+                        let seen_quads = || {
+                            let run = &s.quads[(k as usize).min(s.quads.len())
+                                ..((k + n) as usize).min(s.quads.len())];
+                            n == 1
+                                || run.iter().filter_map(|q| q.unpack()).any(|q| {
+                                    let (lo, hi) = q.bounds();
+                                    meets((DVec3::from(lo) + origin, DVec3::from(hi) + origin))
+                                })
+                        };
+                        if w != UNSEEN && meets(boxes[first_box as usize + r]) && seen_quads() {
+                            if w != 0 {
+                                // A run weighs its count; the place after it is after its
+                                // last quad.
+                                items.push((c32, k + n - 1, w * i64::from(n), k));
+                            } else if collect {
+                                crossings.push((axis, s.origin[axis] + f64::from(at), false));
+                            }
                         }
                         k += n;
                     }

@@ -136,19 +136,20 @@ pub(super) fn quad_side(
 }
 
 /// A chunk's quads as runs of one plane in their drawn order (index into
-/// [`Surfaces::planes`], count), appended to `out`: every quad of a plane stands alike against a ball
-/// ([`quad_side`] depends only on the plane), so a split is chosen per run boundary.
+/// [`Surfaces::planes`], count), appended to `out`, and the box of each run's quads (world
+/// blocks) to `boxes`, one per run: every quad of a plane stands alike against a ball
+/// ([`quad_side`] depends only on the plane), so a split is chosen per run boundary. The
+/// box is a run's, not its plane's: one plane's quads drawn at different places of the
+/// order (the side of a glass floor drawn early, the side of the glass layer above it in
+/// the same plane drawn after the floor's top) each order only an object whose shadow
+/// meets them, so that quads of a plane the object cannot overlap on screen put no
+/// constraint on it that no place can meet (issue 52, G1).
 pub(super) fn plane_runs(
     s: &Surfaces<'_>,
     out: &mut Vec<(u32, u32)>,
     boxes: &mut Vec<(DVec3, DVec3)>,
 ) {
     let start = out.len();
-    let first_box = boxes.len();
-    boxes.resize(
-        first_box + s.planes.len(),
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-    );
     let o = DVec3::from(s.origin);
     for q in s.quads {
         let Some(q) = q.unpack() else { continue };
@@ -160,12 +161,18 @@ pub(super) fn plane_runs(
         else {
             continue;
         };
-        let b = &mut boxes[first_box + i];
-        b.0 = b.0.min(DVec3::from(lo) + o);
-        b.1 = b.1.max(DVec3::from(hi) + o);
+        let (lo, hi) = (DVec3::from(lo) + o, DVec3::from(hi) + o);
         match out[start..].last_mut() {
-            Some((p, n)) if *p == i as u32 => *n += 1,
-            _ => out.push((i as u32, 1)),
+            Some((p, n)) if *p == i as u32 => {
+                *n += 1;
+                if let Some(b) = boxes.last_mut() {
+                    *b = (b.0.min(lo), b.1.max(hi));
+                }
+            }
+            _ => {
+                out.push((i as u32, 1));
+                boxes.push((lo, hi));
+            }
         }
     }
 }
