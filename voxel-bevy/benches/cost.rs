@@ -9,7 +9,7 @@
 //! is `render` + `finish` + `submit` of one encoder on Bevy's device. The GPU is waited for
 //! after each frame, outside the timing.
 //!
-//! `cargo bench -p voxel-bevy --bench cost [-- FRAMES]`
+//! `cargo bench --workspace --bench cost [-- FRAMES]`
 
 #![allow(unsafe_code)] // one libc call: the thread's CPU clock, which std does not offer
 #![allow(clippy::unwrap_used)] // a bench: a failure is a failed run
@@ -106,7 +106,6 @@ fn main() {
         "| technique | Bevy + plugin (ms CPU) | Bevy alone | plugin | crate's render | plugin / crate | draws plugin / crate | fragments plugin / crate |"
     );
     println!("|---|---|---|---|---|---|---|---|");
-    let bevy_alone = bevy_frames(&mut without, frames);
     for t in [
         Technique::SortedQuads,
         Technique::Sorted,
@@ -114,6 +113,8 @@ fn main() {
         Technique::DepthPeeling,
     ] {
         with.app.insert_resource(VoxelTechnique::Use(t));
+        // Bevy alone next to each technique's frames: the machine's load drifts.
+        let bevy_alone = bevy_frames(&mut without, frames);
         let with_plugin = bevy_frames(&mut with, frames);
         // The crate on its own: the same scene, camera, technique and device.
         let config = tests::technique_config(t, size.0, size.1);

@@ -139,19 +139,15 @@ impl Composite {
         p
     }
 
-    /// The bind group of one direction: Bevy's colour, the depth read, the mapping.
-    pub(crate) fn bind_group(
-        &self,
-        device: &wgpu::Device,
-        bevy_color: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-        mapping: [f32; 2],
-        ldr: bool,
-    ) -> wgpu::BindGroup {
+    /// The bind groups of one camera's frame (both directions) for what they read: Bevy's
+    /// colour view, Bevy's depth texture, the crate's scene depth, the depth mapping and
+    /// whether Bevy's colour is tonemapped (LDR). Made when one of those changes (a resize,
+    /// another target, another near plane), not every frame: [`Binding::reads`].
+    pub(crate) fn binding(&self, device: &wgpu::Device, reads: BindingReads) -> Binding {
         let params: [u32; 4] = [
-            mapping[0].to_bits(),
-            mapping[1].to_bits(),
-            u32::from(ldr),
+            reads.mapping[0].to_bits(),
+            reads.mapping[1].to_bits(),
+            u32::from(reads.ldr),
             0,
         ];
         let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -159,24 +155,37 @@ impl Composite {
             contents: bytemuck::cast_slice(&params),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("voxel-bevy composite"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(bevy_color),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(depth),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: buffer.as_entire_binding(),
-                },
-            ],
-        })
+        let bevy_depth = reads
+            .bevy_depth
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        let group = |depth: &wgpu::TextureView| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("voxel-bevy composite"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&reads.bevy_color),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(depth),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: buffer.as_entire_binding(),
+                    },
+                ],
+            })
+        };
+        let into_world = group(&bevy_depth);
+        let into_bevy = group(&reads.scene_depth);
+        Binding {
+            reads,
+            bevy_depth,
+            into_world,
+            into_bevy,
+        }
     }
 
     /// Writes the world's opaque depth (`group` reads the crate's scene depth) into Bevy's
@@ -208,16 +217,45 @@ impl Composite {
     }
 }
 
+/// What a camera's composite bind groups read. The views and textures compare by identity
+/// (wgpu's handles), and a [`Binding`] holds them, so an equal one is the same object.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct BindingReads {
+    /// Bevy's main texture (the view Bevy's opaque pass drew into).
+    pub(crate) bevy_color: wgpu::TextureView,
+    /// Bevy's depth texture.
+    pub(crate) bevy_depth: wgpu::Texture,
+    /// The crate's scene depth (`Renderer::scene_depth_view`, made again on resize).
+    pub(crate) scene_depth: wgpu::TextureView,
+    /// Crate depth = `mapping[0]` · Bevy depth + `mapping[1]` ([`depth_mapping`]).
+    pub(crate) mapping: [f32; 2],
+    /// Bevy's colour is tonemapped (an LDR target).
+    pub(crate) ldr: bool,
+}
+
+/// One camera's composite bind groups ([`Composite::binding`]), kept across frames.
+#[derive(Debug)]
+pub(crate) struct Binding {
+    /// What they read: a frame that reads anything else makes a new binding.
+    pub(crate) reads: BindingReads,
+    /// The view of Bevy's depth texture (read into the world, written into Bevy).
+    pub(crate) bevy_depth: wgpu::TextureView,
+    /// Bevy's colour and depth, read into the crate's scene.
+    pub(crate) into_world: wgpu::BindGroup,
+    /// The crate's scene depth, written into Bevy's depth.
+    pub(crate) into_bevy: wgpu::BindGroup,
+}
+
 /// The frame stage that draws Bevy's opaque pixels into the crate's scene.
 #[derive(Debug)]
-pub(crate) struct BevyOpaque<'a> {
+pub(crate) struct BevyOpaque<'a, 'g> {
     pub(crate) composite: &'a mut Composite,
-    pub(crate) group: wgpu::BindGroup,
+    pub(crate) group: &'g wgpu::BindGroup,
     pipeline: Option<wgpu::RenderPipeline>,
 }
 
-impl<'a> BevyOpaque<'a> {
-    pub(crate) fn new(composite: &'a mut Composite, group: wgpu::BindGroup) -> Self {
+impl<'a, 'g> BevyOpaque<'a, 'g> {
+    pub(crate) fn new(composite: &'a mut Composite, group: &'g wgpu::BindGroup) -> Self {
         Self {
             composite,
             group,
@@ -226,7 +264,7 @@ impl<'a> BevyOpaque<'a> {
     }
 }
 
-impl GameStages for BevyOpaque<'_> {
+impl GameStages for BevyOpaque<'_, '_> {
     fn stages(&self) -> Stages {
         Stages {
             opaque: true,
@@ -241,7 +279,7 @@ impl GameStages for BevyOpaque<'_> {
     fn opaque(&self, pass: &mut wgpu::RenderPass<'_>, _frame: &GameFrame<'_>) {
         if let Some(p) = &self.pipeline {
             pass.set_pipeline(p);
-            pass.set_bind_group(0, &self.group, &[]);
+            pass.set_bind_group(0, self.group, &[]);
             pass.draw(0..3, 0..1);
         }
     }

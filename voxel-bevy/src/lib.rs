@@ -33,6 +33,7 @@ mod composite;
 mod render;
 
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use bevy::app::{App, Plugin, PostUpdate};
@@ -120,7 +121,7 @@ impl Default for VoxelLighting {
     }
 }
 
-/// What the render world reports back, updated every frame.
+/// What the render world reports back: `frames` every frame, the rest when it changes.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct VoxelStatus {
     /// The technique drawing, once the renderer exists.
@@ -391,7 +392,12 @@ struct ChunkQueue(Shared<ChunkOp>);
 
 /// Reports from the render world to the main world.
 #[derive(Resource, Clone, Default)]
-struct ReportQueue(Shared<Report>);
+struct ReportQueue {
+    /// Messages, and the status when it changes.
+    queue: Shared<Report>,
+    /// Frames drawn ([`VoxelStatus::frames`]): counted without a report each frame.
+    frames: Arc<AtomicU64>,
+}
 
 enum Report {
     Message(VoxelMessage),
@@ -413,12 +419,17 @@ impl ChunkSink for QueueSink<'_> {
     }
 }
 
-/// What one frame draws, gathered in the main world and copied into the render world.
+/// What one frame draws, gathered in the main world and copied into the render world (a
+/// cheap copy: the content is shared, rebuilt only when its sources change).
 #[derive(Resource, Clone, Debug, Default)]
 struct VoxelFrame {
     /// Per camera entity (main world): the crate's camera, or why there is none.
     cameras: HashMap<Entity, voxel_render::Camera>,
-    content: Content,
+    /// The game's content: [`VoxelContent`] and the entities, in world coordinates.
+    content: Arc<Content>,
+    /// Counts the rebuilds of `content`: the render world hands the content to the crate
+    /// again only when it differs from the generation it handed last.
+    content_generation: u64,
     technique: VoxelTechnique,
     lighting: Option<Lighting>,
     count: bool,
@@ -578,14 +589,15 @@ fn gather_frame(
     settings: Res<render::PluginSettings>,
     world: Option<Res<VoxelWorld>>,
     cameras: Query<(Entity, &GlobalTransform, &Projection, &Camera), With<VoxelCamera>>,
-    things: Query<(&GlobalTransform, &VoxelTranslucent)>,
-    clouds: Query<(&GlobalTransform, &VoxelParticles)>,
+    things: Query<(Ref<GlobalTransform>, Ref<VoxelTranslucent>)>,
+    clouds: Query<(Ref<GlobalTransform>, Ref<VoxelParticles>)>,
     technique: Res<VoxelTechnique>,
     lighting: Res<VoxelLighting>,
     extra: Res<VoxelContent>,
     mut count: ResMut<VoxelCountNextFrame>,
     mut frame: ResMut<VoxelFrame>,
     mut warned: Local<bool>,
+    mut gathered: Local<Option<(usize, usize)>>,
     mut messages: MessageWriter<VoxelMessage>,
 ) {
     let frame = &mut *frame;
@@ -615,20 +627,48 @@ fn gather_frame(
             Err(_) => {}
         }
     }
-    frame.content.clone_from(&extra.0);
-    for (transform, thing) in &things {
+    // The content is rebuilt only when something it is made of changed: the resource, an
+    // entity's component or transform (`Ref::is_changed` is also true for one just added),
+    // or the number of entities (one removed or despawned).
+    let counts = (things.iter().count(), clouds.iter().count());
+    let changed = extra.is_changed()
+        || *gathered != Some(counts)
+        || things
+            .iter()
+            .any(|(t, thing)| t.is_changed() || thing.is_changed())
+        || clouds
+            .iter()
+            .any(|(t, cloud)| t.is_changed() || cloud.is_changed());
+    if changed {
+        *gathered = Some(counts);
+        frame.content = Arc::new(gather_content(&extra.0, &things, &clouds));
+        frame.content_generation += 1;
+    }
+    frame.count = std::mem::take(&mut count.0);
+    frame.technique = *technique;
+    frame.lighting = Some(lighting.0);
+}
+
+/// The game's content: `extra` and the entities' things, in world coordinates.
+fn gather_content(
+    extra: &Content,
+    things: &Query<(Ref<GlobalTransform>, Ref<VoxelTranslucent>)>,
+    clouds: &Query<(Ref<GlobalTransform>, Ref<VoxelParticles>)>,
+) -> Content {
+    let mut content = extra.clone();
+    for (transform, thing) in things {
         let (scale, rotation, center) = transform.to_scale_rotation_translation();
         let center = dvec3(center);
         let color = srgb_bytes(thing.color);
         match thing.shape {
-            VoxelShape::Particle { half_size } => frame.content.particles.push(Particle {
+            VoxelShape::Particle { half_size } => content.particles.push(Particle {
                 center,
                 half_size: half_size * scale.abs().max_element(),
                 color,
                 opacity: thing.opacity,
                 emissive: thing.emissive,
             }),
-            VoxelShape::Box { half_extents } => frame.content.entities.push(ContentEntity {
+            VoxelShape::Box { half_extents } => content.entities.push(ContentEntity {
                 center,
                 half_extents: [
                     half_extents[0] * scale.x.abs(),
@@ -648,25 +688,20 @@ fn gather_frame(
             }),
         }
     }
-    for (transform, cloud) in &clouds {
+    for (transform, cloud) in clouds {
         let affine = transform.affine();
         let scale = transform.scale().abs().max_element();
-        frame
-            .content
-            .particles
-            .extend(cloud.0.iter().map(|p| Particle {
-                center: dvec3(affine.transform_point3(BevyVec3::new(
-                    p.center.x as f32,
-                    p.center.y as f32,
-                    p.center.z as f32,
-                ))),
-                half_size: p.half_size * scale,
-                ..*p
-            }));
+        content.particles.extend(cloud.0.iter().map(|p| Particle {
+            center: dvec3(affine.transform_point3(BevyVec3::new(
+                p.center.x as f32,
+                p.center.y as f32,
+                p.center.z as f32,
+            ))),
+            half_size: p.half_size * scale,
+            ..*p
+        }));
     }
-    frame.count = std::mem::take(&mut count.0);
-    frame.technique = *technique;
-    frame.lighting = Some(lighting.0);
+    content
 }
 
 fn receive_reports(
@@ -674,7 +709,11 @@ fn receive_reports(
     mut status: ResMut<VoxelStatus>,
     mut messages: MessageWriter<VoxelMessage>,
 ) {
-    for r in drain(&reports.0) {
+    let frames = reports.frames.load(Ordering::Relaxed);
+    if status.frames != frames {
+        status.frames = frames;
+    }
+    for r in drain(&reports.queue) {
         match r {
             Report::Message(m) => {
                 messages.write(m);
@@ -683,6 +722,7 @@ fn receive_reports(
                 let cost = s.last_cost.clone().or_else(|| status.last_cost.take());
                 *status = VoxelStatus {
                     last_cost: cost,
+                    frames,
                     ..s
                 };
             }

@@ -2,7 +2,10 @@
 //! chunks, technique, lighting and content the main world gathered, drawing each
 //! [`crate::VoxelCamera`]'s view between Bevy's opaque and transparent passes.
 
+use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 use std::sync::Arc;
+use std::sync::atomic::Ordering;
 
 use bevy::app::App;
 use bevy::core_pipeline::Core3d;
@@ -16,7 +19,7 @@ use voxel_core::BlockRegistry;
 use voxel_render::content::ContentStages;
 use voxel_render::{Both, GpuContext, Lighting, Renderer, RendererConfig, Technique};
 
-use crate::composite::{BevyOpaque, Composite, depth_mapping};
+use crate::composite::{BevyOpaque, Binding, BindingReads, Composite, depth_mapping};
 use crate::{
     ChunkOp, ChunkQueue, Report, ReportQueue, VoxelFrame, VoxelMessage, VoxelPlugin, VoxelStatus,
     VoxelTechnique, drain, push,
@@ -40,12 +43,17 @@ struct VoxelRender {
     /// The request applied last (`None`: a new renderer applies it).
     technique: Option<VoxelTechnique>,
     lighting: Option<Lighting>,
-    frames: u64,
     /// A frame is being counted (its figures are read at the next prepare).
     counting: bool,
-    /// The content last handed to the content stages (unchanged content is not uploaded
-    /// again).
-    content_drawn: Option<voxel_render::content::Content>,
+    /// The generation of the content last handed to the content stages
+    /// (`VoxelFrame::content_generation`: unchanged content is not handed again).
+    content_generation: Option<u64>,
+    /// The technique last reported in [`VoxelStatus`] (the status is reported when it
+    /// changes).
+    reported: Option<Technique>,
+    /// Each camera's composite bind groups (by its main-world entity), kept while they
+    /// read the same textures.
+    bindings: HashMap<Entity, Binding>,
 }
 
 pub(crate) fn build(app: &mut App, plugin: VoxelPlugin, chunks: ChunkQueue, reports: ReportQueue) {
@@ -87,7 +95,7 @@ fn message(reports: &ReportQueue, m: VoxelMessage) {
         }
         VoxelMessage::Error(e) => log::error!("voxel-bevy: {e}"),
     }
-    push(&reports.0, Report::Message(m));
+    push(&reports.queue, Report::Message(m));
 }
 
 /// Applies the chunk changes, the technique, the lighting and the content.
@@ -103,13 +111,14 @@ fn prepare(
     adapter: Res<RenderAdapter>,
 ) {
     let state = &mut *state;
-    let ctx = state
-        .ctx
-        .get_or_insert_with(|| {
-            GpuContext::from_device(&adapter, device.wgpu_device().clone(), (**queue).clone())
-        })
-        .clone();
+    let ctx = state.ctx.get_or_insert_with(|| {
+        GpuContext::from_device(&adapter, device.wgpu_device().clone(), (**queue).clone())
+    });
     let reports = &*reports;
+    // A camera gone (or not drawn this frame) lets its textures go.
+    state
+        .bindings
+        .retain(|camera, _| frame.cameras.contains_key(camera));
     for op in drain(&chunks.0) {
         match op {
             ChunkOp::Reset(registry) => {
@@ -117,13 +126,14 @@ fn prepare(
                 state.content = None;
                 state.technique = None;
                 state.lighting = None;
-                state.content_drawn = None;
+                state.content_generation = None;
+                state.reported = None;
                 let config = RendererConfig {
                     width: 64,
                     height: 64,
                     ..settings.renderer.clone()
                 };
-                match Renderer::new(&ctx, &registry, config) {
+                match Renderer::new(ctx, &registry, config) {
                     Ok(r) => {
                         match ContentStages::new(&r, Default::default()) {
                             Ok(c) => state.content = Some(c),
@@ -198,22 +208,27 @@ fn prepare(
         }
     }
     if let Some(content) = &mut state.content
-        && state.content_drawn.as_ref() != Some(&frame.content)
+        && state.content_generation != Some(frame.content_generation)
     {
-        match content.set_content(&ctx, frame.content.clone()) {
-            Ok(()) => state.content_drawn = Some(frame.content.clone()),
-            Err(e) => message(reports, VoxelMessage::Error(e.to_string())),
+        // Content the crate refuses is reported once, not every frame until it changes.
+        state.content_generation = Some(frame.content_generation);
+        if let Err(e) = content.set_content(ctx, (*frame.content).clone()) {
+            message(reports, VoxelMessage::Error(e.to_string()));
         }
     }
-    push(
-        &reports.0,
-        Report::Status(VoxelStatus {
-            drawing: Some(renderer.config().oit.technique),
-            adapter: Some(ctx.caps.adapter_name.clone()),
-            frames: state.frames,
-            last_cost,
-        }),
-    );
+    let drawing = renderer.config().oit.technique;
+    if last_cost.is_some() || state.reported != Some(drawing) {
+        state.reported = Some(drawing);
+        push(
+            &reports.queue,
+            Report::Status(VoxelStatus {
+                drawing: Some(drawing),
+                adapter: Some(ctx.caps.adapter_name.clone()),
+                frames: reports.frames.load(Ordering::Relaxed),
+                last_cost,
+            }),
+        );
+    }
 }
 
 /// Draws the world into a [`crate::VoxelCamera`]'s view, after Bevy's opaque pass.
@@ -252,33 +267,43 @@ fn voxel_pass(
         );
         return;
     }
-    let mapping = depth_mapping(camera.near, camera.far);
-    let ldr = !matches!(
-        target.main_texture_format(),
-        wgpu::TextureFormat::Rgba16Float | wgpu::TextureFormat::Rgba32Float
-    );
-    let color_view: &wgpu::TextureView = target.main_texture_view();
-    let bevy_depth = depth
-        .texture()
-        .create_view(&wgpu::TextureViewDescriptor::default());
-    let into_world = composite.bind_group(&ctx.device, color_view, &bevy_depth, mapping, ldr);
-    let into_bevy = composite.bind_group(
-        &ctx.device,
-        color_view,
-        renderer.scene_depth_view(),
-        mapping,
-        ldr,
-    );
+    let reads = BindingReads {
+        bevy_color: (**target.main_texture_view()).clone(),
+        bevy_depth: (**depth.texture()).clone(),
+        scene_depth: renderer.scene_depth_view().clone(),
+        mapping: depth_mapping(camera.near, camera.far),
+        ldr: !matches!(
+            target.main_texture_format(),
+            wgpu::TextureFormat::Rgba16Float | wgpu::TextureFormat::Rgba32Float
+        ),
+    };
+    // The bind groups are made again only when what they read changed.
+    let binding = match state.bindings.entry(main.id()) {
+        Entry::Occupied(e) if e.get().reads == reads => e.into_mut(),
+        Entry::Occupied(mut e) => {
+            e.insert(composite.binding(&ctx.device, reads));
+            e.into_mut()
+        }
+        Entry::Vacant(e) => e.insert(composite.binding(&ctx.device, reads)),
+    };
     let encoder: &mut wgpu::CommandEncoder = render_context.command_encoder();
-    let mut opaque = BevyOpaque::new(composite, into_world);
+    let color_view: &wgpu::TextureView = target.main_texture_view();
+    let mut opaque = BevyOpaque::new(composite, &binding.into_world);
     let mut game = Both::new(&mut *content, &mut opaque);
     match renderer.render(encoder, color_view, camera, &mut game) {
         Ok(_) => {
             drop(game);
-            opaque
-                .composite
-                .depth_into_bevy(encoder, &bevy_depth, &into_bevy);
-            state.frames += 1;
+            let BevyOpaque { composite, .. } = opaque;
+            // The frame may have made the scene's depth again (its first volume in view).
+            if binding.reads.scene_depth != *renderer.scene_depth_view() {
+                let reads = BindingReads {
+                    scene_depth: renderer.scene_depth_view().clone(),
+                    ..binding.reads.clone()
+                };
+                *binding = composite.binding(&ctx.device, reads);
+            }
+            composite.depth_into_bevy(encoder, &binding.bevy_depth, &binding.into_bevy);
+            reports.frames.fetch_add(1, Ordering::Relaxed);
         }
         Err(e) => message(&reports, VoxelMessage::Error(format!("frame: {e}"))),
     }
