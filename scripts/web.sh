@@ -12,18 +12,35 @@
 #                     (the crate's own page); a game's own crate elsewhere (templates/web-game)
 #   WEB_OUT           the output folder: default out/web in this checkout
 #   CARGO_TARGET_DIR  cargo's target folder: default the crate's workspace's target/
+#   WEB_EXAMPLE       build this example of the crate instead of its library, as Bevy's
+#                     examples are built for the web: its `main` runs when the page loads,
+#                     the module is named after it, the page is examples/NAME/index.html
+#                     (voxel-bevy's `web`: docs/bevy.md)
+#   WEB_FEATURES      the crate's features to build with (voxel-bevy: webgl2 or webgpu)
 # With WEB_OUT and CARGO_TARGET_DIR outside it, nothing is written into this checkout (it
-# may be read-only): the crate's own page builds with --locked, so Cargo.lock is read,
-# never rewritten. A game's crate (WEB_CRATE) builds with its own Cargo.lock, in its folder.
+# may be read-only): a crate of this workspace (the crate's own page, voxel-bevy's example)
+# builds with --locked, so Cargo.lock is read, never rewritten. A game's crate (WEB_CRATE)
+# builds with its own Cargo.lock, in its folder.
 set -euo pipefail
 checkout="$(cd "$(dirname "$0")/.." && pwd)"
 cd "$checkout"
 source scripts/ensure-toolchain.sh
 source scripts/ensure-browser.sh
 
+# The workspace a crate folder belongs to (its own folder for a game's crate).
+workspace_root() {
+    cargo metadata --format-version 1 --no-deps --manifest-path "$crate/Cargo.toml" |
+        python3 -c 'import json, sys; print(json.load(sys.stdin)["workspace_root"])'
+}
+
 crate="$(cd "${WEB_CRATE:-web}" && pwd)"
+example="${WEB_EXAMPLE:-}"
+features=()
+if [ -n "${WEB_FEATURES:-}" ]; then
+    features=(--features "$WEB_FEATURES")
+fi
 locked=()
-if [ -z "${WEB_CRATE:-}" ]; then
+if [ -z "${WEB_CRATE:-}" ] || [ "$(workspace_root)" = "$checkout" ]; then
     locked=(--locked)
 fi
 out="${WEB_OUT:-$checkout/out/web}"
@@ -62,15 +79,32 @@ build() {
             return 1
         fi
     fi
-    # A cdylib whatever the crate's Cargo.toml says (voxel-web is an rlib, so that a game's
-    # page that links it, built in the same target folder, never overwrites this module).
-    cargo rustc --release "${locked[@]}" --target wasm32-unknown-unknown \
-        --manifest-path "$crate/Cargo.toml" --lib --crate-type cdylib
+    local wasm page
+    if [ -n "$example" ]; then
+        # An example: a program whose `main` wasm-bindgen makes the module's start.
+        name="$example"
+        page="$crate/examples/$example/index.html"
+        if [ ! -f "$page" ]; then
+            echo "error: WEB_EXAMPLE=$example: no page $page" >&2
+            return 1
+        fi
+        cargo build --release "${locked[@]}" "${features[@]}" --target wasm32-unknown-unknown \
+            --manifest-path "$crate/Cargo.toml" --example "$example"
+        wasm="examples/$example.wasm"
+    else
+        # A cdylib whatever the crate's Cargo.toml says (voxel-web is an rlib, so that a
+        # game's page that links it, built in the same target folder, never overwrites
+        # this module).
+        page="$crate/index.html"
+        cargo rustc --release "${locked[@]}" "${features[@]}" --target wasm32-unknown-unknown \
+            --manifest-path "$crate/Cargo.toml" --lib --crate-type cdylib
+        wasm="$name.wasm"
+    fi
     target="$(target_dir)"
     mkdir -p "$out"
     wasm-bindgen --target web --no-typescript --out-dir "$out" \
-        "$target/wasm32-unknown-unknown/release/$name.wasm"
-    cp "$crate/index.html" "$out/index.html"
+        "$target/wasm32-unknown-unknown/release/$wasm"
+    cp "$page" "$out/index.html"
     echo "built $out ($(du -k "$out/${name}_bg.wasm" | cut -f1) KiB of WebAssembly)" >&2
 }
 

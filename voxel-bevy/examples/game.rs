@@ -15,13 +15,13 @@ fn main() {
         .run();
 }
 
-type Keys<'a> = Res<'a, ButtonInput<KeyCode>>;
-type Assets3d<'a> = (
+pub type Keys<'a> = Res<'a, ButtonInput<KeyCode>>;
+pub type Assets3d<'a> = (
     ResMut<'a, Assets<Mesh>>,
     ResMut<'a, Assets<StandardMaterial>>,
 );
 
-fn setup(mut cmd: Commands, (mut mesh, mut mat): Assets3d) {
+pub fn setup(mut cmd: Commands, (mut mesh, mut mat): Assets3d) {
     let eye = Transform::from_xyz(0.0, 40.0, 30.0);
     cmd.spawn((Camera3d::default(), VoxelCamera, eye));
     let cube = Mesh3d(mesh.add(Cuboid::from_length(2.0)));
@@ -37,7 +37,7 @@ fn setup(mut cmd: Commands, (mut mesh, mut mat): Assets3d) {
     cmd.spawn_batch(sparks);
 }
 
-fn fly(keys: Keys, time: Res<Time>, mut cam: Single<&mut Transform, With<VoxelCamera>>) {
+pub fn fly(keys: Keys, time: Res<Time>, mut cam: Single<&mut Transform, With<VoxelCamera>>) {
     let (key, dt) = (|k| f32::from(u8::from(keys.pressed(k))), time.delta_secs());
     cam.rotate_y((key(KeyCode::ArrowLeft) - key(KeyCode::ArrowRight)) * dt);
     cam.rotate_local_x((key(KeyCode::ArrowUp) - key(KeyCode::ArrowDown)) * dt);
@@ -47,7 +47,7 @@ fn fly(keys: Keys, time: Res<Time>, mut cam: Single<&mut Transform, With<VoxelCa
     cam.translation += (ahead + side + up) * 12.0 * dt;
 }
 
-fn keys(keys: Keys, mut t: ResMut<VoxelTechnique>, mut light: ResMut<VoxelLighting>) {
+pub fn keys(keys: Keys, mut t: ResMut<VoxelTechnique>, mut light: ResMut<VoxelLighting>) {
     if keys.just_pressed(KeyCode::KeyT) {
         *t = t.next();
     }

@@ -48,7 +48,8 @@ impl Composite {
             label: Some("voxel-bevy composite"),
             entries: &[
                 texture(0, wgpu::TextureSampleType::Float { filterable: false }),
-                texture(1, wgpu::TextureSampleType::Depth),
+                // Depth as unfilterable float: see composite.wgsl (WebGL2).
+                texture(1, wgpu::TextureSampleType::Float { filterable: false }),
                 wgpu::BindGroupLayoutEntry {
                     binding: 2,
                     visibility: wgpu::ShaderStages::FRAGMENT,

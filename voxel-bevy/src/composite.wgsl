@@ -20,7 +20,9 @@ struct Params {
 }
 
 @group(0) @binding(0) var bevy_color: texture_2d<f32>;
-@group(0) @binding(1) var depth_in: texture_depth_2d;
+// A depth texture bound as unfilterable float (WebGPU allows it): GLSL, so WebGL2, has no
+// `textureLoad` of a depth texture (naga refuses it), and `.r` is the depth either way.
+@group(0) @binding(1) var depth_in: texture_2d<f32>;
 @group(0) @binding(2) var<uniform> params: Params;
 
 @vertex
@@ -51,7 +53,7 @@ struct WorldOut {
 @fragment
 fn fs_into_world(@builtin(position) p: vec4<f32>) -> WorldOut {
     let xy = vec2<i32>(p.xy);
-    let d = textureLoad(depth_in, xy, 0);
+    let d = textureLoad(depth_in, xy, 0).r;
     let dc = params.a * d + params.b;
     // Nothing Bevy drew (cleared to 0), or past the crate's far plane.
     if d <= 0.0 || dc <= 0.0 {
@@ -69,7 +71,7 @@ fn fs_into_world(@builtin(position) p: vec4<f32>) -> WorldOut {
 
 @fragment
 fn fs_into_bevy(@builtin(position) p: vec4<f32>) -> @builtin(frag_depth) f32 {
-    let dc = textureLoad(depth_in, vec2<i32>(p.xy), 0);
+    let dc = textureLoad(depth_in, vec2<i32>(p.xy), 0).r;
     if dc <= 0.0 {
         discard;
     }

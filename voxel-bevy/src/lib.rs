@@ -19,7 +19,7 @@
 //!
 //! - [`VoxelPlugin`]: the settings (the renderer's [`RendererConfig`], the far plane).
 //! - [`VoxelWorld`] (resource): the blocks, a fixed [`World`] (filled by the game or
-//!   generated) or chunks streamed around the camera from a [`ChunkSource`] (native only);
+//!   generated) or chunks streamed around the camera from a [`ChunkSource`];
 //!   block edits and picking.
 //! - [`VoxelCamera`] (component on a `Camera3d`): that camera's view gets the world.
 //! - [`VoxelTechnique`], [`VoxelLighting`] (resources): what the game controls;
@@ -49,7 +49,6 @@ use glam::{DQuat, DVec3};
 use voxel_core::{BlockId, BlockRegistry, ChunkPos, RayHit, RenderClass, World, WorldPos};
 use voxel_mesh::ChunkMeshes;
 use voxel_render::content::{Content, Entity as ContentEntity, Particle};
-#[cfg(not(target_arch = "wasm32"))]
 use voxel_render::{ChunkSink, ChunkSource, ChunkStreamer, StreamConfig};
 use voxel_render::{Lighting, RendererConfig, Technique};
 
@@ -239,7 +238,6 @@ enum Source {
     Fixed(World),
     /// Chunks streamed around the first [`VoxelCamera`] (a mutex: the streamer's channel
     /// from its workers is not `Sync`, a Bevy resource must be).
-    #[cfg(not(target_arch = "wasm32"))]
     Streamed(Mutex<ChunkStreamer>),
 }
 
@@ -257,7 +255,6 @@ impl std::fmt::Debug for VoxelWorld {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let kind = match &self.source {
             Source::Fixed(_) => "fixed",
-            #[cfg(not(target_arch = "wasm32"))]
             Source::Streamed(_) => "streamed",
         };
         f.debug_struct("VoxelWorld")
@@ -292,8 +289,8 @@ impl VoxelWorld {
     }
 
     /// Chunks streamed from `source` around the first [`VoxelCamera`] (generated and meshed
-    /// on the streamer's worker threads; see `voxel_render::ChunkStreamer`).
-    #[cfg(not(target_arch = "wasm32"))]
+    /// on the streamer's worker threads; on wasm32, which has none, on Bevy's thread in
+    /// each update within `StreamConfig::local_budget`: see `voxel_render::ChunkStreamer`).
     pub fn streamed(
         registry: Arc<BlockRegistry>,
         source: impl ChunkSource,
@@ -309,7 +306,6 @@ impl VoxelWorld {
     pub fn with_world<R>(&self, f: impl FnOnce(&World) -> R) -> R {
         match &self.source {
             Source::Fixed(w) => f(w),
-            #[cfg(not(target_arch = "wasm32"))]
             Source::Streamed(s) => f(s.lock().unwrap_or_else(PoisonError::into_inner).world()),
         }
     }
@@ -318,13 +314,11 @@ impl VoxelWorld {
     pub fn world(&mut self) -> &World {
         match &mut self.source {
             Source::Fixed(w) => w,
-            #[cfg(not(target_arch = "wasm32"))]
             Source::Streamed(s) => s.get_mut().unwrap_or_else(PoisonError::into_inner).world(),
         }
     }
 
     /// The streamer, for a streamed world (its edits to save, its memory, whether it is idle).
-    #[cfg(not(target_arch = "wasm32"))]
     pub fn streamer(&mut self) -> Option<&mut ChunkStreamer> {
         match &mut self.source {
             Source::Streamed(s) => Some(s.get_mut().unwrap_or_else(PoisonError::into_inner)),
@@ -337,7 +331,6 @@ impl VoxelWorld {
     pub fn set_block(&mut self, pos: WorldPos, id: BlockId) -> voxel_render::Result<BlockId> {
         match &mut self.source {
             Source::Fixed(w) => Ok(w.set_block(pos, id)?),
-            #[cfg(not(target_arch = "wasm32"))]
             Source::Streamed(s) => s
                 .get_mut()
                 .unwrap_or_else(PoisonError::into_inner)
@@ -404,10 +397,8 @@ enum Report {
     Status(VoxelStatus),
 }
 
-#[cfg(not(target_arch = "wasm32"))]
 struct QueueSink<'a>(&'a Shared<ChunkOp>);
 
-#[cfg(not(target_arch = "wasm32"))]
 impl ChunkSink for QueueSink<'_> {
     fn upload(&mut self, pos: ChunkPos, meshes: &ChunkMeshes) -> voxel_render::Result<()> {
         push(self.0, ChunkOp::Upload(pos, meshes.clone()));
@@ -513,7 +504,6 @@ fn update_world(
                 Err(e) => report_error(&mut messages, format!("meshing: {e}")),
             }
         }
-        #[cfg(not(target_arch = "wasm32"))]
         Source::Streamed(s) => {
             let Some(eye) = cameras.iter().next() else {
                 return;
@@ -525,8 +515,6 @@ fn update_world(
             }
         }
     }
-    #[cfg(target_arch = "wasm32")]
-    let _ = cameras;
 }
 
 fn report_error(messages: &mut MessageWriter<VoxelMessage>, e: String) {
