@@ -35,7 +35,7 @@ impl Capabilities {
     /// Reads the capabilities of `adapter` for a device created with `features` and
     /// `limits`. On desktop GL older than 4.0 storage buffers and textures count as absent
     /// whatever the driver's extensions say, and on desktop GL older than 4.2 that reports
-    /// compute shaders the world cannot be drawn ([`Need::ShaderBindings`](crate::low_level::Need) fails).
+    /// compute shaders the world cannot be drawn (`low_level::Need::ShaderBindings` fails).
     pub fn new(adapter: &wgpu::Adapter, features: wgpu::Features, limits: wgpu::Limits) -> Self {
         let info = adapter.get_info();
         let mut limits = limits;
