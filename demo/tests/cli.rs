@@ -3,16 +3,9 @@
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
-use std::process::{Command, Output};
+mod common;
 
-fn demo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_demo"))
-        .args(args)
-        .env_remove("DISPLAY")
-        .env_remove("WAYLAND_DISPLAY")
-        .output()
-        .unwrap()
-}
+use common::demo;
 
 /// Runs `args`, expects a failure whose stderr contains every one of `words`.
 fn fails_saying(args: &[&str], words: &[&str]) {
@@ -398,12 +391,7 @@ fn a_broken_vox_model_is_named_before_rendering() {
 /// lavapipe; skipped loudly without an adapter unless `CI` is set).
 #[test]
 fn a_bare_vox_model_renders_from_its_default_camera() {
-    if voxel_render::GpuContext::headless(wgpu::Backends::VULKAN).is_err() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set but no Vulkan adapter"
-        );
-        eprintln!("\n!!!! SKIPPING: no Vulkan adapter !!!!\n");
+    if tests::gpu().is_none() {
         return;
     }
     let dir = std::env::temp_dir().join(format!("demo-cli-vox-ok-{}", std::process::id()));
@@ -449,12 +437,7 @@ fn a_bare_vox_model_renders_from_its_default_camera() {
 /// suite is (on lavapipe; skipped loudly without an adapter unless `CI` is set).
 #[test]
 fn the_showcase_draws_every_technique_and_a_small_chart() {
-    if voxel_render::GpuContext::headless(wgpu::Backends::VULKAN).is_err() {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "CI is set but no Vulkan adapter"
-        );
-        eprintln!("\n!!!! SKIPPING: no Vulkan adapter !!!!\n");
+    if tests::gpu().is_none() {
         return;
     }
     let dir = std::env::temp_dir().join(format!("demo-cli-showcase-{}", std::process::id()));

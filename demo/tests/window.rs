@@ -12,11 +12,27 @@ use std::path::{Path, PathBuf};
 use tests::{Xvfb, skip_or_fail};
 use voxel_render::{GpuContext, Image, Technique};
 
-fn out_dir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/test-output/window");
+/// `target/test-output/<name>/`, emptied and created.
+fn out_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../target/test-output")
+        .join(name);
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// A Vulkan adapter and an Xvfb server, or `None` after [`skip_or_fail`] said which is missing.
+fn vulkan_and_xvfb() -> Option<Xvfb> {
+    if GpuContext::headless(wgpu::Backends::VULKAN).is_err() {
+        skip_or_fail("no Vulkan adapter (install mesa-vulkan-drivers)");
+        return None;
+    }
+    let x = Xvfb::start();
+    if x.is_none() {
+        skip_or_fail("Xvfb could not be started (install xvfb)");
+    }
+    x
 }
 
 fn demo(x: &Xvfb, args: &[&str]) {
@@ -84,13 +100,8 @@ fn distinct(v: &[[u8; 3]]) -> usize {
 
 #[test]
 fn the_window_runs_every_technique_under_xvfb() {
-    if GpuContext::headless(wgpu::Backends::VULKAN).is_err() {
-        return skip_or_fail("no Vulkan adapter (install mesa-vulkan-drivers)");
-    }
-    let Some(x) = Xvfb::start() else {
-        return skip_or_fail("Xvfb could not be started (install xvfb)");
-    };
-    let dir = out_dir();
+    let Some(x) = vulkan_and_xvfb() else { return };
+    let dir = out_dir("window");
     demo(
         &x,
         &[
@@ -204,15 +215,8 @@ fn the_window_runs_every_technique_under_xvfb() {
 
 #[test]
 fn the_window_opens_a_vox_model() {
-    if GpuContext::headless(wgpu::Backends::VULKAN).is_err() {
-        return skip_or_fail("no Vulkan adapter (install mesa-vulkan-drivers)");
-    }
-    let Some(x) = Xvfb::start() else {
-        return skip_or_fail("Xvfb could not be started (install xvfb)");
-    };
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/test-output/window-vox");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let Some(x) = vulkan_and_xvfb() else { return };
+    let dir = out_dir("window-vox");
     let shot = dir.join("harbour.png");
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/vox/harbour.toml");
     demo(
@@ -256,9 +260,7 @@ fn the_window_draws_its_game_content_under_webgl2_limits() {
     let Some(x) = Xvfb::start() else {
         return skip_or_fail("Xvfb could not be started (install xvfb)");
     };
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/test-output/window-webgl2");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = out_dir("window-webgl2");
     for (backend, backends) in [
         ("vulkan", wgpu::Backends::VULKAN),
         ("gl", wgpu::Backends::GL),

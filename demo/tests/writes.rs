@@ -5,28 +5,16 @@
 
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn have_gpu() -> bool {
-    if voxel_render::GpuContext::headless(wgpu::Backends::VULKAN).is_ok() {
-        return true;
-    }
-    assert!(
-        std::env::var_os("CI").is_none(),
-        "CI is set but no Vulkan adapter"
-    );
-    eprintln!("\n!!!! SKIPPING WRITE TESTS: no Vulkan adapter !!!!\n");
-    false
-}
+use common::demo;
 
-fn demo(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_demo"))
-        .args(args)
-        .env_remove("DISPLAY")
-        .env_remove("WAYLAND_DISPLAY")
-        .output()
-        .unwrap()
+/// A Vulkan adapter is there (else the test skips loudly, or fails under `CI`).
+fn have_gpu() -> bool {
+    tests::gpu().is_some()
 }
 
 fn dir(name: &str) -> PathBuf {
@@ -61,6 +49,17 @@ fn scene(dir: &Path) -> String {
     let path = dir.join("tiny.toml");
     std::fs::write(&path, SCENE).unwrap();
     path.to_str().unwrap().to_owned()
+}
+
+/// `demo eval` of `scene` at 32×24, one frame and no warm-up, writing into `out`, with
+/// the options `more`.
+fn eval(scene: &str, out: &str, more: &[&str]) -> Output {
+    let mut args = vec![
+        "eval", "--scenes", scene, "--size", "32x24", "--frames", "1", "--warmup", "0",
+    ];
+    args.extend_from_slice(more);
+    args.extend(["--out", out]);
+    demo(&args)
 }
 
 fn failed_naming(out: &Output, words: &[&str]) {
@@ -116,24 +115,17 @@ fn eval_files_that_cannot_be_written_are_errors() {
         let scene = scene(&d);
         let out = d.join("out");
         std::fs::create_dir_all(out.join(blocked)).unwrap();
-        let run = demo(&[
-            "eval",
-            "--scenes",
+        let run = eval(
             &scene,
-            "--techniques",
-            "opaque-only",
-            "--weights",
-            "none",
-            "--size",
-            "32x24",
-            "--frames",
-            "1",
-            "--warmup",
-            "0",
-            "--no-stability",
-            "--out",
             out.to_str().unwrap(),
-        ]);
+            &[
+                "--techniques",
+                "opaque-only",
+                "--weights",
+                "none",
+                "--no-stability",
+            ],
+        );
         let name = Path::new(blocked).file_name().unwrap().to_str().unwrap();
         failed_naming(&run, &[name]);
     }
@@ -159,27 +151,20 @@ fn render_and_eval_accept_the_same_scene_files() {
     ]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let out = d.join("eval");
-    let e = demo(&[
-        "eval",
-        "--scenes",
+    let e = eval(
         &scene,
-        "--techniques",
-        "sorted-quads",
-        "--weights",
-        "none",
-        "--size",
-        "32x24",
-        "--frames",
-        "1",
-        "--warmup",
-        "0",
-        "--flicker-frames",
-        "3",
-        "--sweep-points",
-        "2",
-        "--out",
         out.to_str().unwrap(),
-    ]);
+        &[
+            "--techniques",
+            "sorted-quads",
+            "--weights",
+            "none",
+            "--flicker-frames",
+            "3",
+            "--sweep-points",
+            "2",
+        ],
+    );
     assert!(e.status.success(), "{}", String::from_utf8_lossy(&e.stderr));
     assert!(out.join("stability/stability.json").exists());
 }
@@ -217,22 +202,11 @@ fn a_heat_map_too_narrow_is_refused_before_rendering() {
     let d = dir("writes-heatmap-width");
     let scene = scene(&d);
     let out = d.join("out");
-    let run = demo(&[
-        "eval",
-        "--scenes",
+    let run = eval(
         &scene,
-        "--size",
-        "32x24",
-        "--frames",
-        "1",
-        "--warmup",
-        "0",
-        "--no-stability",
-        "--heatmap-width",
-        "1",
-        "--out",
         out.to_str().unwrap(),
-    ]);
+        &["--no-stability", "--heatmap-width", "1"],
+    );
     failed_naming(&run, &["heatmap-width"]);
     assert!(!out.exists(), "something was written");
 }

@@ -195,6 +195,69 @@ pub fn frame(ctx: &GpuContext, renderer: &mut Renderer, camera: &Camera) -> Imag
     target.read(ctx).unwrap()
 }
 
+/// What [`compact_terrain`] saw.
+#[derive(Debug)]
+pub struct Compacted {
+    /// The renderer's chunk memory with all the terrain uploaded.
+    pub before: voxel_render::low_level::ChunkMemory,
+    /// Its chunk memory after the unloads and a frame per page it had.
+    pub after: voxel_render::low_level::ChunkMemory,
+    /// The quads of the chunks kept.
+    pub kept_quads: usize,
+    /// The compacted renderer's picture.
+    pub compacted: Image,
+    /// The picture of a fresh renderer given only the chunks kept.
+    pub fresh: Image,
+}
+
+/// Generated terrain (chunks (-3, 0, -3) to (3, 1, 3), the default terrain settings) meshed
+/// and uploaded into a renderer `new` makes; every chunk outside the corner x ≥ 1, z ≥ 1
+/// removed, then a frame drawn per page the terrain took (each compacts at most one away);
+/// then `camera`'s picture of it and of a fresh renderer given only the chunks kept.
+pub fn compact_terrain(
+    ctx: &GpuContext,
+    camera: &Camera,
+    new: impl Fn(&World) -> Renderer,
+) -> Compacted {
+    let world = voxel_core::TerrainGenerator::new(voxel_core::TerrainConfig::default())
+        .generate_world(
+            Arc::new(BlockRegistry::default()),
+            voxel_core::ChunkPos::new(-3, 0, -3),
+            voxel_core::ChunkPos::new(3, 1, 3),
+        )
+        .unwrap();
+    let all: Vec<_> = world.iter().map(|(p, _)| p).collect();
+    let meshes = voxel_mesh::mesh_chunks(&world, &all).unwrap();
+    let kept = |p: &voxel_core::ChunkPos| p.x >= 1 && p.z >= 1;
+    let mut compacted = new(&world);
+    for (pos, m) in &meshes {
+        compacted.upload_chunk(*pos, m).unwrap();
+    }
+    let before = compacted.chunk_memory();
+    for (pos, _) in meshes.iter().filter(|(p, _)| !kept(p)) {
+        compacted.remove_chunk(*pos);
+    }
+    for _ in 0..before.pages {
+        frame(ctx, &mut compacted, camera);
+    }
+    let after = compacted.chunk_memory();
+    let mut fresh = new(&world);
+    for (pos, m) in meshes.iter().filter(|(p, _)| kept(p)) {
+        fresh.upload_chunk(*pos, m).unwrap();
+    }
+    Compacted {
+        before,
+        after,
+        kept_quads: meshes
+            .iter()
+            .filter(|(p, _)| kept(p))
+            .map(|(_, m)| m.len())
+            .sum(),
+        compacted: frame(ctx, &mut compacted, camera),
+        fresh: frame(ctx, &mut fresh, camera),
+    }
+}
+
 /// Per-channel comparison of two images of the same size.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Diff {

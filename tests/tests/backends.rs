@@ -157,6 +157,27 @@ fn assert_like_vulkan(
     );
 }
 
+/// Every real-time technique on `ctx` with each of `scenes`: refused naming a capability,
+/// or drawing like Vulkan (`vk`) with the same technique, as [`assert_like_vulkan`] with
+/// `label` and `tolerance` checks.
+fn every_technique_like_vulkan(
+    vk: &GpuContext,
+    ctx: &GpuContext,
+    scenes: Vec<Scene>,
+    label: &str,
+    tolerance: (f64, f64),
+) {
+    for scene in scenes {
+        for t in Technique::REAL_TIME {
+            let Some((drew, picture)) = draw_or_refuse(ctx, &scene, t) else {
+                continue;
+            };
+            let expected = render(vk, &scene, vulkan_config(ctx, drew));
+            assert_like_vulkan(label, &scene, t, &picture, &expected, tolerance);
+        }
+    }
+}
+
 /// GL against Vulkan: llvmpipe and lavapipe share Mesa's rasteriser and shader compiler,
 /// but not the whole path (GLSL from naga, not SPIR-V; sRGB output written by another
 /// route), so a few edge pixels differ: 33 of 230 400 at 640×360 on the default scene, a
@@ -176,15 +197,7 @@ fn every_real_time_technique_on_gl_draws_like_vulkan_or_names_what_it_lacks() {
         "{}",
         gl.caps.adapter_name
     );
-    for scene in scenes(true) {
-        for t in Technique::REAL_TIME {
-            let Some((drew, picture)) = draw_or_refuse(&gl, &scene, t) else {
-                continue;
-            };
-            let expected = render(&vk, &scene, vulkan_config(&gl, drew));
-            assert_like_vulkan("gl", &scene, t, &picture, &expected, GL_TOLERANCE);
-        }
-    }
+    every_technique_like_vulkan(&vk, &gl, scenes(true), "gl", GL_TOLERANCE);
 }
 
 /// GL with WebGL2's limits: instanced quads through naga's GLSL ES (integer vertex
@@ -204,15 +217,7 @@ fn every_real_time_technique_on_gl_with_webgl2_limits_draws_like_vulkan_or_names
         QuadFetch::choose(&gl.caps, None).unwrap(),
         QuadFetch::Instanced
     );
-    for scene in scenes(false) {
-        for t in Technique::REAL_TIME {
-            let Some((drew, picture)) = draw_or_refuse(&gl, &scene, t) else {
-                continue;
-            };
-            let expected = render(&vk, &scene, vulkan_config(&gl, drew));
-            assert_like_vulkan("gl_webgl2", &scene, t, &picture, &expected, GL_TOLERANCE);
-        }
-    }
+    every_technique_like_vulkan(&vk, &gl, scenes(false), "gl_webgl2", GL_TOLERANCE);
 }
 
 #[test]
@@ -264,16 +269,8 @@ fn under_webgl2_limits_the_world_is_drawn_without_storage_buffers_and_matches_vu
             .unwrap(),
         Technique::PeelReference
     );
-    for scene in scenes(false) {
-        for t in Technique::REAL_TIME {
-            let Some((drew, picture)) = draw_or_refuse(&w2, &scene, t) else {
-                continue;
-            };
-            let expected = render(&vk, &scene, vulkan_config(&w2, drew));
-            // The same shader arithmetic on the same rasteriser: the same picture.
-            assert_like_vulkan("webgl2", &scene, t, &picture, &expected, (0.0, 0.0));
-        }
-    }
+    // The same shader arithmetic on the same rasteriser: the same picture.
+    every_technique_like_vulkan(&vk, &w2, scenes(false), "webgl2", (0.0, 0.0));
 }
 
 #[test]
@@ -430,16 +427,6 @@ fn instanced_pages_compact_and_keep_the_picture() {
     let Some(ctx) = gpu_with_limits(|l| l.max_buffer_size = 128 << 10) else {
         return;
     };
-    let world = voxel_core::TerrainGenerator::new(voxel_core::TerrainConfig::default())
-        .generate_world(
-            std::sync::Arc::new(voxel_core::BlockRegistry::default()),
-            voxel_core::ChunkPos::new(-3, 0, -3),
-            voxel_core::ChunkPos::new(3, 1, 3),
-        )
-        .unwrap();
-    let all: Vec<_> = world.iter().map(|(p, _)| p).collect();
-    let meshes = voxel_mesh::mesh_chunks(&world, &all).unwrap();
-    let kept = |p: &voxel_core::ChunkPos| p.x >= 1 && p.z >= 1;
     let camera = voxel_render::Camera::look_at(
         glam::DVec3::new(40.0, 60.0, 40.0),
         glam::DVec3::new(90.0, 20.0, 90.0),
@@ -448,37 +435,25 @@ fn instanced_pages_compact_and_keep_the_picture() {
         400.0,
     )
     .unwrap();
-    let new = || {
+    let tests::Compacted {
+        before,
+        after,
+        compacted: a,
+        fresh: b,
+        ..
+    } = tests::compact_terrain(&ctx, &camera, |world| {
         let config = RendererConfig {
             quad_fetch: Some(QuadFetch::Instanced),
             // Small enough that its readback fits the buffer limit.
             ..technique_config(Technique::SortedQuads, 160, 90)
         };
         Renderer::new(&ctx, world.registry(), config).unwrap()
-    };
-    let mut compacted = new();
-    for (pos, m) in &meshes {
-        compacted.upload_chunk(*pos, m).unwrap();
-    }
-    let before = compacted.chunk_memory();
+    });
     assert!(before.pages >= 3, "terrain spans several pages: {before:?}");
-    for (pos, _) in meshes.iter().filter(|(p, _)| !kept(p)) {
-        compacted.remove_chunk(*pos);
-    }
-    for _ in 0..before.pages {
-        tests::frame(&ctx, &mut compacted, &camera);
-    }
-    let after = compacted.chunk_memory();
     assert!(
         after.pages < before.pages,
         "no page compacted away: {before:?} -> {after:?}"
     );
-    let mut fresh = new();
-    for (pos, m) in meshes.iter().filter(|(p, _)| kept(p)) {
-        fresh.upload_chunk(*pos, m).unwrap();
-    }
-    let a = tests::frame(&ctx, &mut compacted, &camera);
-    let b = tests::frame(&ctx, &mut fresh, &camera);
     assert!(distinct_colours(&a) > 50, "a real picture");
     // As with storage pages: where coplanar grown opaque quads meet, the draw order (which
     // compaction changes) picks the pixel, within 1/255.

@@ -213,14 +213,18 @@ fn an_unsubmitted_frame_has_no_cost() {
     let Some(ctx) = gpu() else { return };
     let (mut r, target, camera) = suite_renderer(&ctx, "deep_stack");
     r.render_and_submit(&target.view, &camera).unwrap();
-    let encoder = |ctx: &GpuContext| ctx.device.create_command_encoder(&Default::default());
+    // A counted frame recorded into an encoder of its own, not submitted.
+    let record_counted = |renderer: &mut voxel_render::Renderer| {
+        low_level::count_next_frame(renderer);
+        let mut e = ctx.device.create_command_encoder(&Default::default());
+        renderer
+            .render(&mut e, &target.view, &camera, &mut voxel_render::NoGame)
+            .unwrap();
+        e
+    };
 
     // Recorded, not submitted: an error naming the submit, the frame kept.
-    low_level::count_next_frame(&mut r.renderer);
-    let mut e = encoder(&ctx);
-    r.renderer
-        .render(&mut e, &target.view, &camera, &mut voxel_render::NoGame)
-        .unwrap();
+    let e = record_counted(&mut r.renderer);
     let err = low_level::frame_cost(&mut r.renderer).unwrap_err();
     assert!(
         matches!(err, voxel_render::Error::FrameOrder(_)) && err.to_string().contains("submit"),
@@ -232,20 +236,10 @@ fn an_unsubmitted_frame_has_no_cost() {
     assert!(low_level::frame_cost(&mut r.renderer).unwrap().is_none());
 
     // Dropped unsubmitted: nothing ran, no cost; then the next counted frame has one.
-    low_level::count_next_frame(&mut r.renderer);
-    let mut e = encoder(&ctx);
-    r.renderer
-        .render(&mut e, &target.view, &camera, &mut voxel_render::NoGame)
-        .unwrap();
-    drop(e);
+    drop(record_counted(&mut r.renderer));
     assert!(low_level::frame_cost(&mut r.renderer).unwrap().is_none());
     // Also once a later frame has learnt of the drop.
-    low_level::count_next_frame(&mut r.renderer);
-    let mut e = encoder(&ctx);
-    r.renderer
-        .render(&mut e, &target.view, &camera, &mut voxel_render::NoGame)
-        .unwrap();
-    drop(e);
+    drop(record_counted(&mut r.renderer));
     r.render_and_submit(&target.view, &camera).unwrap();
     assert!(low_level::frame_cost(&mut r.renderer).unwrap().is_none());
     low_level::count_next_frame(&mut r.renderer);

@@ -90,6 +90,50 @@ fn same(name: &str, got: &Image, alone: &Image) {
     );
 }
 
+/// Each camera's frame drawn and submitted alone into its target: the pictures.
+fn drawn_alone(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    game: &mut dyn GameStages,
+    cameras: &[Camera; 2],
+    targets: &[Offscreen; 2],
+) -> Vec<Image> {
+    let mut alone = Vec::new();
+    for (camera, target) in cameras.iter().zip(targets) {
+        renderer
+            .render_and_submit(&target.view, camera, game)
+            .unwrap();
+        alone.push(target.read(ctx).unwrap());
+    }
+    alone
+}
+
+/// Both cameras' frames recorded into one encoder and submitted once: each target holds
+/// what its frame drew alone (`name_<i>` when not).
+fn one_encoder_draws_as_alone(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    game: &mut dyn GameStages,
+    (cameras, targets): (&[Camera; 2], &[Offscreen; 2]),
+    alone: &[Image],
+    name: &str,
+) {
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    for (camera, target) in cameras.iter().zip(targets) {
+        renderer
+            .render(&mut encoder, &target.view, camera, game)
+            .unwrap();
+    }
+    ctx.queue.submit([encoder.finish()]);
+    for (i, target) in targets.iter().enumerate() {
+        same(
+            &format!("{name}_{i}"),
+            &target.read(ctx).unwrap(),
+            &alone[i],
+        );
+    }
+}
+
 /// Each technique: both cameras alone, then both in one encoder, then in two encoders
 /// submitted together; the pictures must be the frames drawn alone, exactly. The exact
 /// techniques submit inside their frame: the second frame in another encoder is refused
@@ -104,36 +148,22 @@ fn two_frames_before_a_submit_each_draw_with_their_own_camera() {
         let mut game = content(&r, &scene.content);
         let targets = [Offscreen::new(&ctx, W, H), Offscreen::new(&ctx, W, H)];
         // Twice alone first: adaptive state (peeling's layer count) settles.
-        let mut alone = Vec::new();
-        for _ in 0..2 {
-            alone.clear();
-            for (camera, target) in cameras.iter().zip(&targets) {
-                r.renderer
-                    .render_and_submit(&target.view, camera, &mut game)
-                    .unwrap();
-                alone.push(target.read(&ctx).unwrap());
-            }
-        }
+        drawn_alone(&ctx, &mut r.renderer, &mut game, &cameras, &targets);
+        let alone = drawn_alone(&ctx, &mut r.renderer, &mut game, &cameras, &targets);
         assert_ne!(
             diff(&alone[0], &alone[1]).max,
             0,
             "{name}: the cameras see the same"
         );
 
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        for (camera, target) in cameras.iter().zip(&targets) {
-            r.renderer
-                .render(&mut encoder, &target.view, camera, &mut game)
-                .unwrap();
-        }
-        ctx.queue.submit([encoder.finish()]);
-        for (i, target) in targets.iter().enumerate() {
-            same(
-                &format!("{name}_one_encoder_{i}"),
-                &target.read(&ctx).unwrap(),
-                &alone[i],
-            );
-        }
+        one_encoder_draws_as_alone(
+            &ctx,
+            &mut r.renderer,
+            &mut game,
+            (&cameras, &targets),
+            &alone,
+            &format!("{name}_one_encoder"),
+        );
 
         let mut encoders = Vec::new();
         for (camera, target) in cameras.iter().zip(&targets) {
@@ -261,27 +291,15 @@ fn a_games_own_writes_land_in_its_frame() {
     let mut r = renderer_for(&ctx, &scene, technique_config(Technique::WboitMrt, W, H)).unwrap();
     let mut game = Marker::new(&ctx, DVec3::new(0.5, 2.0, 0.0));
     let targets = [Offscreen::new(&ctx, W, H), Offscreen::new(&ctx, W, H)];
-    let mut alone = Vec::new();
-    for (camera, target) in cameras.iter().zip(&targets) {
-        r.renderer
-            .render_and_submit(&target.view, camera, &mut game)
-            .unwrap();
-        alone.push(target.read(&ctx).unwrap());
-    }
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    for (camera, target) in cameras.iter().zip(&targets) {
-        r.renderer
-            .render(&mut encoder, &target.view, camera, &mut game)
-            .unwrap();
-    }
-    ctx.queue.submit([encoder.finish()]);
-    for (i, target) in targets.iter().enumerate() {
-        same(
-            &format!("marker_{i}"),
-            &target.read(&ctx).unwrap(),
-            &alone[i],
-        );
-    }
+    let alone = drawn_alone(&ctx, &mut r.renderer, &mut game, &cameras, &targets);
+    one_encoder_draws_as_alone(
+        &ctx,
+        &mut r.renderer,
+        &mut game,
+        (&cameras, &targets),
+        &alone,
+        "marker",
+    );
 
     /// A game that writes what wgpu would refuse, and checks each is an error.
     struct BadWrites {

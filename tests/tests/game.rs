@@ -133,6 +133,13 @@ fn render(scene: &Scene, config: RendererConfig) -> Image {
     CTX.with(|ctx| tests::render_with(ctx, scene, config))
 }
 
+/// Asserts that `got` is, within 1/255, what a fresh renderer with `config` draws of
+/// `scene` (`what`: the step that led to `got`).
+fn draws_as_fresh(got: &Image, scene: &Scene, config: RendererConfig, what: &str) {
+    let d = diff(got, &render(scene, config));
+    assert!(d.max <= 1, "{what}: {d:?}");
+}
+
 /// The largest channel difference of each pixel, in 1/255 steps.
 fn pixel_diffs(a: &Image, b: &Image) -> Vec<u8> {
     a.rgba
@@ -341,22 +348,24 @@ fn game_draws_survive_switches_resizes_and_msaa() {
     ] {
         r.set_technique(t).unwrap();
         let got = shot(&mut r);
-        let fresh = render(&scene, technique_config(t, W, H));
-        let d = diff(&got, &fresh);
-        assert!(d.max <= 1, "after switching to {}: {d:?}", t.name());
+        draws_as_fresh(
+            &got,
+            &scene,
+            technique_config(t, W, H),
+            &format!("after switching to {}", t.name()),
+        );
     }
     r.resize(120, 68).unwrap();
     let got = shot(&mut r);
-    let fresh = render(&scene, technique_config(Technique::WboitTwoPass, 120, 68));
-    let d = diff(&got, &fresh);
-    assert!(d.max <= 1, "after a resize: {d:?}");
+    let config = technique_config(Technique::WboitTwoPass, 120, 68);
+    draws_as_fresh(&got, &scene, config, "after a resize");
     r.set_msaa(true).unwrap();
     let got = shot(&mut r);
-    let mut config = technique_config(Technique::WboitTwoPass, 120, 68);
-    config.msaa = true;
-    let fresh = render(&scene, config);
-    let d = diff(&got, &fresh);
-    assert!(d.max <= 1, "after MSAA on: {d:?}");
+    let config = RendererConfig {
+        msaa: true,
+        ..technique_config(Technique::WboitTwoPass, 120, 68)
+    };
+    draws_as_fresh(&got, &scene, config, "after MSAA on");
 }
 
 /// A game that keeps pipelines built for another technique's contract (it switched and
@@ -411,9 +420,12 @@ fn stale_game_pipelines_are_refused_before_recording() {
         .render_and_submit(&target.view, &camera, &mut content)
         .unwrap();
     let got = target.read(&ctx).unwrap();
-    let fresh = render(&scene, technique_config(Technique::SortedQuads, W, H));
-    let d = diff(&got, &fresh);
-    assert!(d.max <= 1, "rebuilt: {d:?}");
+    draws_as_fresh(
+        &got,
+        &scene,
+        technique_config(Technique::SortedQuads, W, H),
+        "rebuilt",
+    );
 
     // Back to WBOIT: the same id again, so pipelines a game kept for it are valid.
     r.set_technique(Technique::WboitMrt).unwrap();
@@ -454,8 +466,12 @@ fn content_stages_follow_switches_and_msaa_by_themselves() {
     for t in [Technique::SortedQuads, Technique::DepthPeeling] {
         r.set_technique(t).unwrap();
         let got = shot(&mut r.renderer, &mut game);
-        let d = diff(&got, &render(&scene, technique_config(t, W, H)));
-        assert!(d.max <= 1, "after switching to {}: {d:?}", t.name());
+        draws_as_fresh(
+            &got,
+            &scene,
+            technique_config(t, W, H),
+            &format!("after switching to {}", t.name()),
+        );
     }
     let built = game.pipelines_built();
     r.set_technique(Technique::WboitMrt).unwrap();
@@ -467,10 +483,11 @@ fn content_stages_follow_switches_and_msaa_by_themselves() {
     );
     r.set_msaa(true).unwrap();
     let got = shot(&mut r.renderer, &mut game);
-    let mut config = technique_config(Technique::WboitMrt, W, H);
-    config.msaa = true;
-    let d = diff(&got, &render(&scene, config));
-    assert!(d.max <= 1, "after MSAA on: {d:?}");
+    let config = RendererConfig {
+        msaa: true,
+        ..technique_config(Technique::WboitMrt, W, H)
+    };
+    draws_as_fresh(&got, &scene, config, "after MSAA on");
 }
 
 /// A flat translucent slab wholly above the water surface seen from under water, and its

@@ -140,6 +140,16 @@ fn overflow_renderer(ctx: &voxel_render::GpuContext, scene: &Scene, headroom: bo
     renderer_for(ctx, scene, config).unwrap().renderer
 }
 
+/// The WBOIT accumulation target's texels after `r`'s last frame.
+fn accumulation(ctx: &voxel_render::GpuContext, r: &Renderer) -> Vec<[f32; 4]> {
+    read_hdr(
+        ctx,
+        voxel_render::low_level::oit(r)
+            .accumulation_target()
+            .unwrap(),
+    )
+}
+
 #[test]
 fn fp16_overflow_never_reaches_the_picture() {
     let Some(ctx) = gpu() else { return };
@@ -150,12 +160,7 @@ fn fp16_overflow_never_reaches_the_picture() {
     // saturates at 65504), and the composite's guard keeps the scene finite.
     let mut r = overflow_renderer(&ctx, &scene, false);
     let img = frame(&ctx, &mut r, &scene.cameras[0]);
-    let accum = read_hdr(
-        &ctx,
-        voxel_render::low_level::oit(&r)
-            .accumulation_target()
-            .unwrap(),
-    );
+    let accum = accumulation(&ctx, &r);
     assert!(
         accum.iter().any(|p| p[3] >= 65504.0),
         "the test scene must overflow fp16"
@@ -172,12 +177,7 @@ fn fp16_overflow_never_reaches_the_picture() {
     // parallel sheets, one per chunk layer, drawn back to front).
     let mut r = overflow_renderer(&ctx, &scene, true);
     let img = frame(&ctx, &mut r, &scene.cameras[0]);
-    let accum = read_hdr(
-        &ctx,
-        voxel_render::low_level::oit(&r)
-            .accumulation_target()
-            .unwrap(),
-    );
+    let accum = accumulation(&ctx, &r);
     assert!(finite(&accum), "headroom keeps the sums finite");
     assert!(finite(&read_hdr(&ctx, r.scene_color())));
     img.save_png(&out_dir("fp16_overflow").join("headroom.png"))
@@ -306,12 +306,7 @@ fn shader_weights_match_at(ctx: &voxel_render::GpuContext, distance: f64) {
         let stats = r
             .render_and_submit(&Offscreen::new(ctx, 33, 33).view, &cam)
             .unwrap();
-        let accum = read_hdr(
-            ctx,
-            voxel_render::low_level::oit(&r)
-                .accumulation_target()
-                .unwrap(),
-        );
+        let accum = accumulation(ctx, &r);
 
         let got = accum[16 * 33 + 16][3];
         let fit = stats

@@ -134,53 +134,22 @@ fn compacting_the_arena_keeps_the_picture() {
     let Some(ctx) = tests::gpu_with_limits(|l| l.max_storage_buffer_binding_size = 64 << 10) else {
         return;
     };
-    let g = generator();
-    let world = g
-        .generate_world(
-            Arc::new(BlockRegistry::default()),
-            ChunkPos::new(-3, 0, -3),
-            ChunkPos::new(3, 1, 3),
-        )
-        .unwrap();
-    let all: Vec<ChunkPos> = world.iter().map(|(p, _)| p).collect();
-    let meshes = voxel_mesh::mesh_chunks(&world, &all).unwrap();
-    // Keep the chunks of one corner; the eye looks at them.
-    let kept = |p: &ChunkPos| p.x >= 1 && p.z >= 1;
-    let eye = DVec3::new(40.0, g.height_at(40, 40) as f64 + 12.0, 40.0);
+    // The eye looks at the corner whose chunks are kept.
+    let eye = DVec3::new(40.0, generator().height_at(40, 40) as f64 + 12.0, 40.0);
     let camera = Camera::look_at(eye, DVec3::new(90.0, 20.0, 90.0), 70.0, 0.1, 400.0).unwrap();
-
-    let mut compacted = renderer(&ctx, DrawMode::Indirect);
-    for (pos, m) in &meshes {
-        compacted.upload_chunk(*pos, m).unwrap();
-    }
-    let before = compacted.chunk_memory();
+    let tests::Compacted {
+        before,
+        after,
+        kept_quads,
+        compacted: a,
+        fresh: b,
+    } = tests::compact_terrain(&ctx, &camera, |_| renderer(&ctx, DrawMode::Indirect));
     assert!(before.pages >= 4, "terrain spans several pages: {before:?}");
-    for (pos, _) in meshes.iter().filter(|(p, _)| !kept(p)) {
-        compacted.remove_chunk(*pos);
-    }
-    for _ in 0..before.pages {
-        tests::frame(&ctx, &mut compacted, &camera);
-    }
-    let after = compacted.chunk_memory();
     assert!(
         after.pages < before.pages && after.arena_bytes < before.arena_bytes,
         "no page compacted away: {before:?} -> {after:?}"
     );
-    assert_eq!(after.quad_bytes, {
-        let q: usize = meshes
-            .iter()
-            .filter(|(p, _)| kept(p))
-            .map(|(_, m)| m.len())
-            .sum();
-        q as u64 * 8
-    });
-
-    let mut fresh = renderer(&ctx, DrawMode::Indirect);
-    for (pos, m) in meshes.iter().filter(|(p, _)| kept(p)) {
-        fresh.upload_chunk(*pos, m).unwrap();
-    }
-    let a = tests::frame(&ctx, &mut compacted, &camera);
-    let b = tests::frame(&ctx, &mut fresh, &camera);
+    assert_eq!(after.quad_bytes, kept_quads as u64 * 8);
     a.save_png(&tests::out_dir("stream").join("compacted.png"))
         .unwrap();
     assert!(tests::distinct_colours(&a) > 50, "a real picture");

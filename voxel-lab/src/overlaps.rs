@@ -15,6 +15,8 @@ use glam::DVec3;
 use voxel_render::Camera;
 use voxel_render::content::Content;
 
+use crate::raymarch::view_basis;
+
 /// A box in world space: centre, and its three axes scaled by the half extents.
 #[derive(Clone, Copy, Debug)]
 struct Solid {
@@ -104,15 +106,7 @@ fn intersect(a: &Solid, b: &Solid) -> bool {
 /// The translucent solids of `content` seen by `camera`: particles (squares facing it),
 /// then translucent entities.
 fn solids(content: &Content, camera: &Camera) -> Vec<Solid> {
-    let f = camera.unit_forward();
-    // The view basis of `Camera::view_proj`, which particles face.
-    let up = if f.y.abs() > 0.999 {
-        DVec3::Z
-    } else {
-        DVec3::Y
-    };
-    let right = f.cross(up).normalize();
-    let up = right.cross(f);
+    let [_, right, up] = view_basis(camera);
     content
         .particles
         .iter()
@@ -190,14 +184,7 @@ pub fn object_mask(content: &Content, camera: &Camera, size: (u32, u32)) -> Vec<
     if crossing.is_empty() && close.is_empty() {
         return mask;
     }
-    let f = camera.unit_forward();
-    let up = if f.y.abs() > 0.999 {
-        DVec3::Z
-    } else {
-        DVec3::Y
-    };
-    let right = f.cross(up).normalize();
-    let up = right.cross(f);
+    let [f, right, up] = view_basis(camera);
     let tan_y = (camera.fov_y_deg.to_radians() / 2.0).tan();
     let tan_x = tan_y * f64::from(w) / f64::from(h);
     for y in 0..h {

@@ -448,6 +448,23 @@ pub fn bind_group(
     })
 }
 
+/// A uniform buffer holding a zeroed `T` (written before each use) and a bind group of it
+/// alone, at binding 0 of `layout`.
+pub(crate) fn zeroed_uniform<T: bytemuck::Pod>(
+    device: &wgpu::Device,
+    (buffer_label, group_label): (&str, &str),
+    layout: &wgpu::BindGroupLayout,
+) -> (wgpu::Buffer, wgpu::BindGroup) {
+    use wgpu::util::DeviceExt;
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(buffer_label),
+        contents: bytemuck::bytes_of(&T::zeroed()),
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+    });
+    let group = bind_group(device, group_label, layout, &[buffer.as_entire_binding()]);
+    (buffer, group)
+}
+
 /// A bind group of texture views at bindings 0, 1, ...
 pub(crate) fn texture_group(
     device: &wgpu::Device,

@@ -183,54 +183,36 @@ impl MediumPass {
         }
         .build_two_sided(device);
         let exit_module = gpu::shader(device, "volume_exit", &[&volume_exit_wgsl()]);
-        let volume_exit = ChunkPipeline {
-            label: "volume_exit",
-            module: &exit_module,
-            fragment_entry: "fs_volume_exit",
-            groups: &groups,
-            targets: &[],
-            depth: DepthMode::Write,
-            samples: 1,
-        }
+        let look = [Some(wgpu::ColorTargetState {
+            format: ENTRY_LOOK_FORMAT,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        })];
+        // The volumes' pipelines: entry points of `volume_exit.wgsl`, writing the entry's
+        // look or no colour.
+        let volume =
+            |label: &'static str, fragment_entry: &'static str, writes_look, depth| ChunkPipeline {
+                label,
+                module: &exit_module,
+                fragment_entry,
+                groups: &groups,
+                targets: if writes_look { &look[..] } else { &[] },
+                depth,
+                samples: 1,
+            };
+        let volume_exit = volume("volume_exit", "fs_volume_exit", false, DepthMode::Write)
+            .build_two_sided_solid(device);
+        let volume_far = volume(
+            "volume_far",
+            "fs_volume_far",
+            false,
+            DepthMode::WriteFarthest,
+        )
         .build_two_sided_solid(device);
-        let volume_far = ChunkPipeline {
-            label: "volume_far",
-            module: &exit_module,
-            fragment_entry: "fs_volume_far",
-            groups: &groups,
-            targets: &[],
-            depth: DepthMode::WriteFarthest,
-            samples: 1,
-        }
-        .build_two_sided_solid(device);
-        let volume_entry2 = ChunkPipeline {
-            label: "volume_entry2",
-            module: &exit_module,
-            fragment_entry: "fs_volume_entry2",
-            groups: &groups,
-            targets: &[Some(wgpu::ColorTargetState {
-                format: ENTRY_LOOK_FORMAT,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
-            depth: DepthMode::Write,
-            samples: 1,
-        }
-        .build_two_sided(device);
-        let volume_entry = ChunkPipeline {
-            label: "volume_entry",
-            module: &exit_module,
-            fragment_entry: "fs_volume_entry",
-            groups: &groups,
-            targets: &[Some(wgpu::ColorTargetState {
-                format: ENTRY_LOOK_FORMAT,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
-            depth: DepthMode::Write,
-            samples: 1,
-        }
-        .build_two_sided(device);
+        let volume_entry2 = volume("volume_entry2", "fs_volume_entry2", true, DepthMode::Write)
+            .build_two_sided(device);
+        let volume_entry = volume("volume_entry", "fs_volume_entry", true, DepthMode::Write)
+            .build_two_sided(device);
         let media = FullscreenPipeline {
             label: "media",
             source: &media_wgsl(),

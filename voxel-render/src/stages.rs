@@ -755,8 +755,7 @@ impl GameDraw<'_> {
         group: &wgpu::BindGroup,
         range: Range<usize>,
     ) {
-        pass.set_bind_group(OIT_GROUP, group, &[]);
-        pass.game(|raw| self.stages.translucent(raw, self.frame, variant, range));
+        self.draw_offsets(pass, variant, group, &[], range);
     }
 
     /// Like [`GameDraw::draw`], with dynamic `offsets` for the group.

@@ -273,18 +273,24 @@ mod tests {
         );
     }
 
+    /// Rays both raycasts refuse (origin, direction, distance): an origin not finite or
+    /// past the world's coordinates, a direction zero or not finite, a distance negative,
+    /// not a number or past the cap.
+    const BAD_RAYS: [([f64; 3], [f64; 3], f64); 8] = [
+        ([f64::NAN, 0.0, 0.0], [0.0, 0.0, -1.0], 5.0),
+        ([3e9, 0.0, 0.0], [0.0, 0.0, -1.0], 5.0),
+        ([0.0; 3], [0.0; 3], 5.0),
+        ([0.0; 3], [f64::INFINITY, 0.0, 0.0], 5.0),
+        ([0.0; 3], [0.0, f64::NAN, -1.0], 5.0),
+        ([0.0; 3], [0.0, 0.0, -1.0], -1.0),
+        ([0.0; 3], [0.0, 0.0, -1.0], f64::NAN),
+        ([0.0; 3], [0.0, 0.0, -1.0], MAX_RAY_DISTANCE * 2.0),
+    ];
+
     #[test]
     fn raycast_refuses_bad_rays_and_stops_at_the_world_edge() {
         let w = wall();
-        for (origin, dir, max) in [
-            ([f64::NAN, 0.0, 0.0], [0.0, 0.0, -1.0], 5.0),
-            ([3e9, 0.0, 0.0], [0.0, 0.0, -1.0], 5.0),
-            ([0.0; 3], [0.0; 3], 5.0),
-            ([0.0; 3], [f64::INFINITY, 0.0, 0.0], 5.0),
-            ([0.0; 3], [0.0, 0.0, -1.0], -1.0),
-            ([0.0; 3], [0.0, 0.0, -1.0], f64::NAN),
-            ([0.0; 3], [0.0, 0.0, -1.0], MAX_RAY_DISTANCE * 2.0),
-        ] {
+        for (origin, dir, max) in BAD_RAYS {
             let err = w.raycast(origin, dir, max, &SOLID).unwrap_err();
             assert!(matches!(err, Error::InvalidRay(_)), "{err}");
         }
@@ -373,16 +379,7 @@ mod tests {
     #[test]
     fn raycast_by_refuses_what_raycast_refuses() {
         let w = wall();
-        for (origin, dir, max) in [
-            ([f64::NAN, 0.0, 0.0], [0.0, 0.0, -1.0], 5.0),
-            ([3e9, 0.0, 0.0], [0.0, 0.0, -1.0], 5.0),
-            ([0.0; 3], [0.0; 3], 5.0),
-            ([0.0; 3], [f64::INFINITY, 0.0, 0.0], 5.0),
-            ([0.0; 3], [0.0, f64::NAN, -1.0], 5.0),
-            ([0.0; 3], [0.0, 0.0, -1.0], -1.0),
-            ([0.0; 3], [0.0, 0.0, -1.0], f64::NAN),
-            ([0.0; 3], [0.0, 0.0, -1.0], MAX_RAY_DISTANCE * 2.0),
-        ] {
+        for (origin, dir, max) in BAD_RAYS {
             let mut asked = 0;
             let by = w
                 .raycast_by(origin, dir, max, |_, _| {

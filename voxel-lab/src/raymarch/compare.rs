@@ -4,9 +4,7 @@
 use voxel_core::RenderClass;
 use voxel_render::{Camera, Image};
 
-use super::hits::Bins;
-use super::light::Light;
-use super::{Projection, RayMarched, RayMarcher, RayResult, Shading, Surface, describe};
+use super::{Picture, RayMarched, RayMarcher, RayResult, Shading, Surface, describe};
 
 /// Where a ray march and a GPU picture differ.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -81,9 +79,7 @@ impl RayMarcher {
         };
         let (width, height) = (ray.image.width, ray.image.height);
         let w = width as usize;
-        let projection = &Projection::new(camera, width, height);
-        let light = &Light::new(self, camera, shading);
-        let bins = &Bins::new(&self.content, camera, projection, light);
+        let picture = &Picture::new(self, camera, (width, height), shading);
         // Rays around a pixel's centre within the edge radius: 32 angles on circles of a
         // quarter, half and the whole radius, dense enough to meet the thin sliver of a
         // face seen at a grazing angle.
@@ -93,17 +89,7 @@ impl RayMarcher {
                 let angle = f64::from(k % 32) * std::f64::consts::TAU / 32.0;
                 let radius = EDGE_RADIUS_PX * f64::from(1 << (k / 32)) / 4.0;
                 let (dx, dy) = (angle.cos() * radius, angle.sin() * radius);
-                self.march(
-                    camera.eye,
-                    projection.dir(x + dx, y + dy),
-                    camera.near,
-                    camera.far,
-                    camera.medium,
-                    shading,
-                    light,
-                    false,
-                    bins.at(x + dx, y + dy),
-                )
+                picture.march(x + dx, y + dy, false)
             })
         };
         let opaque_end =

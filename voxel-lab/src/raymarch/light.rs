@@ -102,13 +102,6 @@ impl Light {
                 color: look.color.map(|c| c * medium_light),
                 density: look.fog,
             });
-        let f = camera.unit_forward();
-        let up = if f.y.abs() > 0.999 {
-            DVec3::Z
-        } else {
-            DVec3::Y
-        };
-        let right = f.cross(up).normalize();
         Self {
             sun,
             ambient,
@@ -116,7 +109,7 @@ impl Light {
             sky: shading.sky.map(f64::from),
             fog,
             medium_light,
-            basis: [f, right, right.cross(f)],
+            basis: super::view_basis(camera),
         }
     }
 }

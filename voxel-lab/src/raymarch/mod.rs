@@ -256,20 +256,7 @@ impl RayMarcher {
         y: f64,
         want_color: bool,
     ) -> RayResult {
-        let light = Light::new(self, camera, shading);
-        let projection = Projection::new(camera, width, height);
-        let bins = Bins::new(&self.content, camera, &projection, &light);
-        self.march(
-            camera.eye,
-            projection.dir(x, y),
-            camera.near,
-            camera.far,
-            camera.medium,
-            shading,
-            &light,
-            want_color,
-            bins.at(x, y),
-        )
+        Picture::new(self, camera, (width, height), shading).march(x, y, want_color)
     }
 
     /// Marches every pixel of a `width` × `height` picture of `camera` (the camera the
@@ -282,25 +269,10 @@ impl RayMarcher {
         shading: &Shading,
     ) -> RayMarched {
         let (w, h) = (width as usize, height as usize);
-        let projection = Projection::new(camera, width, height);
-        let light = Light::new(self, camera, shading);
-        let bins = Bins::new(&self.content, camera, &projection, &light);
-        let march = |x: f64, y: f64, color: bool| {
-            self.march(
-                camera.eye,
-                projection.dir(x, y),
-                camera.near,
-                camera.far,
-                camera.medium,
-                shading,
-                &light,
-                color,
-                bins.at(x, y),
-            )
-        };
+        let picture = Picture::new(self, camera, (width, height), shading);
         let centres: Vec<RayResult> = (0..w * h)
             .into_par_iter()
-            .map(|i| march((i % w) as f64 + 0.5, (i / w) as f64 + 0.5, true))
+            .map(|i| picture.march((i % w) as f64 + 0.5, (i / w) as f64 + 0.5, true))
             .collect();
         let mut rgba = Vec::with_capacity(w * h * 4);
         for c in &centres {
@@ -321,6 +293,54 @@ impl RayMarcher {
     }
 }
 
+/// A picture of a camera to march: its projection, lighting and content bins, made once
+/// for all its rays.
+struct Picture<'a> {
+    marcher: &'a RayMarcher,
+    camera: &'a Camera,
+    shading: &'a Shading,
+    projection: Projection,
+    light: Light,
+    bins: Bins,
+}
+
+impl<'a> Picture<'a> {
+    fn new(
+        marcher: &'a RayMarcher,
+        camera: &'a Camera,
+        (width, height): (u32, u32),
+        shading: &'a Shading,
+    ) -> Self {
+        let projection = Projection::new(camera, width, height);
+        let light = Light::new(marcher, camera, shading);
+        let bins = Bins::new(&marcher.content, camera, &projection, &light);
+        Self {
+            marcher,
+            camera,
+            shading,
+            projection,
+            light,
+            bins,
+        }
+    }
+
+    /// Marches the ray through `(x, y)` (pixels from the top left).
+    fn march(&self, x: f64, y: f64, want_color: bool) -> RayResult {
+        let camera = self.camera;
+        self.marcher.march(
+            camera.eye,
+            self.projection.dir(x, y),
+            camera.near,
+            camera.far,
+            camera.medium,
+            self.shading,
+            &self.light,
+            want_color,
+            self.bins.at(x, y),
+        )
+    }
+}
+
 /// The renderer's projection: ray directions through points of the picture.
 struct Projection {
     forward: DVec3,
@@ -329,22 +349,28 @@ struct Projection {
     size: (f64, f64),
 }
 
+/// The view basis of `Camera::view_proj` (which particles face): the unit forward, right
+/// and up directions. Up is built from world up, or from +z looking straight up or down.
+pub(crate) fn view_basis(camera: &Camera) -> [DVec3; 3] {
+    let f = camera.unit_forward();
+    let up = if f.y.abs() > 0.999 {
+        DVec3::Z
+    } else {
+        DVec3::Y
+    };
+    let right = f.cross(up).normalize();
+    [f, right, right.cross(f)]
+}
+
 impl Projection {
     fn new(camera: &Camera, width: u32, height: u32) -> Self {
-        let f = camera.unit_forward();
-        // The view basis of `Camera::view_proj`.
-        let up = if f.y.abs() > 0.999 {
-            DVec3::Z
-        } else {
-            DVec3::Y
-        };
-        let right = f.cross(up).normalize();
+        let [f, right, up] = view_basis(camera);
         let tan_y = (camera.fov_y_deg.to_radians() / 2.0).tan();
         let aspect = f64::from(width) / f64::from(height);
         Self {
             forward: f,
             right: right * tan_y * aspect,
-            up: right.cross(f) * tan_y,
+            up: up * tan_y,
             size: (f64::from(width), f64::from(height)),
         }
     }

@@ -67,14 +67,8 @@ impl ChunkStreamer {
         let source = self.source.clone();
         let registry = self.registry.clone();
         let edits = self.edits.get(&pos).cloned();
-        let tx = self.tx.clone();
-        let cancelled = self.cancelled.clone();
-        self.jobs += 1;
-        self.pool.spawn(move || {
-            if cancelled.load(Ordering::Relaxed) {
-                return;
-            }
-            let done = match generate_checked(&*source, &registry, pos, edits.as_deref()) {
+        self.spawn(
+            move || match generate_checked(&*source, &registry, pos, edits.as_deref()) {
                 Ok(mut chunk) => {
                     if pack {
                         chunk.pack();
@@ -86,9 +80,8 @@ impl ChunkStreamer {
                     }
                 }
                 Err(why) => Done::Failed { pos, version, why },
-            };
-            let _ = tx.send(done);
-        });
+            },
+        );
     }
 
     pub(super) fn mesh(&mut self, pos: ChunkPos) {
@@ -112,14 +105,8 @@ impl ChunkStreamer {
         let neighbours =
             Neighbourhood::OFFSETS.map(|d| pos.offset(d).and_then(|n| self.world.shared(n)));
         let registry = self.registry.clone();
-        let tx = self.tx.clone();
-        let cancelled = self.cancelled.clone();
-        self.jobs += 1;
-        self.pool.spawn(move || {
-            if cancelled.load(Ordering::Relaxed) {
-                return;
-            }
-            let done = std::panic::catch_unwind(AssertUnwindSafe(|| {
+        self.spawn(move || {
+            std::panic::catch_unwind(AssertUnwindSafe(|| {
                 let meshes = mesh_on_worker(&registry, &centre, &neighbours);
                 let packed = (!centre.is_packed()).then(|| {
                     let mut c = (*centre).clone();
@@ -137,8 +124,21 @@ impl ChunkStreamer {
                 pos,
                 version,
                 why: "meshing panicked".into(),
-            });
-            let _ = tx.send(done);
+            })
+        });
+    }
+
+    /// Runs `job` on the pool and sends what it made back, unless the streamer was dropped
+    /// before the job started.
+    fn spawn(&mut self, job: impl FnOnce() -> Done + Send + 'static) {
+        let tx = self.tx.clone();
+        let cancelled = self.cancelled.clone();
+        self.jobs += 1;
+        self.pool.spawn(move || {
+            if cancelled.load(Ordering::Relaxed) {
+                return;
+            }
+            let _ = tx.send(job());
         });
     }
 }

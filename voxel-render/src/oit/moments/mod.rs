@@ -21,7 +21,6 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
-use wgpu::util::DeviceExt;
 
 use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
@@ -354,16 +353,10 @@ impl TechniqueKind for Mboit {
         let (b0_format, moments_format) = moment_formats(single);
         let moments_layout = gpu::layout(device, "mboit_moments_layout", &group_entries(false));
         let resolve_layout = gpu::layout(device, "mboit_resolve_layout", &group_entries(true));
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("mboit_params"),
-            contents: bytemuck::bytes_of(&MboitParams::zeroed()),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
-        let moments_group = gpu::bind_group(
+        let (params, moments_group) = gpu::zeroed_uniform::<MboitParams>(
             device,
-            "mboit_moments",
+            ("mboit_params", "mboit_moments"),
             &moments_layout,
-            &[params.as_entire_binding()],
         );
         let chunk = |label, resolve: bool, layout: &wgpu::BindGroupLayout, targets: &[_]| {
             let module = gpu::shader(device, label, &[&mboit_wgsl(resolve)]);

@@ -37,7 +37,6 @@ pub(crate) mod fit;
 pub(crate) mod weights;
 
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 use crate::chunks::ChunkStore;
 use crate::context::Capabilities;
@@ -382,16 +381,10 @@ impl TechniqueKind for Wboit {
             log::warn!("WBOIT accumulates in RGBA8: RGBA16F blending unavailable or disabled");
         }
         let params_layout = gpu::layout(device, "wboit_params_layout", &params_entries());
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("wboit_params"),
-            contents: bytemuck::bytes_of(&WboitParams::zeroed()),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
-        let params_group = gpu::bind_group(
+        let (params, params_group) = gpu::zeroed_uniform::<WboitParams>(
             device,
-            "wboit_params",
+            ("wboit_params", "wboit_params"),
             &params_layout,
-            &[params.as_entire_binding()],
         );
         let accum_target = sums::blended(accum_format, sums::ADDITIVE);
         let reveal_target = sums::blended(REVEALAGE_FORMAT, MULTIPLY_ONE_MINUS_SRC);

@@ -543,6 +543,20 @@ fn eye_in(c: ChunkPos) -> DVec3 {
     )
 }
 
+/// [`deterministic`] (view distance 2, hysteresis 1) settled with the eye in chunk 0, then
+/// two chunks along -x, settled and checked: chunk (2, 0, 0) is 4 away there, at the
+/// margin's edge (2 + 2); (3, 0, 0) lies past it. The streamer, the truth, the sink and
+/// the eye.
+fn moved_two_chunks_along_minus_x() -> (ChunkStreamer, Truth, Holder, DVec3) {
+    let (mut s, truth) = deterministic(2, 1);
+    let mut sink = Holder::default();
+    let at_0 = eye_in(ChunkPos::new(0, 0, 0));
+    settle_and_check(&mut s, &mut sink, &truth, at_0, 5_000, "at 0");
+    let eye = eye_in(ChunkPos::new(-2, 0, 0));
+    settle_and_check(&mut s, &mut sink, &truth, eye, 5_000, "moved");
+    (s, truth, sink, eye)
+}
+
 /// The eye flies two chunks away and back (the outer neighbour of the
 /// chunk at the view-distance edge passed the margin meanwhile), then a block is placed
 /// on that chunk's outer face: it is drawn and the streamer becomes idle (before, the
@@ -623,20 +637,7 @@ fn return_trips_of_every_length_hold_the_truth() {
 /// streamer becomes idle (it never did: it waited for a neighbour nobody loaded).
 #[test]
 fn an_edit_of_a_chunk_whose_outer_neighbour_is_past_the_margin_is_remeshed() {
-    let (mut s, mut truth) = deterministic(2, 1);
-    let mut sink = Holder::default();
-    settle_and_check(
-        &mut s,
-        &mut sink,
-        &truth,
-        eye_in(ChunkPos::new(0, 0, 0)),
-        5_000,
-        "at 0",
-    );
-    // Two chunks along -x: chunk (2, 0, 0) is 4 away, at the margin's edge (2 + 2);
-    // (3, 0, 0) lies past it.
-    let eye = eye_in(ChunkPos::new(-2, 0, 0));
-    settle_and_check(&mut s, &mut sink, &truth, eye, 5_000, "moved");
+    let (mut s, mut truth, mut sink, eye) = moved_two_chunks_along_minus_x();
     let edge = ChunkPos::new(2, 0, 0);
     let outer = ChunkPos::new(3, 0, 0);
     let centre = ChunkStreamer::centre_of(eye).unwrap();
@@ -660,18 +661,7 @@ fn an_edit_of_a_chunk_whose_outer_neighbour_is_past_the_margin_is_remeshed() {
 /// so the edit remeshes it). And an edit of a chunk far away changes no drawn chunk.
 #[test]
 fn an_edit_beside_a_drawn_chunk_remeshes_its_border() {
-    let (mut s, mut truth) = deterministic(2, 1);
-    let mut sink = Holder::default();
-    settle_and_check(
-        &mut s,
-        &mut sink,
-        &truth,
-        eye_in(ChunkPos::new(0, 0, 0)),
-        5_000,
-        "at 0",
-    );
-    let eye = eye_in(ChunkPos::new(-2, 0, 0));
-    settle_and_check(&mut s, &mut sink, &truth, eye, 5_000, "moved");
+    let (mut s, mut truth, mut sink, eye) = moved_two_chunks_along_minus_x();
     let outer = ChunkPos::new(3, 0, 0);
     // Fill the face of the outer chunk that touches chunk (2, 0, 0): every face of
     // the drawn chunk's border layer changes.
