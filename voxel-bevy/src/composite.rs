@@ -131,7 +131,7 @@ impl Composite {
     }
 
     /// The pipeline into the crate's scene for `samples` samples, made the first time.
-    fn into_world(&mut self, device: &wgpu::Device, samples: u32) -> wgpu::RenderPipeline {
+    fn world_pipeline(&mut self, device: &wgpu::Device, samples: u32) -> wgpu::RenderPipeline {
         if let Some((_, p)) = self.into_world.iter().find(|(s, _)| *s == samples) {
             return p.clone();
         }
@@ -274,7 +274,10 @@ impl GameStages for BevyOpaque<'_, '_> {
     }
 
     fn prepare(&mut self, ctx: &GpuContext, frame: &GameFrame<'_>) {
-        self.pipeline = Some(self.composite.into_world(&ctx.device, frame.opaque_samples));
+        self.pipeline = Some(
+            self.composite
+                .world_pipeline(&ctx.device, frame.opaque_samples),
+        );
     }
 
     fn opaque(&self, pass: &mut wgpu::RenderPass<'_>, _frame: &GameFrame<'_>) {

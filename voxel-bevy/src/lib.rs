@@ -233,6 +233,7 @@ pub struct VoxelParticles(pub Vec<Particle>);
 pub struct VoxelContent(pub Content);
 
 /// Where the world's blocks come from.
+#[allow(clippy::large_enum_variant)] // one per app: boxing the streamer saves nothing
 enum Source {
     /// A world the game filled (or generated): meshed where it changes.
     Fixed(World),
