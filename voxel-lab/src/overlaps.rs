@@ -15,8 +15,6 @@ use glam::DVec3;
 use voxel_render::Camera;
 use voxel_render::content::Content;
 
-use crate::raymarch::view_basis;
-
 /// A box in world space: centre, and its three axes scaled by the half extents.
 #[derive(Clone, Copy, Debug)]
 struct Solid {
@@ -213,6 +211,19 @@ pub fn overlap_mask(content: &Content, camera: &Camera, size: (u32, u32)) -> Vec
         .into_iter()
         .map(|p| p == Pair::Interpenetrating)
         .collect()
+}
+
+/// The view basis of `Camera::view_proj` (which particles face): the unit forward, right
+/// and up directions. Up is built from world up, or from +z looking straight up or down.
+pub(crate) fn view_basis(camera: &Camera) -> [DVec3; 3] {
+    let f = camera.unit_forward();
+    let up = if f.y.abs() > 0.999 {
+        DVec3::Z
+    } else {
+        DVec3::Y
+    };
+    let right = f.cross(up).normalize();
+    [f, right, right.cross(f)]
 }
 
 #[cfg(test)]

@@ -349,18 +349,7 @@ struct Projection {
     size: (f64, f64),
 }
 
-/// The view basis of `Camera::view_proj` (which particles face): the unit forward, right
-/// and up directions. Up is built from world up, or from +z looking straight up or down.
-pub(crate) fn view_basis(camera: &Camera) -> [DVec3; 3] {
-    let f = camera.unit_forward();
-    let up = if f.y.abs() > 0.999 {
-        DVec3::Z
-    } else {
-        DVec3::Y
-    };
-    let right = f.cross(up).normalize();
-    [f, right, right.cross(f)]
-}
+pub(crate) use crate::overlaps::view_basis;
 
 impl Projection {
     fn new(camera: &Camera, width: u32, height: u32) -> Self {
