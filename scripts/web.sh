@@ -17,6 +17,9 @@
 #                     the module is named after it, the page is examples/NAME/index.html
 #                     (voxel-bevy's `web`: docs/bevy.md)
 #   WEB_FEATURES      the crate's features to build with (voxel-bevy: webgl2 or webgpu)
+#   WEB_PROFILE       cargo's profile: default release; the browser tests build voxel-bevy's
+#                     pages with `web-test` (Cargo.toml: opt-level 1, no debug info), which
+#                     halves a Bevy page's build
 # With WEB_OUT and CARGO_TARGET_DIR outside it, nothing is written into this checkout (it
 # may be read-only): a crate of this workspace (the crate's own page, voxel-bevy's example)
 # builds with --locked, so Cargo.lock is read, never rewritten. A game's crate (WEB_CRATE)
@@ -44,6 +47,7 @@ if [ -z "${WEB_CRATE:-}" ] || [ "$(workspace_root)" = "$checkout" ]; then
     locked=(--locked)
 fi
 out="${WEB_OUT:-$checkout/out/web}"
+profile="${WEB_PROFILE:-release}"
 
 # The crate's name (its [package] name), as a library file name.
 lib_name() {
@@ -88,7 +92,7 @@ build() {
             echo "error: WEB_EXAMPLE=$example: no page $page" >&2
             return 1
         fi
-        cargo build --release "${locked[@]}" "${features[@]}" --target wasm32-unknown-unknown \
+        cargo build --profile "$profile" "${locked[@]}" "${features[@]}" --target wasm32-unknown-unknown \
             --manifest-path "$crate/Cargo.toml" --example "$example"
         wasm="examples/$example.wasm"
     else
@@ -96,14 +100,14 @@ build() {
         # game's page that links it, built in the same target folder, never overwrites
         # this module).
         page="$crate/index.html"
-        cargo rustc --release "${locked[@]}" "${features[@]}" --target wasm32-unknown-unknown \
+        cargo rustc --profile "$profile" "${locked[@]}" "${features[@]}" --target wasm32-unknown-unknown \
             --manifest-path "$crate/Cargo.toml" --lib --crate-type cdylib
         wasm="$name.wasm"
     fi
     target="$(target_dir)"
     mkdir -p "$out"
     wasm-bindgen --target web --no-typescript --out-dir "$out" \
-        "$target/wasm32-unknown-unknown/release/$wasm"
+        "$target/wasm32-unknown-unknown/$profile/$wasm"
     cp "$page" "$out/index.html"
     echo "built $out ($(du -k "$out/${name}_bg.wasm" | cut -f1) KiB of WebAssembly)" >&2
 }

@@ -1,5 +1,5 @@
 //! What the plugin costs over the crate's own `Renderer::render` on the same scene, camera
-//! and device: the thread CPU time of a frame (median of runs), and the GPU work of one
+//! and device: the thread CPU time of a frame (median of rounds), and the GPU work of one
 //! frame by the crate's cost counters (draws, fragments).
 //!
 //! The plugin's CPU per frame is Bevy's frame with the plugin and a `VoxelCamera` less the
@@ -43,26 +43,24 @@ fn median(mut v: Vec<Duration>) -> Duration {
     v[v.len() / 2]
 }
 
+fn median_f64(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
 fn wait(ctx: &voxel_render::GpuContext) {
     ctx.device
         .poll(wgpu::PollType::wait_indefinitely())
         .unwrap();
 }
 
-fn bevy_frames(h: &mut Harness, frames: usize) -> Duration {
-    let ctx = h.ctx();
-    for _ in 0..5 {
-        h.app.update();
-        wait(&ctx);
-    }
-    let mut times = Vec::new();
-    for _ in 0..frames {
-        let t0 = thread_cpu();
-        h.app.update();
-        times.push(thread_cpu() - t0);
-        wait(&ctx);
-    }
-    median(times)
+/// The thread CPU time of one `App::update`, the GPU waited for after it (untimed).
+fn bevy_frame(h: &mut Harness, ctx: &voxel_render::GpuContext) -> Duration {
+    let t0 = thread_cpu();
+    h.app.update();
+    let dt = thread_cpu() - t0;
+    wait(ctx);
+    dt
 }
 
 fn main() {
@@ -97,15 +95,19 @@ fn main() {
     let mut without = app(false);
     with.frames(1);
     let ctx = with.ctx();
+    // Bevy alone runs on its own device.
+    let alone_ctx = without.ctx();
+    let mut second = app(false);
+    let second_ctx = second.ctx();
     let camera = with.camera();
     println!(
-        "scene {name}, {}x{}, {frames} frames a median, {}",
+        "scene {name}, {}x{}, {frames} rounds a median, {}",
         size.0, size.1, ctx.caps.adapter_name
     );
     println!(
-        "| technique | Bevy + plugin (ms CPU) | Bevy alone | plugin | crate's render | plugin / crate | draws plugin / crate | fragments plugin / crate |"
+        "| technique | Bevy + plugin (ms CPU) | Bevy alone | plugin | zero (Bevy alone twice) | crate's render + submit | plugin / crate | crate's `render` alone | plugin / `render` | draws plugin / crate | fragments plugin / crate |"
     );
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for t in [
         Technique::SortedQuads,
         Technique::Sorted,
@@ -113,9 +115,6 @@ fn main() {
         Technique::DepthPeeling,
     ] {
         with.app.insert_resource(VoxelTechnique::Use(t));
-        // Bevy alone next to each technique's frames: the machine's load drifts.
-        let bevy_alone = bevy_frames(&mut without, frames);
-        let with_plugin = bevy_frames(&mut with, frames);
         // The crate on its own: the same scene, camera, technique and device.
         let config = tests::technique_config(t, size.0, size.1);
         let mut renderer = Renderer::new(&ctx, scene.world.registry(), config).unwrap();
@@ -125,28 +124,61 @@ fn main() {
         }
         let mut content = ContentStages::new(&renderer, scene.content.clone()).unwrap();
         let target = tests::Offscreen::new(&ctx, size.0, size.1);
-        let mut own = Vec::new();
-        let mut own_cost = None;
-        for i in 0..frames + 6 {
-            let counted = i == 4;
-            if counted {
-                count_next_frame(&mut renderer);
-            }
-            let t0 = thread_cpu();
+        // `render` alone, and with its encoder's `finish` and `submit`.
+        let mut own_frame = |renderer: &mut Renderer| {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            let t0 = thread_cpu();
             renderer
                 .render(&mut encoder, &target.view, &camera, &mut content)
                 .unwrap();
+            let rendered = thread_cpu() - t0;
             ctx.queue.submit([encoder.finish()]);
             let dt = thread_cpu() - t0;
             wait(&ctx);
-            if counted {
-                own_cost = frame_cost(&mut renderer).unwrap();
-            } else if i > 5 {
-                own.push(dt);
-            }
+            (rendered, dt)
+        };
+        // The crate's frame, counted (after warm-up frames).
+        for _ in 0..4 {
+            own_frame(&mut renderer);
         }
-        let own = median(own);
+        count_next_frame(&mut renderer);
+        own_frame(&mut renderer);
+        let own_cost = frame_cost(&mut renderer).unwrap().unwrap();
+        for _ in 0..5 {
+            bevy_frame(&mut without, &alone_ctx);
+            bevy_frame(&mut with, &ctx);
+            bevy_frame(&mut second, &second_ctx);
+            own_frame(&mut renderer);
+        }
+        // Rounds of one frame each (Bevy alone, Bevy with the plugin, a second Bevy alone,
+        // the crate alone), so that the machine's drifting load hits all alike, in turn
+        // forwards and backwards (what runs right after another may find warmer caches);
+        // the plugin's cost is the median of each round's difference, and the difference of
+        // the two apps without the plugin is the measurement's own zero.
+        let (mut alone, mut plugin_on, mut own, mut plugin) = (vec![], vec![], vec![], vec![]);
+        let (mut render_only, mut zero) = (vec![], vec![]);
+        for round in 0..frames {
+            let (a, w, b);
+            if round % 2 == 0 {
+                a = bevy_frame(&mut without, &alone_ctx);
+                w = bevy_frame(&mut with, &ctx);
+                b = bevy_frame(&mut second, &second_ctx);
+            } else {
+                b = bevy_frame(&mut second, &second_ctx);
+                w = bevy_frame(&mut with, &ctx);
+                a = bevy_frame(&mut without, &alone_ctx);
+            }
+            let (r, o) = own_frame(&mut renderer);
+            render_only.push(r);
+            own.push(o);
+            alone.push(a);
+            plugin_on.push(w);
+            plugin.push(w.as_secs_f64() - a.as_secs_f64());
+            zero.push(b.as_secs_f64() - a.as_secs_f64());
+        }
+        let (bevy_alone, with_plugin) = (median(alone), median(plugin_on));
+        let (own, render_only) = (median(own), median(render_only));
+        let (plugin, zero) = (median_f64(plugin), median_f64(zero));
         // The plugin's frame, counted.
         with.app.insert_resource(VoxelCountNextFrame(true));
         for _ in 0..3 {
@@ -160,19 +192,20 @@ fn main() {
             .last_cost
             .clone()
             .unwrap();
-        let own_cost = own_cost.unwrap();
         let (p, o) = (plugin_cost.all(), own_cost.all());
-        let plugin = with_plugin.saturating_sub(bevy_alone);
         let ms = |d: Duration| d.as_secs_f64() * 1e3;
         let frag = |f: Option<u64>| f.map_or("-".into(), |f| f.to_string());
         println!(
-            "| `{}` | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {} / {} | {} / {} |",
+            "| `{}` | {:.3} | {:.3} | {:.3} | {:+.3} | {:.3} | {:.2} | {:.3} | {:.2} | {} / {} | {} / {} |",
             t.name(),
             ms(with_plugin),
             ms(bevy_alone),
-            ms(plugin),
+            plugin * 1e3,
+            zero * 1e3,
             ms(own),
-            ms(plugin) / ms(own),
+            plugin * 1e3 / ms(own),
+            ms(render_only),
+            plugin * 1e3 / ms(render_only),
             p.draws,
             o.draws,
             frag(p.fragments),
