@@ -2,7 +2,8 @@
 //! cutout and translucent meshes of 8-byte packed quads, culling against neighbour chunks.
 //!
 //! - [`Mesher`]: one chunk with its neighbours → [`ChunkMeshes`] (binary greedy meshing),
-//!   with per-vertex ambient occlusion ([`ao`]).
+//!   with per-vertex ambient occlusion ([`ao`]); [`Mesher::mesh_lit`] adds smooth
+//!   per-vertex light from a [`voxel_core::LightField`] ([`light`]).
 //! - [`PackedQuad`]: the 8-byte quad format the renderer expands in its vertex shader.
 //! - [`mesh_dirty`]: remesh a world's dirty chunks in parallel with rayon.
 //! - [`order`]: exact back-to-front order of a chunk's translucent quads, re-sorted only
@@ -13,6 +14,7 @@
 
 pub mod ao;
 mod bits;
+pub mod light;
 mod mesher;
 pub mod order;
 mod quad;
@@ -20,6 +22,7 @@ pub mod sort;
 mod world;
 
 pub use ao::AO_NONE;
+pub use light::{LightStreams, PackedLight, QuadLight};
 pub use bits::greedy_rects;
 pub use mesher::{ChunkMeshes, MeshOptions, Mesher, Neighbours};
 pub use quad::{FLAG_INTERFACE, PackedQuad, Quad, UV_AXES};
@@ -35,6 +38,10 @@ pub enum Error {
     /// A chunk (or a neighbour) holds a block id that the registry does not know.
     #[error("a chunk holds block id {0}, which the registry does not know")]
     UnknownBlock(BlockId),
+    /// A chunk meshed with light has more than 65 536 distinct corner lights, more than
+    /// the 16-bit indices of [`light::QuadLight`] address.
+    #[error("a chunk has more than 65536 distinct corner lights")]
+    LightPalette,
 }
 
 /// `Result` with this crate's [`Error`] as the default error.
