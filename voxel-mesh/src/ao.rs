@@ -202,12 +202,6 @@ impl Pad {
         &self.by_y
     }
 
-    /// Whether the cell at padded `(px, py, pz)` (each 0..34) is opaque.
-    #[inline]
-    pub(crate) fn opaque_at(&self, px: usize, py: usize, pz: usize) -> bool {
-        self.by_x[py][pz] >> px & 1 != 0
-    }
-
     /// The occluders in front of the faces of layer `layer` of `face` (the layer one step
     /// along the normal, possibly in a neighbour), or `None` when there are none.
     #[inline]

@@ -206,6 +206,8 @@ pub(crate) struct Palette {
     table: Vec<u32>,
     /// Set when a chunk needed more than 65 536 values.
     pub(crate) overflow: bool,
+    /// The last value interned and its index (neighbouring corners often agree).
+    last: Option<(u64, u16)>,
 }
 
 impl Palette {
@@ -220,6 +222,7 @@ impl Palette {
         }
         self.values.clear();
         self.overflow = false;
+        self.last = None;
     }
 
     #[inline]
@@ -229,6 +232,17 @@ impl Palette {
 
     #[inline]
     pub(crate) fn intern(&mut self, v: u64) -> u16 {
+        match self.last {
+            Some((l, i)) if l == v => i,
+            _ => {
+                let i = self.intern_hashed(v);
+                self.last = Some((v, i));
+                i
+            }
+        }
+    }
+
+    fn intern_hashed(&mut self, v: u64) -> u16 {
         if self.table.len() < 2 * (self.values.len() + 1) {
             self.grow();
         }
@@ -284,38 +298,50 @@ fn region(p: usize) -> (usize, usize) {
     }
 }
 
-/// The light chunks of a chunk and its 26 neighbours (`None`: not lit).
+/// The light of a chunk and its 26 neighbours, a layer at a time: per padded layer `py`,
+/// the layers of the nine chunks it crosses by `xr * 3 + zr` (regions of [`region`];
+/// `None`: not lit).
 #[derive(Clone, Copy)]
 pub(crate) struct LitCells<'a> {
-    /// By `xr * 9 + yr * 3 + zr` (regions of [`region`]).
-    chunks: [Option<&'a LightChunk>; 27],
+    layers: [[Option<LightLayer<'a>>; 9]; P],
 }
 
 impl<'a> LitCells<'a> {
     pub(crate) fn new(field: &'a LightField, pos: ChunkPos) -> Self {
+        let chunks: [Option<&'a LightChunk>; 27] = std::array::from_fn(|i| {
+            let d = [i / 9, i / 3 % 3, i % 3].map(|v| v as i32 - 1);
+            pos.offset(d).and_then(|p| field.chunk(p))
+        });
         Self {
-            chunks: std::array::from_fn(|i| {
-                let d = [i / 9, i / 3 % 3, i % 3].map(|v| v as i32 - 1);
-                pos.offset(d).and_then(|p| field.chunk(p))
+            layers: std::array::from_fn(|py| {
+                let (yr, y) = region(py);
+                std::array::from_fn(|k| chunks[k / 3 * 9 + yr * 3 + k % 3].map(|c| c.layer(y)))
             }),
         }
     }
 
-    #[inline(always)]
-    fn chunk(&self, xr: usize, yr: usize, zr: usize) -> Option<&'a LightChunk> {
-        self.chunks[xr * 9 + yr * 3 + zr]
-    }
-
     /// The levels at padded `(px, py, pz)`, `None` where unknown.
-    #[inline]
+    #[inline(always)]
     fn get(&self, px: usize, py: usize, pz: usize) -> Option<u64> {
-        let ((xr, x), (yr, y), (zr, z)) = (region(px), region(py), region(pz));
-        let c = self.chunk(xr, yr, zr)?;
-        Some(match c.layer(y) {
+        let ((xr, x), (zr, z)) = (region(px), region(pz));
+        Some(match self.layers[py][xr * 3 + zr]? {
             LightLayer::Uniform(v) => pack(&v),
             LightLayer::Dense(d) => pack(&d[x << 5 | z]),
         })
     }
+}
+
+/// Per plane of faces: the cells in front of its faces with an odd cell in front (levels,
+/// and spread into 16-bit lanes: channels 0 to 3, then 4 and 5), by `row * 34 + bit`
+/// (padded), and the light of its vertices, by `row * 34 + bit` (rows and bits 0..33).
+#[derive(Clone)]
+struct Plane {
+    raw: [u64; P * P],
+    lo: [u64; P * P],
+    hi: [u64; P * P],
+    vertex: [u64; P * P],
+    /// Bit `vb` of row `vr`: `vertex` holds that vertex.
+    vertex_ok: [u64; P],
 }
 
 /// The light side of the mesher's working memory (see the module docs' "Cost").
@@ -327,6 +353,8 @@ pub(crate) struct LightScratch {
     odd_y: [[u64; P]; P],
     /// Bit `py`: the reference of layer `py` differs from that of a layer next to it.
     boundary: u64,
+    /// Bit `py`: rows of `odd_x[py]` written (to clear).
+    written: u64,
     /// Reference levels per padded layer.
     refs: [u64; P],
     /// Their palette indices, interned on first use (`u16::MAX` before).
@@ -335,6 +363,7 @@ pub(crate) struct LightScratch {
     /// Per face of a plane (`row * 32 + bit`): its corner indices and AO byte.
     keys: Box<[u64; CHUNK_SIZE * CHUNK_SIZE]>,
     aos: Box<[u8; CHUNK_SIZE * CHUNK_SIZE]>,
+    plane: Box<Plane>,
 }
 
 impl LightScratch {
@@ -343,11 +372,19 @@ impl LightScratch {
             odd_x: [[0; P]; P],
             odd_y: [[0; P]; P],
             boundary: 0,
+            written: 0,
             refs: [0; P],
             ref_idx: [u16::MAX; P],
             palette: Palette::default(),
             keys: Box::new([0; CHUNK_SIZE * CHUNK_SIZE]),
             aos: Box::new([0; CHUNK_SIZE * CHUNK_SIZE]),
+            plane: Box::new(Plane {
+                raw: [0; P * P],
+                lo: [0; P * P],
+                hi: [0; P * P],
+                vertex: [0; P * P],
+                vertex_ok: [0; P],
+            }),
         })
     }
 
@@ -356,55 +393,72 @@ impl LightScratch {
     pub(crate) fn build(&mut self, cells: &LitCells<'_>, pad: &Pad) {
         self.palette.clear();
         self.ref_idx = [u16::MAX; P];
-        self.odd_x = [[0; P]; P];
-        self.odd_y = [[0; P]; P];
+        if self.written != 0 {
+            let mut w = self.written;
+            while w != 0 {
+                self.odd_x[w.trailing_zeros() as usize] = [0; P];
+                w &= w - 1;
+            }
+            self.odd_y = [[0; P]; P];
+            self.written = 0;
+        }
         let opaque = pad.rows_x();
         for py in (0..P).rev() {
-            let (yr, y) = region(py);
+            let layers = &cells.layers[py];
+            let above = self.refs.get(py + 1).copied().filter(|_| py + 1 < P);
+            let open_any = opaque[py].iter().any(|&r| r & FULL != FULL);
             // The reference: a uniform layer's levels, or the level most open cells of a
             // dense one hold (tried first: the reference of the layer above).
             let mut inner = [0u32; CHUNK_SIZE];
-            let reference = match cells.chunk(1, yr, 1).map(|c| c.layer(y)) {
+            let reference = match layers[4] {
                 None => 0,
                 Some(LightLayer::Uniform(v)) => pack(&v),
-                Some(LightLayer::Dense(d)) => {
+                Some(LightLayer::Dense(d)) if open_any => {
                     let open: [u32; CHUNK_SIZE] =
                         std::array::from_fn(|z| !(opaque[py][z + 1] >> 1) as u32);
-                    let above = self.refs.get(py + 1).copied();
                     let first = above.unwrap_or_else(|| pack(&d[0]));
-                    let (n_open, n_odd, other) = odd_rows(d, &open, first, &mut inner);
+                    let (n_open, n_odd) = odd_rows(d, &open, first, &mut inner);
+                    let other = (0..CHUNK_SIZE).find(|&z| inner[z] != 0).map(|z| {
+                        pack(&d[(inner[z].trailing_zeros() as usize) << 5 | z])
+                    });
                     match other {
                         Some(second) if 2 * n_odd > n_open => {
-                            let (_, n2, _) = odd_rows(d, &open, second, &mut inner);
+                            let mut again = [0u32; CHUNK_SIZE];
+                            let (_, n2) = odd_rows(d, &open, second, &mut again);
                             if n2 < n_odd {
+                                inner = again;
                                 second
                             } else {
-                                odd_rows(d, &open, first, &mut inner);
                                 first
                             }
                         }
                         _ => first,
                     }
                 }
+                Some(LightLayer::Dense(d)) => pack(&d[0]),
             };
             // A layer without an open cell counts nowhere: it takes the reference above, so
             // that it does not make the layers next to it boundaries.
-            let open = opaque[py].iter().any(|&r| r & FULL != FULL);
-            let reference = match self.refs.get(py + 1) {
-                Some(&above) if !open => above,
+            let reference = match above {
+                Some(a) if !open_any => a,
                 _ => reference,
             };
             self.refs[py] = reference;
-            let uniform = |c: Option<&LightChunk>| {
-                matches!(c.map(|c| c.layer(y)), Some(LightLayer::Uniform(v)) if pack(&v) == reference)
+            let same = |l: &Option<LightLayer<'_>>| {
+                matches!(l, Some(LightLayer::Uniform(v)) if pack(v) == reference)
             };
-            let quiet = (0..9).all(|k| uniform(cells.chunk(k / 3, yr, k % 3)));
-            if quiet {
+            if !open_any || layers.iter().all(same) {
                 continue;
             }
+            let odd_at = |l: Option<LightLayer<'_>>, x: usize, z: usize| match l {
+                None => true,
+                Some(LightLayer::Uniform(v)) => pack(&v) != reference,
+                Some(LightLayer::Dense(d)) => pack(&d[x << 5 | z]) != reference,
+            };
+            self.written |= 1 << py;
             for pz in 0..P {
                 let (zr, z) = region(pz);
-                let mut bits = match cells.chunk(1, yr, zr).map(|c| c.layer(y)) {
+                let mut bits = match layers[3 + zr] {
                     None => INNER,
                     Some(LightLayer::Uniform(v)) if pack(&v) == reference => 0,
                     Some(LightLayer::Uniform(_)) => INNER,
@@ -413,14 +467,8 @@ impl LightScratch {
                         acc | u64::from(pack(&d[x << 5 | z]) != reference) << (x + 1)
                     }),
                 };
-                for (px, xr, x) in [(0, 0, CHUNK_SIZE - 1), (P - 1, 2, 0)] {
-                    let odd = match cells.chunk(xr, yr, zr).map(|c| c.layer(y)) {
-                        None => true,
-                        Some(LightLayer::Uniform(v)) => pack(&v) != reference,
-                        Some(LightLayer::Dense(d)) => pack(&d[x << 5 | z]) != reference,
-                    };
-                    bits |= u64::from(odd) << px;
-                }
+                bits |= u64::from(odd_at(layers[zr], CHUNK_SIZE - 1, z));
+                bits |= u64::from(odd_at(layers[6 + zr], 0, z)) << (P - 1);
                 bits &= !opaque[py][pz] & FULL;
                 self.odd_x[py][pz] = bits;
                 while bits != 0 {
@@ -482,30 +530,45 @@ impl LightScratch {
     }
 }
 
-/// Marks in `out` the open cells (`open`, rows z, bits x) of a dense layer whose levels are
-/// not `reference`; returns the open cells, the odd ones, and the first odd level.
+/// Marks in `out` (rows z, bits x) the open cells (`open`, the same layout) of a dense
+/// layer whose levels are not `reference`; returns the number of open cells and of those
+/// marked. Compares four cells (three words) at a time in memory order, then transposes.
 fn odd_rows(
     d: &[[u8; 6]; CHUNK_SIZE * CHUNK_SIZE],
     open: &[u32; CHUNK_SIZE],
     reference: u64,
     out: &mut [u32; CHUNK_SIZE],
-) -> (u32, u32, Option<u64>) {
-    let (mut n_open, mut n_odd, mut other) = (0, 0, None);
-    for z in 0..CHUNK_SIZE {
-        let mut row = 0u32;
-        for x in 0..CHUNK_SIZE {
-            row |= u32::from(pack(&d[x << 5 | z]) != reference) << x;
+) -> (u32, u32) {
+    const M: u64 = (1 << 48) - 1;
+    let r = reference;
+    // The reference repeated over 24 bytes (four cells), as three little-endian words.
+    let (p0, p1, p2) = (r | r << 48, r >> 16 | r << 32, r >> 32 | r << 16);
+    let mut by_x = [0u32; CHUNK_SIZE];
+    for (column, cells) in by_x.iter_mut().zip(d.as_flattened().chunks_exact(6 * CHUNK_SIZE)) {
+        let mut bits = 0u32;
+        for (k, g) in cells.chunks_exact(24).enumerate() {
+            let w = |i: usize| {
+                let mut b = [0u8; 8];
+                b.copy_from_slice(&g[8 * i..8 * i + 8]);
+                u64::from_le_bytes(b)
+            };
+            let (a, b, c) = (w(0) ^ p0, w(1) ^ p1, w(2) ^ p2);
+            let four = u32::from(a & M != 0)
+                | u32::from((a >> 48 | b << 16) & M != 0) << 1
+                | u32::from((b >> 32 | c << 32) & M != 0) << 2
+                | u32::from(c >> 16 != 0) << 3;
+            bits |= four << (4 * k);
         }
-        row &= open[z];
-        if row != 0 && other.is_none() {
-            let x = row.trailing_zeros() as usize;
-            other = Some(pack(&d[x << 5 | z]));
-        }
-        n_open += open[z].count_ones();
-        n_odd += row.count_ones();
-        out[z] = row;
+        *column = bits;
     }
-    (n_open, n_odd, other)
+    let rows = crate::bits::transpose32(&by_x);
+    let (mut n_open, mut n_odd) = (0, 0);
+    for z in 0..CHUNK_SIZE {
+        out[z] = rows[z] & open[z];
+        n_open += open[z].count_ones();
+        n_odd += out[z].count_ones();
+    }
+    (n_open, n_odd)
 }
 
 /// What the emitting code of a plane needs for light.
@@ -528,69 +591,34 @@ fn padded(axis: usize, next: usize, pr: usize, pb: usize) -> (usize, usize, usiz
     }
 }
 
-/// The levels of a cell that counts (open and known).
-#[inline]
-fn counted(cells: &LitCells<'_>, pad: &Pad, p: (usize, usize, usize)) -> Option<u64> {
-    if pad.opaque_at(p.0, p.1, p.2) {
-        None
-    } else {
-        cells.get(p.0, p.1, p.2)
-    }
+/// Spreads four bytes into the four 16-bit lanes of a word.
+#[inline(always)]
+fn lanes(x: u64) -> u64 {
+    (x & 0xff) | (x & 0xff00) << 8 | (x & 0xff_0000) << 16 | (x & 0xff00_0000) << 24
 }
 
-/// The mean, rounded, per channel, of `n` (1 to 4) levels summed in 16-bit lanes.
-#[inline]
-fn mean(sum: [u16; 6], n: u16) -> u64 {
-    let mut v = 0u64;
-    for (i, s) in sum.into_iter().enumerate() {
-        v |= u64::from((s + n / 2) / n) << (8 * i);
-    }
-    v
+/// The inverse of [`lanes`] (lanes below 256).
+#[inline(always)]
+fn unlanes(l: u64) -> u64 {
+    (l & 0xff) | (l >> 8 & 0xff00) | (l >> 16 & 0xff_0000) | (l >> 24 & 0xff00_0000)
 }
 
-/// The corner lights of the face at row `r`, bit `b` of a plane (`axis`, padded layer
-/// `next` in front), in the slot order of [`QuadLight::new`]; `flat`: the front cell's.
-pub(crate) fn face_corners(
-    cells: &LitCells<'_>,
-    pad: &Pad,
-    axis: usize,
-    next: usize,
-    r: usize,
-    b: usize,
-    flat: bool,
-) -> [u64; 4] {
-    let at = |dr: isize, db: isize| {
-        let pr = (r as isize + 1 + dr) as usize;
-        let pb = (b as isize + 1 + db) as usize;
-        padded(axis, next, pr, pb)
-    };
-    let front = counted(cells, pad, at(0, 0));
-    if flat {
-        return [front.unwrap_or(0); 4];
+/// The mean, rounded half up, of `n` (1 to 4) levels summed in the 16-bit lanes of `s`:
+/// shifts for 1, 2 and 4; for 3, `(s + 1) · 21 846 >> 16` per lane (21 846 is 2^16 / 3
+/// rounded up, exact for sums up to 3 · 255).
+#[inline(always)]
+fn mean_lanes(s: u64, n: u32) -> u64 {
+    const ONES: u64 = 0x0001_0001_0001_0001;
+    const LOW: u64 = 0x00ff_00ff_00ff_00ff;
+    match n {
+        1 => s,
+        2 => (s + ONES) >> 1 & LOW,
+        4 => (s + 2 * ONES) >> 2 & LOW,
+        _ => (0..4).fold(0, |acc, i| {
+            let l = s >> (16 * i) & 0xffff;
+            acc | ((l + 1) * 21846 >> 16) << (16 * i)
+        }),
     }
-    let mut out = [0; 4];
-    for (dr, db) in [(-1, -1), (-1, 1), (1, -1), (1, 1)] {
-        let s1 = at(dr, 0);
-        let s2 = at(0, db);
-        let walled = pad.opaque_at(s1.0, s1.1, s1.2) && pad.opaque_at(s2.0, s2.1, s2.2);
-        let diag = if walled { None } else { Some(at(dr, db)) };
-        let (mut sum, mut n) = ([0u16; 6], 0u16);
-        for v in [Some(s1), Some(s2), diag]
-            .into_iter()
-            .flatten()
-            .filter_map(|p| counted(cells, pad, p))
-            .chain(front)
-        {
-            for (i, s) in sum.iter_mut().enumerate() {
-                *s += (v >> (8 * i) & 0xff) as u16;
-            }
-            n += 1;
-        }
-        let value = if n == 0 { 0 } else { mean(sum, n) };
-        let (du, dv) = if axis == 1 { (dr, db) } else { (db, dr) };
-        out[usize::from(du > 0) + 2 * usize::from(dv > 0)] = value;
-    }
-    out
 }
 
 /// Covers the faces of `sel` (its live rows `live`) whose corner lights and AO are keyed
@@ -678,8 +706,79 @@ impl LitPlane<'_, '_> {
             aos,
             palette,
             refs,
+            plane,
             ..
         } = &mut *self.s;
+        let Plane {
+            raw,
+            lo,
+            hi,
+            vertex,
+            vertex_ok,
+        } = &mut **plane;
+        // The plane's opaque cells in front, rows and bits as `odd`.
+        let op: [u64; P] = match axis {
+            1 => self.pad.rows_x()[next],
+            0 => self.pad.columns_y()[next],
+            _ => std::array::from_fn(|pr| self.pad.rows_x()[pr][next]),
+        };
+        // The cells in front of the selected faces that count (open and known), read once.
+        let mut need = [0u64; P];
+        let mut l = sel_live;
+        while l != 0 {
+            let r = l.trailing_zeros() as usize;
+            l &= l - 1;
+            let d = u64::from(sel[r]);
+            let w = if self.flat { d << 1 } else { d | d << 1 | d << 2 };
+            let rows = if self.flat { r + 1..r + 2 } else { r..r + 3 };
+            for n in &mut need[rows] {
+                *n |= w;
+            }
+        }
+        let mut counts = [0u64; P];
+        for pr in 0..P {
+            let mut bits = need[pr] & !op[pr];
+            while bits != 0 {
+                let pb = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let (px, py, pz) = padded(axis, next, pr, pb);
+                if let Some(v) = self.cells.get(px, py, pz) {
+                    let i = pr * P + pb;
+                    raw[i] = v;
+                    lo[i] = lanes(v & 0xffff_ffff);
+                    hi[i] = lanes(v >> 32);
+                    counts[pr] |= 1 << pb;
+                }
+            }
+        }
+        *vertex_ok = [0; P];
+        // The light of vertex (vr, vb) of the plane, where the rule about the diagonal
+        // does not apply: the mean of the counted cells of the 2 × 2 around it.
+        let mut at_vertex = |vr: usize, vb: usize| -> u64 {
+            let i = vr * P + vb;
+            if vertex_ok[vr] >> vb & 1 != 0 {
+                return vertex[i];
+            }
+            let (m0, m1) = (counts[vr] >> vb & 3, counts[vr + 1] >> vb & 3);
+            let n = (m0.count_ones() + m1.count_ones()) as u32;
+            let v = if n == 0 {
+                0
+            } else {
+                let (mut sl, mut sh) = (0, 0);
+                for (row, m) in [(vr, m0), (vr + 1, m1)] {
+                    for k in 0..2 {
+                        if m >> k & 1 != 0 {
+                            sl += lo[row * P + vb + k];
+                            sh += hi[row * P + vb + k];
+                        }
+                    }
+                }
+                unlanes(mean_lanes(sl, n)) | unlanes(mean_lanes(sh, n)) << 32
+            };
+            vertex[i] = v;
+            vertex_ok[vr] |= 1 << vb;
+            v
+        };
         let mut l = sel_live;
         while l != 0 {
             let r = l.trailing_zeros() as usize;
@@ -688,7 +787,30 @@ impl LitPlane<'_, '_> {
             while bits != 0 {
                 let b = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
-                let c = face_corners(self.cells, self.pad, axis, next, r, b, self.flat);
+                let front = if counts[r + 1] >> (b + 1) & 1 != 0 {
+                    raw[(r + 1) * P + b + 1]
+                } else {
+                    0
+                };
+                let c: [u64; 4] = if self.flat {
+                    [front; 4]
+                } else {
+                    // Corners (dr, db) in the slot order of `QuadLight::new`.
+                    let corners = if axis == 1 {
+                        [(0, 0), (2, 0), (0, 2), (2, 2)]
+                    } else {
+                        [(0, 0), (0, 2), (2, 0), (2, 2)]
+                    };
+                    corners.map(|(dr, db)| {
+                        let walled = op[r + dr] >> (b + 1) & 1 != 0
+                            && op[r + 1] >> (b + db) & 1 != 0;
+                        if walled {
+                            front
+                        } else {
+                            at_vertex(r + dr / 2, b + db / 2)
+                        }
+                    })
+                };
                 let uniform = c[1..].iter().all(|&v| v == c[0]);
                 // A face whose corners all take the reference of its front cell's layer
                 // goes back to the faces covered by reference, so that it merges with them
@@ -730,3 +852,4 @@ pub(crate) fn uniform(i: u16) -> QuadLight {
 
 #[cfg(test)]
 mod tests;
+
