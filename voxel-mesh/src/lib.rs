@@ -5,7 +5,8 @@
 //!   with per-vertex ambient occlusion ([`ao`]); [`Mesher::mesh_lit`] adds smooth
 //!   per-vertex light from a [`voxel_core::LightField`] ([`light`]).
 //! - [`PackedQuad`]: the 8-byte quad format the renderer expands in its vertex shader.
-//! - [`mesh_dirty`]: remesh a world's dirty chunks in parallel with rayon.
+//! - [`mesh_dirty`]: remesh a world's dirty chunks in parallel with rayon
+//!   ([`mesh_dirty_lit`] with light, and the chunks whose light changed).
 //! - [`order`]: exact back-to-front order of a chunk's translucent quads, re-sorted only
 //!   when the eye crosses a trigger plane; exact chunk order.
 //! - [`sort`]: back-to-front ordering of translucent quads and chunks for a camera.
@@ -27,7 +28,7 @@ pub use bits::greedy_rects;
 pub use mesher::{ChunkMeshes, MeshOptions, Mesher, Neighbours};
 pub use quad::{FLAG_INTERFACE, PackedQuad, Quad, UV_AXES};
 pub use voxel_core::Neighbourhood;
-pub use world::{mesh_chunks, mesh_dirty};
+pub use world::{mesh_chunks, mesh_chunks_lit, mesh_dirty, mesh_dirty_lit};
 
 use voxel_core::BlockId;
 

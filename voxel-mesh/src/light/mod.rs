@@ -416,7 +416,23 @@ impl LightScratch {
                 Some(LightLayer::Dense(d)) if open_any => {
                     let open: [u32; CHUNK_SIZE] =
                         std::array::from_fn(|z| !(opaque[py][z + 1] >> 1) as u32);
-                    let first = above.unwrap_or_else(|| pack(&d[0]));
+                    // The majority of 32 open cells spread over the layer (Boyer and Moore's
+                    // vote), else the reference above.
+                    let (mut vote, mut count) = (above.unwrap_or_else(|| pack(&d[0])), 0u32);
+                    for z in 0..CHUNK_SIZE {
+                        let x = z * 7 % CHUNK_SIZE;
+                        if open[z] >> x & 1 != 0 {
+                            let v = pack(&d[x << 5 | z]);
+                            if count == 0 {
+                                (vote, count) = (v, 1);
+                            } else if v == vote {
+                                count += 1;
+                            } else {
+                                count -= 1;
+                            }
+                        }
+                    }
+                    let first = vote;
                     let (n_open, n_odd) = odd_rows(d, &open, first, &mut inner);
                     let other = (0..CHUNK_SIZE).find(|&z| inner[z] != 0).map(|z| {
                         pack(&d[(inner[z].trailing_zeros() as usize) << 5 | z])
@@ -677,6 +693,9 @@ impl LitPlane<'_, '_> {
         mut emit: impl FnMut(usize, usize, usize, usize, u8, QuadLight),
     ) -> u32 {
         let odd = self.s.odd_plane(axis, next, self.pad);
+        if odd.iter().all(|&o| o == 0) {
+            return live;
+        }
         let mut sel = [0u32; CHUNK_SIZE];
         let (mut sel_live, mut left, mut l) = (0u32, live, live);
         while l != 0 {
@@ -760,7 +779,9 @@ impl LitPlane<'_, '_> {
                 return vertex[i];
             }
             let (m0, m1) = (counts[vr] >> vb & 3, counts[vr + 1] >> vb & 3);
-            let n = (m0.count_ones() + m1.count_ones()) as u32;
+            // Set bits of m0 | m1 << 2 (no `count_ones`: x86-64's baseline has no popcnt).
+            const ONES: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
+            let n = u32::from(ONES[(m0 | m1 << 2) as usize]);
             let v = if n == 0 {
                 0
             } else {
@@ -792,25 +813,23 @@ impl LitPlane<'_, '_> {
                 } else {
                     0
                 };
-                let c: [u64; 4] = if self.flat {
-                    [front; 4]
-                } else {
-                    // Corners (dr, db) in the slot order of `QuadLight::new`.
+                let mut c = [front; 4];
+                if !self.flat {
+                    // Corners (dr, db), 0 or 2 for -1 or +1, in the slot order of
+                    // `QuadLight::new`.
                     let corners = if axis == 1 {
                         [(0, 0), (2, 0), (0, 2), (2, 2)]
                     } else {
                         [(0, 0), (0, 2), (2, 0), (2, 2)]
                     };
-                    corners.map(|(dr, db)| {
+                    for (v, (dr, db)) in c.iter_mut().zip(corners) {
                         let walled = op[r + dr] >> (b + 1) & 1 != 0
                             && op[r + 1] >> (b + db) & 1 != 0;
-                        if walled {
-                            front
-                        } else {
-                            at_vertex(r + dr / 2, b + db / 2)
+                        if !walled {
+                            *v = at_vertex(r + dr / 2, b + db / 2);
                         }
-                    })
-                };
+                    }
+                }
                 let uniform = c[1..].iter().all(|&v| v == c[0]);
                 // A face whose corners all take the reference of its front cell's layer
                 // goes back to the faces covered by reference, so that it merges with them

@@ -533,3 +533,27 @@ fn unlit_neighbours_do_not_count_and_forms_agree() {
     let again = mesh_lit(&packed, &f, p, MeshOptions::default());
     assert_eq!(again, alone);
 }
+
+/// A torch placed with its light: `mesh_dirty_lit` remeshes the edited chunk and the
+/// neighbours its light reached, each as `mesh_lit` meshes it.
+#[test]
+fn mesh_dirty_lit_remeshes_where_light_changed() {
+    let mut w = world([0, 0, 0], [2, 0, 0]);
+    fill(&mut w, [0, 0, 0], [95, 0, 31], blocks::STONE);
+    let mut f = LightField::new(&w);
+    w.take_dirty();
+    f.take_changed();
+    // Near the border of chunks 0 and 1, out of reach of chunk 2.
+    w.set_block_lit(&mut f, pos([30, 1, 10]), light_blocks::TORCH)
+        .expect("same registry");
+    let meshes = crate::mesh_dirty_lit(&mut w, &mut f).expect("meshes");
+    let got: Vec<ChunkPos> = meshes.iter().map(|(p, _)| *p).collect();
+    assert!(got.contains(&ChunkPos::new(0, 0, 0)) && got.contains(&ChunkPos::new(1, 0, 0)));
+    for (p, m) in &meshes {
+        assert_eq!(*m, mesh_lit(&w, &f, *p, MeshOptions::default()), "{p:?}");
+        assert!(!m.light.is_empty());
+    }
+    assert!(w.dirty().is_empty() && f.take_changed().is_empty());
+    let again = crate::mesh_dirty_lit(&mut w, &mut f).expect("meshes");
+    assert!(again.is_empty(), "nothing changed since");
+}
