@@ -35,8 +35,8 @@ use block_mesh::{
 use voxel_core::Neighbourhood;
 use voxel_core::blocks::{GLASS, LEAVES, WATER};
 use voxel_core::{
-    BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Face, MaskBuffer, RenderClass,
-    LightField, TerrainConfig, TerrainGenerator, World, blocks,
+    BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Face, LightField, MaskBuffer, RenderClass,
+    TerrainConfig, TerrainGenerator, World, blocks,
 };
 use voxel_mesh::{ChunkMeshes, MeshOptions, Mesher, mesh_chunks};
 
@@ -279,15 +279,6 @@ fn lit_section(reg: &BlockRegistry, world: &World, cases: &[Case], generator: &T
         (q_lit * 8) as f64 / n
     );
 
-    if std::env::var("PROFILE_LIT").is_ok() {
-        for _ in 0..300 {
-            for c in cases {
-                let chunk = world.chunk(c.pos).expect("generated");
-                lit.mesh_lit_into(black_box(chunk), world.neighbourhood(c.pos), &light, c.pos, &mut out).expect("meshes");
-            }
-        }
-        std::process::exit(0);
-    }
     const ROUNDS: usize = 61;
     let mut times: [Vec<f64>; 2] = Default::default();
     for round in 0..ROUNDS {

@@ -23,8 +23,8 @@ pub mod sort;
 mod world;
 
 pub use ao::AO_NONE;
-pub use light::{LightStreams, PackedLight, QuadLight};
 pub use bits::greedy_rects;
+pub use light::{LightStreams, PackedLight, QuadLight};
 pub use mesher::{ChunkMeshes, MeshOptions, Mesher, Neighbours};
 pub use quad::{FLAG_INTERFACE, PackedQuad, Quad, UV_AXES};
 pub use voxel_core::Neighbourhood;

@@ -434,9 +434,9 @@ impl LightScratch {
                     }
                     let first = vote;
                     let (n_open, n_odd) = odd_rows(d, &open, first, &mut inner);
-                    let other = (0..CHUNK_SIZE).find(|&z| inner[z] != 0).map(|z| {
-                        pack(&d[(inner[z].trailing_zeros() as usize) << 5 | z])
-                    });
+                    let other = (0..CHUNK_SIZE)
+                        .find(|&z| inner[z] != 0)
+                        .map(|z| pack(&d[(inner[z].trailing_zeros() as usize) << 5 | z]));
                     match other {
                         Some(second) if 2 * n_odd > n_open => {
                             let mut again = [0u32; CHUNK_SIZE];
@@ -460,9 +460,7 @@ impl LightScratch {
                 _ => reference,
             };
             self.refs[py] = reference;
-            let same = |l: &Option<LightLayer<'_>>| {
-                matches!(l, Some(LightLayer::Uniform(v)) if pack(v) == reference)
-            };
+            let same = |l: &Option<LightLayer<'_>>| matches!(l, Some(LightLayer::Uniform(v)) if pack(v) == reference);
             if !open_any || layers.iter().all(same) {
                 continue;
             }
@@ -472,6 +470,7 @@ impl LightScratch {
                 Some(LightLayer::Dense(d)) => pack(&d[x << 5 | z]) != reference,
             };
             self.written |= 1 << py;
+            #[allow(clippy::needless_range_loop)] // pz indexes three tables and a region
             for pz in 0..P {
                 let (zr, z) = region(pz);
                 let mut bits = match layers[3 + zr] {
@@ -560,7 +559,10 @@ fn odd_rows(
     // The reference repeated over 24 bytes (four cells), as three little-endian words.
     let (p0, p1, p2) = (r | r << 48, r >> 16 | r << 32, r >> 32 | r << 16);
     let mut by_x = [0u32; CHUNK_SIZE];
-    for (column, cells) in by_x.iter_mut().zip(d.as_flattened().chunks_exact(6 * CHUNK_SIZE)) {
+    for (column, cells) in by_x
+        .iter_mut()
+        .zip(d.as_flattened().chunks_exact(6 * CHUNK_SIZE))
+    {
         let mut bits = 0u32;
         for (k, g) in cells.chunks_exact(24).enumerate() {
             let w = |i: usize| {
@@ -632,7 +634,7 @@ fn mean_lanes(s: u64, n: u32) -> u64 {
         4 => (s + 2 * ONES) >> 2 & LOW,
         _ => (0..4).fold(0, |acc, i| {
             let l = s >> (16 * i) & 0xffff;
-            acc | ((l + 1) * 21846 >> 16) << (16 * i)
+            acc | (((l + 1) * 21846) >> 16) << (16 * i)
         }),
     }
 }
@@ -748,7 +750,11 @@ impl LitPlane<'_, '_> {
             let r = l.trailing_zeros() as usize;
             l &= l - 1;
             let d = u64::from(sel[r]);
-            let w = if self.flat { d << 1 } else { d | d << 1 | d << 2 };
+            let w = if self.flat {
+                d << 1
+            } else {
+                d | d << 1 | d << 2
+            };
             let rows = if self.flat { r + 1..r + 2 } else { r..r + 3 };
             for n in &mut need[rows] {
                 *n |= w;
@@ -823,8 +829,8 @@ impl LitPlane<'_, '_> {
                         [(0, 0), (0, 2), (2, 0), (2, 2)]
                     };
                     for (v, (dr, db)) in c.iter_mut().zip(corners) {
-                        let walled = op[r + dr] >> (b + 1) & 1 != 0
-                            && op[r + 1] >> (b + db) & 1 != 0;
+                        let walled =
+                            op[r + dr] >> (b + 1) & 1 != 0 && op[r + 1] >> (b + db) & 1 != 0;
                         if !walled {
                             *v = at_vertex(r + dr / 2, b + db / 2);
                         }
@@ -849,12 +855,13 @@ impl LitPlane<'_, '_> {
                     let i = u64::from(palette.intern(c[0]));
                     i * 0x0001_0001_0001_0001
                 } else {
-                    c.iter()
-                        .enumerate()
-                        .fold(0, |acc, (j, &v)| acc | u64::from(palette.intern(v)) << (16 * j))
+                    c.iter().enumerate().fold(0, |acc, (j, &v)| {
+                        acc | u64::from(palette.intern(v)) << (16 * j)
+                    })
                 };
                 keys[r * CHUNK_SIZE + b] = k;
-                aos[r * CHUNK_SIZE + b] = occ.map_or(crate::AO_NONE, |o| crate::ao::face_ao(o, axis, r, b));
+                aos[r * CHUNK_SIZE + b] =
+                    occ.map_or(crate::AO_NONE, |o| crate::ao::face_ao(o, axis, r, b));
             }
         }
         let sel_live = crate::bits::live_rows(&sel);
@@ -871,4 +878,3 @@ pub(crate) fn uniform(i: u16) -> QuadLight {
 
 #[cfg(test)]
 mod tests;
-

@@ -2,6 +2,9 @@
 //! (fixed scenes and random ones), and the scenes a player checks: a torch's falloff, a
 //! wall that keeps a room dark, chunk borders without seams, light through green glass.
 
+// Corners and channels of parallel arrays (reference and mesh) are compared by index.
+#![allow(clippy::needless_range_loop)]
+
 use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 
@@ -86,8 +89,7 @@ fn reference(w: &World, f: &LightField, p: [i32; 3], face: Face) -> [[u16; 6]; 4
         let s1 = add(front, unit(ua, su));
         let s2 = add(front, unit(va, sv));
         let diag = add(s1, unit(va, sv));
-        let walled =
-            class(w, s1) == RenderClass::Opaque && class(w, s2) == RenderClass::Opaque;
+        let walled = class(w, s1) == RenderClass::Opaque && class(w, s2) == RenderClass::Opaque;
         let mut cells = vec![front, s1, s2];
         if !walled {
             cells.push(diag);
@@ -200,7 +202,10 @@ fn check_against_reference(
         let faces = lit_faces(&lit, p);
         let want = unlit_faces(&unlit, p);
         let got: BTreeMap<_, _> = faces.iter().map(|(k, (_, _, ao))| (*k, *ao)).collect();
-        assert_eq!(got, want, "lit faces and AO of chunk {p:?} are the unlit ones");
+        assert_eq!(
+            got, want,
+            "lit faces and AO of chunk {p:?} are the unlit ones"
+        );
         for ((bp, face), (corners, area, _)) in &faces {
             let face = Face::from_index(*face).expect("face");
             let r = reference(w, f, *bp, face);
@@ -241,7 +246,10 @@ fn a_torch_falls_off_smoothly_across_the_floor() {
     assert_eq!(red[red.len() - 1], 0.0, "dark out of reach: {red:?}");
     for pair in red.windows(2) {
         assert!(pair[1] <= pair[0], "falls off: {red:?}");
-        assert!(pair[0] - pair[1] <= 16.0, "no step above the falloff: {red:?}");
+        assert!(
+            pair[0] - pair[1] <= 16.0,
+            "no step above the falloff: {red:?}"
+        );
     }
     // Smooth: the vertex between two cells takes levels between theirs, not only the
     // levels of the cells (which step by 16 a block).
@@ -516,7 +524,8 @@ fn unlit_neighbours_do_not_count_and_forms_agree() {
         .expect("loaded");
     let mut f = LightField::new(&w);
     let full = mesh_lit(&w, &f, ChunkPos::new(0, 0, 0), MeshOptions::default());
-    f.remove_chunk(&w, ChunkPos::new(1, 0, 0)).expect("same registry");
+    f.remove_chunk(&w, ChunkPos::new(1, 0, 0))
+        .expect("same registry");
     // The reference reads unlit cells as not counted too.
     let alone = mesh_lit(&w, &f, ChunkPos::new(0, 0, 0), MeshOptions::default());
     let p = ChunkPos::new(0, 0, 0);
@@ -524,10 +533,17 @@ fn unlit_neighbours_do_not_count_and_forms_agree() {
     for ((bp, face), e) in &faces {
         let r = reference(&w, &f, *bp, Face::from_index(*face).expect("face"));
         for k in 0..4 {
-            assert_eq!(e.0[k], r[k].map(|v| i64::from(v) * e.1), "{bp:?} {face} {k}");
+            assert_eq!(
+                e.0[k],
+                r[k].map(|v| i64::from(v) * e.1),
+                "{bp:?} {face} {k}"
+            );
         }
     }
-    assert_ne!(full.light, alone.light, "the border reads the neighbour's light");
+    assert_ne!(
+        full.light, alone.light,
+        "the border reads the neighbour's light"
+    );
     let mut packed = w.clone();
     packed.pack_all();
     let again = mesh_lit(&packed, &f, p, MeshOptions::default());

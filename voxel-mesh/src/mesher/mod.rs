@@ -219,7 +219,9 @@ fn emit_plane(
     if sink.lit.is_some() {
         emit_plane_lit(rows, live, face, layer, block, flags, sink);
     } else {
-        emit_ao(rows, live, face, layer, block, flags, sink.out, None, sink.ao);
+        emit_ao(
+            rows, live, face, layer, block, flags, sink.out, None, sink.ao,
+        );
     }
 }
 
@@ -286,7 +288,17 @@ fn emit_plane_lit(
     }
     if axis == 1 {
         let l = crate::light::uniform(lp.s.reference(next));
-        emit_ao(rows, live, face, layer, block, flags, out, Some((lout, l)), *ao);
+        emit_ao(
+            rows,
+            live,
+            face,
+            layer,
+            block,
+            flags,
+            out,
+            Some((lout, l)),
+            *ao,
+        );
         return;
     }
     // The front cells of x and z faces are at their own y: bits y of an x plane, rows y
@@ -306,7 +318,17 @@ fn emit_plane_lit(
         let sub_live = live_rows(&sub) & live;
         if sub_live != 0 {
             let l = crate::light::uniform(lp.s.reference(y + 1));
-            emit_ao(&mut sub, sub_live, face, layer, block, flags, out, Some((lout, l)), *ao);
+            emit_ao(
+                &mut sub,
+                sub_live,
+                face,
+                layer,
+                block,
+                flags,
+                out,
+                Some((lout, l)),
+                *ao,
+            );
         }
         y = end;
     }
@@ -695,9 +717,9 @@ impl Mesher {
                 ao: occludes.then_some(&**pad),
                 lit: lit.map(|cells| {
                     let plane = LitPlane {
-                        s: &mut **light,
+                        s: light,
                         cells,
-                        pad: &**pad,
+                        pad,
                         flat: class == RenderClass::Translucent,
                     };
                     (lights, plane)
