@@ -341,6 +341,39 @@ fn lit_section(reg: &BlockRegistry, world: &World, cases: &[Case], generator: &T
         bytes as f64 / (1 << 20) as f64,
         quad_bytes as f64 / (1 << 20) as f64
     );
+    // The same world's chunks timed, one thread, interleaved rounds.
+    let all: Vec<ChunkPos> = terrain.iter().map(|(p, _)| p).collect();
+    const WORLD_ROUNDS: usize = 7;
+    let mut times: [Vec<f64>; 2] = Default::default();
+    for round in 0..WORLD_ROUNDS {
+        for k in 0..2 {
+            let method = (round + k) % 2;
+            let t = Instant::now();
+            for &p in &all {
+                let chunk = terrain.chunk(p).expect("generated");
+                if method == 0 {
+                    ours.mesh_into(black_box(chunk), terrain.neighbourhood(p), &mut out)
+                        .expect("known blocks");
+                } else {
+                    lit.mesh_lit_into(
+                        black_box(chunk),
+                        terrain.neighbourhood(p),
+                        &light,
+                        p,
+                        &mut out,
+                    )
+                    .expect("meshes");
+                }
+                black_box(&out);
+            }
+            times[method].push(secs(t.elapsed()) / all.len() as f64);
+        }
+    }
+    let [w_ao, w_lit] = times.map(|t| median(t) * 1e6);
+    println!(
+        "the terrain world's chunks, µs per chunk (median of {WORLD_ROUNDS} interleaved rounds): with AO {w_ao:.1}, lit {w_lit:.1}, ratio {:.3}",
+        w_lit / w_ao
+    );
 }
 
 fn mesher_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[Case]) {
