@@ -331,14 +331,12 @@ impl<'a> LitCells<'a> {
     }
 }
 
-/// Per plane of faces: the cells in front of its faces with an odd cell in front (levels,
-/// and spread into 16-bit lanes: channels 0 to 3, then 4 and 5), by `row * 34 + bit`
-/// (padded), and the light of its vertices, by `row * 34 + bit` (rows and bits 0..33).
+/// Per plane of faces: the levels of the cells in front of its faces with an odd cell in
+/// front, by `row * 34 + bit` (padded), and the light of its vertices, by `row * 34 + bit`
+/// (rows and bits 0..33).
 #[derive(Clone)]
 struct Plane {
     raw: [u64; P * P],
-    lo: [u64; P * P],
-    hi: [u64; P * P],
     vertex: [u64; P * P],
     /// Bit `vb` of row `vr`: `vertex` holds that vertex.
     vertex_ok: [u64; P],
@@ -380,8 +378,6 @@ impl LightScratch {
             aos: Box::new([0; CHUNK_SIZE * CHUNK_SIZE]),
             plane: Box::new(Plane {
                 raw: [0; P * P],
-                lo: [0; P * P],
-                hi: [0; P * P],
                 vertex: [0; P * P],
                 vertex_ok: [0; P],
             }),
@@ -732,8 +728,6 @@ impl LitPlane<'_, '_> {
         } = &mut *self.s;
         let Plane {
             raw,
-            lo,
-            hi,
             vertex,
             vertex_ok,
         } = &mut **plane;
@@ -770,8 +764,6 @@ impl LitPlane<'_, '_> {
                 if let Some(v) = self.cells.get(px, py, pz) {
                     let i = pr * P + pb;
                     raw[i] = v;
-                    lo[i] = lanes(v & 0xffff_ffff);
-                    hi[i] = lanes(v >> 32);
                     counts[pr] |= 1 << pb;
                 }
             }
@@ -795,8 +787,9 @@ impl LitPlane<'_, '_> {
                 for (row, m) in [(vr, m0), (vr + 1, m1)] {
                     for k in 0..2 {
                         if m >> k & 1 != 0 {
-                            sl += lo[row * P + vb + k];
-                            sh += hi[row * P + vb + k];
+                            let v = raw[row * P + vb + k];
+                            sl += lanes(v & 0xffff_ffff);
+                            sh += lanes(v >> 32);
                         }
                     }
                 }
