@@ -511,6 +511,17 @@ fn random_scenes_match_the_per_face_reference() {
         ] {
             check_against_reference(&w, &f, options);
         }
+        // Packed chunks mesh alike.
+        let mut packed = w.clone();
+        packed.pack_all();
+        for (p, _) in w.iter() {
+            let options = MeshOptions::default();
+            assert_eq!(
+                mesh_lit(&packed, &f, p, options),
+                mesh_lit(&w, &f, p, options),
+                "{p:?}"
+            );
+        }
     }
 }
 
