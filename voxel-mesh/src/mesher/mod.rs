@@ -303,6 +303,12 @@ fn emit_plane_lit(
     }
     // The front cells of x and z faces are at their own y: bits y of an x plane, rows y
     // of a z plane.
+    // The y that hold faces: bits of any row of an x plane, the live rows of a z plane.
+    let ys = if axis == 0 {
+        rows.iter().fold(0, |acc, &r| acc | r)
+    } else {
+        live
+    };
     let mut y = 0;
     while y < CHUNK_SIZE {
         let mut end = y + 1;
@@ -310,6 +316,26 @@ fn emit_plane_lit(
             end += 1;
         }
         let run = (u32::MAX >> (CHUNK_SIZE - (end - y))) << y;
+        if ys & run == 0 {
+            y = end;
+            continue;
+        }
+        if ys & !run == 0 {
+            // One reference for every face of the plane.
+            let l = crate::light::uniform(lp.s.reference(y + 1));
+            emit_ao(
+                rows,
+                live,
+                face,
+                layer,
+                block,
+                flags,
+                out,
+                Some((lout, l)),
+                *ao,
+            );
+            return;
+        }
         let mut sub: Plane = if axis == 0 {
             std::array::from_fn(|r| rows[r] & run)
         } else {
