@@ -16,6 +16,11 @@
 //! centre's masks into its scratch memory and reads the neighbours' touching layers from
 //! their bit planes). The storage section reports the memory of both forms against a
 //! packed-index palette, and the cost of converting between them.
+//!
+//! The lit section times the lit mesher (`Mesher::mesh_lit`, smooth light per vertex from
+//! a `LightField`) against ours with AO on the same chunks in the same interleaved rounds,
+//! and counts what light costs in quads and stream bytes. `cargo bench -p voxel-mesh
+//! --bench mesher -- lit` runs that section alone.
 
 use std::collections::BTreeSet;
 use std::hint::black_box;
@@ -30,7 +35,7 @@ use block_mesh::{
 use voxel_core::Neighbourhood;
 use voxel_core::blocks::{GLASS, LEAVES, WATER};
 use voxel_core::{
-    BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Face, MaskBuffer, RenderClass,
+    BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Face, LightField, MaskBuffer, RenderClass,
     TerrainConfig, TerrainGenerator, World, blocks,
 };
 use voxel_mesh::{ChunkMeshes, MeshOptions, Mesher, mesh_chunks};
@@ -212,10 +217,163 @@ fn main() {
         has(GLASS) > 0 && has(LEAVES) > 0,
         "bench chunks must hold glass and leaves"
     );
+    if std::env::args().skip(1).any(|a| a == "lit") {
+        lit_section(&reg, &world, &cases, &generator);
+        return;
+    }
     let mut packed = world.clone();
     packed.pack_all();
     mesher_section(&reg, &world, &packed, &cases);
+    lit_section(&reg, &world, &cases, &generator);
     storage_and_terrain_section(&reg, &generator);
+}
+
+/// The lit mesher against ours with AO (the same options, ambient occlusion on) on the
+/// bench chunks, lit by one `LightField` over the chunks and their neighbours, in
+/// interleaved rounds; then quads with and without light on a terrain world.
+fn lit_section(reg: &BlockRegistry, world: &World, cases: &[Case], generator: &TerrainGenerator) {
+    let t = Instant::now();
+    let light = LightField::new(world);
+    let light_s = secs(t.elapsed());
+    let mut ours = Mesher::new(reg);
+    let mut lit = Mesher::new(reg);
+    let mut out = ChunkMeshes::default();
+    let n = cases.len() as f64;
+    let (mut q_plain, mut q_lit, mut split, mut bytes, mut palette, mut palette_max) =
+        (0, 0, [0; 3], 0, 0, 0);
+    for c in cases {
+        let chunk = world.chunk(c.pos).expect("generated");
+        ours.mesh_into(chunk, world.neighbourhood(c.pos), &mut out)
+            .expect("known blocks");
+        q_plain += out.len();
+        lit.mesh_lit_into(chunk, world.neighbourhood(c.pos), &light, c.pos, &mut out)
+            .expect("meshes");
+        q_lit += out.len();
+        split[0] += out.opaque.len();
+        split[1] += out.cutout.len();
+        split[2] += out.translucent.len();
+        bytes += out.light.bytes();
+        palette += out.light.palette.len();
+        palette_max = palette_max.max(out.light.palette.len());
+    }
+    println!(
+        "\n## lit mesher ({} chunks lit by LightField::new over {} chunks in {:.0} ms, one thread)",
+        cases.len(),
+        world.len(),
+        light_s * 1e3
+    );
+    println!(
+        "quads per chunk: with AO {:.0}, lit {:.0} (opaque {:.0} / cutout {:.0} / translucent {:.0}) = {:.3}x",
+        q_plain as f64 / n,
+        q_lit as f64 / n,
+        split[0] as f64 / n,
+        split[1] as f64 / n,
+        split[2] as f64 / n,
+        q_lit as f64 / q_plain as f64
+    );
+    println!(
+        "light streams per chunk: {:.0} bytes ({:.2} bytes a quad: 8 a quad + 8 a palette entry; palette mean {:.1}, max {palette_max} entries); quads {:.0} bytes",
+        bytes as f64 / n,
+        bytes as f64 / q_lit as f64,
+        palette as f64 / n,
+        (q_lit * 8) as f64 / n
+    );
+
+    const ROUNDS: usize = 61;
+    let mut times: [Vec<f64>; 2] = Default::default();
+    for round in 0..ROUNDS {
+        for k in 0..2 {
+            let method = (round + k) % 2;
+            let t = Instant::now();
+            for c in cases {
+                let chunk = world.chunk(c.pos).expect("generated");
+                if method == 0 {
+                    ours.mesh_into(black_box(chunk), world.neighbourhood(c.pos), &mut out)
+                        .expect("known blocks");
+                } else {
+                    lit.mesh_lit_into(
+                        black_box(chunk),
+                        world.neighbourhood(c.pos),
+                        &light,
+                        c.pos,
+                        &mut out,
+                    )
+                    .expect("meshes");
+                }
+                black_box(&out);
+            }
+            times[method].push(secs(t.elapsed()) / n);
+        }
+    }
+    let [t_ao, t_lit] = times.map(|t| median(t) * 1e6);
+    println!("µs per chunk, median of {ROUNDS} interleaved rounds:");
+    println!("ours with AO                                          {t_ao:9.1}");
+    println!("lit (AO and smooth light, light streams)              {t_lit:9.1}");
+    println!(
+        "ratio lit / ours with AO = {:.3} (target <= 1.3)",
+        t_lit / t_ao
+    );
+
+    // A terrain world: what light costs in quads.
+    let registry = Arc::new(reg.clone());
+    let terrain = generator
+        .generate_world(registry, ChunkPos::new(-8, 0, -8), ChunkPos::new(7, 1, 7))
+        .expect("valid world");
+    let t = Instant::now();
+    let light = LightField::new(&terrain);
+    let light_s = secs(t.elapsed());
+    let (mut plain, mut with, mut bytes, mut quad_bytes) = (0, 0, 0, 0);
+    for (p, chunk) in terrain.iter() {
+        ours.mesh_into(chunk, terrain.neighbourhood(p), &mut out)
+            .expect("known blocks");
+        plain += out.len();
+        lit.mesh_lit_into(chunk, terrain.neighbourhood(p), &light, p, &mut out)
+            .expect("meshes");
+        with += out.len();
+        bytes += out.light.bytes();
+        quad_bytes += out.len() * std::mem::size_of::<voxel_mesh::PackedQuad>();
+    }
+    println!(
+        "terrain world of {} chunks (lit in {:.0} ms, one thread): quads lit / with AO = {with} / {plain} = {:.3}; light streams {:.2} MiB beside {:.2} MiB of quads",
+        terrain.len(),
+        light_s * 1e3,
+        with as f64 / plain as f64,
+        bytes as f64 / (1 << 20) as f64,
+        quad_bytes as f64 / (1 << 20) as f64
+    );
+    // The same world's chunks timed, one thread, interleaved rounds.
+    let all: Vec<ChunkPos> = terrain.iter().map(|(p, _)| p).collect();
+    const WORLD_ROUNDS: usize = 7;
+    let mut times: [Vec<f64>; 2] = Default::default();
+    for round in 0..WORLD_ROUNDS {
+        for k in 0..2 {
+            let method = (round + k) % 2;
+            let t = Instant::now();
+            for &p in &all {
+                let chunk = terrain.chunk(p).expect("generated");
+                if method == 0 {
+                    ours.mesh_into(black_box(chunk), terrain.neighbourhood(p), &mut out)
+                        .expect("known blocks");
+                } else {
+                    lit.mesh_lit_into(
+                        black_box(chunk),
+                        terrain.neighbourhood(p),
+                        &light,
+                        p,
+                        &mut out,
+                    )
+                    .expect("meshes");
+                }
+                black_box(&out);
+            }
+            times[method].push(secs(t.elapsed()) / all.len() as f64);
+        }
+    }
+    let [w_ao, w_lit] = times.map(|t| median(t) * 1e6);
+    println!(
+        "the terrain world's chunks, µs per chunk (median of {WORLD_ROUNDS} interleaved rounds): with AO {w_ao:.1}, lit {w_lit:.1}, ratio {:.3}",
+        w_lit / w_ao
+    );
 }
 
 fn mesher_section(reg: &BlockRegistry, world: &World, packed: &World, cases: &[Case]) {

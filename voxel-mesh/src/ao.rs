@@ -190,6 +190,18 @@ impl Pad {
         }
     }
 
+    /// Rows along x: bit `x + 1` of `[y + 1][z + 1]`.
+    #[inline]
+    pub(crate) fn rows_x(&self) -> &[[u64; P]; P] {
+        &self.by_x
+    }
+
+    /// Columns along y: bit `y + 1` of `[x + 1][z + 1]`.
+    #[inline]
+    pub(crate) fn columns_y(&self) -> &[[u64; P]; P] {
+        &self.by_y
+    }
+
     /// The occluders in front of the faces of layer `layer` of `face` (the layer one step
     /// along the normal, possibly in a neighbour), or `None` when there are none.
     #[inline]
@@ -365,6 +377,14 @@ pub(crate) fn cover_occluded(
         }
     }
     remaining
+}
+
+/// The AO byte of the face at row `r`, bit `b` of a plane with occluders `occ` (normal
+/// `axis`): what [`cover_occluded`] gives it.
+#[inline]
+pub(crate) fn face_ao(occ: &Occluders, axis: usize, r: usize, b: usize) -> u8 {
+    let (up, mid, down) = (occ[r] >> b & 7, occ[r + 1] >> b & 7, occ[r + 2] >> b & 7);
+    AO_TABLES[usize::from(axis == 1)][(up | mid << 3 | down << 6) as usize]
 }
 
 /// The AO value (0 to 3) of corner `(u, v)` (each 0 or 1) of an AO byte.

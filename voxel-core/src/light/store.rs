@@ -35,6 +35,17 @@ impl Light {
     }
 }
 
+/// One layer (the 32 × 32 cells of one y) of a [`LightChunk`], as stored: what a reader
+/// that visits many cells (the lit mesher) uses to skip per-cell work where a layer is
+/// uniform.
+#[derive(Clone, Copy, Debug)]
+pub enum LightLayer<'a> {
+    /// Every cell of the layer holds these levels (sky R, G, B, block R, G, B).
+    Uniform([u8; 6]),
+    /// The levels of each cell, indexed by `x << 5 | z`.
+    Dense(&'a [[u8; 6]; CHUNK_AREA]),
+}
+
 #[derive(Clone, Debug)]
 enum Layer {
     Uniform(Levels),
@@ -76,6 +87,15 @@ impl LightChunk {
     pub fn get(&self, x: usize, y: usize, z: usize) -> Option<Light> {
         (x < CHUNK_SIZE && y < CHUNK_SIZE && z < CHUNK_SIZE)
             .then(|| Light::from_levels(self.levels(local(x, y, z))))
+    }
+
+    /// Layer `y` (below 32) as stored: uniform levels, or one entry per cell.
+    #[inline]
+    pub fn layer(&self, y: usize) -> LightLayer<'_> {
+        match &self.layers[y] {
+            Layer::Uniform(v) => LightLayer::Uniform(*v),
+            Layer::Dense(d) => LightLayer::Dense(d),
+        }
     }
 
     #[inline]

@@ -52,12 +52,13 @@
 //! depth peeling are per pixel and do not care.
 
 use voxel_core::{
-    BlockId, BlockRegistry, CHUNK_AREA, CHUNK_SIZE, Chunk, ColumnMask, Face, LayerMask, MaskBuffer,
-    Neighbourhood, Occupancy, RenderClass, row_index,
+    BlockId, BlockRegistry, CHUNK_AREA, CHUNK_SIZE, Chunk, ChunkPos, ColumnMask, Face, LayerMask,
+    LightField, MaskBuffer, Neighbourhood, Occupancy, RenderClass, row_index,
 };
 
 use crate::ao::{AO_NONE, Pad, cover_occluded};
 use crate::bits::{greedy_rects_live, live_rows};
+use crate::light::{LightScratch, LightStreams, LitCells, LitPlane, QuadLight};
 use crate::{Error, PackedQuad, Result};
 
 /// The quads of one chunk, split by the pass that draws them.
@@ -69,6 +70,9 @@ pub struct ChunkMeshes {
     pub cutout: Vec<PackedQuad>,
     /// Blended faces (water, glass), drawn by the transparency technique.
     pub translucent: Vec<PackedQuad>,
+    /// The corner light of each quad of the three meshes ([`Mesher::mesh_lit`]); empty when
+    /// meshed without light.
+    pub light: LightStreams,
 }
 
 impl ChunkMeshes {
@@ -87,13 +91,15 @@ impl ChunkMeshes {
         self.opaque.clear();
         self.cutout.clear();
         self.translucent.clear();
+        self.light.clear();
     }
 
-    fn for_class(&mut self, class: RenderClass) -> &mut Vec<PackedQuad> {
+    /// The mesh of `class` and its light stream.
+    fn for_class(&mut self, class: RenderClass) -> (&mut Vec<PackedQuad>, &mut Vec<QuadLight>) {
         match class {
-            RenderClass::Cutout => &mut self.cutout,
-            RenderClass::Translucent => &mut self.translucent,
-            RenderClass::Opaque | RenderClass::Air => &mut self.opaque,
+            RenderClass::Cutout => (&mut self.cutout, &mut self.light.cutout),
+            RenderClass::Translucent => (&mut self.translucent, &mut self.light.translucent),
+            RenderClass::Opaque | RenderClass::Air => (&mut self.opaque, &mut self.light.opaque),
         }
     }
 }
@@ -165,6 +171,8 @@ pub struct Mesher {
     pad: Box<Pad>,
     /// An edge neighbour's touching layer, per type.
     edge_layers: Vec<(BlockId, LayerMask)>,
+    /// Light of the chunk and the shell around it, for the lit mesher.
+    light: Box<LightScratch>,
 }
 
 /// Where a plane's faces go: the mesh, and (with ambient occlusion) the occluders of the
@@ -172,6 +180,8 @@ pub struct Mesher {
 struct Sink<'a> {
     out: &'a mut Vec<PackedQuad>,
     ao: Option<&'a Pad>,
+    /// When meshing with light: the mesh's light stream and what the corner light needs.
+    lit: Option<(&'a mut Vec<QuadLight>, LitPlane<'a, 'a>)>,
 }
 
 impl std::fmt::Debug for Mesher {
@@ -199,21 +209,154 @@ fn or_into(dst: &mut [u32], src: &[u32]) {
 #[inline]
 fn emit_plane(
     rows: &mut Plane,
-    mut live: u32,
+    live: u32,
     face: Face,
     layer: usize,
     block: BlockId,
     flags: u32,
     sink: &mut Sink<'_>,
 ) {
-    if let Some(occ) = sink.ao.and_then(|pad| pad.occluders(face, layer)) {
-        let out = &mut *sink.out;
+    if sink.lit.is_some() {
+        emit_plane_lit(rows, live, face, layer, block, flags, sink);
+    } else {
+        emit_ao(
+            rows, live, face, layer, block, flags, sink.out, None, sink.ao,
+        );
+    }
+}
+
+/// [`emit_plane`] without light, or with the same light entry (`light`) for every quad.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn emit_ao(
+    rows: &mut Plane,
+    mut live: u32,
+    face: Face,
+    layer: usize,
+    block: BlockId,
+    flags: u32,
+    out: &mut Vec<PackedQuad>,
+    mut light: Option<(&mut Vec<QuadLight>, QuadLight)>,
+    ao: Option<&Pad>,
+) {
+    if let Some(occ) = ao.and_then(|pad| pad.occluders(face, layer)) {
         live = cover_occluded(rows, live, occ, face.axis(), |r, h, b, w, ao| {
             out.push(quad(face, layer, r, h, b, w, block, flags, ao));
+            if let Some((l, e)) = &mut light {
+                l.push(*e);
+            }
         });
     }
     if live != 0 {
-        cover(rows, live, face, layer, block, flags, AO_NONE, sink.out);
+        greedy_rects_live(rows, live, |r, h, b, w| {
+            out.push(quad(face, layer, r, h, b, w, block, flags, AO_NONE));
+            if let Some((l, e)) = &mut light {
+                l.push(*e);
+            }
+        });
+    }
+}
+
+/// [`emit_plane`] with light: faces with an odd cell in front of them are covered by
+/// their own corner lights ([`LitPlane::emit_odd`]), the others take their layer's
+/// reference at every corner and are covered as without light, a run of layers of one
+/// reference at a time.
+#[inline]
+fn emit_plane_lit(
+    rows: &mut Plane,
+    live: u32,
+    face: Face,
+    layer: usize,
+    block: BlockId,
+    flags: u32,
+    sink: &mut Sink<'_>,
+) {
+    let Sink { out, ao, lit } = sink;
+    let Some((lout, lp)) = lit.as_mut() else {
+        return;
+    };
+    let axis = face.axis();
+    // Padded index of the layer in front: layer + 1 ± 1.
+    let next = if face.is_positive() { layer + 2 } else { layer };
+    let occ = ao.and_then(|pad| pad.occluders(face, layer));
+    let live = lp.emit_odd(rows, live, axis, next, occ, |r, h, b, w, a, l| {
+        out.push(quad(face, layer, r, h, b, w, block, flags, a));
+        lout.push(l);
+    });
+    if live == 0 {
+        return;
+    }
+    if axis == 1 {
+        let l = crate::light::uniform(lp.s.reference(next));
+        emit_ao(
+            rows,
+            live,
+            face,
+            layer,
+            block,
+            flags,
+            out,
+            Some((lout, l)),
+            *ao,
+        );
+        return;
+    }
+    // The front cells of x and z faces are at their own y: bits y of an x plane, rows y
+    // of a z plane.
+    // The y that hold faces: bits of any row of an x plane, the live rows of a z plane.
+    let ys = if axis == 0 {
+        rows.iter().fold(0, |acc, &r| acc | r)
+    } else {
+        live
+    };
+    let mut y = 0;
+    while y < CHUNK_SIZE {
+        let mut end = y + 1;
+        while end < CHUNK_SIZE && lp.s.same_reference(end + 1, y + 1) {
+            end += 1;
+        }
+        let run = (u32::MAX >> (CHUNK_SIZE - (end - y))) << y;
+        if ys & run == 0 {
+            y = end;
+            continue;
+        }
+        if ys & !run == 0 {
+            // One reference for every face of the plane.
+            let l = crate::light::uniform(lp.s.reference(y + 1));
+            emit_ao(
+                rows,
+                live,
+                face,
+                layer,
+                block,
+                flags,
+                out,
+                Some((lout, l)),
+                *ao,
+            );
+            return;
+        }
+        let mut sub: Plane = if axis == 0 {
+            std::array::from_fn(|r| rows[r] & run)
+        } else {
+            std::array::from_fn(|r| if run >> r & 1 != 0 { rows[r] } else { 0 })
+        };
+        let sub_live = live_rows(&sub) & live;
+        if sub_live != 0 {
+            let l = crate::light::uniform(lp.s.reference(y + 1));
+            emit_ao(
+                &mut sub,
+                sub_live,
+                face,
+                layer,
+                block,
+                flags,
+                out,
+                Some((lout, l)),
+                *ao,
+            );
+        }
+        y = end;
     }
 }
 
@@ -249,25 +392,6 @@ fn quad(
         _ => PackedQuad::new([b, r, layer], w, h, face, block),
     };
     q.with_flags(flags).with_ao(ao)
-}
-
-/// Covers the faces in `rows` (whose rows holding any are `live`) with rectangles, emitted
-/// as quads.
-#[inline]
-#[allow(clippy::too_many_arguments)]
-fn cover(
-    rows: &mut Plane,
-    live: u32,
-    face: Face,
-    layer: usize,
-    block: BlockId,
-    flags: u32,
-    ao: u8,
-    out: &mut Vec<PackedQuad>,
-) {
-    greedy_rects_live(rows, live, |r, h, b, w| {
-        out.push(quad(face, layer, r, h, b, w, block, flags, ao));
-    });
 }
 
 /// Emits the faces in `rows` (a plane holding some): those whose neighbour is set in the
@@ -325,6 +449,7 @@ impl Mesher {
             options,
             pad: Pad::new(),
             edge_layers: Vec::new(),
+            light: LightScratch::new(),
             s: Box::new(Scratch {
                 opaque: EMPTY_OCCUPANCY,
                 hide: EMPTY_OCCUPANCY,
@@ -373,7 +498,47 @@ impl Mesher {
         neighbours: impl Into<Neighbourhood<'n>>,
         out: &mut ChunkMeshes,
     ) -> Result<()> {
-        let neighbourhood: Neighbourhood<'n> = neighbours.into();
+        self.mesh_impl(chunk, neighbours.into(), None, out)
+    }
+
+    /// Meshes `chunk`, the chunk at `pos`, with the light of `light`: the quads of
+    /// [`Mesher::mesh`] (merged only where their corner lights agree too) and the corner
+    /// light of each ([`ChunkMeshes::light`]; see [`crate::light`]). Light across the
+    /// chunk's borders is read from the neighbour chunks' light, so two chunks give a
+    /// vertex on their shared border the same light; cells of chunks `light` has not lit
+    /// do not count. Fails as [`Mesher::mesh`] does, or with [`Error::LightPalette`].
+    pub fn mesh_lit<'n>(
+        &mut self,
+        chunk: &Chunk,
+        neighbours: impl Into<Neighbourhood<'n>>,
+        light: &LightField,
+        pos: ChunkPos,
+    ) -> Result<ChunkMeshes> {
+        let mut out = ChunkMeshes::default();
+        self.mesh_lit_into(chunk, neighbours, light, pos, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Mesher::mesh_lit`] into `out`, reusing its allocations.
+    pub fn mesh_lit_into<'n>(
+        &mut self,
+        chunk: &Chunk,
+        neighbours: impl Into<Neighbourhood<'n>>,
+        light: &LightField,
+        pos: ChunkPos,
+        out: &mut ChunkMeshes,
+    ) -> Result<()> {
+        let cells = LitCells::new(light, pos);
+        self.mesh_impl(chunk, neighbours.into(), Some(&cells), out)
+    }
+
+    fn mesh_impl<'n>(
+        &mut self,
+        chunk: &Chunk,
+        neighbourhood: Neighbourhood<'n>,
+        lit: Option<&LitCells<'_>>,
+        out: &mut ChunkMeshes,
+    ) -> Result<()> {
         out.clear();
         let around = Neighbourhood::OFFSETS
             .iter()
@@ -395,6 +560,7 @@ impl Mesher {
             built,
             pad,
             edge_layers,
+            light,
         } = self;
         let classes = &*classes;
         let s = &mut **s;
@@ -489,9 +655,11 @@ impl Mesher {
             // any cutout or translucent block (uniform leaves included) is meshed below.
             return Ok(());
         }
-        if options.ambient_occlusion {
-            // Nothing opaque anywhere around: no face is occluded, no shell to fill.
-            let any_opaque = s.opaque.by_y.iter().any(|&r| r != 0)
+        if options.ambient_occlusion || lit.is_some() {
+            // Nothing opaque anywhere around: no face is occluded, no shell to fill (light
+            // reads the shell's opaque cells: it is always filled).
+            let any_opaque = lit.is_some()
+                || s.opaque.by_y.iter().any(|&r| r != 0)
                 || s.nb_opaque.iter().flatten().any(|&r| r != 0)
                 || Neighbourhood::OFFSETS[6..].iter().any(|&d| {
                     neighbourhood
@@ -509,6 +677,9 @@ impl Mesher {
             } else {
                 pad.clear();
             }
+        }
+        if let Some(cells) = lit {
+            light.build(cells, pad);
         }
 
         // The media that blocks of this chunk stand in: their cells hold the medium too.
@@ -566,9 +737,19 @@ impl Mesher {
             });
             let occludes = options.ambient_occlusion
                 && (class != RenderClass::Translucent || options.translucent_occlusion);
+            let (quads, lights) = out.for_class(class);
             let mut sink = Sink {
-                out: out.for_class(class),
+                out: quads,
                 ao: occludes.then_some(&**pad),
+                lit: lit.map(|cells| {
+                    let plane = LitPlane {
+                        s: light,
+                        cells,
+                        pad,
+                        flat: class == RenderClass::Translucent,
+                    };
+                    (lights, plane)
+                }),
             };
             if uniform {
                 // One block type everywhere. An opaque or translucent type hides itself, so
@@ -585,7 +766,7 @@ impl Mesher {
                         for l in (0..CHUNK_SIZE).filter(|&l| l != border) {
                             let shaded =
                                 sink.ao.is_some_and(|pad| pad.occluders(face, l).is_some());
-                            if shaded {
+                            if shaded || sink.lit.is_some() {
                                 let mut all = [u32::MAX; CHUNK_SIZE];
                                 emit_plane(&mut all, u32::MAX, face, l, id, 0, &mut sink);
                             } else {
@@ -622,6 +803,13 @@ impl Mesher {
                 pool(p, m, None);
                 mesh_one(m, p, false);
             }
+        }
+        if lit.is_some() {
+            if light.palette.overflow {
+                out.clear();
+                return Err(Error::LightPalette);
+            }
+            light.palette.write(&mut out.light.palette);
         }
         Ok(())
     }
