@@ -1,6 +1,6 @@
 //! World, fly camera (WASD, Space/Shift, arrows turn), a turning glass box, glowing sparks and
 //! a Bevy cube; T cycles techniques, N day/night. `cargo run -p voxel-bevy --example game`
-use bevy::prelude::*;
+use bevy::{camera::Exposure, prelude::*};
 use voxel_bevy::voxel_render::Lighting;
 use voxel_bevy::*;
 
@@ -22,12 +22,13 @@ pub type Assets3d<'a> = (
 );
 
 pub fn setup(mut cmd: Commands, (mut mesh, mut mat): Assets3d) {
-    let eye = Transform::from_xyz(0.0, 40.0, 30.0);
+    let eye = (Transform::from_xyz(0.0, 40.0, 30.0), Exposure::OVERCAST);
     cmd.spawn((Camera3d::default(), VoxelCamera, eye));
     let cube = Mesh3d(mesh.add(Cuboid::from_length(2.0)));
     let red = MeshMaterial3d(mat.add(Color::srgb(0.8, 0.3, 0.2)));
     cmd.spawn((cube, red, Transform::from_xyz(4.0, 34.0, 0.0)));
-    cmd.spawn(DirectionalLight::default());
+    let sun = Transform::from_xyz(1.0, 3.0, 2.0).looking_at(Vec3::ZERO, Vec3::Y);
+    cmd.spawn((DirectionalLight::default(), sun));
     let glass = VoxelTranslucent::cuboid([2.0; 3], Color::srgb(0.3, 0.8, 0.6), 0.5);
     cmd.spawn((glass, Transform::from_xyz(-4.0, 34.0, 0.0)));
     let spark = VoxelTranslucent::particle(0.1, Color::srgb(1.0, 0.8, 0.3), 0.8);

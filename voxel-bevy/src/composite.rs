@@ -18,6 +18,9 @@ pub(crate) struct Composite {
     /// Into the crate's scene, by sample count.
     into_world: Vec<(u32, wgpu::RenderPipeline)>,
     into_bevy: wgpu::RenderPipeline,
+    /// Nearest, for depth (composite.wgsl: a depth texture read without a sampler reads 0
+    /// on WebGL2).
+    nearest: wgpu::Sampler,
 }
 
 /// The depth mapping between Bevy's infinite reverse-Z projection and the crate's, with the
@@ -60,6 +63,12 @@ impl Composite {
                     },
                     count: None,
                 },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
+                    count: None,
+                },
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -74,6 +83,10 @@ impl Composite {
             pipeline_layout,
             into_world: Vec::new(),
             into_bevy,
+            nearest: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("voxel-bevy composite depth"),
+                ..Default::default()
+            }),
         }
     }
 
@@ -175,6 +188,10 @@ impl Composite {
                     wgpu::BindGroupEntry {
                         binding: 2,
                         resource: buffer.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::Sampler(&self.nearest),
                     },
                 ],
             })

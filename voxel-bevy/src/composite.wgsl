@@ -24,6 +24,16 @@ struct Params {
 // `textureLoad` of a depth texture (naga refuses it), and `.r` is the depth either way.
 @group(0) @binding(1) var depth_in: texture_2d<f32>;
 @group(0) @binding(2) var<uniform> params: Params;
+// Depth is read through a nearest sampler, not `textureLoad`: on WebGL2 a texture read
+// without a sampler takes the texture's own filter, linear by default, and a depth texture
+// filtered linearly is incomplete in GLES 3.0 (it reads 0: Bevy's meshes vanished there).
+@group(0) @binding(3) var nearest: sampler;
+
+// The depth texel under the fragment at `p` (a pixel centre).
+fn depth_at(p: vec2<f32>) -> f32 {
+    let size = vec2<f32>(textureDimensions(depth_in));
+    return textureSampleLevel(depth_in, nearest, p / size, 0.0).r;
+}
 
 @vertex
 fn vs_fullscreen(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
@@ -53,7 +63,7 @@ struct WorldOut {
 @fragment
 fn fs_into_world(@builtin(position) p: vec4<f32>) -> WorldOut {
     let xy = vec2<i32>(p.xy);
-    let d = textureLoad(depth_in, xy, 0).r;
+    let d = depth_at(p.xy);
     let dc = params.a * d + params.b;
     // Nothing Bevy drew (cleared to 0), or past the crate's far plane.
     if d <= 0.0 || dc <= 0.0 {
@@ -71,7 +81,7 @@ fn fs_into_world(@builtin(position) p: vec4<f32>) -> WorldOut {
 
 @fragment
 fn fs_into_bevy(@builtin(position) p: vec4<f32>) -> @builtin(frag_depth) f32 {
-    let dc = textureLoad(depth_in, vec2<i32>(p.xy), 0).r;
+    let dc = depth_at(p.xy);
     if dc <= 0.0 {
         discard;
     }

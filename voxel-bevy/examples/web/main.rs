@@ -17,8 +17,6 @@ use bevy::prelude::*;
 use voxel_bevy::{VoxelPlugin, VoxelWorld};
 
 fn main() {
-    #[cfg(target_arch = "wasm32")]
-    report::log_to_console();
     let terrain = voxel_core::TerrainGenerator::new(Default::default());
     let world = VoxelWorld::generated(&terrain, radius()).expect("the default terrain");
     // The page's canvas, following the window (natively: a window, as game.rs's).
@@ -31,6 +29,9 @@ fn main() {
         primary_window: Some(window),
         ..default()
     });
+    // In a page: Bevy's log plugin, to the browser's console (the reports keep its errors).
+    #[cfg(target_arch = "wasm32")]
+    let plugins = plugins.set(report::log_plugin());
     let mut app = App::new();
     app.add_plugins((plugins, VoxelPlugin::default()))
         .insert_resource(world)

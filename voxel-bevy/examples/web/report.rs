@@ -3,14 +3,19 @@
 //! right after Bevy presented the frame (as web/'s page does: a 2D canvas draws it). Once two
 //! pictures in a row are the same (the world, the cube and the things all drawn), it hides
 //! the game's things (the glass box, the sparks, the Bevy cube) and reports until the
-//! picture is steady again: the test compares the two. Errors logged (the `log` crate's:
-//! the plugin's, wgpu's) and a panic (a beacon) are posted too.
+//! picture is steady again: the test compares the two. Errors logged (Bevy's, and the `log`
+//! crate's: the plugin's, wgpu's) and a panic (a beacon) are posted too.
 
 use std::collections::HashSet;
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use bevy::camera::primitives::Aabb;
+use bevy::log::LogPlugin;
+use bevy::log::tracing::field::{Field, Visit};
+use bevy::log::tracing::{Event, Level, Subscriber};
+use bevy::log::tracing_subscriber::Layer;
+use bevy::log::tracing_subscriber::layer::Context;
 use bevy::prelude::*;
 use bevy::render::renderer::RenderAdapterInfo;
 use bevy::render::{Render, RenderApp, RenderSystems};
@@ -22,7 +27,7 @@ const EVERY: u64 = 15;
 /// The first report.
 const FIRST: u64 = 10;
 
-/// Errors logged (the `log` crate's).
+/// Errors logged (Bevy's, and the `log` crate's: the plugin's, wgpu's).
 static ERRORS: Mutex<Vec<String>> = Mutex::new(Vec::new());
 
 /// A URL parameter of the page.
@@ -33,11 +38,12 @@ pub fn url_parameter(name: &str) -> Option<String> {
         .get(name)
 }
 
-/// The `log` crate's records (the plugin's, wgpu's; the features voxel-bevy builds Bevy
-/// with have no `bevy_log`) to the browser's console; errors are kept for the reports.
-pub fn log_to_console() {
-    if log::set_logger(&CONSOLE).is_ok() {
-        log::set_max_level(log::LevelFilter::Info);
+/// Bevy's log plugin (to the browser's console, the `log` crate's records included), with
+/// the errors kept for the reports.
+pub fn log_plugin() -> LogPlugin {
+    LogPlugin {
+        custom_layer: |_| Some(Box::new(KeepErrors)),
+        ..default()
     }
 }
 
@@ -234,45 +240,34 @@ fn post(path: &str, body: &str) {
     let _ = window.fetch_with_str_and_init(path, &init);
 }
 
-static CONSOLE: Console = Console;
+/// Errors logged, kept for the reports: a layer of Bevy's log subscriber, which also
+/// receives the `log` crate's records (the plugin's, wgpu's) and writes everything to the
+/// browser's console.
+struct KeepErrors;
 
-/// The console, warnings and errors only from wgpu and naga (a line per pipeline otherwise).
-struct Console;
-
-impl log::Log for Console {
-    fn enabled(&self, meta: &log::Metadata<'_>) -> bool {
-        let noisy = meta.target().starts_with("wgpu") || meta.target().starts_with("naga");
-        meta.level()
-            <= if noisy {
-                log::Level::Warn
-            } else {
-                log::Level::Info
-            }
-    }
-
-    fn log(&self, record: &log::Record<'_>) {
-        if !self.enabled(record.metadata()) {
+impl<S: Subscriber> Layer<S> for KeepErrors {
+    fn on_event(&self, event: &Event<'_>, _: Context<'_, S>) {
+        if *event.metadata().level() != Level::ERROR {
             return;
         }
-        let line = format!(
-            "[{}] {}: {}",
-            record.level(),
-            record.target(),
-            record.args()
-        );
-        let value = JsValue::from_str(&line);
-        match record.level() {
-            log::Level::Error => {
-                web_sys::console::error_1(&value);
-                ERRORS
-                    .lock()
-                    .unwrap_or_else(PoisonError::into_inner)
-                    .push(line);
-            }
-            log::Level::Warn => web_sys::console::warn_1(&value),
-            _ => web_sys::console::log_1(&value),
+        let mut line = format!("{}:", event.metadata().target());
+        event.record(&mut Fields(&mut line));
+        ERRORS
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push(line);
+    }
+}
+
+/// An event's fields as text.
+struct Fields<'a>(&'a mut String);
+
+impl Visit for Fields<'_> {
+    fn record_debug(&mut self, field: &Field, value: &dyn std::fmt::Debug) {
+        if field.name() == "message" {
+            *self.0 += &format!(" {value:?}");
+        } else {
+            *self.0 += &format!(" {}={value:?}", field.name());
         }
     }
-
-    fn flush(&self) {}
 }

@@ -82,7 +82,11 @@ impl Harness {
                 })
                 .set(RenderPlugin {
                     render_creation: RenderCreation::Automatic(Box::new(WgpuSettings {
-                        backends: Some(wgpu::Backends::VULKAN),
+                        // Vulkan, or the backend WGPU_BACKEND names (`gl`: the GL path the
+                        // WebGL2 page takes, natively).
+                        backends: Some(
+                            wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN),
+                        ),
                         ..Default::default()
                     })),
                     ..Default::default()
