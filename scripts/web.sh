@@ -19,7 +19,7 @@
 #   WEB_FEATURES      the crate's features to build with (voxel-bevy: webgl2 or webgpu)
 #   WEB_PROFILE       cargo's profile: default release; the browser tests build voxel-bevy's
 #                     pages with `web-test` (Cargo.toml: opt-level 1, no debug info), which
-#                     halves a Bevy page's build
+#                     takes a third of the CPU of a release build of a Bevy page
 # With WEB_OUT and CARGO_TARGET_DIR outside it, nothing is written into this checkout (it
 # may be read-only): a crate of this workspace (the crate's own page, voxel-bevy's example)
 # builds with --locked, so Cargo.lock is read, never rewritten. A game's crate (WEB_CRATE)

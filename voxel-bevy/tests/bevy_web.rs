@@ -1,7 +1,7 @@
 //! The Bevy example in the browser: `examples/web` (game.rs's world, fly camera, Bevy cube,
 //! glass box and sparks, drawn by the plugin into the page's canvas) built for wasm32 by
 //! `scripts/web.sh` with voxel-bevy's `webgl2` feature and with its `webgpu` feature (in the
-//! `web-test` profile: opt-level 1, no debug info, half a release build's time), each
+//! `web-test` profile: opt-level 1, no debug info: a third of a release build's CPU), each
 //! opened in headless Chromium (WebGL2 on ANGLE over SwiftShader; WebGPU on SwiftShader).
 //!
 //! The page runs with `?report=1` (examples/web/report.rs): it posts its state and the
