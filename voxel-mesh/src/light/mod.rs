@@ -337,9 +337,14 @@ impl<'a> LitCells<'a> {
 #[derive(Clone)]
 struct Plane {
     raw: [u64; P * P],
+    /// The same levels spread into 16-bit lanes: sky (`[0]`) and block (`[1]`).
+    spread: [[u64; 2]; P * P],
     vertex: [u64; P * P],
     /// Bit `vb` of row `vr`: `vertex` holds that vertex.
     vertex_ok: [u64; P],
+    /// The palette index of a vertex's light, where `index_ok` says it is interned.
+    index: [u16; P * P],
+    index_ok: [u64; P],
 }
 
 /// The light side of the mesher's working memory (see the module docs' "Cost").
@@ -378,8 +383,11 @@ impl LightScratch {
             aos: Box::new([0; CHUNK_SIZE * CHUNK_SIZE]),
             plane: Box::new(Plane {
                 raw: [0; P * P],
+                spread: [[0; 2]; P * P],
                 vertex: [0; P * P],
                 vertex_ok: [0; P],
+                index: [0; P * P],
+                index_ok: [0; P],
             }),
         })
     }
@@ -728,8 +736,11 @@ impl LitPlane<'_, '_> {
         } = &mut *self.s;
         let Plane {
             raw,
+            spread,
             vertex,
             vertex_ok,
+            index,
+            index_ok,
         } = &mut **plane;
         // The plane's opaque cells in front, rows and bits as `odd`.
         let op: [u64; P] = match axis {
@@ -739,6 +750,8 @@ impl LitPlane<'_, '_> {
         };
         // The cells in front of the selected faces that count (open and known), read once.
         let mut need = [0u64; P];
+        // Bit `pr`: row `pr` of `need` holds a cell.
+        let mut need_live = 0u64;
         let mut l = sel_live;
         while l != 0 {
             let r = l.trailing_zeros() as usize;
@@ -750,12 +763,19 @@ impl LitPlane<'_, '_> {
                 d | d << 1 | d << 2
             };
             let rows = if self.flat { r + 1..r + 2 } else { r..r + 3 };
+            need_live |= if self.flat { 2 } else { 7 } << r;
             for n in &mut need[rows] {
                 *n |= w;
             }
         }
         let mut counts = [0u64; P];
-        for pr in 0..P {
+        let mut nl = need_live;
+        while nl != 0 {
+            let pr = nl.trailing_zeros() as usize;
+            nl &= nl - 1;
+            // Vertices of row `pr` are cached below.
+            vertex_ok[pr] = 0;
+            index_ok[pr] = 0;
             let mut bits = need[pr] & !op[pr];
             while bits != 0 {
                 let pb = bits.trailing_zeros() as usize;
@@ -764,11 +784,11 @@ impl LitPlane<'_, '_> {
                 if let Some(v) = self.cells.get(px, py, pz) {
                     let i = pr * P + pb;
                     raw[i] = v;
+                    spread[i] = [lanes(v & 0xff_ffff), lanes(v >> 24)];
                     counts[pr] |= 1 << pb;
                 }
             }
         }
-        *vertex_ok = [0; P];
         // The light of vertex (vr, vb) of the plane, where the rule about the diagonal
         // does not apply: the mean of the counted cells of the 2 × 2 around it.
         let mut at_vertex = |vr: usize, vb: usize| -> u64 {
@@ -787,13 +807,13 @@ impl LitPlane<'_, '_> {
                 for (row, m) in [(vr, m0), (vr + 1, m1)] {
                     for k in 0..2 {
                         if m >> k & 1 != 0 {
-                            let v = raw[row * P + vb + k];
-                            sl += lanes(v & 0xffff_ffff);
-                            sh += lanes(v >> 32);
+                            let [l, h] = spread[row * P + vb + k];
+                            sl += l;
+                            sh += h;
                         }
                     }
                 }
-                unlanes(mean_lanes(sl, n)) | unlanes(mean_lanes(sh, n)) << 32
+                unlanes(mean_lanes(sl, n)) | unlanes(mean_lanes(sh, n)) << 24
             };
             vertex[i] = v;
             vertex_ok[vr] |= 1 << vb;
@@ -813,6 +833,9 @@ impl LitPlane<'_, '_> {
                     0
                 };
                 let mut c = [front; 4];
+                // The vertex of each corner (`NONE`: the front cell's light).
+                const NONE: (usize, usize) = (usize::MAX, 0);
+                let mut at = [NONE; 4];
                 if !self.flat {
                     // Corners (dr, db), 0 or 2 for -1 or +1, in the slot order of
                     // `QuadLight::new`.
@@ -821,11 +844,12 @@ impl LitPlane<'_, '_> {
                     } else {
                         [(0, 0), (0, 2), (2, 0), (2, 2)]
                     };
-                    for (v, (dr, db)) in c.iter_mut().zip(corners) {
+                    for ((v, a), (dr, db)) in c.iter_mut().zip(&mut at).zip(corners) {
                         let walled =
                             op[r + dr] >> (b + 1) & 1 != 0 && op[r + 1] >> (b + db) & 1 != 0;
                         if !walled {
-                            *v = at_vertex(r + dr / 2, b + db / 2);
+                            *a = (r + dr / 2, b + db / 2);
+                            *v = at_vertex(a.0, a.1);
                         }
                     }
                 }
@@ -844,13 +868,24 @@ impl LitPlane<'_, '_> {
                     left |= 1 << r;
                     continue;
                 }
+                // Each vertex's light is interned once per plane.
+                let mut intern = |(vr, vb): (usize, usize), v: u64| -> u16 {
+                    if vr == usize::MAX {
+                        return palette.intern(v);
+                    }
+                    if index_ok[vr] >> vb & 1 != 0 {
+                        return index[vr * P + vb];
+                    }
+                    let i = palette.intern(v);
+                    index[vr * P + vb] = i;
+                    index_ok[vr] |= 1 << vb;
+                    i
+                };
                 let k = if uniform {
-                    let i = u64::from(palette.intern(c[0]));
+                    let i = u64::from(intern(at[0], c[0]));
                     i * 0x0001_0001_0001_0001
                 } else {
-                    c.iter().enumerate().fold(0, |acc, (j, &v)| {
-                        acc | u64::from(palette.intern(v)) << (16 * j)
-                    })
+                    (0..4).fold(0, |acc, j| acc | u64::from(intern(at[j], c[j])) << (16 * j))
                 };
                 keys[r * CHUNK_SIZE + b] = k;
                 aos[r * CHUNK_SIZE + b] =
