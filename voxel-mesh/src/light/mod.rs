@@ -354,8 +354,6 @@ pub(crate) struct LightScratch {
     odd_x: [[u64; P]; P],
     /// The same cells, columns along y: bit `py` of `odd_y[px][pz]`.
     odd_y: [[u64; P]; P],
-    /// Bit `py`: the reference of layer `py` differs from that of a layer next to it.
-    boundary: u64,
     /// Bit `py`: rows of `odd_x[py]` written (to clear).
     written: u64,
     /// Reference levels per padded layer.
@@ -374,7 +372,6 @@ impl LightScratch {
         Box::new(Self {
             odd_x: [[0; P]; P],
             odd_y: [[0; P]; P],
-            boundary: 0,
             written: 0,
             refs: [0; P],
             ref_idx: [u16::MAX; P],
@@ -474,20 +471,31 @@ impl LightScratch {
                 Some(LightLayer::Dense(d)) => pack(&d[x << 5 | z]) != reference,
             };
             self.written |= 1 << py;
+            // Per layer of the nine: `Some(odd)` where every cell is alike (unknown or
+            // uniform), `None` where it is dense.
+            let whole: [Option<bool>; 9] = std::array::from_fn(|k| match layers[k] {
+                None => Some(true),
+                Some(LightLayer::Uniform(v)) => Some(pack(&v) != reference),
+                Some(LightLayer::Dense(_)) => None,
+            });
+            let border = |k: usize, x: usize, z: usize| match whole[k] {
+                Some(o) => o,
+                None => odd_at(layers[k], x, z),
+            };
             #[allow(clippy::needless_range_loop)] // pz indexes three tables and a region
             for pz in 0..P {
                 let (zr, z) = region(pz);
-                let mut bits = match layers[3 + zr] {
-                    None => INNER,
-                    Some(LightLayer::Uniform(v)) if pack(&v) == reference => 0,
-                    Some(LightLayer::Uniform(_)) => INNER,
-                    Some(LightLayer::Dense(_)) if zr == 1 => u64::from(inner[z]) << 1,
-                    Some(LightLayer::Dense(d)) => (0..CHUNK_SIZE).fold(0, |acc, x| {
+                let mut bits = match (whole[3 + zr], layers[3 + zr]) {
+                    (Some(true), _) => INNER,
+                    (Some(false), _) => 0,
+                    (None, _) if zr == 1 => u64::from(inner[z]) << 1,
+                    (None, Some(LightLayer::Dense(d))) => (0..CHUNK_SIZE).fold(0, |acc, x| {
                         acc | u64::from(pack(&d[x << 5 | z]) != reference) << (x + 1)
                     }),
+                    (None, _) => INNER,
                 };
-                bits |= u64::from(odd_at(layers[zr], CHUNK_SIZE - 1, z));
-                bits |= u64::from(odd_at(layers[6 + zr], 0, z)) << (P - 1);
+                bits |= u64::from(border(zr, CHUNK_SIZE - 1, z));
+                bits |= u64::from(border(6 + zr, 0, z)) << (P - 1);
                 bits &= !opaque[py][pz] & FULL;
                 self.odd_x[py][pz] = bits;
                 while bits != 0 {
@@ -496,12 +504,6 @@ impl LightScratch {
                     self.odd_y[px][pz] |= 1 << py;
                 }
             }
-        }
-        self.boundary = 0;
-        for py in 0..P {
-            let differs = (py > 0 && self.refs[py - 1] != self.refs[py])
-                || (py + 1 < P && self.refs[py + 1] != self.refs[py]);
-            self.boundary |= u64::from(differs) << py;
         }
     }
 
@@ -521,30 +523,13 @@ impl LightScratch {
     }
 
     /// The odd cells of the layer in front of a plane of faces (`axis`, padded layer
-    /// `next`), in the plane's layout (rows and bits as [`Pad::occluders`]). For x and z
-    /// planes the cells of a layer whose reference differs from a layer next to it count
-    /// as odd.
+    /// `next`), in the plane's layout (rows and bits as [`Pad::occluders`]).
     #[inline]
-    fn odd_plane(&self, axis: usize, next: usize, pad: &Pad) -> [u64; P] {
+    fn odd_plane(&self, axis: usize, next: usize) -> [u64; P] {
         match axis {
             1 => self.odd_x[next],
-            0 => {
-                let opaque = pad.columns_y();
-                std::array::from_fn(|pz| {
-                    self.odd_y[next][pz] | (self.boundary & !opaque[next][pz] & FULL)
-                })
-            }
-            _ => {
-                let opaque = pad.rows_x();
-                std::array::from_fn(|py| {
-                    let b = if self.boundary >> py & 1 != 0 {
-                        !opaque[py][next] & FULL
-                    } else {
-                        0
-                    };
-                    self.odd_x[py][next] | b
-                })
-            }
+            0 => self.odd_y[next],
+            _ => std::array::from_fn(|py| self.odd_x[py][next]),
         }
     }
 }
@@ -698,8 +683,26 @@ impl LitPlane<'_, '_> {
         occ: Option<&crate::ao::Occluders>,
         mut emit: impl FnMut(usize, usize, usize, usize, u8, QuadLight),
     ) -> u32 {
-        let odd = self.s.odd_plane(axis, next, self.pad);
-        if odd.iter().all(|&o| o == 0) {
+        // The plane's opaque cells in front, rows and bits as `odd`.
+        let op: [u64; P] = match axis {
+            1 => self.pad.rows_x()[next],
+            0 => self.pad.columns_y()[next],
+            _ => std::array::from_fn(|pr| self.pad.rows_x()[pr][next]),
+        };
+        let odd = self.s.odd_plane(axis, next);
+        // Side faces: bit `p` of `low` (`high`), the reference of layer `p` differs from
+        // that of layer `p + 1` (`p - 1`): a face at padded y whose open cells in front
+        // reach a layer of another reference (y - 1 or y + 1) has an odd cell in front.
+        let refs = &self.s.refs;
+        let (mut low, mut high) = (0u64, 0u64);
+        if axis != 1 && !self.flat {
+            for p in 0..P - 1 {
+                let d = u64::from(refs[p] != refs[p + 1]);
+                low |= d << p;
+                high |= d << (p + 1);
+            }
+        }
+        if low == 0 && odd.iter().all(|&o| o == 0) {
             return live;
         }
         let mut sel = [0u32; CHUNK_SIZE];
@@ -711,7 +714,28 @@ impl LitPlane<'_, '_> {
                 odd[r + 1] >> 1
             } else {
                 let v = odd[r] | odd[r + 1] | odd[r + 2];
-                v | v >> 1 | v >> 2
+                let v = v | v >> 1 | v >> 2;
+                if low == 0 {
+                    v
+                } else if axis == 0 {
+                    // Bits are y.
+                    let open = !(op[r] & op[r + 1] & op[r + 2]) & FULL;
+                    v | (open & low) | (open & high) >> 2
+                } else {
+                    // Rows are y.
+                    let open = |pr: usize| {
+                        let o = !op[pr] & FULL;
+                        o | o >> 1 | o >> 2
+                    };
+                    let mut e = 0;
+                    if low >> r & 1 != 0 {
+                        e |= open(r);
+                    }
+                    if high >> (r + 2) & 1 != 0 {
+                        e |= open(r + 2);
+                    }
+                    v | e
+                }
             };
             let s = rows[r] & v as u32;
             if s != 0 {
@@ -742,12 +766,6 @@ impl LitPlane<'_, '_> {
             index,
             index_ok,
         } = &mut **plane;
-        // The plane's opaque cells in front, rows and bits as `odd`.
-        let op: [u64; P] = match axis {
-            1 => self.pad.rows_x()[next],
-            0 => self.pad.columns_y()[next],
-            _ => std::array::from_fn(|pr| self.pad.rows_x()[pr][next]),
-        };
         // The cells in front of the selected faces that count (open and known), read once.
         let mut need = [0u64; P];
         // Bit `pr`: row `pr` of `need` holds a cell.
