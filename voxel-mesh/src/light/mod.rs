@@ -46,9 +46,11 @@
 //! field stores the layer dense, with a reference level of that layer (the level most of its
 //! open cells hold), giving the *odd* cells: open cells that are unknown or hold another
 //! level. A face with no odd cell in front of it takes its layer's reference at every
-//! corner (for the side faces of two layers of different references every cell of both
-//! counts as odd), and such faces are merged as the unlit mesher merges them, grouped by
-//! reference. Only faces with an odd cell in front read the cells and average them.
+//! corner (a side face counts as having one too where an open cell in front of it lies in
+//! the layer above or below, of another reference), and such faces are merged as the
+//! unlit mesher merges them, grouped by reference. Only faces with an odd cell in front
+//! read the cells and average them, each vertex's light computed and interned once per
+//! plane.
 
 use bytemuck::{Pod, Zeroable};
 use voxel_core::{CHUNK_SIZE, ChunkPos, Light, LightChunk, LightField, LightLayer};
