@@ -306,6 +306,8 @@ fn region(p: usize) -> (usize, usize) {
 #[derive(Clone, Copy)]
 pub(crate) struct LitCells<'a> {
     layers: [[Option<LightLayer<'a>>; 9]; P],
+    /// The 27 chunks, by `xr * 9 + yr * 3 + zr` (regions of [`region`]).
+    chunks: [Option<&'a LightChunk>; 27],
 }
 
 impl<'a> LitCells<'a> {
@@ -319,7 +321,15 @@ impl<'a> LitCells<'a> {
                 let (yr, y) = region(py);
                 std::array::from_fn(|k| chunks[k / 3 * 9 + yr * 3 + k % 3].map(|c| c.layer(y)))
             }),
+            chunks,
         }
+    }
+
+    /// The field's odd cells of the layer of padded `py` in chunk `k` (`xr * 3 + zr`, as
+    /// `layers`), where it is dense.
+    fn odd_cells(&self, py: usize, k: usize) -> Option<&'a voxel_core::OddCells> {
+        let (yr, y) = region(py);
+        self.chunks[k / 3 * 9 + yr * 3 + k % 3].and_then(|c| c.odd_cells(y))
     }
 
     /// The levels at padded `(px, py, pz)`, `None` where unknown.
@@ -416,9 +426,22 @@ impl LightScratch {
             let reference = match layers[4] {
                 None => 0,
                 Some(LightLayer::Uniform(v)) => pack(&v),
-                Some(LightLayer::Dense(d)) if open_any => {
+                Some(LightLayer::Dense(d)) if open_any => 'dense: {
                     let open: [u32; CHUNK_SIZE] =
                         std::array::from_fn(|z| !(opaque[py][z + 1] >> 1) as u32);
+                    // The field's odd cells of the layer, where at most half the open
+                    // cells are odd against its reference.
+                    if let Some(odd) = cells.odd_cells(py, 4) {
+                        let (mut n_open, mut n_odd) = (0, 0);
+                        for z in 0..CHUNK_SIZE {
+                            inner[z] = odd.rows[z] & open[z];
+                            n_open += open[z].count_ones();
+                            n_odd += inner[z].count_ones();
+                        }
+                        if 2 * n_odd <= n_open {
+                            break 'dense pack(&odd.reference);
+                        }
+                    }
                     // The majority of 32 open cells spread over the layer (Boyer and Moore's
                     // vote), else the reference above.
                     let (mut vote, mut count) = (above.unwrap_or_else(|| pack(&d[0])), 0u32);
@@ -491,9 +514,14 @@ impl LightScratch {
                     (Some(true), _) => INNER,
                     (Some(false), _) => 0,
                     (None, _) if zr == 1 => u64::from(inner[z]) << 1,
-                    (None, Some(LightLayer::Dense(d))) => (0..CHUNK_SIZE).fold(0, |acc, x| {
-                        acc | u64::from(pack(&d[x << 5 | z]) != reference) << (x + 1)
-                    }),
+                    (None, Some(LightLayer::Dense(d))) => match cells.odd_cells(py, 3 + zr) {
+                        Some(odd) if pack(&odd.reference) == reference => {
+                            u64::from(odd.rows[z]) << 1
+                        }
+                        _ => (0..CHUNK_SIZE).fold(0, |acc, x| {
+                            acc | u64::from(pack(&d[x << 5 | z]) != reference) << (x + 1)
+                        }),
+                    },
                     (None, _) => INNER,
                 };
                 bits |= u64::from(border(zr, CHUNK_SIZE - 1, z));
