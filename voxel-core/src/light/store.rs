@@ -84,9 +84,10 @@ pub struct OddCells {
 
 impl OddCells {
     fn of(cells: &[Levels; CHUNK_AREA]) -> Self {
-        // Boyer and Moore's vote over the cells that are not dark.
+        // Boyer and Moore's vote over a sample of the cells that are not dark (every
+        // seventh: 147 cells spread over the rows and columns).
         let (mut vote, mut count) = ([0u8; 6], 0u32);
-        for c in cells.iter().filter(|c| **c != [0; 6]) {
+        for c in cells.iter().step_by(7).filter(|c| **c != [0; 6]) {
             if count == 0 {
                 (vote, count) = (*c, 1);
             } else if *c == vote {
@@ -95,9 +96,21 @@ impl OddCells {
                 count -= 1;
             }
         }
+        // Columns (bit z of `by_x[x]`, memory order), then rows.
+        let mut by_x = [0u32; CHUNK_SIZE];
+        for (col, cs) in by_x.iter_mut().zip(cells.chunks_exact(CHUNK_SIZE)) {
+            *col = cs
+                .iter()
+                .enumerate()
+                .fold(0, |acc, (z, c)| acc | u32::from(*c != vote) << z);
+        }
         let mut rows = [0u32; CHUNK_SIZE];
-        for (i, c) in cells.iter().enumerate() {
-            rows[i & 31] |= u32::from(*c != vote) << (i >> 5);
+        for (x, &col) in by_x.iter().enumerate() {
+            let mut b = col;
+            while b != 0 {
+                rows[b.trailing_zeros() as usize] |= 1 << x;
+                b &= b - 1;
+            }
         }
         Self {
             reference: vote,
