@@ -45,7 +45,9 @@
 //! **Cost.** Each layer's light is compared once, a cell at a time only where the light
 //! field stores the layer dense, with a reference level of that layer (the level most of its
 //! open cells hold), giving the *odd* cells: open cells that are unknown or hold another
-//! level. A face with no odd cell in front of it takes its layer's reference at every
+//! level. For a dense layer the field's odd cells ([`LightChunk::odd_cells`], kept until
+//! the layer is written) give both, where at most half the open cells are odd against
+//! them. A face with no odd cell in front of it takes its layer's reference at every
 //! corner (a side face counts as having one too where an open cell in front of it lies in
 //! the layer above or below, of another reference), and such faces are merged as the
 //! unlit mesher merges them, grouped by reference. Only faces with an odd cell in front
