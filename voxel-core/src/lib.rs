@@ -24,7 +24,7 @@ pub use chunk::{
     column_index, row_index,
 };
 pub use error::{Error, Result};
-pub use light::{LIGHT_FALLOFF, Light, LightChunk, LightField, LightLayer, light_blocks};
+pub use light::{LIGHT_FALLOFF, Light, LightChunk, LightField, LightLayer, OddCells, light_blocks};
 pub use terrain::{
     Showcase, Site, SiteKind, TerrainBlocks, TerrainConfig, TerrainGenerator, TerrainRole,
 };

@@ -62,7 +62,7 @@ mod tests;
 use std::collections::{BTreeSet, HashMap, HashSet};
 use std::sync::Arc;
 
-pub use store::{Light, LightChunk, LightLayer};
+pub use store::{Light, LightChunk, LightLayer, OddCells};
 
 use crate::{BlockDef, BlockId, BlockRegistry, ChunkPos, Error, Result, World, WorldPos};
 use engine::Entry;

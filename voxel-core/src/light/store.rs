@@ -2,6 +2,8 @@
 //! whose cells all hold the same levels (open sky, dark rock) is 6 bytes, any other 6 KiB.
 //! Also the sky's beam entering each column of a chunk from above.
 
+use std::sync::OnceLock;
+
 use crate::{CHUNK_AREA, CHUNK_SIZE};
 
 /// The six levels of a cell: sky red, green, blue, then block red, green, blue.
@@ -49,7 +51,72 @@ pub enum LightLayer<'a> {
 #[derive(Clone, Debug)]
 enum Layer {
     Uniform(Levels),
-    Dense(Box<[Levels; CHUNK_AREA]>),
+    Dense(Box<Dense>),
+}
+
+#[derive(Clone, Debug)]
+struct Dense {
+    cells: [Levels; CHUNK_AREA],
+    /// The layer's [`OddCells`], made on first use after the layer was last written.
+    odd: OnceLock<OddCells>,
+}
+
+impl Dense {
+    fn new(cells: [Levels; CHUNK_AREA]) -> Box<Self> {
+        Box::new(Self {
+            cells,
+            odd: OnceLock::new(),
+        })
+    }
+}
+
+/// Which cells of a dense layer hold other levels than most of its lit cells: what a
+/// reader that compares every cell with one level (the lit mesher) reads instead, kept
+/// with the layer until the layer is written ([`LightChunk::odd_cells`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct OddCells {
+    /// The levels most cells of the layer hold, of those not all 0 (dark rock does not
+    /// count: it is mostly opaque), else 0.
+    pub reference: [u8; 6],
+    /// Bit `x` of `rows[z]`: cell `(x, z)` holds other levels than `reference`.
+    pub rows: [u32; CHUNK_SIZE],
+}
+
+impl OddCells {
+    fn of(cells: &[Levels; CHUNK_AREA]) -> Self {
+        // Boyer and Moore's vote over a sample of the cells that are not dark (every
+        // seventh: 147 cells spread over the rows and columns).
+        let (mut vote, mut count) = ([0u8; 6], 0u32);
+        for c in cells.iter().step_by(7).filter(|c| **c != [0; 6]) {
+            if count == 0 {
+                (vote, count) = (*c, 1);
+            } else if *c == vote {
+                count += 1;
+            } else {
+                count -= 1;
+            }
+        }
+        // Columns (bit z of `by_x[x]`, memory order), then rows.
+        let mut by_x = [0u32; CHUNK_SIZE];
+        for (col, cs) in by_x.iter_mut().zip(cells.chunks_exact(CHUNK_SIZE)) {
+            *col = cs
+                .iter()
+                .enumerate()
+                .fold(0, |acc, (z, c)| acc | u32::from(*c != vote) << z);
+        }
+        let mut rows = [0u32; CHUNK_SIZE];
+        for (x, &col) in by_x.iter().enumerate() {
+            let mut b = col;
+            while b != 0 {
+                rows[b.trailing_zeros() as usize] |= 1 << x;
+                b &= b - 1;
+            }
+        }
+        Self {
+            reference: vote,
+            rows,
+        }
+    }
 }
 
 /// The light of the 32³ blocks of a chunk: 6 bytes a block (RGB sky and RGB block light, a
@@ -74,8 +141,8 @@ impl LightChunk {
                 if layer.iter().all(|l| *l == layer[0]) {
                     Layer::Uniform(layer[0])
                 } else {
-                    let mut b = Box::new([[0; 6]; CHUNK_AREA]);
-                    b.copy_from_slice(layer);
+                    let mut b = Dense::new([[0; 6]; CHUNK_AREA]);
+                    b.cells.copy_from_slice(layer);
                     Layer::Dense(b)
                 }
             })
@@ -94,7 +161,16 @@ impl LightChunk {
     pub fn layer(&self, y: usize) -> LightLayer<'_> {
         match &self.layers[y] {
             Layer::Uniform(v) => LightLayer::Uniform(*v),
-            Layer::Dense(d) => LightLayer::Dense(d),
+            Layer::Dense(d) => LightLayer::Dense(&d.cells),
+        }
+    }
+
+    /// The odd cells of layer `y` (below 32) where it is stored dense (`None` where it is
+    /// uniform), made on the first call after the layer was last written.
+    pub fn odd_cells(&self, y: usize) -> Option<&OddCells> {
+        match &self.layers[y] {
+            Layer::Uniform(_) => None,
+            Layer::Dense(d) => Some(d.odd.get_or_init(|| OddCells::of(&d.cells))),
         }
     }
 
@@ -102,7 +178,7 @@ impl LightChunk {
     pub(super) fn levels(&self, l: Local) -> Levels {
         match &self.layers[usize::from(l >> 10)] {
             Layer::Uniform(v) => *v,
-            Layer::Dense(d) => d[usize::from(l & 1023)],
+            Layer::Dense(d) => d.cells[usize::from(l & 1023)],
         }
     }
 
@@ -110,7 +186,7 @@ impl LightChunk {
     pub(super) fn channel(&self, l: Local, ch: usize) -> u8 {
         match &self.layers[usize::from(l >> 10)] {
             Layer::Uniform(v) => v[ch],
-            Layer::Dense(d) => d[usize::from(l & 1023)][ch],
+            Layer::Dense(d) => d.cells[usize::from(l & 1023)][ch],
         }
     }
 
@@ -121,10 +197,13 @@ impl LightChunk {
             if u[ch] == v {
                 return;
             }
-            *layer = Layer::Dense(Box::new([*u; CHUNK_AREA]));
+            *layer = Layer::Dense(Dense::new([*u; CHUNK_AREA]));
         }
         if let Layer::Dense(d) = layer {
-            d[usize::from(l & 1023)][ch] = v;
+            d.cells[usize::from(l & 1023)][ch] = v;
+            if d.odd.get().is_some() {
+                d.odd = OnceLock::new();
+            }
         }
     }
 
@@ -140,9 +219,9 @@ impl LightChunk {
     pub(super) fn compact(&mut self) {
         for layer in &mut self.layers {
             if let Layer::Dense(d) = layer
-                && d.iter().all(|l| *l == d[0])
+                && d.cells.iter().all(|l| *l == d.cells[0])
             {
-                *layer = Layer::Uniform(d[0]);
+                *layer = Layer::Uniform(d.cells[0]);
             }
         }
     }
@@ -159,7 +238,7 @@ impl LightChunk {
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<Self>()
             + CHUNK_SIZE * std::mem::size_of::<Layer>()
-            + self.dense_layers() * CHUNK_AREA * 6
+            + self.dense_layers() * std::mem::size_of::<Dense>()
     }
 }
 

@@ -547,3 +547,44 @@ fn storage_is_six_bytes_a_block_where_layers_vary() {
     assert_eq!(ground.dense_layers(), 0, "flat ground: every layer uniform");
     assert!(f.memory_bytes() < 4096, "{}", f.memory_bytes());
 }
+
+/// Every dense layer's odd cells are the cells holding other levels than its reference,
+/// made anew after an edit writes the layer.
+#[test]
+fn odd_cells_follow_the_edits() {
+    let mut w = world();
+    load(&mut w, [0, 0, 0], [0, 0, 0]);
+    fill(&mut w, [0, 0, 0], [31, 4, 31], blocks::STONE);
+    fill(&mut w, [4, 5, 4], [12, 9, 12], blocks::WATER);
+    let mut f = LightField::new(&w);
+    let p = ChunkPos::new(0, 0, 0);
+    let check = |f: &LightField| {
+        let c = f.chunk(p).expect("lit");
+        let mut dense = 0;
+        for y in 0..CHUNK_SIZE {
+            let (LightLayer::Dense(d), Some(odd)) = (c.layer(y), c.odd_cells(y)) else {
+                assert!(c.odd_cells(y).is_none(), "a uniform layer has none");
+                continue;
+            };
+            dense += 1;
+            for x in 0..CHUNK_SIZE {
+                for z in 0..CHUNK_SIZE {
+                    let want = d[x << 5 | z] != odd.reference;
+                    assert_eq!(odd.rows[z] >> x & 1 != 0, want, "({x}, {y}, {z})");
+                }
+            }
+        }
+        dense
+    };
+    assert!(check(&f) > 0, "water makes dense layers");
+    for (q, id) in [
+        ([8, 7, 20], TORCH),
+        ([20, 6, 8], TORCH),
+        ([8, 7, 20], BlockId::AIR),
+        ([6, 5, 6], blocks::STONE),
+    ] {
+        w.set_block_lit(&mut f, WorldPos::new(q[0], q[1], q[2]), id)
+            .unwrap();
+        check(&f);
+    }
+}

@@ -45,10 +45,14 @@
 //! **Cost.** Each layer's light is compared once, a cell at a time only where the light
 //! field stores the layer dense, with a reference level of that layer (the level most of its
 //! open cells hold), giving the *odd* cells: open cells that are unknown or hold another
-//! level. A face with no odd cell in front of it takes its layer's reference at every
-//! corner (for the side faces of two layers of different references every cell of both
-//! counts as odd), and such faces are merged as the unlit mesher merges them, grouped by
-//! reference. Only faces with an odd cell in front read the cells and average them.
+//! level. For a dense layer the field's odd cells ([`LightChunk::odd_cells`], kept until
+//! the layer is written) give both, where at most half the open cells are odd against
+//! them. A face with no odd cell in front of it takes its layer's reference at every
+//! corner (a side face counts as having one too where an open cell in front of it lies in
+//! the layer above or below, of another reference), and such faces are merged as the
+//! unlit mesher merges them, grouped by reference. Only faces with an odd cell in front
+//! read the cells and average them, each vertex's light computed and interned once per
+//! plane.
 
 use bytemuck::{Pod, Zeroable};
 use voxel_core::{CHUNK_SIZE, ChunkPos, Light, LightChunk, LightField, LightLayer};
@@ -304,6 +308,8 @@ fn region(p: usize) -> (usize, usize) {
 #[derive(Clone, Copy)]
 pub(crate) struct LitCells<'a> {
     layers: [[Option<LightLayer<'a>>; 9]; P],
+    /// The 27 chunks, by `xr * 9 + yr * 3 + zr` (regions of [`region`]).
+    chunks: [Option<&'a LightChunk>; 27],
 }
 
 impl<'a> LitCells<'a> {
@@ -317,7 +323,15 @@ impl<'a> LitCells<'a> {
                 let (yr, y) = region(py);
                 std::array::from_fn(|k| chunks[k / 3 * 9 + yr * 3 + k % 3].map(|c| c.layer(y)))
             }),
+            chunks,
         }
+    }
+
+    /// The field's odd cells of the layer of padded `py` in chunk `k` (`xr * 3 + zr`, as
+    /// `layers`), where it is dense.
+    fn odd_cells(&self, py: usize, k: usize) -> Option<&'a voxel_core::OddCells> {
+        let (yr, y) = region(py);
+        self.chunks[k / 3 * 9 + yr * 3 + k % 3].and_then(|c| c.odd_cells(y))
     }
 
     /// The levels at padded `(px, py, pz)`, `None` where unknown.
@@ -337,9 +351,14 @@ impl<'a> LitCells<'a> {
 #[derive(Clone)]
 struct Plane {
     raw: [u64; P * P],
+    /// The same levels spread into 16-bit lanes: sky (`[0]`) and block (`[1]`).
+    spread: [[u64; 2]; P * P],
     vertex: [u64; P * P],
     /// Bit `vb` of row `vr`: `vertex` holds that vertex.
     vertex_ok: [u64; P],
+    /// The palette index of a vertex's light, where `index_ok` says it is interned.
+    index: [u16; P * P],
+    index_ok: [u64; P],
 }
 
 /// The light side of the mesher's working memory (see the module docs' "Cost").
@@ -349,8 +368,6 @@ pub(crate) struct LightScratch {
     odd_x: [[u64; P]; P],
     /// The same cells, columns along y: bit `py` of `odd_y[px][pz]`.
     odd_y: [[u64; P]; P],
-    /// Bit `py`: the reference of layer `py` differs from that of a layer next to it.
-    boundary: u64,
     /// Bit `py`: rows of `odd_x[py]` written (to clear).
     written: u64,
     /// Reference levels per padded layer.
@@ -369,7 +386,6 @@ impl LightScratch {
         Box::new(Self {
             odd_x: [[0; P]; P],
             odd_y: [[0; P]; P],
-            boundary: 0,
             written: 0,
             refs: [0; P],
             ref_idx: [u16::MAX; P],
@@ -378,8 +394,11 @@ impl LightScratch {
             aos: Box::new([0; CHUNK_SIZE * CHUNK_SIZE]),
             plane: Box::new(Plane {
                 raw: [0; P * P],
+                spread: [[0; 2]; P * P],
                 vertex: [0; P * P],
                 vertex_ok: [0; P],
+                index: [0; P * P],
+                index_ok: [0; P],
             }),
         })
     }
@@ -409,9 +428,22 @@ impl LightScratch {
             let reference = match layers[4] {
                 None => 0,
                 Some(LightLayer::Uniform(v)) => pack(&v),
-                Some(LightLayer::Dense(d)) if open_any => {
+                Some(LightLayer::Dense(d)) if open_any => 'dense: {
                     let open: [u32; CHUNK_SIZE] =
                         std::array::from_fn(|z| !(opaque[py][z + 1] >> 1) as u32);
+                    // The field's odd cells of the layer, where at most half the open
+                    // cells are odd against its reference.
+                    if let Some(odd) = cells.odd_cells(py, 4) {
+                        let (mut n_open, mut n_odd) = (0, 0);
+                        for z in 0..CHUNK_SIZE {
+                            inner[z] = odd.rows[z] & open[z];
+                            n_open += open[z].count_ones();
+                            n_odd += inner[z].count_ones();
+                        }
+                        if 2 * n_odd <= n_open {
+                            break 'dense pack(&odd.reference);
+                        }
+                    }
                     // The majority of 32 open cells spread over the layer (Boyer and Moore's
                     // vote), else the reference above.
                     let (mut vote, mut count) = (above.unwrap_or_else(|| pack(&d[0])), 0u32);
@@ -466,20 +498,36 @@ impl LightScratch {
                 Some(LightLayer::Dense(d)) => pack(&d[x << 5 | z]) != reference,
             };
             self.written |= 1 << py;
+            // Per layer of the nine: `Some(odd)` where every cell is alike (unknown or
+            // uniform), `None` where it is dense.
+            let whole: [Option<bool>; 9] = std::array::from_fn(|k| match layers[k] {
+                None => Some(true),
+                Some(LightLayer::Uniform(v)) => Some(pack(&v) != reference),
+                Some(LightLayer::Dense(_)) => None,
+            });
+            let border = |k: usize, x: usize, z: usize| match whole[k] {
+                Some(o) => o,
+                None => odd_at(layers[k], x, z),
+            };
             #[allow(clippy::needless_range_loop)] // pz indexes three tables and a region
             for pz in 0..P {
                 let (zr, z) = region(pz);
-                let mut bits = match layers[3 + zr] {
-                    None => INNER,
-                    Some(LightLayer::Uniform(v)) if pack(&v) == reference => 0,
-                    Some(LightLayer::Uniform(_)) => INNER,
-                    Some(LightLayer::Dense(_)) if zr == 1 => u64::from(inner[z]) << 1,
-                    Some(LightLayer::Dense(d)) => (0..CHUNK_SIZE).fold(0, |acc, x| {
-                        acc | u64::from(pack(&d[x << 5 | z]) != reference) << (x + 1)
-                    }),
+                let mut bits = match (whole[3 + zr], layers[3 + zr]) {
+                    (Some(true), _) => INNER,
+                    (Some(false), _) => 0,
+                    (None, _) if zr == 1 => u64::from(inner[z]) << 1,
+                    (None, Some(LightLayer::Dense(d))) => match cells.odd_cells(py, 3 + zr) {
+                        Some(odd) if pack(&odd.reference) == reference => {
+                            u64::from(odd.rows[z]) << 1
+                        }
+                        _ => (0..CHUNK_SIZE).fold(0, |acc, x| {
+                            acc | u64::from(pack(&d[x << 5 | z]) != reference) << (x + 1)
+                        }),
+                    },
+                    (None, _) => INNER,
                 };
-                bits |= u64::from(odd_at(layers[zr], CHUNK_SIZE - 1, z));
-                bits |= u64::from(odd_at(layers[6 + zr], 0, z)) << (P - 1);
+                bits |= u64::from(border(zr, CHUNK_SIZE - 1, z));
+                bits |= u64::from(border(6 + zr, 0, z)) << (P - 1);
                 bits &= !opaque[py][pz] & FULL;
                 self.odd_x[py][pz] = bits;
                 while bits != 0 {
@@ -488,12 +536,6 @@ impl LightScratch {
                     self.odd_y[px][pz] |= 1 << py;
                 }
             }
-        }
-        self.boundary = 0;
-        for py in 0..P {
-            let differs = (py > 0 && self.refs[py - 1] != self.refs[py])
-                || (py + 1 < P && self.refs[py + 1] != self.refs[py]);
-            self.boundary |= u64::from(differs) << py;
         }
     }
 
@@ -513,30 +555,13 @@ impl LightScratch {
     }
 
     /// The odd cells of the layer in front of a plane of faces (`axis`, padded layer
-    /// `next`), in the plane's layout (rows and bits as [`Pad::occluders`]). For x and z
-    /// planes the cells of a layer whose reference differs from a layer next to it count
-    /// as odd.
+    /// `next`), in the plane's layout (rows and bits as [`Pad::occluders`]).
     #[inline]
-    fn odd_plane(&self, axis: usize, next: usize, pad: &Pad) -> [u64; P] {
+    fn odd_plane(&self, axis: usize, next: usize) -> [u64; P] {
         match axis {
             1 => self.odd_x[next],
-            0 => {
-                let opaque = pad.columns_y();
-                std::array::from_fn(|pz| {
-                    self.odd_y[next][pz] | (self.boundary & !opaque[next][pz] & FULL)
-                })
-            }
-            _ => {
-                let opaque = pad.rows_x();
-                std::array::from_fn(|py| {
-                    let b = if self.boundary >> py & 1 != 0 {
-                        !opaque[py][next] & FULL
-                    } else {
-                        0
-                    };
-                    self.odd_x[py][next] | b
-                })
-            }
+            0 => self.odd_y[next],
+            _ => std::array::from_fn(|py| self.odd_x[py][next]),
         }
     }
 }
@@ -690,8 +715,26 @@ impl LitPlane<'_, '_> {
         occ: Option<&crate::ao::Occluders>,
         mut emit: impl FnMut(usize, usize, usize, usize, u8, QuadLight),
     ) -> u32 {
-        let odd = self.s.odd_plane(axis, next, self.pad);
-        if odd.iter().all(|&o| o == 0) {
+        // The plane's opaque cells in front, rows and bits as `odd`.
+        let op: [u64; P] = match axis {
+            1 => self.pad.rows_x()[next],
+            0 => self.pad.columns_y()[next],
+            _ => std::array::from_fn(|pr| self.pad.rows_x()[pr][next]),
+        };
+        let odd = self.s.odd_plane(axis, next);
+        // Side faces: bit `p` of `low` (`high`), the reference of layer `p` differs from
+        // that of layer `p + 1` (`p - 1`): a face at padded y whose open cells in front
+        // reach a layer of another reference (y - 1 or y + 1) has an odd cell in front.
+        let refs = &self.s.refs;
+        let (mut low, mut high) = (0u64, 0u64);
+        if axis != 1 && !self.flat {
+            for p in 0..P - 1 {
+                let d = u64::from(refs[p] != refs[p + 1]);
+                low |= d << p;
+                high |= d << (p + 1);
+            }
+        }
+        if low == 0 && odd.iter().all(|&o| o == 0) {
             return live;
         }
         let mut sel = [0u32; CHUNK_SIZE];
@@ -703,7 +746,28 @@ impl LitPlane<'_, '_> {
                 odd[r + 1] >> 1
             } else {
                 let v = odd[r] | odd[r + 1] | odd[r + 2];
-                v | v >> 1 | v >> 2
+                let v = v | v >> 1 | v >> 2;
+                if low == 0 {
+                    v
+                } else if axis == 0 {
+                    // Bits are y.
+                    let open = !(op[r] & op[r + 1] & op[r + 2]) & FULL;
+                    v | (open & low) | (open & high) >> 2
+                } else {
+                    // Rows are y.
+                    let open = |pr: usize| {
+                        let o = !op[pr] & FULL;
+                        o | o >> 1 | o >> 2
+                    };
+                    let mut e = 0;
+                    if low >> r & 1 != 0 {
+                        e |= open(r);
+                    }
+                    if high >> (r + 2) & 1 != 0 {
+                        e |= open(r + 2);
+                    }
+                    v | e
+                }
             };
             let s = rows[r] & v as u32;
             if s != 0 {
@@ -728,17 +792,16 @@ impl LitPlane<'_, '_> {
         } = &mut *self.s;
         let Plane {
             raw,
+            spread,
             vertex,
             vertex_ok,
+            index,
+            index_ok,
         } = &mut **plane;
-        // The plane's opaque cells in front, rows and bits as `odd`.
-        let op: [u64; P] = match axis {
-            1 => self.pad.rows_x()[next],
-            0 => self.pad.columns_y()[next],
-            _ => std::array::from_fn(|pr| self.pad.rows_x()[pr][next]),
-        };
         // The cells in front of the selected faces that count (open and known), read once.
         let mut need = [0u64; P];
+        // Bit `pr`: row `pr` of `need` holds a cell.
+        let mut need_live = 0u64;
         let mut l = sel_live;
         while l != 0 {
             let r = l.trailing_zeros() as usize;
@@ -750,12 +813,19 @@ impl LitPlane<'_, '_> {
                 d | d << 1 | d << 2
             };
             let rows = if self.flat { r + 1..r + 2 } else { r..r + 3 };
+            need_live |= if self.flat { 2 } else { 7 } << r;
             for n in &mut need[rows] {
                 *n |= w;
             }
         }
         let mut counts = [0u64; P];
-        for pr in 0..P {
+        let mut nl = need_live;
+        while nl != 0 {
+            let pr = nl.trailing_zeros() as usize;
+            nl &= nl - 1;
+            // Vertices of row `pr` are cached below.
+            vertex_ok[pr] = 0;
+            index_ok[pr] = 0;
             let mut bits = need[pr] & !op[pr];
             while bits != 0 {
                 let pb = bits.trailing_zeros() as usize;
@@ -764,11 +834,11 @@ impl LitPlane<'_, '_> {
                 if let Some(v) = self.cells.get(px, py, pz) {
                     let i = pr * P + pb;
                     raw[i] = v;
+                    spread[i] = [lanes(v & 0xff_ffff), lanes(v >> 24)];
                     counts[pr] |= 1 << pb;
                 }
             }
         }
-        *vertex_ok = [0; P];
         // The light of vertex (vr, vb) of the plane, where the rule about the diagonal
         // does not apply: the mean of the counted cells of the 2 × 2 around it.
         let mut at_vertex = |vr: usize, vb: usize| -> u64 {
@@ -787,13 +857,13 @@ impl LitPlane<'_, '_> {
                 for (row, m) in [(vr, m0), (vr + 1, m1)] {
                     for k in 0..2 {
                         if m >> k & 1 != 0 {
-                            let v = raw[row * P + vb + k];
-                            sl += lanes(v & 0xffff_ffff);
-                            sh += lanes(v >> 32);
+                            let [l, h] = spread[row * P + vb + k];
+                            sl += l;
+                            sh += h;
                         }
                     }
                 }
-                unlanes(mean_lanes(sl, n)) | unlanes(mean_lanes(sh, n)) << 32
+                unlanes(mean_lanes(sl, n)) | unlanes(mean_lanes(sh, n)) << 24
             };
             vertex[i] = v;
             vertex_ok[vr] |= 1 << vb;
@@ -813,6 +883,9 @@ impl LitPlane<'_, '_> {
                     0
                 };
                 let mut c = [front; 4];
+                // The vertex of each corner (`NONE`: the front cell's light).
+                const NONE: (usize, usize) = (usize::MAX, 0);
+                let mut at = [NONE; 4];
                 if !self.flat {
                     // Corners (dr, db), 0 or 2 for -1 or +1, in the slot order of
                     // `QuadLight::new`.
@@ -821,11 +894,12 @@ impl LitPlane<'_, '_> {
                     } else {
                         [(0, 0), (0, 2), (2, 0), (2, 2)]
                     };
-                    for (v, (dr, db)) in c.iter_mut().zip(corners) {
+                    for ((v, a), (dr, db)) in c.iter_mut().zip(&mut at).zip(corners) {
                         let walled =
                             op[r + dr] >> (b + 1) & 1 != 0 && op[r + 1] >> (b + db) & 1 != 0;
                         if !walled {
-                            *v = at_vertex(r + dr / 2, b + db / 2);
+                            *a = (r + dr / 2, b + db / 2);
+                            *v = at_vertex(a.0, a.1);
                         }
                     }
                 }
@@ -844,13 +918,24 @@ impl LitPlane<'_, '_> {
                     left |= 1 << r;
                     continue;
                 }
+                // Each vertex's light is interned once per plane.
+                let mut intern = |(vr, vb): (usize, usize), v: u64| -> u16 {
+                    if vr == usize::MAX {
+                        return palette.intern(v);
+                    }
+                    if index_ok[vr] >> vb & 1 != 0 {
+                        return index[vr * P + vb];
+                    }
+                    let i = palette.intern(v);
+                    index[vr * P + vb] = i;
+                    index_ok[vr] |= 1 << vb;
+                    i
+                };
                 let k = if uniform {
-                    let i = u64::from(palette.intern(c[0]));
+                    let i = u64::from(intern(at[0], c[0]));
                     i * 0x0001_0001_0001_0001
                 } else {
-                    c.iter().enumerate().fold(0, |acc, (j, &v)| {
-                        acc | u64::from(palette.intern(v)) << (16 * j)
-                    })
+                    (0..4).fold(0, |acc, j| acc | u64::from(intern(at[j], c[j])) << (16 * j))
                 };
                 keys[r * CHUNK_SIZE + b] = k;
                 aos[r * CHUNK_SIZE + b] =
