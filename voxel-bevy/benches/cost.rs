@@ -87,6 +87,7 @@ fn main() {
             size,
             false,
             plugin,
+            wgpu::Backends::VULKAN,
         );
         h.app.insert_resource(VoxelContent(scene.content.clone()));
         h

@@ -207,6 +207,17 @@ fn without_bevy(
 
 #[test]
 fn bevy_meshes_and_the_world_occlude_each_other_through_water_and_glass() {
+    occlusion(wgpu::Backends::VULKAN);
+}
+
+/// The same on wgpu's GL backend (GLES through EGL: llvmpipe here), the path of Bevy's
+/// WebGL2 builds natively.
+#[test]
+fn bevy_meshes_and_the_world_occlude_each_other_on_gl() {
+    occlusion(wgpu::Backends::GL);
+}
+
+fn occlusion(backends: wgpu::Backends) {
     if !have_gpu() {
         return;
     }
@@ -240,7 +251,7 @@ fn bevy_meshes_and_the_world_occlude_each_other_through_water_and_glass() {
     let eye = DVec3::new(0.0, 9.0, 22.0);
     let forward = DVec3::new(0.0, -6.5, -22.0);
     let size = (240, 135);
-    let mut h = Harness::new(
+    let mut h = Harness::with_plugin(
         VoxelWorld::from_world(w.clone()),
         eye,
         forward,
@@ -249,6 +260,8 @@ fn bevy_meshes_and_the_world_occlude_each_other_through_water_and_glass() {
         500.0,
         size,
         false,
+        true,
+        backends,
     );
     {
         let world = h.app.world_mut();
@@ -283,6 +296,11 @@ fn bevy_meshes_and_the_world_occlude_each_other_through_water_and_glass() {
     }
     h.frames(2);
     let ctx = h.ctx();
+    assert!(
+        backends.contains(ctx.caps.backend.into()),
+        "Bevy drew on {:?}, not {backends:?}",
+        ctx.caps.backend
+    );
     let camera = h.camera();
     let plain = without_bevy(&ctx, &w, &[], &camera, Technique::SortedQuads, size);
     for t in [
@@ -293,7 +311,7 @@ fn bevy_meshes_and_the_world_occlude_each_other_through_water_and_glass() {
         h.app.insert_resource(VoxelTechnique::Use(t));
         let bevy = h.frames(3);
         let reference = without_bevy(&ctx, &w, &boxes, &camera, t, size);
-        let tag = format!("occlusion-{}", t.name());
+        let tag = format!("occlusion-{backends:?}-{}", t.name());
         save(&tag, &bevy, &reference);
         let share = share_over_one(&bevy, &reference);
         eprintln!("{tag}: {:.4} % of pixels over 1/255", share * 100.0);

@@ -53,11 +53,16 @@ impl Harness {
         size: (u32, u32),
         hdr: bool,
     ) -> Self {
-        Self::with_plugin(world, eye, forward, fov_deg, near, far, size, hdr, true)
+        // Vulkan, or the backend WGPU_BACKEND names (`gl`: the GL path the WebGL2 page
+        // takes, natively).
+        let backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
+        Self::with_plugin(
+            world, eye, forward, fov_deg, near, far, size, hdr, true, backends,
+        )
     }
 
-    /// [`Harness::new`], or without the plugin (`plugin` false: the same camera settings,
-    /// Bevy alone), for the cost bench.
+    /// [`Harness::new`] on `backends`, or without the plugin (`plugin` false: the same
+    /// camera settings, Bevy alone), for the cost bench.
     #[allow(clippy::too_many_arguments)] // a camera's numbers
     pub fn with_plugin(
         world: VoxelWorld,
@@ -69,6 +74,7 @@ impl Harness {
         size: (u32, u32),
         hdr: bool,
         plugin: bool,
+        backends: wgpu::Backends,
     ) -> Self {
         let mut app = App::new();
         app.add_plugins(
@@ -82,11 +88,7 @@ impl Harness {
                 })
                 .set(RenderPlugin {
                     render_creation: RenderCreation::Automatic(Box::new(WgpuSettings {
-                        // Vulkan, or the backend WGPU_BACKEND names (`gl`: the GL path the
-                        // WebGL2 page takes, natively).
-                        backends: Some(
-                            wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN),
-                        ),
+                        backends: Some(backends),
                         ..Default::default()
                     })),
                     ..Default::default()

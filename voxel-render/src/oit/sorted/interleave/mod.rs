@@ -134,10 +134,12 @@ pub(crate) fn interleave(
     (orderer.order, orderer.splits)
 }
 
-/// The most planes an object is split at (into at most 12 parts, each clipped by at most
-/// two planes an axis): a thing crosses a handful of a chunk's planes, not hundreds (a pole
-/// through three panes and a chunk border).
-pub(crate) const MAX_SPLIT_PLANES: usize = 4;
+/// The most parts an object is cut into: the planes it crosses are taken nearest its centre
+/// first while the parts between them (the product over the axes of one more than the cuts
+/// along each) stay within this, so every plane is cut where an object crosses up to 63
+/// along one axis (a beam through panes) or, say, 7 and 7 along two; each part is clipped
+/// by at most two planes an axis.
+pub(crate) const MAX_SPLIT_PARTS: usize = 64;
 
 /// How many times a part is cut again (where its cuts leave it across chunks no one place
 /// suits).
@@ -245,8 +247,8 @@ impl Interleaver {
     ///
     /// **Objects through a plane** (`split_quads`). An object that reaches through planes
     /// of quads in a chunk no test decides (a cube through a water surface, a pole through
-    /// panes, foam whose face lies in the surface) is cut at up to [`MAX_SPLIT_PLANES`] of
-    /// them, those nearest its centre: each part (the object's box between the planes) is
+    /// panes, foam whose face lies in the surface) is cut at them, nearest its centre first,
+    /// into at most [`MAX_SPLIT_PARTS`] parts: each part (the object's box between the planes) is
     /// placed on its own and drawn with its clip (the renderer discards the fragments
     /// outside it), so that each lies wholly on one side of each plane it was cut at and
     /// the planes order it exactly. So is an object across chunk borders that no one place

@@ -6,14 +6,15 @@ use glam::DVec3;
 
 use super::cells::cells_and_keys;
 use super::sound::{SOUND, plane_runs, plane_weight, safe, seen_planes, shadow_misses, touch};
-use super::{Ball, Clip, ClipPlane, Frame, Interleaver, MAX_SPLIT_DEPTH, MAX_SPLIT_PLANES, Part};
+use super::{Ball, Clip, ClipPlane, Frame, Interleaver, MAX_SPLIT_DEPTH, MAX_SPLIT_PARTS, Part};
 
 /// A plane's weight in [`Interleaver::place`] where the eye does not see it.
 const UNSEEN: i64 = i64::MIN;
 
 impl Interleaver {
-    /// Cuts `whole` at the planes it crosses (`self.crossings`, the nearest
-    /// [`MAX_SPLIT_PLANES`] to its centre) into the parts between them, and places each.
+    /// Cuts `whole` at the planes it crosses (`self.crossings`; nearest its centre first, as
+    /// many as keep the parts within [`MAX_SPLIT_PARTS`]) into the parts between them, and
+    /// places each.
     pub(super) fn split(
         &mut self,
         frame: &Frame<'_, '_>,
@@ -28,7 +29,16 @@ impl Interleaver {
         // A plane of quads that is also a chunk border is cut as a plane of quads.
         crossings.dedup_by(|x, y| (x.0, x.1) == (y.0, y.1));
         crossings.sort_by(|x, y| (c[x.0] - x.1).abs().total_cmp(&(c[y.0] - y.1).abs()));
-        crossings.truncate(MAX_SPLIT_PLANES);
+        // Nearest first, while the parts (the product of cuts + 1 over the axes) fit.
+        let mut per_axis = [1usize; 3];
+        let kept = crossings
+            .iter()
+            .take_while(|&&(axis, ..)| {
+                per_axis[axis] += 1;
+                per_axis.iter().product::<usize>() <= MAX_SPLIT_PARTS
+            })
+            .count();
+        crossings.truncate(kept);
         // Per axis: the box's ends and the cuts between them.
         let mut bounds: [Vec<(f64, bool)>; 3] = Default::default();
         for a in 0..3 {
