@@ -74,6 +74,9 @@ pub fn add(app: &mut App) {
     }
 }
 
+/// The game's things the page removes: its translucent entities and Bevy meshes.
+type GameThings = Or<(With<VoxelTranslucent>, With<Mesh3d>)>;
+
 /// Where the page is: the game's things shown, hidden, or both pictures posted.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 enum Phase {
@@ -114,7 +117,7 @@ fn request(
     camera: Single<(&Camera, &GlobalTransform), With<VoxelCamera>>,
     boxes: Query<(&GlobalTransform, &VoxelTranslucent)>,
     meshes: Query<(&GlobalTransform, &Aabb), With<Mesh3d>>,
-    things: Query<Entity, Or<(With<VoxelTranslucent>, With<Mesh3d>)>>,
+    things: Query<Entity, GameThings>,
     mut commands: Commands,
     mut frames: Local<u64>,
     mut phase: Local<Phase>,
