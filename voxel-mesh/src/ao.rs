@@ -33,6 +33,8 @@ use voxel_core::{
     BlockId, CHUNK_SIZE, Face, LayerMask, Neighbourhood, Occupancy, column_index, row_index,
 };
 
+use crate::bits::greedy_rects_keyed;
+
 /// AO byte of a face no opaque block touches: every corner 3.
 pub const AO_NONE: u8 = 0xff;
 
@@ -315,18 +317,16 @@ static AO_TABLES: [[u8; 512]; 2] = [ao_table(false), ao_table(true)];
 /// (it decides which corner is which slot).
 ///
 /// The corner values of a face are read once from the 3×3 occluders in front of it (one
-/// table lookup). The cover is [`crate::greedy_rects`]'s, with the AO byte as a per-face
-/// key: in each row from the lowest, the lowest face not yet covered starts a run as long
-/// as the next faces have its byte, and the run grows down while the row below has the
-/// same faces with the same byte. Rectangles of different bytes never meet, so this gives
-/// exactly the rectangles of grouping the faces by byte and covering each group alone.
+/// table lookup, [`face_ao`]), and the faces are covered by
+/// [`crate::bits::greedy_rects_keyed`] with the AO byte as the key, which gives exactly the
+/// rectangles of grouping the faces by byte and covering each group alone.
 #[inline]
 pub(crate) fn cover_occluded(
     rows: &mut [u32; CHUNK_SIZE],
     rows_live: u32,
     occ: &Occluders,
     axis: usize,
-    mut emit: impl FnMut(usize, usize, usize, usize, u8),
+    emit: impl FnMut(usize, usize, usize, usize, u8),
 ) -> u32 {
     // The faces an occluder touches (any of the nine cells in front).
     let mut shaded = [0u32; CHUNK_SIZE];
@@ -343,39 +343,8 @@ pub(crate) fn cover_occluded(
         live |= u32::from(s != 0) << r;
         remaining &= !(u32::from(rows[r] == 0) << r);
     }
-    let table = &AO_TABLES[usize::from(axis == 1)];
-    // The AO byte of the face at bit `b` of row `r`.
-    let ao_at = |r: usize, b: usize| {
-        let (up, mid, down) = (occ[r] >> b & 7, occ[r + 1] >> b & 7, occ[r + 2] >> b & 7);
-        table[(up | mid << 3 | down << 6) as usize]
-    };
-    while live != 0 {
-        let r = live.trailing_zeros() as usize;
-        live &= live - 1;
-        let mut bits = shaded[r];
-        while bits != 0 {
-            let b0 = bits.trailing_zeros() as usize;
-            let ao = ao_at(r, b0);
-            let mut end = b0 + 1;
-            while end < CHUNK_SIZE && bits >> end & 1 != 0 && ao_at(r, end) == ao {
-                end += 1;
-            }
-            let run = (u32::MAX >> (CHUNK_SIZE - (end - b0))) << b0;
-            bits &= !run;
-            let mut h = 1;
-            while r + h < CHUNK_SIZE
-                && shaded[r + h] & run == run
-                && (b0..end).all(|b| ao_at(r + h, b) == ao)
-            {
-                shaded[r + h] &= !run;
-                if shaded[r + h] == 0 {
-                    live &= !(1 << (r + h));
-                }
-                h += 1;
-            }
-            emit(r, h, b0, end - b0, ao);
-        }
-    }
+    let ao_at = |r: usize, b: usize| face_ao(occ, axis, r, b);
+    greedy_rects_keyed(&mut shaded, live, ao_at, emit);
     remaining
 }
 

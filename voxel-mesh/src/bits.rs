@@ -20,6 +20,45 @@ pub(crate) fn live_rows(rows: &[u32; 32]) -> u32 {
         .fold(0u32, |acc, (r, &bits)| acc | u32::from(bits != 0) << r)
 }
 
+/// [`greedy_rects_live`] with a key per face (`key(row, bit)`): a rectangle covers faces of
+/// one key only. The run grows right while the next face has the key of its first, and down
+/// while the row below has the same faces with the same keys. Rectangles of different keys
+/// never meet, so this gives exactly the rectangles of grouping the faces by key and
+/// covering each group alone. `rows` is emptied.
+#[inline]
+pub(crate) fn greedy_rects_keyed<K: Copy + PartialEq>(
+    rows: &mut [u32; 32],
+    mut live: u32,
+    key: impl Fn(usize, usize) -> K,
+    mut emit: impl FnMut(usize, usize, usize, usize, K),
+) {
+    while live != 0 {
+        let r = live.trailing_zeros() as usize;
+        live &= live - 1;
+        let mut bits = rows[r];
+        rows[r] = 0;
+        while bits != 0 {
+            let b0 = bits.trailing_zeros() as usize;
+            let k = key(r, b0);
+            let mut end = b0 + 1;
+            while end < 32 && bits >> end & 1 != 0 && key(r, end) == k {
+                end += 1;
+            }
+            let run = (u32::MAX >> (32 - (end - b0))) << b0;
+            bits &= !run;
+            let mut h = 1;
+            while r + h < 32 && rows[r + h] & run == run && (b0..end).all(|b| key(r + h, b) == k) {
+                rows[r + h] &= !run;
+                if rows[r + h] == 0 {
+                    live &= !(1 << (r + h));
+                }
+                h += 1;
+            }
+            emit(r, h, b0, end - b0, k);
+        }
+    }
+}
+
 /// [`greedy_rects`] when the caller knows which rows hold bits (`live`, one bit per row):
 /// empty rows cost nothing.
 #[inline]

@@ -58,6 +58,7 @@ use bytemuck::{Pod, Zeroable};
 use voxel_core::{CHUNK_SIZE, ChunkPos, Light, LightChunk, LightField, LightLayer};
 
 use crate::ao::Pad;
+use crate::bits::greedy_rects_keyed;
 
 /// Side of the padded shell (a chunk and one block of each neighbour around it).
 pub(crate) const P: usize = CHUNK_SIZE + 2;
@@ -662,43 +663,18 @@ fn mean_lanes(s: u64, n: u32) -> u64 {
 
 /// Covers the faces of `sel` (its live rows `live`) whose corner lights and AO are keyed
 /// in `keys` and `aos` (`row * 32 + bit`) with rectangles of equal keys: the greedy cover
-/// of [`crate::greedy_rects`] with a per-face key, as `ao::cover_occluded` does.
+/// of [`greedy_rects_keyed`] with the pair as the key, as `ao::cover_occluded` keys by AO.
 fn cover_keyed(
     sel: &mut [u32; CHUNK_SIZE],
-    mut live: u32,
+    live: u32,
     keys: &[u64; CHUNK_SIZE * CHUNK_SIZE],
     aos: &[u8; CHUNK_SIZE * CHUNK_SIZE],
     mut emit: impl FnMut(usize, usize, usize, usize, u8, QuadLight),
 ) {
     let key = |r: usize, b: usize| (keys[r * CHUNK_SIZE + b], aos[r * CHUNK_SIZE + b]);
-    while live != 0 {
-        let r = live.trailing_zeros() as usize;
-        live &= live - 1;
-        let mut bits = sel[r];
-        sel[r] = 0;
-        while bits != 0 {
-            let b0 = bits.trailing_zeros() as usize;
-            let k = key(r, b0);
-            let mut end = b0 + 1;
-            while end < CHUNK_SIZE && bits >> end & 1 != 0 && key(r, end) == k {
-                end += 1;
-            }
-            let run = (u32::MAX >> (CHUNK_SIZE - (end - b0))) << b0;
-            bits &= !run;
-            let mut h = 1;
-            while r + h < CHUNK_SIZE
-                && sel[r + h] & run == run
-                && (b0..end).all(|b| key(r + h, b) == k)
-            {
-                sel[r + h] &= !run;
-                if sel[r + h] == 0 {
-                    live &= !(1 << (r + h));
-                }
-                h += 1;
-            }
-            emit(r, h, b0, end - b0, k.1, QuadLight::from_key(k.0));
-        }
-    }
+    greedy_rects_keyed(sel, live, key, |r, h, b, w, (light, ao)| {
+        emit(r, h, b, w, ao, QuadLight::from_key(light));
+    });
 }
 
 impl LitPlane<'_, '_> {

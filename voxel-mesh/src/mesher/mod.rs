@@ -286,8 +286,10 @@ fn emit_plane_lit(
     if live == 0 {
         return;
     }
-    if axis == 1 {
-        let l = crate::light::uniform(lp.s.reference(next));
+    // Faces of `rows` (live rows `live`) covered as without light, every quad with the
+    // light entry of one reference.
+    let mut uniform = |rows: &mut Plane, live: u32, reference| {
+        let l = crate::light::uniform(reference);
         emit_ao(
             rows,
             live,
@@ -296,9 +298,12 @@ fn emit_plane_lit(
             block,
             flags,
             out,
-            Some((lout, l)),
+            Some((&mut **lout, l)),
             *ao,
         );
+    };
+    if axis == 1 {
+        uniform(rows, live, lp.s.reference(next));
         return;
     }
     // The front cells of x and z faces are at their own y: bits y of an x plane, rows y
@@ -322,18 +327,7 @@ fn emit_plane_lit(
         }
         if ys & !run == 0 {
             // One reference for every face of the plane.
-            let l = crate::light::uniform(lp.s.reference(y + 1));
-            emit_ao(
-                rows,
-                live,
-                face,
-                layer,
-                block,
-                flags,
-                out,
-                Some((lout, l)),
-                *ao,
-            );
+            uniform(rows, live, lp.s.reference(y + 1));
             return;
         }
         let mut sub: Plane = if axis == 0 {
@@ -343,18 +337,7 @@ fn emit_plane_lit(
         };
         let sub_live = live_rows(&sub) & live;
         if sub_live != 0 {
-            let l = crate::light::uniform(lp.s.reference(y + 1));
-            emit_ao(
-                &mut sub,
-                sub_live,
-                face,
-                layer,
-                block,
-                flags,
-                out,
-                Some((lout, l)),
-                *ao,
-            );
+            uniform(&mut sub, sub_live, lp.s.reference(y + 1));
         }
         y = end;
     }
