@@ -20,13 +20,15 @@
 #[path = "../../web/tests/common/mod.rs"]
 mod page;
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 use std::path::Path;
 use std::sync::Mutex;
 use std::sync::mpsc::channel;
 use std::time::{Duration, Instant};
 
-use page::{Browser, GPU_FLAGS, build_page, chromium, out_dir, png_of_data_url, root, serve, skip};
+use page::{
+    Browser, GPU_FLAGS, Report, build_page, chromium, out_dir, png_of_data_url, root, serve, skip,
+};
 use voxel_render::Image;
 
 /// How long the page may take to post both steady pictures (about a minute here on a
@@ -50,23 +52,7 @@ fn the_web_example_draws_on_webgpu() {
     run("webgpu", "BrowserWebGpu");
 }
 
-/// A report the page posted, as its fields (`glass` and `cube` may repeat: the last wins).
-#[derive(Debug)]
-struct Report(HashMap<String, String>);
-
 impl Report {
-    fn get(&self, key: &str) -> &str {
-        self.0
-            .get(key)
-            .map_or_else(|| panic!("no {key} in the report"), String::as_str)
-    }
-
-    fn number(&self, key: &str) -> u64 {
-        self.get(key)
-            .parse()
-            .unwrap_or_else(|_| panic!("{key}: {:?}", self.get(key)))
-    }
-
     /// A `x0 y0 x1 y1` rectangle on the canvas, in whole pixels within `size`.
     fn rect(&self, key: &str, size: (u32, u32)) -> [u32; 4] {
         let v: Vec<f32> = self
@@ -123,12 +109,7 @@ fn run(feature: &str, backend: &str) {
         let text = String::from_utf8_lossy(&post.body).into_owned();
         assert_ne!(post.path, "/panic", "{feature}: the page panicked: {text}");
         assert_eq!(post.path, "/status", "{feature}: an unknown post: {text}");
-        let report = Report(
-            text.lines()
-                .filter_map(|l| l.split_once(": "))
-                .map(|(k, v)| (k.to_owned(), v.to_owned()))
-                .collect(),
-        );
+        let report = Report::parse(&text);
         eprintln!(
             "{feature}: {:.0} s: {}",
             start.elapsed().as_secs_f64(),

@@ -16,7 +16,6 @@
 
 mod common;
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::mpsc::{Receiver, channel};
@@ -24,7 +23,8 @@ use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
 use common::{
-    Browser, GPU_FLAGS, Post, build_page, chromium, out_dir, png_of_data_url, root, serve, skip,
+    Browser, GPU_FLAGS, Post, Report, build_page, chromium, out_dir, png_of_data_url, root, serve,
+    skip,
 };
 
 /// How long a page may take to report what a test waits for (a few seconds here; a
@@ -56,32 +56,7 @@ fn page() -> &'static Mutex<PathBuf> {
     })
 }
 
-/// A report the page posted, as its fields.
-#[derive(Debug, Clone)]
-struct State(HashMap<String, String>);
-
-impl State {
-    fn parse(text: &str) -> Self {
-        Self(
-            text.lines()
-                .filter_map(|l| l.split_once(": "))
-                .map(|(k, v)| (k.to_owned(), v.to_owned()))
-                .collect(),
-        )
-    }
-
-    fn get(&self, key: &str) -> &str {
-        self.0
-            .get(key)
-            .map_or_else(|| panic!("no {key} in {self:?}"), String::as_str)
-    }
-
-    fn number(&self, key: &str) -> u64 {
-        self.get(key)
-            .parse()
-            .unwrap_or_else(|_| panic!("{key}: {:?}", self.get(key)))
-    }
-
+impl Report {
     /// A `WxH` field.
     fn size(&self, key: &str) -> (u32, u32) {
         let (w, h) = self.get(key).split_once('x').unwrap();
@@ -99,8 +74,8 @@ fn visit(
     flags: &[&str],
     size: (u32, u32),
     name: &str,
-    until: impl Fn(&State) -> bool,
-) -> State {
+    until: impl Fn(&Report) -> bool,
+) -> Report {
     let binary = chromium().unwrap();
     let out = out_dir(&format!("web-page-tests/{name}"));
     let (tx, posts): (_, Receiver<Post>) = channel();
@@ -125,7 +100,7 @@ fn visit(
             "/picture" => picture = png_of_data_url(&text).unwrap_or_default(),
             "/status" => {
                 eprintln!("{name}: {} s\n{text}", start.elapsed().as_secs());
-                let state = State::parse(&text);
+                let state = Report::parse(&text);
                 assert!(
                     !state.get("status").starts_with("error"),
                     "{name}: the page shows an error: {text}"
@@ -144,7 +119,7 @@ fn visit(
 /// What every page must show: the scene (not a blank or white box), no error logged,
 /// the canvas as wide as the window and as tall as what the header leaves, its drawing
 /// buffer its size, and no scroll bars (the document no larger than the window).
-fn check_page(name: &str, s: &State) {
+fn check_page(name: &str, s: &Report) {
     let colours = s.number("colours") as usize;
     assert!(
         colours >= MIN_COLOURS,

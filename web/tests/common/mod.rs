@@ -3,6 +3,7 @@
 
 #![allow(dead_code)] // each test binary uses its part
 
+use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
@@ -250,4 +251,32 @@ pub fn png_of_data_url(url: &str) -> Option<Vec<u8>> {
         }
     }
     Some(out)
+}
+
+/// A report a page posted (`key: value` lines), as its fields; a key that repeats keeps its
+/// last value.
+#[derive(Debug, Clone)]
+pub struct Report(HashMap<String, String>);
+
+impl Report {
+    pub fn parse(text: &str) -> Self {
+        Self(
+            text.lines()
+                .filter_map(|l| l.split_once(": "))
+                .map(|(k, v)| (k.to_owned(), v.to_owned()))
+                .collect(),
+        )
+    }
+
+    pub fn get(&self, key: &str) -> &str {
+        self.0
+            .get(key)
+            .map_or_else(|| panic!("no {key} in {self:?}"), String::as_str)
+    }
+
+    pub fn number(&self, key: &str) -> u64 {
+        self.get(key)
+            .parse()
+            .unwrap_or_else(|_| panic!("{key}: {:?}", self.get(key)))
+    }
 }
