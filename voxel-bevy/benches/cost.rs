@@ -38,14 +38,13 @@ fn thread_cpu() -> Duration {
     Duration::new(t.tv_sec as u64, t.tv_nsec as u32)
 }
 
-fn median(mut v: Vec<Duration>) -> Duration {
-    v.sort();
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 
-fn median_f64(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
 }
 
 fn wait(ctx: &voxel_render::GpuContext) {
@@ -170,16 +169,16 @@ fn main() {
                 a = bevy_frame(&mut without, &alone_ctx);
             }
             let (r, o) = own_frame(&mut renderer);
+            let [a, w, b, r, o] = [a, w, b, r, o].map(ms);
             render_only.push(r);
             own.push(o);
             alone.push(a);
             plugin_on.push(w);
-            plugin.push(w.as_secs_f64() - a.as_secs_f64());
-            zero.push(b.as_secs_f64() - a.as_secs_f64());
+            plugin.push(w - a);
+            zero.push(b - a);
         }
-        let (bevy_alone, with_plugin) = (median(alone), median(plugin_on));
-        let (own, render_only) = (median(own), median(render_only));
-        let (plugin, zero) = (median_f64(plugin), median_f64(zero));
+        let [bevy_alone, with_plugin, own, render_only, plugin, zero] =
+            [alone, plugin_on, own, render_only, plugin, zero].map(median);
         // The plugin's frame, counted.
         with.app.insert_resource(VoxelCountNextFrame(true));
         for _ in 0..3 {
@@ -194,19 +193,18 @@ fn main() {
             .clone()
             .unwrap();
         let (p, o) = (plugin_cost.all(), own_cost.all());
-        let ms = |d: Duration| d.as_secs_f64() * 1e3;
         let frag = |f: Option<u64>| f.map_or("-".into(), |f| f.to_string());
         println!(
             "| `{}` | {:.3} | {:.3} | {:.3} | {:+.3} | {:.3} | {:.2} | {:.3} | {:.2} | {} / {} | {} / {} |",
             t.name(),
-            ms(with_plugin),
-            ms(bevy_alone),
-            plugin * 1e3,
-            zero * 1e3,
-            ms(own),
-            plugin * 1e3 / ms(own),
-            ms(render_only),
-            plugin * 1e3 / ms(render_only),
+            with_plugin,
+            bevy_alone,
+            plugin,
+            zero,
+            own,
+            plugin / own,
+            render_only,
+            plugin / render_only,
             p.draws,
             o.draws,
             frag(p.fragments),
