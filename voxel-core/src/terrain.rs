@@ -317,6 +317,32 @@ const CANOPY: i64 = 2;
 /// the structure can be seen from around it.
 const CLEARING: i64 = 22;
 
+/// The coarsest level of detail [`TerrainGenerator::generate_level_chunk`] makes: cells of
+/// 2^6 = 64 blocks, a level chunk 2048 blocks (64 full-detail chunks) wide; with a level
+/// a ring, a view distance of 2048 chunks.
+pub const MAX_LEVEL: u8 = 6;
+
+/// How many blocks wide (in x and z) a cell of level `level` is: `2^level` (levels over
+/// [`MAX_LEVEL`] are taken as it).
+pub fn level_scale(level: u8) -> i64 {
+    1 << level.min(MAX_LEVEL)
+}
+
+/// World block coordinates of the first block of chunk `pos` of level `level`: x and z
+/// `32 · 2^level` blocks a chunk, y 32 (a level's cells are one block high).
+pub fn level_origin(level: u8, pos: ChunkPos) -> [i64; 3] {
+    level_origin_scaled(level_scale(level), pos)
+}
+
+fn level_origin_scaled(scale: i64, pos: ChunkPos) -> [i64; 3] {
+    let n = CHUNK_SIZE as i64;
+    [
+        i64::from(pos.x) * n * scale,
+        i64::from(pos.y) * n,
+        i64::from(pos.z) * n * scale,
+    ]
+}
+
 /// The terrain generator. Cheap to share between threads.
 #[derive(Debug, Clone)]
 pub struct TerrainGenerator {
@@ -466,8 +492,34 @@ impl TerrainGenerator {
 
     /// Generates the chunk at `pos`. Never panics: positions near the `i32` limits work.
     pub fn generate_chunk(&self, pos: ChunkPos) -> Chunk {
-        let [ox, oy, oz] = pos.origin();
+        self.generate_cells(pos, 1)
+    }
+
+    /// Generates chunk `pos` of level of detail `level` (0 to [`MAX_LEVEL`]; larger levels
+    /// are taken as [`MAX_LEVEL`]): [`CHUNK_SIZE`]³ cells, each `2^level` blocks wide in x
+    /// and z and one block high, so that the chunk covers the blocks from
+    /// [`level_origin`]`(level, pos)` on, `32 · 2^level` wide and 32 high. Straight from
+    /// the generator, without the full-detail chunks it covers: each cell holds the block
+    /// the full-detail world has at its *sample column*, the column
+    /// `2^(level−1)` blocks into the cell on x and z (the cell's own column at level 0), at
+    /// the cell's height. Level 0 is [`TerrainGenerator::generate_chunk`] exactly.
+    ///
+    /// Heights stay exact (a cell is one block high), so the sea's surface, a lake's floor
+    /// under its surface and a structure's roof lie at the same height at every level; only
+    /// the horizontal detail thins out, as Distant Horizons' column spans do. Trees and
+    /// structures are sampled as the ground is: a coarse level keeps the fraction of the
+    /// ground they cover, not each one (a 5-block canopy shows in some cells of level 2's
+    /// 4-block cells and not in others).
+    pub fn generate_level_chunk(&self, level: u8, pos: ChunkPos) -> Chunk {
+        self.generate_cells(pos, level_scale(level))
+    }
+
+    /// The chunk of `scale`-block-wide cells at level position `pos`.
+    fn generate_cells(&self, pos: ChunkPos, scale: i64) -> Chunk {
         let n = CHUNK_SIZE as i64;
+        // World blocks: the chunk's first block, and a cell's sample column.
+        let [ox, oy, oz] = level_origin_scaled(scale, pos);
+        let sample = |o: i64, c: usize| o + c as i64 * scale + scale / 2;
         let mut chunk = Chunk::default();
         let sea = self.sea();
         let local = |y: i64| (y - oy).clamp(0, n) as usize;
@@ -478,7 +530,7 @@ impl TerrainGenerator {
         // Ground and sea, a column run at a time.
         for x in 0..CHUNK_SIZE {
             for z in 0..CHUNK_SIZE {
-                let h = self.height_at(ox + x as i64, oz + z as i64);
+                let h = self.height_at(sample(ox, x), sample(oz, z));
                 let shore = h <= sea + 1;
                 let top = if shore { sand } else { grass };
                 let soil = if shore { sand } else { dirt };
@@ -497,16 +549,45 @@ impl TerrainGenerator {
             }
         }
 
-        let margin = CLEARING + 8;
-        let sites = self.sites_in(ox - margin, oz - margin, ox + n + margin, oz + n + margin);
+        let (w, margin) = (n * scale, CLEARING + 8);
+        let sites = self.sites_in(ox - margin, oz - margin, ox + w + margin, oz + w + margin);
         let mut boxes = Vec::new();
-        self.trees(ox, oz, &sites, &mut boxes);
+        let cell = |v: i64| v.div_euclid(TREE_CELL);
+        let mut cells = Vec::new();
+        if scale <= 2 {
+            // Every tree cell whose canopy may reach into the chunk.
+            for cx in cell(ox - CANOPY)..=cell(ox + w + CANOPY) {
+                for cz in cell(oz - CANOPY)..=cell(oz + w + CANOPY) {
+                    cells.push((cx, cz));
+                }
+            }
+        } else {
+            // Only the cells whose canopy may reach a sample column (at most four each).
+            for x in 0..CHUNK_SIZE {
+                let sx = sample(ox, x);
+                for z in 0..CHUNK_SIZE {
+                    let sz = sample(oz, z);
+                    for cx in cell(sx - CANOPY)..=cell(sx + CANOPY) {
+                        for cz in cell(sz - CANOPY)..=cell(sz + CANOPY) {
+                            cells.push((cx, cz));
+                        }
+                    }
+                }
+            }
+            cells.sort_unstable();
+            cells.dedup();
+        }
+        self.trees(&cells, &sites, &mut boxes);
         for site in &sites {
             structure(site, &mut boxes);
         }
+        // The cells whose sample column lies in a box's `[min, max]` on x and z (on y, the
+        // cells are blocks).
+        let first = |min: i64, o: i64| (min - o - scale / 2 + scale - 1).div_euclid(scale);
+        let last = |max: i64, o: i64| (max - o - scale / 2).div_euclid(scale);
         for b in &boxes {
-            let min = [b.min[0] - ox, b.min[1] - oy, b.min[2] - oz].map(|v| v.max(0));
-            let max = [b.max[0] - ox, b.max[1] - oy, b.max[2] - oz].map(|v| v.min(n - 1));
+            let min = [first(b.min[0], ox), b.min[1] - oy, first(b.min[2], oz)].map(|v| v.max(0));
+            let max = [last(b.max[0], ox), b.max[1] - oy, last(b.max[2], oz)].map(|v| v.min(n - 1));
             if min.iter().zip(&max).all(|(a, b)| a <= b) {
                 // Clipped to the chunk above, so always in range.
                 let id = b.role.map_or(BlockId::AIR, |r| self.block(r));
@@ -516,45 +597,41 @@ impl TerrainGenerator {
         chunk
     }
 
-    /// Trees whose canopy may reach into the chunk at `(ox, oz)`, as boxes (leaves first, so
-    /// the trunk wins where they overlap).
-    fn trees(&self, ox: i64, oz: i64, sites: &[Site], out: &mut Vec<WorldBox>) {
+    /// The trees of tree cells `cells`, as boxes (leaves first, so the trunk wins where
+    /// they overlap).
+    fn trees(&self, cells: &[(i64, i64)], sites: &[Site], out: &mut Vec<WorldBox>) {
         let sea = self.sea();
-        let n = CHUNK_SIZE as i64;
-        let cell = |v: i64| v.div_euclid(TREE_CELL);
-        for cx in cell(ox - CANOPY)..=cell(ox + n + CANOPY) {
-            for cz in cell(oz - CANOPY)..=cell(oz + n + CANOPY) {
-                let r = hash(self.config.seed, cx, cz, 1);
-                if (r % 10_000) as f64 >= self.config.tree_density * 10_000.0 {
-                    continue;
-                }
-                let tx = cx * TREE_CELL + 1 + ((r >> 16) % (TREE_CELL as u64 - 2)) as i64;
-                let tz = cz * TREE_CELL + 1 + ((r >> 24) % (TREE_CELL as u64 - 2)) as i64;
-                let near_site = sites.iter().any(|s| {
-                    let [hx, hz] = s.half_extent();
-                    (tx - s.center[0]).abs() <= hx + CLEARING
-                        && (tz - s.center[2]).abs() <= hz + CLEARING
-                });
-                let h = self.height_at(tx, tz);
-                if near_site || h <= sea + 1 {
-                    continue;
-                }
-                let top = h + 4 + ((r >> 32) % 3) as i64;
-                out.push(bx(
-                    [tx - 2, top - 2, tz - 2],
-                    [tx + 2, top - 1, tz + 2],
-                    LEAVES,
-                ));
-                out.push(bx([tx - 1, top, tz - 1], [tx + 1, top, tz + 1], LEAVES));
-                out.push(bx([tx - 1, top + 1, tz], [tx + 1, top + 1, tz], LEAVES));
-                out.push(bx([tx, top + 1, tz - 1], [tx, top + 1, tz + 1], LEAVES));
-                // Corners of the wide layers are cut at random, as trees look less boxy so.
-                for (i, (dx, dz)) in [(-2, -2), (2, -2), (-2, 2), (2, 2)].into_iter().enumerate() {
-                    let y = top - 1 - ((r >> (40 + i)) & 1) as i64;
-                    out.push(air([tx + dx, y, tz + dz], [tx + dx, top - 1, tz + dz]));
-                }
-                out.push(bx([tx, h + 1, tz], [tx, top, tz], WOOD));
+        for &(cx, cz) in cells {
+            let r = hash(self.config.seed, cx, cz, 1);
+            if (r % 10_000) as f64 >= self.config.tree_density * 10_000.0 {
+                continue;
             }
+            let tx = cx * TREE_CELL + 1 + ((r >> 16) % (TREE_CELL as u64 - 2)) as i64;
+            let tz = cz * TREE_CELL + 1 + ((r >> 24) % (TREE_CELL as u64 - 2)) as i64;
+            let near_site = sites.iter().any(|s| {
+                let [hx, hz] = s.half_extent();
+                (tx - s.center[0]).abs() <= hx + CLEARING
+                    && (tz - s.center[2]).abs() <= hz + CLEARING
+            });
+            let h = self.height_at(tx, tz);
+            if near_site || h <= sea + 1 {
+                continue;
+            }
+            let top = h + 4 + ((r >> 32) % 3) as i64;
+            out.push(bx(
+                [tx - 2, top - 2, tz - 2],
+                [tx + 2, top - 1, tz + 2],
+                LEAVES,
+            ));
+            out.push(bx([tx - 1, top, tz - 1], [tx + 1, top, tz + 1], LEAVES));
+            out.push(bx([tx - 1, top + 1, tz], [tx + 1, top + 1, tz], LEAVES));
+            out.push(bx([tx, top + 1, tz - 1], [tx, top + 1, tz + 1], LEAVES));
+            // Corners of the wide layers are cut at random, as trees look less boxy so.
+            for (i, (dx, dz)) in [(-2, -2), (2, -2), (-2, 2), (2, 2)].into_iter().enumerate() {
+                let y = top - 1 - ((r >> (40 + i)) & 1) as i64;
+                out.push(air([tx + dx, y, tz + dz], [tx + dx, top - 1, tz + dz]));
+            }
+            out.push(bx([tx, h + 1, tz], [tx, top, tz], WOOD));
         }
     }
 
@@ -936,5 +1013,82 @@ mod tests {
             g.generate_chunk(ChunkPos::new(0, 3, 0)).as_uniform(),
             Some(AIR)
         );
+    }
+
+    #[test]
+    fn a_level_cell_holds_the_full_detail_block_of_its_sample_column() {
+        // Around the showcase's structure (glass, trees, shore and sea), at every level:
+        // each cell is the block the full-detail chunks hold at its sample column.
+        let g = generator();
+        let site = g.sites_in(-768, -768, 768, 768)[0];
+        let n = CHUNK_SIZE as i64;
+        let mut kinds = std::collections::BTreeSet::new();
+        for level in 0..=3u8 {
+            let s = level_scale(level);
+            let at = |v: i64| v.div_euclid(n * s) as i32;
+            let pos = ChunkPos::new(at(site.center[0]), 0, at(site.center[2]));
+            let chunk = g.generate_level_chunk(level, pos);
+            let [ox, oy, oz] = level_origin(level, pos);
+            // Fine chunks by position, generated once each.
+            let mut fine = std::collections::HashMap::new();
+            for x in (0..CHUNK_SIZE).step_by(3) {
+                for z in (0..CHUNK_SIZE).step_by(3) {
+                    for y in 0..CHUNK_SIZE {
+                        let b = [
+                            ox + x as i64 * s + s / 2,
+                            oy + y as i64,
+                            oz + z as i64 * s + s / 2,
+                        ];
+                        let c = b.map(|v| v.div_euclid(n));
+                        let key = (c[0], c[1], c[2]);
+                        let f = fine.entry(key).or_insert_with(|| {
+                            g.generate_chunk(ChunkPos::new(c[0] as i32, c[1] as i32, c[2] as i32))
+                        });
+                        let l = b.map(|v| v.rem_euclid(n) as usize);
+                        let want = f.get(l[0], l[1], l[2]).unwrap();
+                        let got = chunk.get(x, y, z).unwrap();
+                        assert_eq!(got, want, "level {level} cell {x},{y},{z} (block {b:?})");
+                        kinds.insert(got.index());
+                    }
+                }
+            }
+        }
+        // The sampled cells held sea, glass and leaves, not only ground.
+        for id in [WATER, GLASS, LEAVES, SAND, GRASS] {
+            assert!(kinds.contains(&id.index()), "no {id:?} sampled");
+        }
+    }
+
+    #[test]
+    fn the_sea_surface_is_at_the_same_height_at_every_level() {
+        let g = generator();
+        let sea = g.config().sea_level as usize;
+        for level in 0..=MAX_LEVEL {
+            let c = g.generate_level_chunk(level, ChunkPos::new(3, 0, -5));
+            let mut water_columns = 0;
+            for x in 0..CHUNK_SIZE {
+                for z in 0..CHUNK_SIZE {
+                    if c.get(x, sea, z).unwrap() == WATER {
+                        water_columns += 1;
+                        assert_ne!(c.get(x, sea + 1, z).unwrap(), WATER, "level {level}");
+                    }
+                }
+            }
+            assert!(water_columns > 0, "level {level}: no sea in the chunk");
+        }
+        // Levels past the coarsest are the coarsest.
+        let p = ChunkPos::new(1, 0, 1);
+        assert_eq!(
+            g.generate_level_chunk(MAX_LEVEL + 3, p).to_dense(),
+            g.generate_level_chunk(MAX_LEVEL, p).to_dense()
+        );
+        for p in [
+            ChunkPos::new(ChunkPos::MAX, 0, ChunkPos::MIN),
+            ChunkPos::new(ChunkPos::MIN, 1, ChunkPos::MAX),
+        ] {
+            g.generate_level_chunk(MAX_LEVEL, p)
+                .check_invariants()
+                .unwrap();
+        }
     }
 }
