@@ -399,6 +399,69 @@ pub(crate) fn stream(a: StreamArgs, device: &headless::Device) -> Result<()> {
     Ok(())
 }
 
+/// The default terrain to a far view distance in levels of detail (`voxel_lab::far`).
+pub(crate) fn far(a: FarArgs, device: &headless::Device) -> Result<()> {
+    let opts = voxel_lab::far::FarOptions {
+        full_detail: a.full_detail,
+        view_distance: a.view_distance,
+        size: a.size,
+        seed: a.seed,
+        techniques: names(&a.techniques, &Technique::ALL, false, technique)
+            .map_err(|e| e.in_option("--techniques"))?,
+        compare: a.compare,
+        out: a.out.clone(),
+    };
+    opts.validate()?;
+    writable_dir(&a.out)?;
+    let ctx = device.context()?;
+    eprintln!("adapter: {}", ctx.caps.adapter_name);
+    let r = voxel_lab::far::run(&ctx, &opts)?;
+    let mib = |b: u64| b as f64 / f64::from(1 << 20);
+    println!(
+        "view distance {} chunks (full detail to {}, levels to {}): built in {:.0} ms, uploaded in {:.0} ms; GPU {:.1} MiB of buffers ({:.1} MiB of quads)",
+        r.view_distance,
+        r.full_detail,
+        r.coarsest,
+        r.build_ms,
+        r.upload_ms,
+        mib(r.gpu_buffer_bytes),
+        mib(r.gpu_quad_bytes)
+    );
+    println!(
+        "| level | cell (blocks) | chunks from..to | chunks (drawn) | quads opaque / cutout / translucent | MiB | KiB per chunk of distance |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for l in &r.levels {
+        println!(
+            "| {} | {} | {}..{} | {} ({}) | {} / {} / {} | {:.1} | {:.1} |",
+            l.level,
+            l.cell_blocks,
+            l.from_chunks,
+            l.to_chunks,
+            l.chunks,
+            l.chunks_drawn,
+            l.quads[0],
+            l.quads[1],
+            l.quads[2],
+            mib(l.bytes),
+            l.bytes_per_chunk_of_distance / 1024.0
+        );
+    }
+    if let Some(c) = &r.compare {
+        println!(
+            "against full detail: holes {:.4} % of pixels; far pixels {:.1} %, far water {:.1} %; far water mean step {:.2}/255, far ground {:.2}/255; far mean |error| {:.2}/255",
+            c.holes * 100.0,
+            c.far_pixels * 100.0,
+            c.far_water_pixels * 100.0,
+            c.water_step(),
+            c.ground_step(),
+            c.far_mean_abs
+        );
+    }
+    println!("wrote {}", a.out.join("far.json").display());
+    Ok(())
+}
+
 /// Renders one scene with every technique and writes the pictures, error maps and sheet.
 pub(crate) fn gallery(a: GalleryArgs, device: &headless::Device) -> Result<()> {
     writable_dir(&a.out)?;

@@ -9,7 +9,7 @@ use voxel_lab::headless;
 use voxel_render::{BayerSize, Technique, WeightFunction};
 
 mod commands;
-use commands::{backends, eval, gallery, render, showcase, stats, stream, window};
+use commands::{backends, eval, far, gallery, render, showcase, stats, stream, window};
 
 /// The voxel OIT renderer's demo: a window when there is a display, else the headless
 /// showcase.
@@ -88,6 +88,10 @@ enum Command {
     /// Flies over generated terrain with chunk streaming; writes stream.json (CPU and GPU
     /// time per frame, uploads, memory), frames.json and a chart of CPU ms per frame.
     Stream(StreamArgs),
+    /// The default terrain to a far view distance in levels of detail: a picture per
+    /// technique, GPU memory and quads per level, build time (--compare: scored against
+    /// full detail of the same view); far.json.
+    Far(FarArgs),
     /// One scene (a scene file or a .vox model) under every technique: each picture, its
     /// FLIP error map against the reference, and gallery.png with all of them.
     Gallery(GalleryArgs),
@@ -136,6 +140,32 @@ fn draw_mode(s: &str) -> Result<voxel_render::DrawMode> {
             value: s.to_owned(),
             expected: "indirect or per-chunk",
         })
+}
+
+#[derive(Args, Debug)]
+struct FarArgs {
+    /// Full detail to this many chunks from the eye (even, 2 to 64).
+    #[arg(long, default_value_t = 32)]
+    full_detail: u32,
+    /// View distance in chunks (the full detail to 2048): rings of levels 2x, 4x, ...
+    /// coarser reach it.
+    #[arg(long, default_value_t = 512)]
+    view_distance: u32,
+    /// Techniques: all, or a comma-separated list.
+    #[arg(long, num_args = 1.., value_delimiter = ',', default_value = "sorted-quads")]
+    techniques: Vec<String>,
+    /// Also render full detail to the view distance (at most 64) and score the levels.
+    #[arg(long)]
+    compare: bool,
+    /// Picture size.
+    #[arg(long, value_parser = size, default_value = "1280x720")]
+    size: (u32, u32),
+    /// Terrain seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
 }
 
 #[derive(Args, Debug)]
@@ -471,6 +501,7 @@ fn main() {
         Some(Command::Render(a)) => render(a, &device),
         Some(Command::Eval(a)) => eval(a, &device),
         Some(Command::Stream(a)) => stream(a, &device),
+        Some(Command::Far(a)) => far(a, &device),
         Some(Command::Gallery(a)) => gallery(a, &device),
         Some(Command::Backends(a)) => backends(a),
     };

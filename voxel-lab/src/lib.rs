@@ -30,6 +30,7 @@ pub mod distribution;
 pub mod edges;
 pub mod error;
 pub mod eval;
+pub mod far;
 pub mod files;
 pub mod gallery;
 pub mod headless;

@@ -15,6 +15,7 @@
 
 pub mod ao;
 mod bits;
+pub mod levels;
 pub mod light;
 mod mesher;
 pub mod order;

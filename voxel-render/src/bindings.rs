@@ -186,6 +186,10 @@ pub(crate) struct ChunkUniforms {
     pub origin: [i32; 3],
     /// Whole-chunk opacity multiplier (fade-in), 1 when settled.
     pub alpha: f32,
+    /// Blocks per cell along x and z: 1 for a chunk, `2^level` for a chunk of a level of
+    /// detail ([`voxel_core::level_scale`]; its cells are one block high).
+    pub scale: u32,
+    pub _pad: [u32; 3],
 }
 
 /// Layouts every chunk pipeline is built against.
@@ -314,7 +318,11 @@ mod tests {
         assert_layout::<ChunkUniforms>(
             &module,
             "ChunkInfo",
-            &[field!(ChunkUniforms, origin), field!(ChunkUniforms, alpha)],
+            &[
+                field!(ChunkUniforms, origin),
+                field!(ChunkUniforms, alpha),
+                field!(ChunkUniforms, scale),
+            ],
         );
     }
 }

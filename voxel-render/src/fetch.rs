@@ -284,7 +284,7 @@ pub(crate) struct Records {
 }
 
 /// Bytes of a chunk record (`ChunkUniforms`, checked by a test).
-pub(crate) const RECORD_BYTES: usize = 16;
+pub(crate) const RECORD_BYTES: usize = 32;
 
 impl Records {
     /// Room for `slots` records on a device of `limits`.

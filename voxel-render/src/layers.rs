@@ -93,8 +93,9 @@ pub(crate) fn bounds(planes: &[Plane]) -> Option<(Vec3, Vec3)> {
 /// (filled by the chunk store's culling when asked for).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct LayerBuffer {
-    /// Each chunk and the end of its planes in `planes` (its start is the previous end).
-    runs: Vec<(ChunkPos, u32)>,
+    /// Each chunk, its level of detail and the end of its planes in `planes` (its start is
+    /// the previous end).
+    runs: Vec<(ChunkPos, u8, u32)>,
     planes: Vec<Plane>,
 }
 
@@ -105,11 +106,12 @@ impl LayerBuffer {
         self.planes.clear();
     }
 
-    /// Adds the chunk at `pos` with its `planes` (nothing when it has none).
-    pub(crate) fn push(&mut self, pos: ChunkPos, planes: &[Plane]) {
+    /// Adds the chunk at `pos` of level of detail `level` with its `planes` (nothing when it
+    /// has none).
+    pub(crate) fn push(&mut self, pos: ChunkPos, level: u8, planes: &[Plane]) {
         if !planes.is_empty() {
             self.planes.extend_from_slice(planes);
-            self.runs.push((pos, self.planes.len() as u32));
+            self.runs.push((pos, level, self.planes.len() as u32));
         }
     }
 
@@ -125,28 +127,32 @@ impl LayerBuffer {
 /// The planes of the visible translucent chunks of a frame (see [`LayerBuffer`]).
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct VisibleLayers<'a> {
-    runs: &'a [(ChunkPos, u32)],
+    runs: &'a [(ChunkPos, u8, u32)],
     planes: &'a [Plane],
 }
 
 impl<'a> VisibleLayers<'a> {
-    /// Each chunk and its planes.
-    pub(crate) fn iter(&self) -> impl Iterator<Item = (ChunkPos, &'a [Plane])> + 'a {
+    /// Each chunk, its level of detail and its planes (chunk-local cells).
+    pub(crate) fn iter(&self) -> impl Iterator<Item = (ChunkPos, u8, &'a [Plane])> + 'a {
         let planes = self.planes;
         let mut start = 0;
-        self.runs.iter().map(move |&(pos, end)| {
+        self.runs.iter().map(move |&(pos, level, end)| {
             let run = &planes[start as usize..end as usize];
             start = end;
-            (pos, run)
+            (pos, level, run)
         })
     }
 
     /// The box of each chunk's translucent mesh, world blocks.
     pub(crate) fn boxes(&self) -> impl Iterator<Item = (DVec3, DVec3)> + 'a {
-        self.iter().filter_map(|(pos, planes)| {
+        self.iter().filter_map(|(pos, level, planes)| {
             let origin = DVec3::from(pos.origin().map(|v| v as f64));
+            let scale = DVec3::from(crate::chunks::gpu_chunk::cell_scale(level));
             let (lo, hi) = bounds(planes)?;
-            Some((origin + lo.as_dvec3(), origin + hi.as_dvec3()))
+            Some((
+                origin + lo.as_dvec3() * scale,
+                origin + hi.as_dvec3() * scale,
+            ))
         })
     }
 }
@@ -193,10 +199,10 @@ mod tests {
         assert!((f64::from(glass.tau) - want).abs() < 1e-6, "{}", glass.tau);
 
         let mut buffer = LayerBuffer::default();
-        buffer.push(ChunkPos::new(1, 2, 3), &planes);
-        buffer.push(ChunkPos::new(4, 5, 6), &[]);
-        buffer.push(ChunkPos::new(7, 8, 9), &planes[..1]);
-        let runs: Vec<_> = buffer.view().iter().map(|(p, r)| (p, r.len())).collect();
+        buffer.push(ChunkPos::new(1, 2, 3), 0, &planes);
+        buffer.push(ChunkPos::new(4, 5, 6), 0, &[]);
+        buffer.push(ChunkPos::new(7, 8, 9), 0, &planes[..1]);
+        let runs: Vec<_> = buffer.view().iter().map(|(p, _, r)| (p, r.len())).collect();
         assert_eq!(
             runs,
             [(ChunkPos::new(1, 2, 3), 3), (ChunkPos::new(7, 8, 9), 1)]

@@ -78,6 +78,7 @@ pub use oit::{
 pub use readback::Image;
 pub use renderer::{
     FrameStats, Renderer, config::Lighting, config::OUTPUT_FORMATS, config::RendererConfig,
+    level_key,
 };
 pub use stages::{
     Both, GameFrame, GameStages, NoGame, Stages, TranslucentContract, TranslucentObject,

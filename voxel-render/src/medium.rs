@@ -463,15 +463,13 @@ fn translucent_near(chunks: &ChunkStore, eye: DVec3, reach: f64) -> Vec<NearFace
                 if chunk.mesh(MeshKind::Translucent).is_none() {
                     continue;
                 }
-                let o = pos.origin().map(|v| v as f64);
+                let o = DVec3::from(pos.origin().map(|v| v as f64));
+                let scale = DVec3::from(chunk.scale());
                 for q in chunk.translucent_quads() {
                     let Some(u) = q.unpack() else { continue };
                     let axis = u.face.axis();
                     let (min, max) = u.bounds();
-                    let (min, max) = (
-                        DVec3::from(min) + DVec3::from(o),
-                        DVec3::from(max) + DVec3::from(o),
-                    );
+                    let (min, max) = (DVec3::from(min) * scale + o, DVec3::from(max) * scale + o);
                     let distance = (eye.clamp(min, max) - eye).length();
                     if distance <= reach {
                         // A +face's block lies below its plane, a -face's above.

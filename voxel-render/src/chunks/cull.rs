@@ -18,6 +18,8 @@ pub(super) const REGION_CHUNKS: [i32; 3] = [8, 4, 8];
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Member {
     pub(super) pos: ChunkPos,
+    /// Its level of detail (0: a chunk; see [`super::GpuChunk::level`]).
+    pub(super) level: u8,
     pub(super) slot: u32,
     pub(super) meshes: [Option<Alloc>; 3],
     /// Where its translucent mesh's planes lie in its region's `planes`.
@@ -31,6 +33,10 @@ pub(super) struct Region {
     pub(super) key: [i32; 3],
     /// Block coordinates of the region's lowest corner.
     pub(super) origin: [i64; 3],
+    /// The coarsest level of detail among its members (set, never lowered while the
+    /// region lives): a member of level `l` reaches `2^l` chunks in x and z from its
+    /// position, past the region's own box.
+    pub(super) level: u8,
     pub(super) members: Vec<Member>,
     /// The translucent planes of the members ([`crate::layers`]), member by member, and
     /// how many of them belong to no member any more (compacted when more than half).
@@ -105,6 +111,7 @@ impl Regions {
         &mut self,
         slot: u32,
         pos: ChunkPos,
+        level: u8,
         meshes: [Option<Alloc>; 3],
         planes: Option<&[Plane]>,
     ) {
@@ -114,7 +121,8 @@ impl Regions {
         }
         if let Some(p) = self.places[s] {
             let region = &mut self.regions[p.region as usize];
-            if region.members[p.index as usize].pos == pos {
+            let m = &region.members[p.index as usize];
+            if m.pos == pos && m.level == level {
                 region.members[p.index as usize].meshes = meshes;
                 if let Some(planes) = planes {
                     region.set_planes(p.index as usize, planes);
@@ -129,6 +137,7 @@ impl Regions {
             self.regions.push(Region {
                 key,
                 origin: [0, 1, 2].map(|k| i64::from(key[k]) * i64::from(REGION_CHUNKS[k]) * n),
+                level: 0,
                 members: Vec::new(),
                 planes: Vec::new(),
                 garbage: 0,
@@ -136,6 +145,7 @@ impl Regions {
             self.regions.len() as u32 - 1
         });
         let r = &mut self.regions[region as usize];
+        r.level = r.level.max(level);
         let index = r.members.len();
         self.places[s] = Some(Place {
             region,
@@ -144,6 +154,7 @@ impl Regions {
         let at = r.planes.len() as u32;
         r.members.push(Member {
             pos,
+            level,
             slot,
             meshes,
             planes: [at, at],
@@ -180,21 +191,25 @@ impl Regions {
     }
 
     /// Calls `visit` with every chunk whose box is not wholly outside one of the frustum's
-    /// planes, its distance ([`Frustum::chunk_distance`]: the same chunks, the same
+    /// planes, its distance ([`Frustum::level_chunk_distance`]: the same chunks, the same
     /// numbers) and its translucent planes, region by region.
     pub(super) fn cull(&self, frustum: &Frustum, mut visit: impl FnMut(&Member, f64, &[Plane])) {
-        let size = REGION_CHUNKS.map(|c| i64::from(c) * CHUNK_SIZE as i64);
+        let n = CHUNK_SIZE as i64;
         for r in &self.regions {
+            // Its box, reaching as far as its widest member does past it.
+            let reach = (voxel_core::level_scale(r.level) - 1) * n;
+            let size =
+                [0, 1, 2].map(|k| i64::from(REGION_CHUNKS[k]) * n + if k == 1 { 0 } else { reach });
             match frustum.region_cover(r.origin, size) {
                 Cover::Outside => {}
                 Cover::Inside => {
                     for (i, m) in r.members.iter().enumerate() {
-                        visit(m, frustum.centre_distance(m.pos), r.planes_of(i));
+                        visit(m, frustum.centre_distance(m.pos, m.level), r.planes_of(i));
                     }
                 }
                 Cover::Partial => {
                     for (i, m) in r.members.iter().enumerate() {
-                        if let Some(d) = frustum.chunk_distance(m.pos) {
+                        if let Some(d) = frustum.level_chunk_distance(m.pos, m.level) {
                             visit(m, d, r.planes_of(i));
                         }
                     }
@@ -309,11 +324,17 @@ impl Frustum {
 
     /// Distance from the eye to the chunk's centre, or `None` when the chunk's box lies
     /// wholly outside one plane.
+    #[cfg(test)]
     pub(crate) fn chunk_distance(&self, pos: ChunkPos) -> Option<f64> {
-        let s = CHUNK_SIZE as f64;
+        self.level_chunk_distance(pos, 0)
+    }
+
+    /// [`Frustum::level_chunk_distance`] of the chunk keyed `pos` of level of detail `level`
+    /// (its box `2^level` chunks wide in x and z).
+    pub(crate) fn level_chunk_distance(&self, pos: ChunkPos, level: u8) -> Option<f64> {
         let min = self.relative(pos);
         let lo = min.as_vec3();
-        let hi = (min + DVec3::splat(s)).as_vec3();
+        let hi = (min + Self::extent(level)).as_vec3();
         for p in &self.planes {
             let n = p.truncate();
             // The box corner farthest along the plane normal.
@@ -322,7 +343,12 @@ impl Frustum {
                 return None;
             }
         }
-        Some(self.centre_distance(pos))
+        Some(self.centre_distance(pos, level))
+    }
+
+    /// The size of a chunk of level `level`, blocks.
+    fn extent(level: u8) -> DVec3 {
+        DVec3::from(super::gpu_chunk::cell_scale(level)) * CHUNK_SIZE as f64
     }
 
     /// The chunk's lowest corner relative to the eye.
@@ -332,14 +358,14 @@ impl Frustum {
     }
 
     /// Distance from the eye to the chunk's centre (the number
-    /// [`Frustum::chunk_distance`] gives).
-    fn centre_distance(&self, pos: ChunkPos) -> f64 {
-        (self.relative(pos) + DVec3::splat(CHUNK_SIZE as f64 / 2.0)).length()
+    /// [`Frustum::level_chunk_distance`] gives).
+    fn centre_distance(&self, pos: ChunkPos, level: u8) -> f64 {
+        (self.relative(pos) + Self::extent(level) / 2.0).length()
     }
 
     /// Where the box from block `origin` of `size` blocks lies: wholly outside one plane,
     /// wholly inside all of them, or neither, decided only where the decision holds for
-    /// [`Frustum::chunk_distance`]'s test of every chunk in the box despite rounding. That
+    /// [`Frustum::level_chunk_distance`]'s test of every chunk in the box despite rounding. That
     /// test rounds the box corners to f32 and sums three products and the plane's offset
     /// in f32: at most about 3.2·10⁻⁷ of `S` = Σ|nᵢ|·|corner coordinateᵢ| + |w| off the
     /// exact value, and so is this one's. A chunk's exact value lies between this box's

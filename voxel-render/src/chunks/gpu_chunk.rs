@@ -12,7 +12,12 @@ use crate::layers::{self, Plane};
 /// A chunk on the GPU: where its meshes are, and what techniques derive from.
 #[derive(Debug)]
 pub struct GpuChunk {
+    /// Where it starts (a chunk's position; for a chunk of a level of detail, the
+    /// full-detail chunk at its first block).
     pub(super) pos: ChunkPos,
+    /// Its level of detail: 0 for a chunk, else its cells are `2^level` blocks wide in x and
+    /// z ([`voxel_core::level_scale`]).
+    pub(super) level: u8,
     pub(super) meshes: [Option<Alloc>; 3],
     /// The translucent quads in their current GPU order, kept for techniques that derive
     /// something from them (sorting, the fitted WBOIT weight).
@@ -49,6 +54,16 @@ impl GpuChunk {
         self.pos
     }
 
+    /// Its level of detail (0: a chunk).
+    pub fn level(&self) -> u8 {
+        self.level
+    }
+
+    /// Blocks per cell along x, y and z.
+    pub(crate) fn scale(&self) -> [f64; 3] {
+        cell_scale(self.level)
+    }
+
     /// Whether the translucent mesh has a face of a volume (a block type with absorption,
     /// [`voxel_core::BlockDef::absorption`]).
     pub(crate) fn has_volume(&self) -> bool {
@@ -63,10 +78,11 @@ impl GpuChunk {
     /// The box the translucent quads span, in world blocks (min, max).
     pub(crate) fn translucent_bounds(&self) -> Option<([f64; 3], [f64; 3])> {
         let o = self.pos.origin().map(|v| v as f64);
+        let s = self.scale();
         self.translucent_bounds.map(|(lo, hi)| {
             (
-                [0, 1, 2].map(|a| lo[a] + o[a]),
-                [0, 1, 2].map(|a| hi[a] + o[a]),
+                [0, 1, 2].map(|a| lo[a] * s[a] + o[a]),
+                [0, 1, 2].map(|a| hi[a] * s[a] + o[a]),
             )
         })
     }
@@ -79,6 +95,7 @@ impl GpuChunk {
             lo: DVec3::from(lo),
             hi: DVec3::from(hi),
             origin: self.pos.origin().map(|v| v as f64),
+            scale: self.scale(),
             planes: &self.translucent_planes,
             quads: &self.translucent,
         })
@@ -105,6 +122,8 @@ pub(crate) struct Surfaces<'a> {
     pub hi: DVec3,
     /// The chunk's origin, world blocks.
     pub origin: [f64; 3],
+    /// Blocks per cell along x, y and z (1 but in a level of detail).
+    pub scale: [f64; 3],
     /// The distinct planes: which way the quads face, chunk-local coordinate on the axis.
     pub planes: &'a [(Face, u8)],
     /// The quads, in their drawn order.
@@ -112,6 +131,16 @@ pub(crate) struct Surfaces<'a> {
 }
 
 impl Surfaces<'_> {
+    /// World blocks of the chunk-local point `local` (cells).
+    pub(crate) fn world(&self, local: [f64; 3]) -> DVec3 {
+        DVec3::from([0, 1, 2].map(|a| self.origin[a] + local[a] * self.scale[a]))
+    }
+
+    /// World coordinate along `axis` of the chunk-local plane `at` (cells).
+    pub(crate) fn plane_at(&self, axis: usize, at: f64) -> f64 {
+        self.origin[axis] + at * self.scale[axis]
+    }
+
     /// Distances from `eye` to the box: its nearest point, its centre, its farthest corner.
     pub(crate) fn distances(&self, eye: DVec3) -> [f64; 3] {
         let near = eye.clamp(self.lo, self.hi).distance(eye);
@@ -137,4 +166,10 @@ pub(super) fn distinct_planes(layers: &[Plane]) -> Vec<(Face, u8)> {
 pub(super) fn layers_bounds(layers: &[Plane]) -> Option<([f64; 3], [f64; 3])> {
     let (lo, hi) = layers::bounds(layers)?;
     Some((lo.as_dvec3().to_array(), hi.as_dvec3().to_array()))
+}
+
+/// Blocks per cell along x, y and z at level of detail `level`.
+pub(crate) fn cell_scale(level: u8) -> [f64; 3] {
+    let s = voxel_core::level_scale(level) as f64;
+    [s, 1.0, s]
 }

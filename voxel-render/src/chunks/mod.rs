@@ -9,7 +9,7 @@
 //! into regions of [`REGION_CHUNKS`] (Sodium's 8 × 4 × 8), whose box is tested first, so that
 //! a region outside the frustum costs one test and one wholly inside costs none per chunk;
 //! only the chunks of regions the frustum's planes cut are tested one by one. The result is
-//! exactly what testing every chunk with [`Frustum::chunk_distance`] finds (a randomized
+//! exactly what testing every chunk with [`Frustum::level_chunk_distance`] finds (a randomized
 //! test).
 //!
 //! Each upload of a chunk gets a new *generation* number, so that what a technique derives

@@ -270,10 +270,15 @@ impl ChunkStore {
     ///
     /// The places a frame in flight draws are never written: a replaced mesh keeps its
     /// place until that frame is submitted ([`ChunkStore::frame_submitted`]).
+    ///
+    /// `level` is the chunk's level of detail (0: a chunk; see
+    /// [`crate::Renderer::upload_level_chunk`]), `pos` its key: the full-detail chunk where
+    /// it starts.
     pub(crate) fn upload(
         &mut self,
         ctx: &GpuContext,
         pos: ChunkPos,
+        level: u8,
         meshes: &ChunkMeshes,
     ) -> Result<()> {
         let limit = self.arena.max_mesh_quads();
@@ -342,13 +347,13 @@ impl ChunkStore {
                 (s, 1.0)
             }
         };
-        let origin = pos.origin().map(|v| v as i32);
-        self.write_info(ctx, slot, ChunkUniforms { origin, alpha }, false);
+        self.write_info(ctx, slot, record(pos, level, alpha), false);
         // One pass over the translucent quads; their box and distinct planes follow.
         let planes = layers::planes(&meshes.translucent, &self.block_opacity);
-        self.regions.set(slot, pos, allocs, Some(&planes));
+        self.regions.set(slot, pos, level, allocs, Some(&planes));
         self.slots[slot as usize] = Some(GpuChunk {
             pos,
+            level,
             meshes: allocs,
             translucent: meshes.translucent.clone(),
             translucent_bounds: layers_bounds(&planes),
@@ -521,10 +526,8 @@ impl ChunkStore {
         in_frame: bool,
     ) {
         if let Some(&slot) = self.by_pos.get(&pos) {
-            let info = ChunkUniforms {
-                origin: pos.origin().map(|v| v as i32),
-                alpha: alpha.clamp(0.0, 1.0),
-            };
+            let level = self.by_slot(slot).map_or(0, |c| c.level);
+            let info = record(pos, level, alpha.clamp(0.0, 1.0));
             self.write_info(ctx, slot, info, in_frame);
         }
     }
@@ -537,7 +540,7 @@ impl ChunkStore {
 
     /// Finds the visible meshes of every kind in one pass over the regions (see the module
     /// docs) and puts them in draw order into `out` (see [`Culled`]): the meshes of every
-    /// chunk whose box [`Frustum::chunk_distance`] does not put outside the frustum. With
+    /// chunk whose box [`Frustum::level_chunk_distance`] does not put outside the frustum. With
     /// `layers`, it also copies the visible translucent meshes' planes
     /// ([`Culled::translucent_layers`]).
     pub(crate) fn cull(&self, frustum: &Frustum, layers: bool, out: &mut Culled) {
@@ -562,13 +565,13 @@ impl ChunkStore {
             }
             if let Some(mesh) = m.meshes[2] {
                 far.push(FarEntry {
-                    key: voxel_mesh::order::chunk_order_key(m.pos, eye),
+                    key: order_key(m.pos, m.level, eye),
                     pos: m.pos,
                     slot: m.slot,
                     mesh,
                 });
                 if layers {
-                    buffer.push(m.pos, planes);
+                    buffer.push(m.pos, m.level, planes);
                 }
             }
         });
@@ -635,7 +638,7 @@ impl ChunkStore {
         for ((s, k, _), to) in moving.iter().zip(placed) {
             if let Some(c) = self.slots[*s].as_mut() {
                 c.meshes[*k] = Some(to);
-                self.regions.set(*s as u32, c.pos, c.meshes, None);
+                self.regions.set(*s as u32, c.pos, c.level, c.meshes, None);
             }
         }
         self.remake_groups(&ctx.device);
@@ -659,4 +662,31 @@ fn write_order(
         }
         _ => Err(quads),
     }
+}
+
+/// The record of the chunk keyed `pos` (where it starts) of level `level`.
+fn record(pos: ChunkPos, level: u8, alpha: f32) -> ChunkUniforms {
+    ChunkUniforms {
+        origin: pos.origin().map(|v| v as i32),
+        alpha,
+        scale: voxel_core::level_scale(level) as u32,
+        _pad: [0; 3],
+    }
+}
+
+/// The draw-order key of the translucent mesh of the chunk keyed `pos` of level `level`
+/// (largest first): [`voxel_mesh::order::chunk_order_key`] among the chunks of a level (in
+/// the level's own grid, whose cells it is exact for), coarser levels before finer ones.
+/// Exact for levels laid out as rings around the eye: each level's chunks cover a
+/// square (in x and z) that holds the finer levels' and the eye, so a ray from the eye
+/// leaves the finer levels' square before it meets a coarser chunk.
+pub(crate) fn order_key(pos: ChunkPos, level: u8, eye: [f64; 3]) -> u128 {
+    let s = voxel_core::level_scale(level);
+    let in_level = ChunkPos::new(
+        (i64::from(pos.x).div_euclid(s)) as i32,
+        pos.y,
+        (i64::from(pos.z).div_euclid(s)) as i32,
+    );
+    let eye = [eye[0] / s as f64, eye[1], eye[2] / s as f64];
+    (u128::from(level) << 100) | voxel_mesh::order::chunk_order_key(in_level, eye)
 }

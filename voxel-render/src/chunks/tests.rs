@@ -122,6 +122,7 @@ fn regions_follow_uploads_and_removals() {
             regions.set(
                 slot,
                 pos,
+                0,
                 [mesh(0, step), None, mesh(1, step)],
                 planes.as_deref(),
             );
@@ -209,7 +210,7 @@ fn region_culling_finds_what_testing_every_chunk_finds() {
                 continue;
             }
             let planes = marked_planes(u64::from(slot % 3), slot);
-            regions.set(slot, pos, [mesh(0, slot), None, None], Some(&planes));
+            regions.set(slot, pos, 0, [mesh(0, slot), None, None], Some(&planes));
             held.push((slot, pos, planes));
         }
         for _ in 0..40 {

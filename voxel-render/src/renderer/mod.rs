@@ -63,7 +63,7 @@ pub struct ChunkMemory {
     pub arena_bytes: u64,
     /// Of those, bytes holding quads (the rest is free room and fragmentation).
     pub quad_bytes: u64,
-    /// Bytes of the chunk records (16 per slot, with room to grow).
+    /// Bytes of the chunk records (32 per slot, with room to grow).
     pub record_bytes: u64,
     /// Bytes of the indirect draw commands (16 per mesh drawn, with room to grow).
     pub indirect_bytes: u64,
@@ -337,8 +337,41 @@ impl Renderer {
                 ChunkPos::MAX
             )));
         }
+        self.upload_keyed(pos, 0, meshes)
+    }
+
+    /// Uploads or replaces chunk `pos` of level of detail `level` (1 to
+    /// [`voxel_core::MAX_LEVEL`]): the meshes of a [`voxel_core::TerrainGenerator::generate_level_chunk`]
+    /// chunk (or any chunk of cells `2^level` blocks wide in x and z and one block high),
+    /// meshed as any chunk is. It is drawn by every technique as a chunk is, and fades in as
+    /// one does. Level 0 is [`Renderer::upload_chunk`].
+    ///
+    /// It is kept under the full-detail chunk where it starts, [`level_key`]`(level, pos)`,
+    /// and replaces whatever chunk was kept there; [`Renderer::remove_chunk`] of that key
+    /// removes it. Levels are meant to lie in rings around the eye, each a square (in
+    /// chunks, x and z) holding the finer ones: the order of translucent meshes across
+    /// levels is exact then (coarser first), and overlapping levels draw both. A position
+    /// whose key lies outside the `i32` world is an error.
+    pub fn upload_level_chunk(
+        &mut self,
+        level: u8,
+        pos: ChunkPos,
+        meshes: &ChunkMeshes,
+    ) -> Result<()> {
+        self.ctx.check_device()?;
+        let key = level_key(level, pos).ok_or_else(|| {
+            Error::InvalidSetting(format!(
+                "level {level} chunk {pos:?}: levels go from 0 to {}, and the chunk must \
+                 start inside the i32 world",
+                voxel_core::MAX_LEVEL
+            ))
+        })?;
+        self.upload_keyed(key, level, meshes)
+    }
+
+    fn upload_keyed(&mut self, pos: ChunkPos, level: u8, meshes: &ChunkMeshes) -> Result<()> {
         let new = self.chunks.get(pos).is_none();
-        self.chunks.upload(&self.ctx, pos, meshes)?;
+        self.chunks.upload(&self.ctx, pos, level, meshes)?;
         if new && self.config.fade_in_frames > 0 && self.chunks.get(pos).is_some() {
             self.fading.insert(pos, self.frame_index);
             self.chunks.set_alpha(&self.ctx, pos, 0.0, false);
@@ -676,4 +709,17 @@ impl Renderer {
 /// Copies what the manager holds (technique after fallback) into a renderer's config.
 fn config_with(mine: &mut OitConfig, manager: &OitConfig) {
     mine.clone_from(manager);
+}
+
+/// The key of chunk `pos` of level of detail `level` on the GPU: the full-detail chunk
+/// where it starts (`pos` times `2^level` in x and z). `None` past
+/// [`voxel_core::MAX_LEVEL`] or outside the `i32` world.
+pub fn level_key(level: u8, pos: ChunkPos) -> Option<ChunkPos> {
+    if level > voxel_core::MAX_LEVEL {
+        return None;
+    }
+    let s = voxel_core::level_scale(level);
+    let wide = |v: i32| i32::try_from(i64::from(v) * s).ok();
+    let key = ChunkPos::new(wide(pos.x)?, pos.y, wide(pos.z)?);
+    key.is_valid().then_some(key)
 }

@@ -14,6 +14,12 @@
 struct ChunkInfo {
     origin: vec3<i32>,
     alpha: f32,
+    // Blocks per cell along x and z: 1, or 2^level for a chunk of a level of detail (its
+    // cells one block high).
+    scale: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -142,7 +148,12 @@ fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool) -> VsOut {
     if (face & 1u) == 0u {
         p[axis] += 1.0;
     }
-    var uv = corner * size;
+    // Cells to blocks (a level of detail's cells are `scale` blocks wide in x and z); the
+    // quad's size and its texture coordinates in blocks.
+    let cell = vec3<f32>(f32(chunk.scale), 1.0, f32(chunk.scale));
+    p *= cell;
+    let size_blocks = size * vec2<f32>(cell[u_axis], cell[v_axis]);
+    var uv = corner * size_blocks;
     p[u_axis] += uv.x;
     p[v_axis] += uv.y;
     // Camera-relative position: integer parts cancel exactly before any float rounding.
@@ -176,7 +187,7 @@ fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool) -> VsOut {
         let c = quad_corner(positive, flip, first + 2u);
         let e0 = b - a;
         let e1 = c - a;
-        let d = corner + grown / size - a;
+        let d = corner + grown / size_blocks - a;
         let det = e0.x * e1.y - e1.x * e0.y;
         let beta = (d.x * e1.y - e1.x * d.y) / det;
         let gamma = (e0.x * d.y - d.x * e0.y) / det;

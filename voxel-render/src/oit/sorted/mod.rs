@@ -217,9 +217,12 @@ impl Sorted {
         let Some(entry) = self.orders.get_mut(&pos) else {
             return (built, false);
         };
-        // The eye in chunk-local blocks, in f64: exact wherever the world is.
+        // The eye in chunk-local cells (blocks but in a level of detail, whose cells are
+        // wider in x and z: a scale on an axis keeps which side of each plane the eye is
+        // on), in f64: exact wherever the world is.
         let o = pos.origin();
-        let local = [0, 1, 2].map(|k| eye[k] - o[k] as f64);
+        let scale = chunks.get(pos).map_or([1.0; 3], |c| c.scale());
+        let local = [0, 1, 2].map(|k| (eye[k] - o[k] as f64) / scale[k]);
         let key = entry.order.region_key(local);
         if entry.sorted_for == Some(key)
             && (entry.stamp == stamp || chunks.reapply_order(pos, entry.stamp))

@@ -67,7 +67,7 @@ impl Fitter {
     /// across them.
     pub(crate) fn fit<'a>(
         &mut self,
-        layers: impl IntoIterator<Item = (ChunkPos, &'a [Plane])>,
+        layers: impl IntoIterator<Item = (ChunkPos, u8, &'a [Plane])>,
         view_proj: Mat4,
         eye: DVec3,
         near: f32,
@@ -154,7 +154,7 @@ type Seen = (f32, [Vec2; 2], [f32; 2]);
 /// each corner from the projection's columns (the projection is linear before the
 /// divide), a quarter of the multiplications of four full transforms.
 fn visible_planes<'a>(
-    layers: impl IntoIterator<Item = (ChunkPos, &'a [Plane])>,
+    layers: impl IntoIterator<Item = (ChunkPos, u8, &'a [Plane])>,
     view_proj: Mat4,
     eye: DVec3,
     seen: &mut Vec<Seen>,
@@ -162,10 +162,13 @@ fn visible_planes<'a>(
     seen.clear();
     let columns = [view_proj.x_axis, view_proj.y_axis, view_proj.z_axis];
     let (mut min, mut max) = (Vec2::INFINITY, Vec2::NEG_INFINITY);
-    for (pos, planes) in layers {
+    for (pos, level, planes) in layers {
         let origin = DVec3::from(pos.origin().map(|v| v as f64));
-        let eye_local = eye - origin;
+        // Chunk-local cells (a level of detail's are wider than a block in x and z).
+        let scale = crate::chunks::gpu_chunk::cell_scale(level);
+        let eye_local = (eye - origin) / DVec3::from(scale);
         let base = view_proj * (origin - eye).as_vec3().extend(1.0);
+        let columns = [0, 1, 2].map(|a| columns[a] * scale[a] as f32);
         for plane in planes {
             if !faces(plane, eye_local) {
                 continue;
@@ -326,7 +329,7 @@ mod tests {
         let planes = layers::planes(quads, &opacity());
         let origin = ChunkPos::new(0, 0, 0);
         Fitter::default().fit(
-            [(origin, &planes[..])],
+            [(origin, 0, &planes[..])],
             cam.view_proj(1.0),
             cam.eye,
             0.1,
@@ -422,7 +425,7 @@ mod tests {
         let planes = layers::planes(&quads, &opacity());
         let origin = ChunkPos::new(0, 0, 0);
         let fit = Fitter::default().fit(
-            [(origin, &planes[..])],
+            [(origin, 0, &planes[..])],
             cam.view_proj(1.0),
             cam.eye,
             0.1,
@@ -556,7 +559,12 @@ mod tests {
             };
             let vp = cam.view_proj(16.0 / 9.0);
             let mut fast = Vec::new();
-            visible_planes(layers.iter().map(|(p, l)| (*p, &l[..])), vp, eye, &mut fast);
+            visible_planes(
+                layers.iter().map(|(p, l)| (*p, 0, &l[..])),
+                vp,
+                eye,
+                &mut fast,
+            );
             let want = oracle(&meshes, &opacity, vp, eye);
             assert_eq!(fast.len(), want.len(), "the same planes are seen");
             compared += usize::from(!want.is_empty());

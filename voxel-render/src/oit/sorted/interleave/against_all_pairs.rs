@@ -226,6 +226,7 @@ fn where_the_sound_tests_decide_the_fast_order_agrees_with_all_pairs() {
                     lo: *lo,
                     hi: *hi,
                     origin: *origin,
+                    scale: [1.0; 3],
                     planes,
                     quads,
                 })

@@ -239,7 +239,6 @@ impl Interleaver {
                     for pl in planes.iter() {
                         weights[pl.index as usize] = plane_weight(b, pl);
                     }
-                    let origin = DVec3::from(s.origin);
                     let mut k = 0u32;
                     for (r, &(p, n)) in runs.iter().enumerate() {
                         let w = weights[p as usize];
@@ -258,7 +257,7 @@ impl Interleaver {
                             n == 1
                                 || run.iter().filter_map(|q| q.unpack()).any(|q| {
                                     let (lo, hi) = q.bounds();
-                                    meets((DVec3::from(lo) + origin, DVec3::from(hi) + origin))
+                                    meets((s.world(lo), s.world(hi)))
                                 })
                         };
                         if w != UNSEEN && meets(boxes[first_box as usize + r]) && seen_quads() {
@@ -267,7 +266,7 @@ impl Interleaver {
                                 // last quad.
                                 items.push((c32, k + n - 1, w * i64::from(n), k));
                             } else if collect {
-                                crossings.push((axis, s.origin[axis] + f64::from(at), false));
+                                crossings.push((axis, s.plane_at(axis, f64::from(at)), false));
                             }
                         }
                         k += n;

@@ -29,7 +29,7 @@ pub(super) fn seen_planes(s: &Surfaces<'_>, eye: DVec3, two_sided: bool, out: &m
     out.extend(s.planes.iter().enumerate().filter_map(|(i, &(face, c))| {
         let axis = face.axis();
         let facing = if face.is_positive() { 1.0 } else { -1.0 };
-        let at = s.origin[axis] + f64::from(c);
+        let at = s.plane_at(axis, f64::from(c));
         let e = (eye[axis] - at) * facing;
         ((two_sided || e > 0.0) && e != 0.0).then_some(SeenPlane {
             axis,
@@ -150,7 +150,6 @@ pub(super) fn plane_runs(
     boxes: &mut Vec<(DVec3, DVec3)>,
 ) {
     let start = out.len();
-    let o = DVec3::from(s.origin);
     for q in s.quads {
         let Some(q) = q.unpack() else { continue };
         let (lo, hi) = q.bounds();
@@ -161,7 +160,7 @@ pub(super) fn plane_runs(
         else {
             continue;
         };
-        let (lo, hi) = (DVec3::from(lo) + o, DVec3::from(hi) + o);
+        let (lo, hi) = (s.world(lo), s.world(hi));
         match out[start..].last_mut() {
             Some((p, n)) if *p == i as u32 => {
                 *n += 1;

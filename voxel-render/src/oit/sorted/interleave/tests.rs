@@ -75,6 +75,7 @@ fn surfaces<'a>(lo: [f64; 3], hi: [f64; 3], planes: &'a [(Face, u8)]) -> Surface
         lo: DVec3::from(lo),
         hi: DVec3::from(hi),
         origin: [0.0; 3],
+        scale: [1.0; 3],
         planes,
         quads: &[],
     }
@@ -185,6 +186,7 @@ fn decided_sides_agree_with_rays() {
             lo,
             hi,
             origin,
+            scale: [1.0; 3],
             planes: &planes,
             quads: &[],
         };
@@ -260,6 +262,7 @@ fn objects_go_before_the_first_chunk_they_are_behind() {
         lo: DVec3::new(0.0, 7.0, -64.0),
         hi: DVec3::new(32.0, 7.0, -32.0),
         origin: [0.0, 0.0, -64.0],
+        scale: [1.0; 3],
         planes: &planes,
         quads: &[],
     };
@@ -267,6 +270,7 @@ fn objects_go_before_the_first_chunk_they_are_behind() {
         lo: DVec3::new(0.0, 7.0, -32.0),
         hi: DVec3::new(32.0, 7.0, 0.0),
         origin: [0.0, 0.0, -32.0],
+        scale: [1.0; 3],
         planes: &planes,
         quads: &[],
     };
@@ -334,6 +338,7 @@ fn between_water_and_a_pane_of_one_chunk_an_object_goes_between_their_quads() {
         lo: DVec3::new(0.0, 4.0, 0.0),
         hi: DVec3::new(32.0, 10.0, 32.0),
         origin: [0.0; 3],
+        scale: [1.0; 3],
         planes: &planes,
         quads: &quads,
     };
@@ -399,6 +404,7 @@ fn water_surface<'a>(quads: &'a [PackedQuad], planes: &'a [(Face, u8)]) -> Surfa
         lo: DVec3::new(0.0, 4.0, 0.0),
         hi: DVec3::new(32.0, 4.0, 32.0),
         origin: [0.0; 3],
+        scale: [1.0; 3],
         planes,
         quads,
     }

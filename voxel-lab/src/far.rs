@@ -1,0 +1,410 @@
+//! Far views in levels of detail (`demo far`): the default terrain to a view distance of
+//! hundreds of chunks in rings of coarser levels ([`voxel_mesh::levels`]), built straight
+//! from the generator, drawn by every technique; what it costs (time to build, GPU memory
+//! per level, bytes per chunk of view distance), and, where full detail fits, how the
+//! picture compares with full detail of the same view ([`compare`]).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use glam::DVec3;
+use serde::Serialize;
+use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator};
+use voxel_mesh::ChunkMeshes;
+use voxel_mesh::levels::{LevelRings, mesh_level_chunks};
+use voxel_render::{Camera, GpuContext, Image, NoGame, Renderer, RendererConfig, Technique};
+
+use crate::headless::Offscreen;
+use crate::summary::write_json;
+use crate::{Error, Result};
+
+/// The largest view distance `demo far` takes, in chunks.
+pub const MAX_FAR_DISTANCE: u32 = 2048;
+
+/// What `demo far` runs.
+#[derive(Clone, Debug)]
+pub struct FarOptions {
+    /// Full detail to this many chunks from the eye (even, 2 to 64).
+    pub full_detail: u32,
+    /// The view distance in chunks (at least `full_detail`, at most [`MAX_FAR_DISTANCE`]).
+    pub view_distance: u32,
+    /// Picture size.
+    pub size: (u32, u32),
+    /// Terrain seed.
+    pub seed: u32,
+    /// The techniques drawn.
+    pub techniques: Vec<Technique>,
+    /// Also render the same view in full detail to the view distance and score the levels
+    /// against it ([`compare`]); at most 64 chunks.
+    pub compare: bool,
+    /// Output folder.
+    pub out: PathBuf,
+}
+
+impl Default for FarOptions {
+    fn default() -> Self {
+        Self {
+            full_detail: 32,
+            view_distance: 512,
+            size: (1280, 720),
+            seed: 1,
+            techniques: vec![Technique::SortedQuads],
+            compare: false,
+            out: PathBuf::from("far-out"),
+        }
+    }
+}
+
+impl FarOptions {
+    /// Checks the options a user gives.
+    pub fn validate(&self) -> Result<()> {
+        if !(2..=64).contains(&self.full_detail) || self.full_detail % 2 != 0 {
+            return Err(Error::option(
+                "--full-detail",
+                format!("{}: it must be even, from 2 to 64 chunks", self.full_detail),
+            ));
+        }
+        if !(self.full_detail..=MAX_FAR_DISTANCE).contains(&self.view_distance) {
+            return Err(Error::option(
+                "--view-distance",
+                format!(
+                    "{}: it must be from the full detail ({}) to {MAX_FAR_DISTANCE} chunks",
+                    self.view_distance, self.full_detail
+                ),
+            ));
+        }
+        if self.compare && self.view_distance > 64 {
+            return Err(Error::option(
+                "--compare",
+                "full detail is drawn to at most 64 chunks: give --view-distance 64 or less",
+            ));
+        }
+        if self.techniques.is_empty() {
+            return Err(Error::option("--techniques", "no technique given"));
+        }
+        Ok(())
+    }
+}
+
+/// One level's share of a far view.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct LevelRow {
+    /// The level (0: full detail).
+    pub level: u8,
+    /// Blocks per cell in x and z.
+    pub cell_blocks: i64,
+    /// From this many full-detail chunks from the eye (at least) to `to_chunks`.
+    pub from_chunks: i64,
+    /// To this many full-detail chunks from the eye (at least).
+    pub to_chunks: i64,
+    /// Its chunks (those with no face included).
+    pub chunks: usize,
+    /// Its chunks with a mesh.
+    pub chunks_drawn: usize,
+    /// Opaque, cutout and translucent quads.
+    pub quads: [usize; 3],
+    /// GPU bytes: 8 a quad and a 32-byte record a chunk drawn.
+    pub bytes: u64,
+    /// `bytes` per chunk of the view distance it spans (`to_chunks − from_chunks`).
+    pub bytes_per_chunk_of_distance: f64,
+}
+
+/// What `demo far` measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct FarReport {
+    /// The adapter.
+    pub adapter: String,
+    /// Full detail to, in chunks.
+    pub full_detail: u32,
+    /// How far the coarsest level reaches at least, in chunks.
+    pub view_distance: i64,
+    /// The coarsest level.
+    pub coarsest: u8,
+    /// Per level, full detail first.
+    pub levels: Vec<LevelRow>,
+    /// Generating and meshing every level, wall-clock ms on this machine's cores.
+    pub build_ms: f64,
+    /// Uploading every mesh, ms.
+    pub upload_ms: f64,
+    /// The renderer's chunk memory after the upload: arena pages, records and draws.
+    pub gpu_buffer_bytes: u64,
+    /// Of those, bytes holding quads.
+    pub gpu_quad_bytes: u64,
+    /// The pictures written, one per technique.
+    pub pictures: Vec<String>,
+    /// The comparison with full detail, when asked for.
+    pub compare: Option<Comparison>,
+}
+
+/// The default far view's eye and target: above the showcase's structure, looking over it
+/// to the sea and the horizon (the eye 40 blocks above the structure's floor, pitched
+/// 0.12 rad down).
+pub fn default_view(generator: &TerrainGenerator) -> Result<Camera> {
+    let show = generator
+        .showcase(1)?
+        .ok_or_else(|| Error::option("--seed", "no structure within 768 blocks of the origin"))?;
+    let eye = DVec3::from(show.eye) + DVec3::new(0.0, 40.0, 0.0);
+    let dir = DVec3::from(show.water_dir).normalize_or(DVec3::X);
+    let forward = (dir * 0.12f64.cos()) - DVec3::new(0.0, 0.12f64.sin(), 0.0);
+    Ok(Camera::look_at(
+        eye,
+        eye + forward * 100.0,
+        60.0,
+        0.1,
+        f64::from(MAX_FAR_DISTANCE) * 32.0 * 2.0,
+    )?)
+}
+
+/// Every level's meshes for `camera`'s eye.
+pub fn build(
+    generator: &TerrainGenerator,
+    registry: &BlockRegistry,
+    rings: &LevelRings,
+    camera: &Camera,
+) -> Result<Vec<(u8, ChunkPos, ChunkMeshes)>> {
+    let eye = camera.eye.to_array();
+    let chunks = rings.all(eye);
+    Ok(mesh_level_chunks(generator, registry, rings, eye, &chunks)?)
+}
+
+/// Uploads level meshes to `renderer`.
+pub fn upload(renderer: &mut Renderer, meshes: &[(u8, ChunkPos, ChunkMeshes)]) -> Result<()> {
+    for (l, p, m) in meshes {
+        renderer.upload_level_chunk(*l, *p, m)?;
+    }
+    Ok(())
+}
+
+/// Renders `camera` and reads the picture back.
+pub fn picture(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    target: &Offscreen,
+    camera: &Camera,
+) -> Result<Image> {
+    renderer.render_and_submit(&target.view, camera, &mut NoGame)?;
+    Ok(target.read(ctx)?)
+}
+
+/// Per level: chunks, quads and bytes.
+pub fn level_rows(rings: &LevelRings, meshes: &[(u8, ChunkPos, ChunkMeshes)]) -> Vec<LevelRow> {
+    let r = i64::from(rings.radius);
+    (0..=rings.coarsest)
+        .map(|level| {
+            let mut row = LevelRow {
+                level,
+                cell_blocks: voxel_core::level_scale(level),
+                from_chunks: if level == 0 { 0 } else { r << (level - 1) },
+                to_chunks: r << level,
+                ..LevelRow::default()
+            };
+            for (_, _, m) in meshes.iter().filter(|(l, _, _)| *l == level) {
+                row.chunks += 1;
+                if !m.is_empty() {
+                    row.chunks_drawn += 1;
+                    row.bytes += 32;
+                }
+                row.quads[0] += m.opaque.len();
+                row.quads[1] += m.cutout.len();
+                row.quads[2] += m.translucent.len();
+            }
+            row.bytes += 8 * row.quads.iter().sum::<usize>() as u64;
+            row.bytes_per_chunk_of_distance =
+                row.bytes as f64 / (row.to_chunks - row.from_chunks).max(1) as f64;
+            row
+        })
+        .collect()
+}
+
+/// Builds the far view of `opts`, draws it with each technique, and writes the pictures
+/// and `far.json` into `opts.out`.
+pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
+    opts.validate()?;
+    let generator = TerrainGenerator::new(TerrainConfig {
+        seed: opts.seed,
+        ..TerrainConfig::default()
+    });
+    let registry = std::sync::Arc::new(BlockRegistry::default());
+    let rings = LevelRings::reaching(opts.full_detail, opts.view_distance);
+    let camera = default_view(&generator)?;
+    let t = Instant::now();
+    let meshes = build(&generator, &registry, &rings, &camera)?;
+    let build_ms = t.elapsed().as_secs_f64() * 1e3;
+    let (width, height) = opts.size;
+    let config = RendererConfig {
+        width,
+        height,
+        ..RendererConfig::default()
+    };
+    let mut renderer = Renderer::new(ctx, &registry, config)?;
+    let t = Instant::now();
+    upload(&mut renderer, &meshes)?;
+    let upload_ms = t.elapsed().as_secs_f64() * 1e3;
+    let memory = renderer.chunk_memory();
+    let target = Offscreen::new(ctx, width, height);
+    let mut pictures = Vec::new();
+    let mut first = None;
+    for &t in &opts.techniques {
+        renderer.set_technique(t)?;
+        let image = picture(ctx, &mut renderer, &target, &camera)?;
+        let name = format!("far-{}.png", t.name());
+        image.save_png(&opts.out.join(&name))?;
+        pictures.push(name);
+        first.get_or_insert(image);
+    }
+    let compare = match (opts.compare, first) {
+        (true, Some(levels)) => {
+            let full = LevelRings {
+                radius: (opts.view_distance as i32 + 1) & !1,
+                coarsest: 0,
+                y: rings.y.clone(),
+            };
+            let c = compare(
+                ctx,
+                &mut renderer,
+                &target,
+                &camera,
+                &levels,
+                &build(&generator, &registry, &full, &camera)?,
+                &rings,
+                &opts.out,
+            )?;
+            Some(c)
+        }
+        _ => None,
+    };
+    let report = FarReport {
+        adapter: ctx.caps.adapter_name.clone(),
+        full_detail: opts.full_detail,
+        view_distance: rings.view_distance(),
+        coarsest: rings.coarsest,
+        levels: level_rows(&rings, &meshes),
+        build_ms,
+        upload_ms,
+        gpu_buffer_bytes: memory.arena_bytes + memory.record_bytes + memory.indirect_bytes,
+        gpu_quad_bytes: memory.quad_bytes,
+        pictures,
+        compare,
+    };
+    write_json(&opts.out.join("far.json"), &report)?;
+    Ok(report)
+}
+
+/// A far view's picture against full detail of the same view.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    /// Pixels the far view leaves to the sky where full detail draws something, of all.
+    pub holes: f64,
+    /// Pixels where full detail shows something beyond the full-detail ring (the levels'
+    /// part of the picture), of all.
+    pub far_pixels: f64,
+    /// Of those, water (full detail's picture changes where its translucent meshes are
+    /// left out).
+    pub far_water_pixels: f64,
+    /// The mean colour of the far water, full detail and levels (sRGB, 0 to 255).
+    pub far_water_mean: [[f64; 3]; 2],
+    /// The mean colour of the rest of the far pixels, full detail and levels.
+    pub far_ground_mean: [[f64; 3]; 2],
+    /// The mean of |levels − full detail| over the far pixels, per channel, /255.
+    pub far_mean_abs: f64,
+}
+
+impl Comparison {
+    /// The largest channel difference of the far water's mean colour, /255.
+    pub fn water_step(&self) -> f64 {
+        step(&self.far_water_mean)
+    }
+
+    /// The largest channel difference of the rest of the far pixels' mean colour, /255.
+    pub fn ground_step(&self) -> f64 {
+        step(&self.far_ground_mean)
+    }
+}
+
+fn step(m: &[[f64; 3]; 2]) -> f64 {
+    (0..3)
+        .map(|c| (m[0][c] - m[1][c]).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Scores the far view's picture `levels` (of `renderer`'s technique) against full detail
+/// `full` (level-0 meshes of the whole view) from the same `camera`: the renderer's chunks
+/// are replaced by `full`'s. Which pixels are far, water or sky is read off pictures of
+/// full detail with parts left out: the sky (no chunk), the full-detail ring of `rings`
+/// alone, and full detail without its translucent meshes. Writes `full.png` into `out`.
+#[allow(clippy::too_many_arguments)]
+pub fn compare(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    target: &Offscreen,
+    camera: &Camera,
+    levels: &Image,
+    full: &[(u8, ChunkPos, ChunkMeshes)],
+    rings: &LevelRings,
+    out: &std::path::Path,
+) -> Result<Comparison> {
+    let eye = camera.eye.to_array();
+    renderer.clear_chunks();
+    let sky = picture(ctx, renderer, target, camera)?;
+    let near: Vec<_> = full
+        .iter()
+        .filter(|(_, p, _)| rings.contains(0, *p, eye))
+        .cloned()
+        .collect();
+    upload(renderer, &near)?;
+    let ring = picture(ctx, renderer, target, camera)?;
+    upload(renderer, full)?;
+    let all = picture(ctx, renderer, target, camera)?;
+    all.save_png(&out.join("full.png"))?;
+    let dry: Vec<_> = full
+        .iter()
+        .map(|(l, p, m)| {
+            let mut m = m.clone();
+            m.translucent.clear();
+            (*l, *p, m)
+        })
+        .collect();
+    renderer.clear_chunks();
+    upload(renderer, &dry)?;
+    let no_water = picture(ctx, renderer, target, camera)?;
+    renderer.clear_chunks();
+
+    let px = |im: &Image, i: usize| [0, 1, 2].map(|c| f64::from(im.rgba[i * 4 + c]));
+    let differs = |a: [f64; 3], b: [f64; 3]| (0..3).any(|c| (a[c] - b[c]).abs() > 2.0);
+    let n = (levels.width * levels.height) as usize;
+    let (mut holes, mut far, mut water) = (0usize, 0usize, 0usize);
+    let mut sums = [[[0.0; 3]; 2]; 2];
+    let mut abs = 0.0;
+    for i in 0..n {
+        let (s, r, a, d, l) = (
+            px(&sky, i),
+            px(&ring, i),
+            px(&all, i),
+            px(&no_water, i),
+            px(levels, i),
+        );
+        if differs(a, s) && !differs(l, s) {
+            holes += 1;
+        }
+        if !differs(a, r) {
+            continue;
+        }
+        far += 1;
+        let k = usize::from(differs(a, d));
+        water += k;
+        for c in 0..3 {
+            sums[k][0][c] += a[c];
+            sums[k][1][c] += l[c];
+            abs += (a[c] - l[c]).abs() / 3.0;
+        }
+    }
+    let mean = |s: [[f64; 3]; 2], count: usize| s.map(|v| v.map(|x| x / count.max(1) as f64));
+    Ok(Comparison {
+        holes: holes as f64 / n as f64,
+        far_pixels: far as f64 / n as f64,
+        far_water_pixels: water as f64 / n as f64,
+        far_water_mean: mean(sums[1], water),
+        far_ground_mean: mean(sums[0], far - water),
+        far_mean_abs: abs / far.max(1) as f64,
+    })
+}

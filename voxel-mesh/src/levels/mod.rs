@@ -1,0 +1,272 @@
+//! Far views in levels of detail: which chunks of which level cover the world around an eye
+//! ([`LevelRings`]), and their meshes straight from the terrain generator
+//! ([`mesh_level_chunks`]), by the same mesher into the same quads as any chunk.
+//!
+//! A chunk of level `k` holds 32³ cells `2^k` blocks wide in x and z and one block high
+//! ([`voxel_core::TerrainGenerator::generate_level_chunk`]); level 0 is the full-detail
+//! chunk. The levels lie in square rings (in x and z) around the eye, each a fixed number of
+//! its own chunks wide, so that a level covers twice the distance of the one inside it
+//! with as many chunks (Voxy's and clipmaps' layout): see [`LevelRings`].
+//!
+//! Where two levels meet, a mesh is culled against the *water* of the chunk across the
+//! border (the translucent volumes the generator puts there, at the mesh's own level) and
+//! against nothing else: a lake's surface runs on across the border with no wall of water
+//! between the levels, and the ground's faces toward the other level are kept, so that
+//! where the two levels' ground differs in height the step is closed by a wall of ground
+//! (a skirt), never open to the sky.
+
+#[cfg(not(target_arch = "wasm32"))]
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::ops::RangeInclusive;
+use std::sync::Arc;
+
+use voxel_core::{
+    BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Neighbourhood, RenderClass, TerrainGenerator,
+    level_scale,
+};
+
+use crate::{ChunkMeshes, MeshOptions, Mesher, Result};
+
+/// The layout of a far view: full detail in a square of `2 · radius + 2` chunks around the
+/// eye, then one ring per level to `coarsest`, each `radius` of its own chunks from the
+/// eye's, between the chunk heights `y`.
+///
+/// For an eye in chunk `c_k` of level `k` (`floor(eye / (32 · 2^k))` in x and z), level `k`
+/// covers its chunks in the square `[2 c_{k+1} − radius, 2 c_{k+1} + radius + 1]`, less the
+/// square the finer level covers, `[c_k − radius/2, c_k + radius/2]` (level `k`'s chunks,
+/// which is level `k − 1`'s square exactly: `radius` is even). The eye is at least `radius`
+/// chunks of level `k` from the outer edge of level `k`, so at least `radius · 2^k`
+/// full-detail chunks: the view distance is `radius · 2^coarsest` chunks.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LevelRings {
+    /// Chunks of its own level from the eye's chunk to the edge of each level, even, 2 to
+    /// 256.
+    pub radius: i32,
+    /// The coarsest level, 0 (full detail only) to [`voxel_core::MAX_LEVEL`].
+    pub coarsest: u8,
+    /// The chunk heights (y) of every level.
+    pub y: RangeInclusive<i32>,
+}
+
+impl LevelRings {
+    /// Rings reaching at least `view_distance` chunks from the eye with full detail to
+    /// `full_detail` chunks (rounded up to an even number), for the default terrain's
+    /// heights (chunks 0 and 1).
+    pub fn reaching(full_detail: u32, view_distance: u32) -> Self {
+        let radius = (full_detail.clamp(2, 256) as i32 + 1) & !1;
+        let mut coarsest = 0u8;
+        while (i64::from(radius) << coarsest) < i64::from(view_distance)
+            && coarsest < voxel_core::MAX_LEVEL
+        {
+            coarsest += 1;
+        }
+        Self {
+            radius,
+            coarsest,
+            y: 0..=1,
+        }
+    }
+
+    /// Checks the fields against their ranges.
+    pub fn validate(&self) -> std::result::Result<(), String> {
+        if !(2..=256).contains(&self.radius) || self.radius % 2 != 0 {
+            return Err(format!(
+                "ring radius {}: it must be even, from 2 to 256 chunks",
+                self.radius
+            ));
+        }
+        if self.coarsest > voxel_core::MAX_LEVEL {
+            return Err(format!(
+                "coarsest level {}: at most {}",
+                self.coarsest,
+                voxel_core::MAX_LEVEL
+            ));
+        }
+        if self.y.is_empty() {
+            return Err(format!("empty chunk heights {:?}", self.y));
+        }
+        Ok(())
+    }
+
+    /// The view distance in full-detail chunks: how far the coarsest level reaches from the
+    /// eye at least.
+    pub fn view_distance(&self) -> i64 {
+        i64::from(self.radius) << self.coarsest
+    }
+
+    /// The eye's chunk at level `level` along x and z (clamped to the `i32` chunks).
+    fn eye_chunk(level: u8, eye: [f64; 3]) -> [i64; 2] {
+        let w = (CHUNK_SIZE as i64 * level_scale(level)) as f64;
+        let c = |v: f64| {
+            let c = (v / w).floor();
+            if c.is_nan() {
+                0
+            } else {
+                c.clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i64
+            }
+        };
+        [c(eye[0]), c(eye[2])]
+    }
+
+    /// The square of level `level`'s chunks its ring fills (x and z, inclusive) and the
+    /// square inside it it leaves to the finer level (none at level 0).
+    fn squares(&self, level: u8, eye: [f64; 3]) -> ([[i64; 2]; 2], Option<[[i64; 2]; 2]>) {
+        let r = i64::from(self.radius);
+        let up = Self::eye_chunk(level + 1, eye);
+        let outer = up.map(|c| [2 * c - r, 2 * c + r + 1]);
+        let inner =
+            (level > 0).then(|| Self::eye_chunk(level, eye).map(|c| [c - r / 2, c + r / 2]));
+        (outer, inner)
+    }
+
+    /// Whether chunk `pos` of level `level` is drawn for an eye at `eye` (world blocks).
+    pub fn contains(&self, level: u8, pos: ChunkPos, eye: [f64; 3]) -> bool {
+        if level > self.coarsest || !self.y.contains(&pos.y) {
+            return false;
+        }
+        let (outer, inner) = self.squares(level, eye);
+        let p = [i64::from(pos.x), i64::from(pos.z)];
+        let within = |s: [[i64; 2]; 2]| (0..2).all(|k| (s[k][0]..=s[k][1]).contains(&p[k]));
+        within(outer) && !inner.is_some_and(within)
+    }
+
+    /// The chunks of level `level` drawn for an eye at `eye`, nearest first.
+    pub fn chunks(&self, level: u8, eye: [f64; 3]) -> Vec<ChunkPos> {
+        if level > self.coarsest {
+            return Vec::new();
+        }
+        let (outer, _) = self.squares(level, eye);
+        let c = Self::eye_chunk(level, eye);
+        let mut out = Vec::new();
+        for x in outer[0][0]..=outer[0][1] {
+            for z in outer[1][0]..=outer[1][1] {
+                let (Ok(xi), Ok(zi)) = (i32::try_from(x), i32::try_from(z)) else {
+                    continue;
+                };
+                for y in self.y.clone() {
+                    let p = ChunkPos::new(xi, y, zi);
+                    if p.is_valid() && self.contains(level, p, eye) {
+                        out.push(p);
+                    }
+                }
+            }
+        }
+        out.sort_by_key(|p| {
+            let d = [i64::from(p.x) - c[0], i64::from(p.z) - c[1]];
+            (d[0] * d[0] + d[1] * d[1], *p)
+        });
+        out
+    }
+
+    /// Every level's chunks for an eye at `eye`: coarsest level first (the horizon comes
+    /// first), each level's nearest first.
+    pub fn all(&self, eye: [f64; 3]) -> Vec<(u8, ChunkPos)> {
+        (0..=self.coarsest)
+            .rev()
+            .flat_map(|l| self.chunks(l, eye).into_iter().map(move |p| (l, p)))
+            .collect()
+    }
+}
+
+/// The meshes of the level chunks `chunks` of generator `generator` (over `registry`), for
+/// rings `rings` and an eye at `eye`: each culled against its level's chunks around it where
+/// the rings hold them, and against only the water of the chunk across a level border
+/// (see the module docs). Generated and meshed in parallel (one after another on wasm32).
+/// Ambient occlusion only at level 0 (a coarse cell is 2 to 64 blocks wide: its occlusion
+/// would darken a slope's whole cell).
+pub fn mesh_level_chunks(
+    generator: &TerrainGenerator,
+    registry: &BlockRegistry,
+    rings: &LevelRings,
+    eye: [f64; 3],
+    chunks: &[(u8, ChunkPos)],
+) -> Result<Vec<(u8, ChunkPos, ChunkMeshes)>> {
+    // Every chunk a mesh reads: its own and its 26 neighbours, each at the mesh's level.
+    let mut needed: Vec<(u8, ChunkPos)> = chunks
+        .iter()
+        .flat_map(|&(l, p)| {
+            Neighbourhood::OFFSETS
+                .iter()
+                .filter_map(move |&d| p.offset(d).map(|n| (l, n)))
+                .chain([(l, p)])
+        })
+        .collect();
+    needed.sort_unstable();
+    needed.dedup();
+    let mut water = vec![false; registry.len()];
+    for (id, d) in registry.iter() {
+        if let Some(w) = water.get_mut(id.index()) {
+            *w = d.class == RenderClass::Translucent && d.absorption > 0.0;
+        }
+    }
+    let make = |&(l, p): &(u8, ChunkPos)| {
+        let chunk = generator.generate_level_chunk(l, p);
+        // Across a level border (in x or z) only the water counts; above and below the
+        // rings' heights the chunk as it is (rock below, sky above).
+        let across = !rings.contains(l, p, eye) && rings.y.contains(&p.y);
+        let chunk = if across { only(&chunk, &water) } else { chunk };
+        ((l, p), Arc::new(chunk))
+    };
+    #[cfg(not(target_arch = "wasm32"))]
+    let made: HashMap<_, _> = needed.par_iter().map(make).collect();
+    #[cfg(target_arch = "wasm32")]
+    let made: HashMap<_, _> = needed.iter().map(make).collect();
+
+    let fine = Mesher::new(registry);
+    let coarse = Mesher::with_options(
+        registry,
+        MeshOptions {
+            ambient_occlusion: false,
+            ..MeshOptions::default()
+        },
+    );
+    let mesh = |(fine, coarse): &mut (Mesher, Mesher), &(l, p): &(u8, ChunkPos)| {
+        let mesher = if l == 0 { fine } else { coarse };
+        let around =
+            Neighbourhood::from_fn(|d| p.offset(d).and_then(|n| made.get(&(l, n))).map(|c| &**c));
+        let own = made.get(&(l, p)).map(|c| &**c);
+        let meshes = match own {
+            Some(c) => mesher.mesh(c, around)?,
+            None => ChunkMeshes::default(),
+        };
+        Ok((l, p, meshes))
+    };
+    #[cfg(not(target_arch = "wasm32"))]
+    let out = chunks
+        .par_iter()
+        .map_init(|| (fine.clone(), coarse.clone()), mesh)
+        .collect();
+    #[cfg(target_arch = "wasm32")]
+    let out = {
+        let mut m = (fine, coarse);
+        chunks.iter().map(|c| mesh(&mut m, c)).collect()
+    };
+    out
+}
+
+/// `chunk` with only the blocks `keep` marks (by id), air elsewhere.
+fn only(chunk: &Chunk, keep: &[bool]) -> Chunk {
+    let kept = |id: voxel_core::BlockId| keep.get(id.index()).copied().unwrap_or(false);
+    if !chunk.palette().any(|(id, _)| kept(id)) {
+        return Chunk::default();
+    }
+    let mut out = Chunk::default();
+    for x in 0..CHUNK_SIZE {
+        for z in 0..CHUNK_SIZE {
+            for y in 0..CHUNK_SIZE {
+                if let Ok(id) = chunk.get(x, y, z)
+                    && kept(id)
+                {
+                    // In range: the loops stay inside the chunk.
+                    let _ = out.set(x, y, z, id);
+                }
+            }
+        }
+    }
+    out.pack();
+    out
+}
+
+#[cfg(test)]
+mod tests;

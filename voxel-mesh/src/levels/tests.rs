@@ -1,0 +1,155 @@
+use std::collections::HashMap;
+
+use voxel_core::{Face, TerrainConfig, blocks};
+
+use super::*;
+
+/// A small deterministic generator of eyes (xorshift).
+fn eyes(n: usize, spread: f64) -> Vec<[f64; 3]> {
+    let mut s = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..n)
+        .map(|_| [(next() - 0.5) * spread, 30.0, (next() - 0.5) * spread])
+        .collect()
+}
+
+#[test]
+fn the_levels_tile_the_view_once_and_reach_the_view_distance() {
+    let rings = LevelRings {
+        radius: 4,
+        coarsest: 3,
+        y: 0..=0,
+    };
+    assert_eq!(rings.view_distance(), 32);
+    for eye in eyes(40, 4000.0)
+        .into_iter()
+        .chain([[0.5, 1.0, -0.5], [-33.0, 0.0, 64.0]])
+    {
+        // Every full-detail chunk column within the coarsest square is covered by exactly
+        // one chunk of one level.
+        let mut cover: HashMap<[i64; 2], u32> = HashMap::new();
+        for (l, p) in rings.all(eye) {
+            let s = level_scale(l);
+            for dx in 0..s {
+                for dz in 0..s {
+                    *cover
+                        .entry([i64::from(p.x) * s + dx, i64::from(p.z) * s + dz])
+                        .or_default() += 1;
+                }
+            }
+        }
+        assert!(
+            cover.values().all(|&n| n == 1),
+            "a column drawn twice, eye {eye:?}"
+        );
+        let c = [eye[0], eye[2]].map(|v| (v / 32.0).floor() as i64);
+        // No hole: the square of the view distance around the eye's chunk is covered.
+        let r = rings.view_distance();
+        for x in c[0] - r..=c[0] + r {
+            for z in c[1] - r..=c[1] + r {
+                assert!(cover.contains_key(&[x, z]), "hole at {x},{z} eye {eye:?}");
+            }
+        }
+        // Each level starts at least its radius in its own chunks from the eye, past the
+        // level inside it: full detail holds the eye's chunk and `radius` chunks each way.
+        for x in c[0] - 4..=c[0] + 4 {
+            for z in c[1] - 4..=c[1] + 4 {
+                let p = ChunkPos::new(x as i32, 0, z as i32);
+                assert!(
+                    rings.contains(0, p, eye),
+                    "{p:?} not full detail, eye {eye:?}"
+                );
+            }
+        }
+        // Coarsest first, and each level nearest first.
+        let all = rings.all(eye);
+        assert!(all.windows(2).all(|w| w[0].0 >= w[1].0));
+    }
+    // Chunk heights outside the rings' are never drawn.
+    assert!(!rings.contains(0, ChunkPos::new(0, 1, 0), [0.0; 3]));
+    assert!(rings.validate().is_ok());
+    for bad in [
+        LevelRings {
+            radius: 3,
+            ..rings.clone()
+        },
+        LevelRings {
+            radius: 0,
+            ..rings.clone()
+        },
+        LevelRings {
+            coarsest: 9,
+            ..rings.clone()
+        },
+        LevelRings {
+            y: 1..=0,
+            ..rings.clone()
+        },
+    ] {
+        assert!(bad.validate().is_err(), "{bad:?}");
+    }
+    let r = LevelRings::reaching(32, 512);
+    assert_eq!((r.radius, r.coarsest, r.view_distance()), (32, 4, 512));
+    assert_eq!(LevelRings::reaching(31, 10).coarsest, 0);
+}
+
+#[test]
+fn a_flat_sea_meets_itself_across_level_borders_and_the_ground_is_skirted() {
+    // A flat sea floor 6 blocks under the surface everywhere: the only faces are the sea's
+    // surface, the floor's top, and the ground's walls toward another level.
+    let generator = TerrainGenerator::new(TerrainConfig {
+        base_height: 18,
+        amplitude: 0.0,
+        tree_density: 0.0,
+        structures: false,
+        ..TerrainConfig::default()
+    });
+    let registry = BlockRegistry::default();
+    let rings = LevelRings {
+        radius: 2,
+        coarsest: 2,
+        y: 0..=0,
+    };
+    let eye = [40.0, 30.0, -20.0];
+    let chunks = rings.all(eye);
+    let meshes = mesh_level_chunks(&generator, &registry, &rings, eye, &chunks).unwrap();
+    assert_eq!(meshes.len(), chunks.len());
+    let mut walls = 0;
+    for (l, p, m) in &meshes {
+        assert!(m.cutout.is_empty());
+        for q in &m.translucent {
+            let q = q.unpack().unwrap();
+            assert_eq!(q.block, blocks::WATER);
+            assert_eq!(q.face, Face::PosY, "a water wall in level {l} chunk {p:?}");
+            assert_eq!(q.pos[1], 24, "the surface at the sea level");
+        }
+        for q in &m.opaque {
+            let q = q.unpack().unwrap();
+            if matches!(q.face, Face::PosY | Face::NegY) {
+                continue;
+            }
+            // A wall: on the chunk's border, toward a chunk of another level.
+            let axis = q.face.axis();
+            let at = i64::from(q.pos[axis]);
+            let out = if q.face.is_positive() { 1 } else { -1 };
+            assert!(
+                (q.face.is_positive() && at == 31) || (!q.face.is_positive() && at == 0),
+                "a wall inside level {l} chunk {p:?}"
+            );
+            let mut d = [0; 3];
+            d[axis] = out;
+            let n = p.offset(d).unwrap();
+            assert!(
+                !rings.contains(*l, n, eye),
+                "a wall between two chunks of level {l}"
+            );
+            walls += 1;
+        }
+    }
+    assert!(walls > 0, "no skirt where levels meet");
+}
