@@ -449,10 +449,14 @@ pub(crate) fn far(a: FarArgs, device: &headless::Device) -> Result<()> {
     }
     if let Some(c) = &r.compare {
         println!(
-            "against full detail: holes {:.4} % of pixels; far pixels {:.1} %, far water {:.1} %; far water mean step {:.2}/255, far ground {:.2}/255; far mean |error| {:.2}/255",
+            "against full detail: holes {:.4} % of pixels, skyline differs on {:.4} %; far pixels \
+             {:.1} %, far water {:.2} % (levels {:.2} %); far water mean step {:.2}/255, far \
+             ground {:.2}/255; far mean |error| {:.2}/255",
             c.holes * 100.0,
+            c.skyline * 100.0,
             c.far_pixels * 100.0,
             c.far_water_pixels * 100.0,
+            c.far_water_pixels_levels * 100.0,
             c.water_step(),
             c.ground_step(),
             c.far_mean_abs

@@ -58,7 +58,7 @@ impl Default for FarOptions {
 impl FarOptions {
     /// Checks the options a user gives.
     pub fn validate(&self) -> Result<()> {
-        if !(2..=64).contains(&self.full_detail) || self.full_detail % 2 != 0 {
+        if !(2..=64).contains(&self.full_detail) || !self.full_detail.is_multiple_of(2) {
             return Err(Error::option(
                 "--full-detail",
                 format!("{}: it must be even, from 2 to 64 chunks", self.full_detail),
@@ -183,7 +183,7 @@ pub fn picture(
     camera: &Camera,
 ) -> Result<Image> {
     renderer.render_and_submit(&target.view, camera, &mut NoGame)?;
-    Ok(target.read(ctx)?)
+    target.read(ctx)
 }
 
 /// Per level: chunks, quads and bytes.
@@ -243,17 +243,15 @@ pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
     let memory = renderer.chunk_memory();
     let target = Offscreen::new(ctx, width, height);
     let mut pictures = Vec::new();
-    let mut first = None;
     for &t in &opts.techniques {
         renderer.set_technique(t)?;
         let image = picture(ctx, &mut renderer, &target, &camera)?;
         let name = format!("far-{}.png", t.name());
         image.save_png(&opts.out.join(&name))?;
         pictures.push(name);
-        first.get_or_insert(image);
     }
-    let compare = match (opts.compare, first) {
-        (true, Some(levels)) => {
+    let compare = match opts.compare {
+        true => {
             let full = LevelRings {
                 radius: (opts.view_distance as i32 + 1) & !1,
                 coarsest: 0,
@@ -264,14 +262,14 @@ pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
                 &mut renderer,
                 &target,
                 &camera,
-                &levels,
+                &meshes,
                 &build(&generator, &registry, &full, &camera)?,
                 &rings,
                 &opts.out,
             )?;
             Some(c)
         }
-        _ => None,
+        false => None,
     };
     let report = FarReport {
         adapter: ctx.caps.adapter_name.clone(),
@@ -293,19 +291,26 @@ pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
 /// A far view's picture against full detail of the same view.
 #[derive(Clone, Debug, Serialize)]
 pub struct Comparison {
-    /// Pixels the far view leaves to the sky where full detail draws something, of all.
+    /// Pixels where the far view shows the sky through the ground (below its skyline in the
+    /// column) where full detail draws something, of all.
     pub holes: f64,
+    /// Pixels where the skyline differs (sky in one picture above the other's skyline in
+    /// the column: a far tree or hill top sampled away or in), of all.
+    pub skyline: f64,
     /// Pixels where full detail shows something beyond the full-detail ring (the levels'
     /// part of the picture), of all.
     pub far_pixels: f64,
     /// Of those, water (full detail's picture changes where its translucent meshes are
     /// left out).
     pub far_water_pixels: f64,
+    /// The same in the far view's picture (each picture's far water is its own).
+    pub far_water_pixels_levels: f64,
     /// The mean colour of the far water, full detail and levels (sRGB, 0 to 255).
     pub far_water_mean: [[f64; 3]; 2],
     /// The mean colour of the rest of the far pixels, full detail and levels.
     pub far_ground_mean: [[f64; 3]; 2],
-    /// The mean of |levels − full detail| over the far pixels, per channel, /255.
+    /// The mean of |levels − full detail| over the far pixels of full detail, per channel,
+    /// /255.
     pub far_mean_abs: f64,
 }
 
@@ -327,84 +332,125 @@ fn step(m: &[[f64; 3]; 2]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Scores the far view's picture `levels` (of `renderer`'s technique) against full detail
-/// `full` (level-0 meshes of the whole view) from the same `camera`: the renderer's chunks
-/// are replaced by `full`'s. Which pixels are far, water or sky is read off pictures of
-/// full detail with parts left out: the sky (no chunk), the full-detail ring of `rings`
-/// alone, and full detail without its translucent meshes. Writes `full.png` into `out`.
-#[allow(clippy::too_many_arguments)]
-pub fn compare(
-    ctx: &GpuContext,
-    renderer: &mut Renderer,
-    target: &Offscreen,
-    camera: &Camera,
-    levels: &Image,
-    full: &[(u8, ChunkPos, ChunkMeshes)],
-    rings: &LevelRings,
-    out: &std::path::Path,
-) -> Result<Comparison> {
-    let eye = camera.eye.to_array();
-    renderer.clear_chunks();
-    let sky = picture(ctx, renderer, target, camera)?;
-    let near: Vec<_> = full
-        .iter()
-        .filter(|(_, p, _)| rings.contains(0, *p, eye))
-        .cloned()
-        .collect();
-    upload(renderer, &near)?;
-    let ring = picture(ctx, renderer, target, camera)?;
-    upload(renderer, full)?;
-    let all = picture(ctx, renderer, target, camera)?;
-    all.save_png(&out.join("full.png"))?;
-    let dry: Vec<_> = full
+/// `meshes` without their translucent meshes.
+fn dry(meshes: &[(u8, ChunkPos, ChunkMeshes)]) -> Vec<(u8, ChunkPos, ChunkMeshes)> {
+    meshes
         .iter()
         .map(|(l, p, m)| {
             let mut m = m.clone();
             m.translucent.clear();
             (*l, *p, m)
         })
-        .collect();
-    renderer.clear_chunks();
-    upload(renderer, &dry)?;
-    let no_water = picture(ctx, renderer, target, camera)?;
-    renderer.clear_chunks();
+        .collect()
+}
 
+/// Scores the far view of the level meshes `levels` against full detail `full` (level-0
+/// meshes of the whole view) from the same `camera`, both drawn with `renderer`'s
+/// technique (its chunks are replaced). Which pixels are far, water or sky is read off
+/// pictures with parts left out: the sky (no chunk), the full-detail ring of `rings` alone
+/// (far pixels: where a picture differs from it), and each picture without its
+/// translucent meshes (water: where it differs from them). Writes `full.png`, `levels.png`
+/// and `compare-map.png` (the far view, its holes magenta, the skyline's differences red,
+/// its far water yellow) into `out`.
+#[allow(clippy::too_many_arguments)]
+pub fn compare(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    target: &Offscreen,
+    camera: &Camera,
+    levels: &[(u8, ChunkPos, ChunkMeshes)],
+    full: &[(u8, ChunkPos, ChunkMeshes)],
+    rings: &LevelRings,
+    out: &std::path::Path,
+) -> Result<Comparison> {
+    let eye = camera.eye.to_array();
+    let mut draw = |meshes: &[(u8, ChunkPos, ChunkMeshes)]| -> Result<Image> {
+        renderer.clear_chunks();
+        upload(renderer, meshes)?;
+        picture(ctx, renderer, target, camera)
+    };
+    let sky = draw(&[])?;
+    let near: Vec<_> = full
+        .iter()
+        .filter(|(_, p, _)| rings.contains(0, *p, eye))
+        .cloned()
+        .collect();
+    let ring = draw(&near)?;
+    let pictures = [draw(full)?, draw(levels)?];
+    let dry = [draw(&dry(full))?, draw(&dry(levels))?];
+    renderer.clear_chunks();
+    pictures[0].save_png(&out.join("full.png"))?;
+    pictures[1].save_png(&out.join("levels.png"))?;
+
+    let (w, h) = (sky.width as usize, sky.height as usize);
+    let n = w * h;
     let px = |im: &Image, i: usize| [0, 1, 2].map(|c| f64::from(im.rgba[i * 4 + c]));
     let differs = |a: [f64; 3], b: [f64; 3]| (0..3).any(|c| (a[c] - b[c]).abs() > 2.0);
-    let n = (levels.width * levels.height) as usize;
-    let (mut holes, mut far, mut water) = (0usize, 0usize, 0usize);
+    // Each picture's skyline: per column, the first row (from the top) that is not sky.
+    let skyline = |im: &Image| -> Vec<usize> {
+        (0..w)
+            .map(|x| {
+                (0..h)
+                    .find(|&y| differs(px(im, y * w + x), px(&sky, y * w + x)))
+                    .unwrap_or(h)
+            })
+            .collect()
+    };
+    let tops = [skyline(&pictures[0]), skyline(&pictures[1])];
+    let mut map = pictures[1].clone();
+    let (mut holes, mut sky_diff) = (0usize, 0usize);
+    let mut far = [0usize; 2];
+    let mut water = [0usize; 2];
     let mut sums = [[[0.0; 3]; 2]; 2];
     let mut abs = 0.0;
     for i in 0..n {
-        let (s, r, a, d, l) = (
-            px(&sky, i),
-            px(&ring, i),
-            px(&all, i),
-            px(&no_water, i),
-            px(levels, i),
-        );
-        if differs(a, s) && !differs(l, s) {
-            holes += 1;
+        let (x, y) = (i % w, i / w);
+        let s = px(&sky, i);
+        let [a, l] = [px(&pictures[0], i), px(&pictures[1], i)];
+        if differs(a, s) != differs(l, s) {
+            if y >= tops[0][x].max(tops[1][x]) {
+                // Below both skylines: sky where the ground should be, or the reverse.
+                if differs(a, s) {
+                    holes += 1;
+                    map.rgba[i * 4..i * 4 + 3].copy_from_slice(&[255, 0, 255]);
+                }
+            } else {
+                sky_diff += 1;
+                map.rgba[i * 4..i * 4 + 3].copy_from_slice(&[255, 0, 0]);
+            }
         }
-        if !differs(a, r) {
-            continue;
-        }
-        far += 1;
-        let k = usize::from(differs(a, d));
-        water += k;
-        for c in 0..3 {
-            sums[k][0][c] += a[c];
-            sums[k][1][c] += l[c];
-            abs += (a[c] - l[c]).abs() / 3.0;
+        let r = px(&ring, i);
+        for k in 0..2 {
+            let p = px(&pictures[k], i);
+            if !differs(p, r) {
+                continue;
+            }
+            far[k] += 1;
+            let wet = differs(p, px(&dry[k], i));
+            water[k] += usize::from(wet);
+            for c in 0..3 {
+                sums[usize::from(!wet)][k][c] += p[c];
+            }
+            if k == 0 {
+                abs += (0..3).map(|c| (a[c] - l[c]).abs()).sum::<f64>() / 3.0;
+            } else if wet {
+                map.rgba[i * 4..i * 4 + 3].copy_from_slice(&[255, 255, 0]);
+            }
         }
     }
-    let mean = |s: [[f64; 3]; 2], count: usize| s.map(|v| v.map(|x| x / count.max(1) as f64));
+    map.save_png(&out.join("compare-map.png"))?;
+    let mean = |s: [[f64; 3]; 2], count: [usize; 2]| {
+        [0, 1].map(|k| s[k].map(|x| x / count[k].max(1) as f64))
+    };
+    let ground = [far[0] - water[0], far[1] - water[1]];
     Ok(Comparison {
         holes: holes as f64 / n as f64,
-        far_pixels: far as f64 / n as f64,
-        far_water_pixels: water as f64 / n as f64,
-        far_water_mean: mean(sums[1], water),
-        far_ground_mean: mean(sums[0], far - water),
-        far_mean_abs: abs / far.max(1) as f64,
+        skyline: sky_diff as f64 / n as f64,
+        far_pixels: far[0] as f64 / n as f64,
+        far_water_pixels: water[0] as f64 / n as f64,
+        far_water_pixels_levels: water[1] as f64 / n as f64,
+        far_water_mean: mean(sums[0], water),
+        far_ground_mean: mean(sums[1], ground),
+        far_mean_abs: abs / far[0].max(1) as f64,
     })
 }

@@ -26,7 +26,7 @@ use voxel_core::{
     level_scale,
 };
 
-use crate::{ChunkMeshes, MeshOptions, Mesher, Result};
+use crate::{ChunkMeshes, Mesher, Result};
 
 /// The layout of a far view: full detail in a square of `2 · radius + 2` chunks around the
 /// eye, then one ring per level to `coarsest`, each `radius` of its own chunks from the
@@ -172,9 +172,11 @@ impl LevelRings {
 /// The meshes of the level chunks `chunks` of generator `generator` (over `registry`), for
 /// rings `rings` and an eye at `eye`: each culled against its level's chunks around it where
 /// the rings hold them, and against only the water of the chunk across a level border
-/// (see the module docs). Generated and meshed in parallel (one after another on wasm32).
-/// Ambient occlusion only at level 0 (a coarse cell is 2 to 64 blocks wide: its occlusion
-/// would darken a slope's whole cell).
+/// (see the module docs). Generated and meshed in parallel (one after another on wasm32),
+/// with ambient occlusion at every level: a coarse cell's occlusion spans the cell, which
+/// darkens a far slope about as much as the fine steps it replaces do on average (without
+/// it the far ground came out 5.4/255 lighter than full detail; with it 1.4/255:
+/// `demo far --compare`).
 pub fn mesh_level_chunks(
     generator: &TerrainGenerator,
     registry: &BlockRegistry,
@@ -213,20 +215,10 @@ pub fn mesh_level_chunks(
     #[cfg(target_arch = "wasm32")]
     let made: HashMap<_, _> = needed.iter().map(make).collect();
 
-    let fine = Mesher::new(registry);
-    let coarse = Mesher::with_options(
-        registry,
-        MeshOptions {
-            ambient_occlusion: false,
-            ..MeshOptions::default()
-        },
-    );
-    let mesh = |(fine, coarse): &mut (Mesher, Mesher), &(l, p): &(u8, ChunkPos)| {
-        let mesher = if l == 0 { fine } else { coarse };
+    let mesh = |mesher: &mut Mesher, &(l, p): &(u8, ChunkPos)| {
         let around =
             Neighbourhood::from_fn(|d| p.offset(d).and_then(|n| made.get(&(l, n))).map(|c| &**c));
-        let own = made.get(&(l, p)).map(|c| &**c);
-        let meshes = match own {
+        let meshes = match made.get(&(l, p)) {
             Some(c) => mesher.mesh(c, around)?,
             None => ChunkMeshes::default(),
         };
@@ -235,11 +227,11 @@ pub fn mesh_level_chunks(
     #[cfg(not(target_arch = "wasm32"))]
     let out = chunks
         .par_iter()
-        .map_init(|| (fine.clone(), coarse.clone()), mesh)
+        .map_init(|| Mesher::new(registry), mesh)
         .collect();
     #[cfg(target_arch = "wasm32")]
     let out = {
-        let mut m = (fine, coarse);
+        let mut m = Mesher::new(registry);
         chunks.iter().map(|c| mesh(&mut m, c)).collect()
     };
     out

@@ -87,6 +87,7 @@ fn the_levels_tile_the_view_once_and_reach_the_view_distance() {
             ..rings.clone()
         },
         LevelRings {
+            #[allow(clippy::reversed_empty_ranges)]
             y: 1..=0,
             ..rings.clone()
         },

@@ -1,0 +1,272 @@
+//! Far views in levels of detail (issue 50): a chunk of a level is drawn where its cells
+//! are, its water reads as the fine water it replaces, every technique draws level
+//! geometry (`sorted-quads` as the A-buffer does), and the far view of the default terrain
+//! against full detail of the same view: no holes, the far ground's and water's colour.
+
+
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use glam::DVec3;
+use tests::{Offscreen, diff, frame, gpu, out_dir, technique_config};
+use voxel_core::{BlockRegistry, Chunk, ChunkPos, TerrainConfig, TerrainGenerator, blocks};
+use voxel_lab::far;
+use voxel_mesh::Mesher;
+use voxel_mesh::levels::LevelRings;
+use voxel_render::{Camera, Image, Renderer, Technique, level_key};
+
+/// A chunk of level `level` (over the default registry) holding `cells` (inclusive
+/// corners, cells) of `id`, and the full-detail world holding the same blocks.
+fn level_box_and_fine(
+    level: u8,
+    min: [usize; 3],
+    max: [usize; 3],
+    id: voxel_core::BlockId,
+) -> (Chunk, voxel_core::World) {
+    let mut chunk = Chunk::default();
+    chunk.fill_box(min, max, id).unwrap();
+    let s = voxel_core::level_scale(level) as i32;
+    let lo = [min[0] as i32 * s, min[1] as i32, min[2] as i32 * s];
+    let hi = [
+        (max[0] as i32 + 1) * s - 1,
+        max[1] as i32,
+        (max[2] as i32 + 1) * s - 1,
+    ];
+    (chunk, tests::box_world(&[(lo, hi, id)]))
+}
+
+/// Draws a level chunk at level `level`, position 0, with `technique`, from `camera`.
+fn draw_level(
+    ctx: &voxel_render::GpuContext,
+    chunk: &Chunk,
+    level: u8,
+    technique: Technique,
+    camera: &Camera,
+) -> Image {
+    let registry = BlockRegistry::default();
+    let mut renderer =
+        Renderer::new(ctx, &registry, technique_config(technique, 320, 180)).unwrap();
+    let meshes = Mesher::new(&registry)
+        .mesh(chunk, voxel_core::Neighbourhood::default())
+        .unwrap();
+    renderer
+        .upload_level_chunk(level, ChunkPos::new(0, 0, 0), &meshes)
+        .unwrap();
+    frame(ctx, &mut renderer, camera)
+}
+
+#[test]
+fn a_level_chunk_is_drawn_where_its_cells_are_and_its_water_reads_as_fine_water() {
+    let Some(ctx) = gpu() else { return };
+    let camera = Camera::look_at(
+        DVec3::new(-14.0, 22.0, -9.0),
+        DVec3::new(12.0, 3.0, 10.0),
+        60.0,
+        0.1,
+        500.0,
+    )
+    .unwrap();
+    let dir = out_dir("far/level-chunk");
+    for (name, id, techniques) in [
+        ("stone", blocks::STONE, vec![Technique::SortedQuads]),
+        (
+            "water",
+            blocks::WATER,
+            vec![
+                Technique::SortedQuads,
+                Technique::Reference,
+                Technique::WboitMrt,
+            ],
+        ),
+        ("glass", blocks::RED_GLASS, vec![Technique::SortedQuads]),
+    ] {
+        // Level 2: cells of 4 × 1 × 4 blocks; a box of 5 × 3 × 4 cells is 20 × 3 × 16
+        // blocks, drawn as the full-detail box of those blocks is.
+        let (chunk, world) = level_box_and_fine(2, [1, 2, 0], [5, 4, 3], id);
+        for technique in techniques {
+            let coarse = draw_level(&ctx, &chunk, 2, technique, &camera);
+            let scene = tests::scene(name, world.clone(), [0.0; 3], [1.0; 3]);
+            let mut renderer =
+                tests::renderer_for(&ctx, &scene, technique_config(technique, 320, 180)).unwrap();
+            let fine = frame(&ctx, &mut renderer.renderer, &camera);
+            coarse
+                .save_png(&dir.join(format!("{name}-{technique}-level.png")))
+                .unwrap();
+            fine.save_png(&dir.join(format!("{name}-{technique}-fine.png")))
+                .unwrap();
+            let d = diff(&coarse, &fine);
+            let drawn = tests::distinct_colours(&fine);
+            assert!(drawn > 4, "{name}: the box is not in the picture");
+            // The same quads at the same places: at most rounding apart (the coarse box's
+            // quads are the fine box's merged quads, scaled).
+            assert!(
+                d.max <= 1,
+                "{name} with {technique}: the level chunk differs by {}/255 on {} pixels from \
+                 the fine blocks it stands for; see {}",
+                d.max,
+                d.over_one,
+                dir.display()
+            );
+        }
+    }
+    // Bad levels and positions are errors, not panics.
+    let registry = BlockRegistry::default();
+    let mut renderer = Renderer::new(
+        &ctx,
+        &registry,
+        technique_config(Technique::SortedQuads, 8, 8),
+    )
+    .unwrap();
+    let empty = voxel_mesh::ChunkMeshes::default();
+    assert!(
+        renderer
+            .upload_level_chunk(voxel_core::MAX_LEVEL + 1, ChunkPos::new(0, 0, 0), &empty)
+            .is_err()
+    );
+    assert!(
+        renderer
+            .upload_level_chunk(6, ChunkPos::new(ChunkPos::MAX, 0, 0), &empty)
+            .is_err()
+    );
+    assert_eq!(
+        level_key(3, ChunkPos::new(-2, 1, 5)),
+        Some(ChunkPos::new(-16, 1, 40))
+    );
+}
+
+/// The default far view, small: full detail to 8 chunks, levels to 32.
+fn small_rings() -> LevelRings {
+    LevelRings::reaching(8, 32)
+}
+
+#[test]
+fn every_technique_draws_level_geometry_and_sorted_quads_as_the_a_buffer_does() {
+    let Some(ctx) = gpu() else { return };
+    let generator = TerrainGenerator::new(TerrainConfig::default());
+    let registry = BlockRegistry::default();
+    let rings = small_rings();
+    assert_eq!((rings.coarsest, rings.view_distance()), (2, 32));
+    let camera = far::default_view(&generator).unwrap();
+    let meshes = far::build(&generator, &registry, &rings, &camera).unwrap();
+    let (w, h) = (480, 270);
+    let mut renderer = Renderer::new(
+        &ctx,
+        &registry,
+        technique_config(Technique::Reference, w, h),
+    )
+    .unwrap();
+    far::upload(&mut renderer, &meshes).unwrap();
+    let target = Offscreen::new(&ctx, w, h);
+    let reference = far::picture(&ctx, &mut renderer, &target, &camera).unwrap();
+    let dir = out_dir("far/techniques");
+    reference.save_png(&dir.join("reference.png")).unwrap();
+    renderer.set_technique(Technique::OpaqueOnly).unwrap();
+    let dry = far::picture(&ctx, &mut renderer, &target, &camera).unwrap();
+    // Water and glass are drawn: the reference differs from the picture without them.
+    let wet = diff(&reference, &dry).over_one;
+    assert!(
+        wet > (w * h / 50) as usize,
+        "hardly any water drawn: {wet} pixels"
+    );
+    for technique in Technique::supported(&ctx.caps) {
+        if matches!(technique, Technique::Reference | Technique::OpaqueOnly) {
+            continue;
+        }
+        renderer.set_technique(technique).unwrap();
+        let image = far::picture(&ctx, &mut renderer, &target, &camera).unwrap();
+        image
+            .save_png(&dir.join(format!("{technique}.png")))
+            .unwrap();
+        let d = diff(&image, &reference);
+        let over_8 = image
+            .rgba
+            .chunks_exact(4)
+            .zip(reference.rgba.chunks_exact(4))
+            .filter(|(p, q)| (0..3).any(|c| p[c].abs_diff(q[c]) > 8))
+            .count();
+        let share = over_8 as f64 / f64::from(w * h);
+        println!(
+            "{technique}: {} pixels off by more than 1/255, {over_8} ({:.3} %) by more than 8, at most {}/255",
+            d.over_one,
+            share * 100.0,
+            d.max
+        );
+        // Every technique draws the water of the levels (its picture is not the dry one).
+        assert!(
+            diff(&image, &dry).over_one > wet / 2,
+            "{technique} does not draw the levels' water"
+        );
+        if matches!(technique, Technique::SortedQuads | Technique::PeelReference) {
+            assert!(
+                share <= 0.001,
+                "{technique}: {:.3} % of pixels off the A-buffer by more than 8/255; see {}",
+                share * 100.0,
+                dir.display()
+            );
+        }
+    }
+}
+
+#[test]
+fn the_far_view_against_full_detail_has_no_holes_and_the_far_colours_of_full_detail() {
+    let Some(ctx) = gpu() else { return };
+    let generator = TerrainGenerator::new(TerrainConfig::default());
+    let registry = BlockRegistry::default();
+    let rings = small_rings();
+    let camera = far::default_view(&generator).unwrap();
+    let levels = far::build(&generator, &registry, &rings, &camera).unwrap();
+    let full_rings = LevelRings {
+        radius: 32,
+        coarsest: 0,
+        y: rings.y.clone(),
+    };
+    let full = far::build(&generator, &registry, &full_rings, &camera).unwrap();
+    let (w, h) = (640, 360);
+    let mut renderer = Renderer::new(
+        &ctx,
+        &registry,
+        technique_config(Technique::SortedQuads, w, h),
+    )
+    .unwrap();
+    let target = Offscreen::new(&ctx, w, h);
+    let dir = out_dir("far/against-full-detail");
+    let c = far::compare(
+        &ctx,
+        &mut renderer,
+        &target,
+        &camera,
+        &levels,
+        &full,
+        &rings,
+        &dir,
+    )
+    .unwrap();
+    println!("{c:#?}");
+    println!(
+        "far water step {:.2}/255, far ground step {:.2}/255",
+        c.water_step(),
+        c.ground_step()
+    );
+    assert!(c.far_pixels > 0.01, "the levels are hardly in the picture");
+    assert!(c.far_water_pixels > 0.001, "no far water in the picture");
+    assert!(
+        c.holes <= 0.0001,
+        "holes on {:.4} % of pixels; see {}",
+        c.holes * 100.0,
+        dir.display()
+    );
+    assert!(
+        c.skyline <= 0.005,
+        "the skyline differs on {:.3} %",
+        c.skyline * 100.0
+    );
+    assert!(
+        c.ground_step() <= 2.0,
+        "far ground {:.2}/255 off",
+        c.ground_step()
+    );
+    assert!(
+        c.water_step() <= 3.0,
+        "far water {:.2}/255 off",
+        c.water_step()
+    );
+}
