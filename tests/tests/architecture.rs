@@ -30,6 +30,7 @@ const RENDER: &[&str] = &[
     "renderer",
     "content",
     "stream",
+    "far",
     "low_level",
 ];
 
@@ -55,6 +56,7 @@ const LAB: &[&str] = &[
     "costs",
     "report",
     "stream",
+    "far",
     "gallery",
     "backends",
 ];

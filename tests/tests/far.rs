@@ -3,7 +3,6 @@
 //! geometry (`sorted-quads` as the A-buffer does), and the far view of the default terrain
 //! against full detail of the same view: no holes, the far ground's and water's colour.
 
-
 #![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
 
 use glam::DVec3;
@@ -217,6 +216,7 @@ fn the_far_view_against_full_detail_has_no_holes_and_the_far_colours_of_full_det
     let full_rings = LevelRings {
         radius: 32,
         coarsest: 0,
+        finest: 0,
         y: rings.y.clone(),
     };
     let full = far::build(&generator, &registry, &full_rings, &camera).unwrap();
@@ -269,4 +269,138 @@ fn the_far_view_against_full_detail_has_no_holes_and_the_far_colours_of_full_det
         "far water {:.2}/255 off",
         c.water_step()
     );
+}
+
+/// Each full-detail chunk column of `drawn` (level, position) counted: every one once.
+fn assert_tiles_once(drawn: &[(u8, ChunkPos)], what: &str) {
+    let mut cover = std::collections::HashMap::<[i64; 3], u32>::new();
+    for &(l, p) in drawn {
+        let s = voxel_core::level_scale(l);
+        for dx in 0..s {
+            for dz in 0..s {
+                *cover
+                    .entry([
+                        i64::from(p.x) * s + dx,
+                        i64::from(p.y),
+                        i64::from(p.z) * s + dz,
+                    ])
+                    .or_default() += 1;
+            }
+        }
+    }
+    assert!(
+        cover.values().all(|&n| n == 1),
+        "{what}: a place drawn twice"
+    );
+}
+
+#[test]
+fn a_far_field_is_built_coarse_first_off_the_frame_and_follows_the_eye() {
+    use std::sync::Arc;
+    use voxel_render::far::{FarConfig, FarField};
+    let Some(ctx) = gpu() else { return };
+    let generator = Arc::new(TerrainGenerator::new(TerrainConfig::default()));
+    let registry = Arc::new(BlockRegistry::default());
+    let config = FarConfig {
+        rings: LevelRings::reaching(4, 32),
+        ..FarConfig::default()
+    };
+    assert_eq!(config.rings.coarsest, 3);
+    let mut field = FarField::new(Arc::clone(&generator), Arc::clone(&registry), config).unwrap();
+    let (w, h) = (480, 270);
+    let mut renderer = Renderer::new(
+        &ctx,
+        &registry,
+        technique_config(Technique::SortedQuads, w, h),
+    )
+    .unwrap();
+    let camera = far::default_view(&generator).unwrap();
+    let dir = out_dir("far/field");
+    // Updates until a view with `finest` level 0 is drawn, or 120 s; the finest level of
+    // each view swapped in, and the updates' longest time.
+    let run = |field: &mut FarField, renderer: &mut Renderer, eye: DVec3, what: &str| {
+        let start = std::time::Instant::now();
+        let mut swaps = Vec::new();
+        let mut longest = 0f64;
+        loop {
+            let t = std::time::Instant::now();
+            let s = field.update(renderer, eye).unwrap();
+            longest = longest.max(t.elapsed().as_secs_f64() * 1e3);
+            if s.swapped {
+                swaps.push((s.drawn_finest.unwrap(), s.uploaded_bytes));
+                let drawn: Vec<_> = field.drawn().collect();
+                assert_tiles_once(&drawn, what);
+                // The renderer holds the field's chunks (those with a face: an empty mesh is
+                // not kept), and nothing else.
+                let held = voxel_render::low_level::chunks(renderer).len();
+                assert!(
+                    held <= drawn.len() && held * 4 > drawn.len() * 3,
+                    "{what}: the renderer holds {held} chunks, the field drew {}",
+                    drawn.len()
+                );
+                let cam = Camera { eye, ..camera };
+                let target = Offscreen::new(&ctx, w, h);
+                let image = far::picture(&ctx, renderer, &target, &cam).unwrap();
+                image
+                    .save_png(&dir.join(format!("{what}-{}.png", swaps.len())))
+                    .unwrap();
+                if s.drawn_finest == Some(0) {
+                    break;
+                }
+            }
+            assert!(
+                start.elapsed().as_secs() < 120,
+                "{what}: not finished in 120 s"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        println!(
+            "{what}: views drawn (finest level, bytes uploaded) {swaps:?}; longest update {longest:.1} ms"
+        );
+        swaps
+    };
+    // From nothing: the coarsest level alone first, then one level finer at a time.
+    let first = run(&mut field, &mut renderer, camera.eye, "start");
+    assert_eq!(
+        first.iter().map(|s| s.0).collect::<Vec<_>>(),
+        [3, 2, 1, 0],
+        "not built coarse first"
+    );
+    let total: u64 = first.iter().map(|s| s.1).sum();
+    // Within the hysteresis the view stays.
+    let near = camera.eye + DVec3::new(10.0, 0.0, -10.0);
+    for _ in 0..20 {
+        let s = field.update(&mut renderer, near).unwrap();
+        assert!(
+            !s.swapped && s.missing == 0,
+            "replanned within the hysteresis: {s:?}"
+        );
+    }
+    // Past it, the finished view around the eye, built from what is drawn: only the
+    // chunks that changed are uploaded.
+    let moved = run(
+        &mut field,
+        &mut renderer,
+        camera.eye + DVec3::new(70.0, 0.0, 0.0),
+        "moved",
+    );
+    assert_eq!(
+        moved.len(),
+        1,
+        "a step of the eye rebuilt the view coarse first"
+    );
+    assert!(
+        moved[0].1 * 2 < total,
+        "a step of the eye uploaded {} bytes of {total}",
+        moved[0].1
+    );
+    // A jump far away: coarse first again.
+    let far_eye = camera.eye + DVec3::new(100_000.0, 0.0, 0.0);
+    let jumped = run(&mut field, &mut renderer, far_eye, "jumped");
+    assert_eq!(jumped[0].0, 3, "after a jump the horizon comes first");
+    // A NaN eye changes nothing.
+    let before: Vec<_> = field.drawn().collect();
+    let s = field.update(&mut renderer, DVec3::NAN).unwrap();
+    assert!(!s.swapped);
+    assert_eq!(field.drawn().collect::<Vec<_>>(), before);
 }

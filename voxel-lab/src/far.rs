@@ -255,6 +255,7 @@ pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
             let full = LevelRings {
                 radius: (opts.view_distance as i32 + 1) & !1,
                 coarsest: 0,
+                finest: 0,
                 y: rings.y.clone(),
             };
             let c = compare(

@@ -9,6 +9,8 @@
 //!   passes of a frame ([`Renderer::render`]); [`Camera`] to look with.
 //! - [`Technique`] and its settings in [`OitConfig`]: how translucent water, glass and
 //!   leaves are composed, switchable at run time.
+//! - [`far::FarField`]: generated terrain to a far view distance in levels of detail
+//!   around a moving eye, built coarse first off the frame.
 //! - [`ChunkStreamer`]: the chunks around a moving eye, generated, meshed and uploaded on
 //!   rayon's workers (on wasm32, where a browser page has one thread, on the page's
 //!   thread within a time budget per update).
@@ -31,7 +33,7 @@
 //! `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
 //! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` →
 //! `content` (ready-made game content) → `stream` (chunks loaded around a moving eye) →
-//! `low_level`. A test
+//! `far` (levels of detail around a moving eye) → `low_level`. A test
 //! (`tests/tests/architecture.rs`) checks that no `crate::` path points back up.
 
 #![warn(missing_docs)]
@@ -45,6 +47,7 @@ pub mod content;
 mod context;
 mod cost;
 mod error;
+pub mod far;
 mod fetch;
 mod gpu;
 mod ladder;

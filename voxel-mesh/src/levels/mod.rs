@@ -45,6 +45,10 @@ pub struct LevelRings {
     pub radius: i32,
     /// The coarsest level, 0 (full detail only) to [`voxel_core::MAX_LEVEL`].
     pub coarsest: u8,
+    /// The finest level drawn, 0 to `coarsest`: it fills its whole square, the eye's
+    /// chunks included (0 for a finished view; coarser while a view is built coarse first,
+    /// see [`LevelRings::coarse_first`]).
+    pub finest: u8,
     /// The chunk heights (y) of every level.
     pub y: RangeInclusive<i32>,
 }
@@ -64,6 +68,7 @@ impl LevelRings {
         Self {
             radius,
             coarsest,
+            finest: 0,
             y: 0..=1,
         }
     }
@@ -81,6 +86,12 @@ impl LevelRings {
                 "coarsest level {}: at most {}",
                 self.coarsest,
                 voxel_core::MAX_LEVEL
+            ));
+        }
+        if self.finest > self.coarsest {
+            return Err(format!(
+                "finest level {} over the coarsest {}",
+                self.finest, self.coarsest
             ));
         }
         if self.y.is_empty() {
@@ -115,14 +126,14 @@ impl LevelRings {
         let r = i64::from(self.radius);
         let up = Self::eye_chunk(level + 1, eye);
         let outer = up.map(|c| [2 * c - r, 2 * c + r + 1]);
-        let inner =
-            (level > 0).then(|| Self::eye_chunk(level, eye).map(|c| [c - r / 2, c + r / 2]));
+        let inner = (level > self.finest)
+            .then(|| Self::eye_chunk(level, eye).map(|c| [c - r / 2, c + r / 2]));
         (outer, inner)
     }
 
     /// Whether chunk `pos` of level `level` is drawn for an eye at `eye` (world blocks).
     pub fn contains(&self, level: u8, pos: ChunkPos, eye: [f64; 3]) -> bool {
-        if level > self.coarsest || !self.y.contains(&pos.y) {
+        if level > self.coarsest || level < self.finest || !self.y.contains(&pos.y) {
             return false;
         }
         let (outer, inner) = self.squares(level, eye);
@@ -133,7 +144,7 @@ impl LevelRings {
 
     /// The chunks of level `level` drawn for an eye at `eye`, nearest first.
     pub fn chunks(&self, level: u8, eye: [f64; 3]) -> Vec<ChunkPos> {
-        if level > self.coarsest {
+        if level > self.coarsest || level < self.finest {
             return Vec::new();
         }
         let (outer, _) = self.squares(level, eye);
@@ -162,10 +173,37 @@ impl LevelRings {
     /// Every level's chunks for an eye at `eye`: coarsest level first (the horizon comes
     /// first), each level's nearest first.
     pub fn all(&self, eye: [f64; 3]) -> Vec<(u8, ChunkPos)> {
-        (0..=self.coarsest)
+        (self.finest..=self.coarsest)
             .rev()
             .flat_map(|l| self.chunks(l, eye).into_iter().map(move |p| (l, p)))
             .collect()
+    }
+}
+
+impl LevelRings {
+    /// The same rings with level `finest` the finest drawn, filling its square: the view a
+    /// far view is built through, coarse first (its coarsest level alone, then one level
+    /// finer at a time), each a whole view with no hole and nothing drawn twice.
+    pub fn coarse_first(&self, finest: u8) -> Self {
+        Self {
+            finest: finest.min(self.coarsest),
+            ..self.clone()
+        }
+    }
+
+    /// Which of the 26 neighbours of chunk `pos` of level `level` the rings hold at that
+    /// level or lie above or below the rings' heights (bit `i`:
+    /// [`Neighbourhood::OFFSETS`]`[i]`): what its mesh depends on besides the terrain (a
+    /// neighbour across a level border counts by its water only).
+    pub fn neighbours_held(&self, level: u8, pos: ChunkPos, eye: [f64; 3]) -> u32 {
+        Neighbourhood::OFFSETS
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| {
+                pos.offset(**d)
+                    .is_some_and(|n| self.contains(level, n, eye) || !self.y.contains(&n.y))
+            })
+            .fold(0, |m, (i, _)| m | 1 << i)
     }
 }
 

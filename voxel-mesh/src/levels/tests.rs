@@ -23,6 +23,7 @@ fn the_levels_tile_the_view_once_and_reach_the_view_distance() {
     let rings = LevelRings {
         radius: 4,
         coarsest: 3,
+        finest: 0,
         y: 0..=0,
     };
     assert_eq!(rings.view_distance(), 32);
@@ -31,32 +32,36 @@ fn the_levels_tile_the_view_once_and_reach_the_view_distance() {
         .chain([[0.5, 1.0, -0.5], [-33.0, 0.0, 64.0]])
     {
         // Every full-detail chunk column within the coarsest square is covered by exactly
-        // one chunk of one level.
-        let mut cover: HashMap<[i64; 2], u32> = HashMap::new();
-        for (l, p) in rings.all(eye) {
-            let s = level_scale(l);
-            for dx in 0..s {
-                for dz in 0..s {
-                    *cover
-                        .entry([i64::from(p.x) * s + dx, i64::from(p.z) * s + dz])
-                        .or_default() += 1;
+        // one chunk of one level, in the finished view and in each coarse-first one.
+        for finest in (0..=rings.coarsest).rev() {
+            let plan = rings.coarse_first(finest);
+            let mut cover: HashMap<[i64; 2], u32> = HashMap::new();
+            for (l, p) in plan.all(eye) {
+                let s = level_scale(l);
+                for dx in 0..s {
+                    for dz in 0..s {
+                        *cover
+                            .entry([i64::from(p.x) * s + dx, i64::from(p.z) * s + dz])
+                            .or_default() += 1;
+                    }
                 }
             }
-        }
-        assert!(
-            cover.values().all(|&n| n == 1),
-            "a column drawn twice, eye {eye:?}"
-        );
-        let c = [eye[0], eye[2]].map(|v| (v / 32.0).floor() as i64);
-        // No hole: the square of the view distance around the eye's chunk is covered.
-        let r = rings.view_distance();
-        for x in c[0] - r..=c[0] + r {
-            for z in c[1] - r..=c[1] + r {
-                assert!(cover.contains_key(&[x, z]), "hole at {x},{z} eye {eye:?}");
+            assert!(
+                cover.values().all(|&n| n == 1),
+                "a column drawn twice, eye {eye:?}"
+            );
+            let c = [eye[0], eye[2]].map(|v| (v / 32.0).floor() as i64);
+            // No hole: the square of the view distance around the eye's chunk is covered.
+            let r = rings.view_distance();
+            for x in c[0] - r..=c[0] + r {
+                for z in c[1] - r..=c[1] + r {
+                    assert!(cover.contains_key(&[x, z]), "hole at {x},{z} eye {eye:?}");
+                }
             }
         }
         // Each level starts at least its radius in its own chunks from the eye, past the
         // level inside it: full detail holds the eye's chunk and `radius` chunks each way.
+        let c = [eye[0], eye[2]].map(|v| (v / 32.0).floor() as i64);
         for x in c[0] - 4..=c[0] + 4 {
             for z in c[1] - 4..=c[1] + 4 {
                 let p = ChunkPos::new(x as i32, 0, z as i32);
@@ -87,6 +92,10 @@ fn the_levels_tile_the_view_once_and_reach_the_view_distance() {
             ..rings.clone()
         },
         LevelRings {
+            finest: 4,
+            ..rings.clone()
+        },
+        LevelRings {
             #[allow(clippy::reversed_empty_ranges)]
             y: 1..=0,
             ..rings.clone()
@@ -114,6 +123,7 @@ fn a_flat_sea_meets_itself_across_level_borders_and_the_ground_is_skirted() {
     let rings = LevelRings {
         radius: 2,
         coarsest: 2,
+        finest: 0,
         y: 0..=0,
     };
     let eye = [40.0, 30.0, -20.0];
