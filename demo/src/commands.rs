@@ -409,6 +409,7 @@ pub(crate) fn far(a: FarArgs, device: &headless::Device) -> Result<()> {
         techniques: names(&a.techniques, &Technique::ALL, false, technique)
             .map_err(|e| e.in_option("--techniques"))?,
         compare: a.compare,
+        fly_frames: a.fly_frames,
         out: a.out.clone(),
     };
     opts.validate()?;
@@ -418,15 +419,30 @@ pub(crate) fn far(a: FarArgs, device: &headless::Device) -> Result<()> {
     let r = voxel_lab::far::run(&ctx, &opts)?;
     let mib = |b: u64| b as f64 / f64::from(1 << 20);
     println!(
-        "view distance {} chunks (full detail to {}, levels to {}): built in {:.0} ms, uploaded in {:.0} ms; GPU {:.1} MiB of buffers ({:.1} MiB of quads)",
+        "view distance {} chunks (full detail to {}, levels to {}): the horizon (coarsest level) \
+         drawn after {:.0} ms, the finished view after {:.0} ms ({} views, coarse first); GPU \
+         {:.1} MiB of buffers ({:.1} MiB of quads)",
         r.view_distance,
         r.full_detail,
         r.coarsest,
-        r.build_ms,
-        r.upload_ms,
+        r.horizon_ms,
+        r.built_ms,
+        r.views,
         mib(r.gpu_buffer_bytes),
         mib(r.gpu_quad_bytes)
     );
+    if r.flight_frames > 0 {
+        println!(
+            "flight of {} frames at {} blocks/s: update p50 {:.3} ms, p95 {:.3}, max {:.3} on the frame's thread; {} views swapped in, at most {} chunks missing",
+            r.flight_frames,
+            voxel_lab::far::FLIGHT_SPEED,
+            r.flight_update_ms.p50,
+            r.flight_update_ms.p95,
+            r.flight_update_ms.max,
+            r.flight_swaps,
+            r.flight_most_missing
+        );
+    }
     println!(
         "| level | cell (blocks) | chunks from..to | chunks (drawn) | quads opaque / cutout / translucent | MiB | KiB per chunk of distance |"
     );

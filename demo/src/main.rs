@@ -157,6 +157,10 @@ struct FarArgs {
     /// Also render full detail to the view distance (at most 64) and score the levels.
     #[arg(long)]
     compare: bool,
+    /// Frames flown at 20 blocks a second once the view is built (0 to 100000), each
+    /// frame's far-field update timed.
+    #[arg(long, default_value_t = 600)]
+    fly_frames: usize,
     /// Picture size.
     #[arg(long, value_parser = size, default_value = "1280x720")]
     size: (u32, u32),

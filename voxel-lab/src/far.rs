@@ -5,13 +5,16 @@
 //! picture compares with full detail of the same view ([`compare`]).
 
 use std::path::PathBuf;
-use std::time::Instant;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use serde::Serialize;
 use voxel_core::{BlockRegistry, ChunkPos, TerrainConfig, TerrainGenerator};
 use voxel_mesh::ChunkMeshes;
 use voxel_mesh::levels::{LevelRings, mesh_level_chunks};
+use voxel_render::far::{FarConfig, FarField};
+use voxel_render::low_level::MeshKind;
 use voxel_render::{Camera, GpuContext, Image, NoGame, Renderer, RendererConfig, Technique};
 
 use crate::headless::Offscreen;
@@ -37,9 +40,15 @@ pub struct FarOptions {
     /// Also render the same view in full detail to the view distance and score the levels
     /// against it ([`compare`]); at most 64 chunks.
     pub compare: bool,
+    /// Frames flown after the view is built, at [`FLIGHT_SPEED`] blocks a second and 60
+    /// frames a second (each frame's update timed), 0 to 100 000.
+    pub fly_frames: usize,
     /// Output folder.
     pub out: PathBuf,
 }
+
+/// How fast the flight of `demo far` goes, blocks a second (issue 50's flight).
+pub const FLIGHT_SPEED: f64 = 20.0;
 
 impl Default for FarOptions {
     fn default() -> Self {
@@ -50,6 +59,7 @@ impl Default for FarOptions {
             seed: 1,
             techniques: vec![Technique::SortedQuads],
             compare: false,
+            fly_frames: 600,
             out: PathBuf::from("far-out"),
         }
     }
@@ -78,6 +88,9 @@ impl FarOptions {
                 "--compare",
                 "full detail is drawn to at most 64 chunks: give --view-distance 64 or less",
             ));
+        }
+        if self.fly_frames > 100_000 {
+            return Err(Error::option("--fly-frames", "at most 100000"));
         }
         if self.techniques.is_empty() {
             return Err(Error::option("--techniques", "no technique given"));
@@ -122,10 +135,22 @@ pub struct FarReport {
     pub coarsest: u8,
     /// Per level, full detail first.
     pub levels: Vec<LevelRow>,
-    /// Generating and meshing every level, wall-clock ms on this machine's cores.
-    pub build_ms: f64,
-    /// Uploading every mesh, ms.
-    pub upload_ms: f64,
+    /// From nothing to the first view drawn (the coarsest level alone), wall-clock ms, the
+    /// far field's worker meshing on this machine's cores.
+    pub horizon_ms: f64,
+    /// From nothing to the finished view drawn, ms.
+    pub built_ms: f64,
+    /// The views swapped in until then (coarse first: one per level).
+    pub views: usize,
+    /// The flight after it: [`FarField::update`]'s time per frame on the frame's thread
+    /// (planning, taking meshes, the swaps' uploads), ms.
+    pub flight_update_ms: crate::stream::Spread,
+    /// Frames flown.
+    pub flight_frames: usize,
+    /// Views swapped in during the flight.
+    pub flight_swaps: usize,
+    /// The most chunks a view being built lacked during the flight.
+    pub flight_most_missing: usize,
     /// The renderer's chunk memory after the upload: arena pages, records and draws.
     pub gpu_buffer_bytes: u64,
     /// Of those, bytes holding quads.
@@ -186,50 +211,53 @@ pub fn picture(
     target.read(ctx)
 }
 
-/// Per level: chunks, quads and bytes.
-pub fn level_rows(rings: &LevelRings, meshes: &[(u8, ChunkPos, ChunkMeshes)]) -> Vec<LevelRow> {
+/// Per level, the chunks, quads and bytes `renderer` holds.
+pub fn held_rows(rings: &LevelRings, renderer: &Renderer) -> Vec<LevelRow> {
     let r = i64::from(rings.radius);
-    (0..=rings.coarsest)
-        .map(|level| {
-            let mut row = LevelRow {
-                level,
-                cell_blocks: voxel_core::level_scale(level),
-                from_chunks: if level == 0 { 0 } else { r << (level - 1) },
-                to_chunks: r << level,
-                ..LevelRow::default()
-            };
-            for (_, _, m) in meshes.iter().filter(|(l, _, _)| *l == level) {
-                row.chunks += 1;
-                if !m.is_empty() {
-                    row.chunks_drawn += 1;
-                    row.bytes += 32;
-                }
-                row.quads[0] += m.opaque.len();
-                row.quads[1] += m.cutout.len();
-                row.quads[2] += m.translucent.len();
-            }
-            row.bytes += 8 * row.quads.iter().sum::<usize>() as u64;
-            row.bytes_per_chunk_of_distance =
-                row.bytes as f64 / (row.to_chunks - row.from_chunks).max(1) as f64;
-            row
+    let mut rows: Vec<LevelRow> = (0..=rings.coarsest)
+        .map(|level| LevelRow {
+            level,
+            cell_blocks: voxel_core::level_scale(level),
+            from_chunks: if level == 0 { 0 } else { r << (level - 1) },
+            to_chunks: r << level,
+            ..LevelRow::default()
         })
-        .collect()
+        .collect();
+    for c in voxel_render::low_level::chunks(renderer).iter() {
+        let Some(row) = rows.get_mut(usize::from(c.level())) else {
+            continue;
+        };
+        row.chunks += 1;
+        row.chunks_drawn += 1;
+        row.bytes += 32;
+        for (k, kind) in [MeshKind::Opaque, MeshKind::Cutout, MeshKind::Translucent]
+            .into_iter()
+            .enumerate()
+        {
+            let q = c.mesh(kind).map_or(0, |a| a.quads as usize);
+            row.quads[k] += q;
+            row.bytes += 8 * q as u64;
+        }
+    }
+    for row in &mut rows {
+        row.bytes_per_chunk_of_distance =
+            row.bytes as f64 / (row.to_chunks - row.from_chunks).max(1) as f64;
+    }
+    rows
 }
 
-/// Builds the far view of `opts`, draws it with each technique, and writes the pictures
-/// and `far.json` into `opts.out`.
+/// Builds the far view of `opts` through a [`FarField`] from nothing (timing the first
+/// and the finished view), draws it with each technique, flies on, and writes the
+/// pictures and `far.json` into `opts.out`.
 pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
     opts.validate()?;
-    let generator = TerrainGenerator::new(TerrainConfig {
+    let generator = Arc::new(TerrainGenerator::new(TerrainConfig {
         seed: opts.seed,
         ..TerrainConfig::default()
-    });
-    let registry = std::sync::Arc::new(BlockRegistry::default());
+    }));
+    let registry = Arc::new(BlockRegistry::default());
     let rings = LevelRings::reaching(opts.full_detail, opts.view_distance);
     let camera = default_view(&generator)?;
-    let t = Instant::now();
-    let meshes = build(&generator, &registry, &rings, &camera)?;
-    let build_ms = t.elapsed().as_secs_f64() * 1e3;
     let (width, height) = opts.size;
     let config = RendererConfig {
         width,
@@ -237,10 +265,36 @@ pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
         ..RendererConfig::default()
     };
     let mut renderer = Renderer::new(ctx, &registry, config)?;
+    let mut field = FarField::new(
+        Arc::clone(&generator),
+        Arc::clone(&registry),
+        FarConfig {
+            rings: rings.clone(),
+            ..FarConfig::default()
+        },
+    )?;
     let t = Instant::now();
-    upload(&mut renderer, &meshes)?;
-    let upload_ms = t.elapsed().as_secs_f64() * 1e3;
+    let (mut horizon_ms, mut views) = (None, 0);
+    loop {
+        let s = field.update(&mut renderer, camera.eye)?;
+        if s.swapped {
+            views += 1;
+            horizon_ms.get_or_insert(t.elapsed().as_secs_f64() * 1e3);
+        }
+        if s.drawn_finest == Some(0) {
+            break;
+        }
+        if t.elapsed().as_secs() > 1800 {
+            return Err(Error::option(
+                "--view-distance",
+                "the view took over 30 minutes to build",
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let built_ms = t.elapsed().as_secs_f64() * 1e3;
     let memory = renderer.chunk_memory();
+    let levels = held_rows(&rings, &renderer);
     let target = Offscreen::new(ctx, width, height);
     let mut pictures = Vec::new();
     for &t in &opts.techniques {
@@ -250,6 +304,19 @@ pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
         image.save_png(&opts.out.join(&name))?;
         pictures.push(name);
     }
+    // The flight: along the view's horizontal direction at FLIGHT_SPEED, 60 frames a second.
+    let dir = DVec3::new(camera.forward.x, 0.0, camera.forward.z).normalize_or(DVec3::X);
+    let frame = Duration::from_secs_f64(1.0 / 60.0);
+    let (mut times, mut swaps, mut most_missing) = (Vec::new(), 0, 0);
+    for f in 0..opts.fly_frames {
+        let start = Instant::now();
+        let eye = camera.eye + dir * (FLIGHT_SPEED * (f + 1) as f64 / 60.0);
+        let s = field.update(&mut renderer, eye)?;
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+        swaps += usize::from(s.swapped);
+        most_missing = most_missing.max(s.missing);
+        std::thread::sleep(frame.saturating_sub(start.elapsed()));
+    }
     let compare = match opts.compare {
         true => {
             let full = LevelRings {
@@ -258,12 +325,13 @@ pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
                 finest: 0,
                 y: rings.y.clone(),
             };
+            let levels = build(&generator, &registry, &rings, &camera)?;
             let c = compare(
                 ctx,
                 &mut renderer,
                 &target,
                 &camera,
-                &meshes,
+                &levels,
                 &build(&generator, &registry, &full, &camera)?,
                 &rings,
                 &opts.out,
@@ -277,9 +345,14 @@ pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
         full_detail: opts.full_detail,
         view_distance: rings.view_distance(),
         coarsest: rings.coarsest,
-        levels: level_rows(&rings, &meshes),
-        build_ms,
-        upload_ms,
+        levels,
+        horizon_ms: horizon_ms.unwrap_or(built_ms),
+        built_ms,
+        views,
+        flight_update_ms: crate::stream::Spread::of(&times),
+        flight_frames: opts.fly_frames,
+        flight_swaps: swaps,
+        flight_most_missing: most_missing,
         gpu_buffer_bytes: memory.arena_bytes + memory.record_bytes + memory.indirect_bytes,
         gpu_quad_bytes: memory.quad_bytes,
         pictures,

@@ -22,7 +22,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use voxel_core::{BlockRegistry, ChunkPos, TerrainGenerator};
 use voxel_mesh::ChunkMeshes;
-use voxel_mesh::levels::{LevelRings, mesh_level_chunks};
+use voxel_mesh::levels::{LevelCache, LevelRings, mesh_level_chunks_with};
 
 use crate::{Error, Renderer, Result, level_key};
 
@@ -70,15 +70,19 @@ pub struct FarStatus {
 
 /// The levels of detail of generated terrain around a moving eye, on a [`Renderer`]'s GPU:
 /// see the module docs. Call [`FarField::update`] once a frame with the eye; it never
-/// waits for meshing.
+/// waits for planning or meshing, which run on its worker.
 pub struct FarField {
     generator: Arc<TerrainGenerator>,
     registry: Arc<BlockRegistry>,
     config: FarConfig,
-    /// The eye the target view is planned around.
+    /// The eye the view is planned around.
     anchor: Option<DVec3>,
-    /// The view being built (a coarse-first view, then the finished one), its chunks.
-    target: Option<(LevelRings, [f64; 3], Vec<Key>)>,
+    /// The plan asked of the worker last (its number); older plans that come back are
+    /// dropped.
+    planning: Option<u64>,
+    plans: u64,
+    /// The view being built.
+    target: Option<Target>,
     /// The view drawn: its finest level and chunks.
     drawn: Option<(u8, HashSet<Key>)>,
     /// Meshes made, by chunk and neighbours held.
@@ -86,6 +90,15 @@ pub struct FarField {
     /// Chunks sent to be meshed and not back yet.
     in_flight: HashSet<Key>,
     jobs: Jobs,
+}
+
+/// A view being built: its rings (a coarse-first view, or the finished one), the eye it is
+/// planned around, its chunks, and those neither drawn nor meshed yet.
+#[derive(Debug)]
+struct Target {
+    rings: LevelRings,
+    keys: Vec<Key>,
+    pending: HashSet<Key>,
 }
 
 impl std::fmt::Debug for FarField {
@@ -100,30 +113,56 @@ impl std::fmt::Debug for FarField {
     }
 }
 
-/// A job: the view (rings and eye) and the chunks to mesh for it.
-type Job = (LevelRings, [f64; 3], Vec<Key>);
-/// A job's result.
-type Done = (
-    Vec<Key>,
-    std::result::Result<Vec<ChunkMeshes>, voxel_mesh::Error>,
-);
+/// What the worker is asked: a view's chunks (plan number, rings, eye), or the meshes of
+/// some of them.
+enum Job {
+    Plan(u64, LevelRings, [f64; 3]),
+    Mesh(LevelRings, [f64; 3], Vec<Key>),
+}
 
-/// Where meshing runs: a worker thread, or (wasm32) the updating thread.
+/// What the worker answers.
+enum Done {
+    Planned(u64, LevelRings, Vec<Key>),
+    Meshed(
+        Vec<Key>,
+        std::result::Result<Vec<ChunkMeshes>, voxel_mesh::Error>,
+    ),
+}
+
+/// Where planning and meshing run: a worker thread, or (wasm32) the updating thread.
 struct Jobs {
     #[cfg(not(target_arch = "wasm32"))]
     send: std::sync::mpsc::Sender<Job>,
     #[cfg(not(target_arch = "wasm32"))]
     receive: std::sync::mpsc::Receiver<Done>,
     #[cfg(target_arch = "wasm32")]
-    queue: Vec<Job>,
+    queue: std::collections::VecDeque<Job>,
+    #[cfg(target_arch = "wasm32")]
+    cache: LevelCache,
 }
 
-fn run_job(generator: &TerrainGenerator, registry: &BlockRegistry, job: Job) -> Done {
-    let (rings, eye, keys) = job;
-    let chunks: Vec<(u8, ChunkPos)> = keys.iter().map(|&(l, p, _)| (l, p)).collect();
-    let meshes = mesh_level_chunks(generator, registry, &rings, eye, &chunks)
-        .map(|v| v.into_iter().map(|(_, _, m)| m).collect());
-    (keys, meshes)
+fn run_job(
+    cache: &mut LevelCache,
+    generator: &TerrainGenerator,
+    registry: &BlockRegistry,
+    job: Job,
+) -> Done {
+    match job {
+        Job::Plan(n, rings, eye) => {
+            let keys = rings
+                .all(eye)
+                .into_iter()
+                .map(|(l, p)| (l, p, rings.neighbours_held(l, p, eye)))
+                .collect();
+            Done::Planned(n, rings, keys)
+        }
+        Job::Mesh(rings, eye, keys) => {
+            let chunks: Vec<(u8, ChunkPos)> = keys.iter().map(|&(l, p, _)| (l, p)).collect();
+            let meshes = mesh_level_chunks_with(cache, generator, registry, &rings, eye, &chunks)
+                .map(|v| v.into_iter().map(|(_, _, m)| m).collect());
+            Done::Meshed(keys, meshes)
+        }
+    }
 }
 
 impl Jobs {
@@ -137,8 +176,9 @@ impl Jobs {
             std::thread::Builder::new()
                 .name("far-field".into())
                 .spawn(move || {
+                    let mut cache = LevelCache::default();
                     for job in jobs {
-                        if done.send(run_job(&g, &r, job)).is_err() {
+                        if done.send(run_job(&mut cache, &g, &r, job)).is_err() {
                             break;
                         }
                     }
@@ -149,7 +189,10 @@ impl Jobs {
         #[cfg(target_arch = "wasm32")]
         {
             let _ = (generator, registry);
-            Self { queue: Vec::new() }
+            Self {
+                queue: std::collections::VecDeque::new(),
+                cache: LevelCache::default(),
+            }
         }
     }
 
@@ -162,7 +205,7 @@ impl Jobs {
         }
         #[cfg(target_arch = "wasm32")]
         {
-            self.queue.push(job);
+            self.queue.push_back(job);
             Ok(())
         }
     }
@@ -175,11 +218,11 @@ impl Jobs {
         }
         #[cfg(target_arch = "wasm32")]
         {
-            if self.queue.is_empty() {
-                return Vec::new();
-            }
-            let job = self.queue.remove(0);
-            vec![run_job(_generator, _registry, job)]
+            self.queue
+                .pop_front()
+                .map(|job| run_job(&mut self.cache, _generator, _registry, job))
+                .into_iter()
+                .collect()
         }
     }
 }
@@ -209,6 +252,8 @@ impl FarField {
                 ..config
             },
             anchor: None,
+            planning: None,
+            plans: 0,
             target: None,
             drawn: None,
             ready: HashMap::new(),
@@ -229,132 +274,133 @@ impl FarField {
             .flat_map(|(_, d)| d.iter().map(|&(l, p, _)| (l, p)))
     }
 
-    /// Follows the eye at `eye` (world blocks): plans the view when the eye left the
-    /// anchor, sends the chunks it lacks to be meshed, takes the meshes made, and swaps the
-    /// next view in when it is complete. Never waits for meshing. A NaN eye is ignored (the
-    /// drawn view stays).
+    /// Follows the eye at `eye` (world blocks): asks for a new plan when the eye left the
+    /// anchor, takes the plans and meshes the worker made, sends the chunks a view lacks to
+    /// be meshed, and swaps the view in when it is complete. Never waits for the worker. A
+    /// NaN eye is ignored (the drawn view stays).
     pub fn update(&mut self, renderer: &mut Renderer, eye: DVec3) -> Result<FarStatus> {
         let mut status = FarStatus::default();
         if eye.is_finite() {
-            self.plan(eye);
+            self.follow(eye)?;
         }
-        for (keys, meshes) in self.jobs.done(&self.generator, &self.registry) {
-            for k in &keys {
-                self.in_flight.remove(k);
+        for done in self.jobs.done(&self.generator, &self.registry) {
+            match done {
+                Done::Planned(n, rings, keys) if self.planning == Some(n) => {
+                    self.planning = None;
+                    self.planned(rings, keys)?;
+                }
+                Done::Planned(..) => {}
+                Done::Meshed(keys, meshes) => {
+                    let meshes = meshes.map_err(|e| {
+                        Error::Unsupported(format!("the far field could not mesh a chunk: {e}"))
+                    })?;
+                    for (k, m) in keys.into_iter().zip(meshes) {
+                        self.in_flight.remove(&k);
+                        if let Some(t) = &mut self.target {
+                            t.pending.remove(&k);
+                        }
+                        self.ready.insert(k, m);
+                    }
+                }
             }
-            let meshes = meshes.map_err(|e| {
-                Error::Unsupported(format!("the far field could not mesh a chunk: {e}"))
-            })?;
-            for (k, m) in keys.into_iter().zip(meshes) {
-                self.ready.insert(k, m);
-            }
         }
-        let Some((rings, at, keys)) = self.target.clone() else {
-            return Ok(self.status(status));
-        };
-        let drawn = self.drawn.as_ref().map(|(_, d)| d);
-        let missing: Vec<Key> = keys
-            .iter()
-            .filter(|k| {
-                !self.ready.contains_key(k)
-                    && !self.in_flight.contains(k)
-                    && !drawn.is_some_and(|d| d.contains(k))
-            })
-            .copied()
-            .collect();
-        for batch in missing.chunks(self.config.batch) {
-            self.in_flight.extend(batch.iter().copied());
-            self.jobs.send((rings.clone(), at, batch.to_vec()))?;
-        }
-        let complete = keys
-            .iter()
-            .all(|k| self.ready.contains_key(k) || drawn.is_some_and(|d| d.contains(k)));
-        if complete {
-            status.uploaded_bytes = self.swap(renderer, &rings, &keys)?;
+        if self.target.as_ref().is_some_and(|t| t.pending.is_empty()) {
+            status.uploaded_bytes = self.swap(renderer)?;
             status.swapped = true;
         }
-        Ok(self.status(status))
-    }
-
-    fn status(&self, mut status: FarStatus) -> FarStatus {
         status.drawn_finest = self.drawn.as_ref().map(|(l, _)| *l);
         status.drawn_chunks = self.drawn.as_ref().map_or(0, |(_, d)| d.len());
         status.ready = self.ready.len();
-        status.missing = self.target.as_ref().map_or(0, |(_, _, keys)| {
-            keys.iter()
-                .filter(|k| {
-                    !self.ready.contains_key(k)
-                        && !self.drawn.as_ref().is_some_and(|(_, d)| d.contains(k))
-                })
-                .count()
-        });
-        status
+        status.missing = self.target.as_ref().map_or(0, |t| t.pending.len());
+        Ok(status)
     }
 
-    /// Moves the anchor to the eye when it left it (or there is none), and picks the view
-    /// to build: the finished view, or, where little of it is drawn, the coarsest
-    /// coarse-first view not drawn yet.
-    fn plan(&mut self, eye: DVec3) {
+    /// Asks for the plan of the finished view around the eye when it left the anchor (or
+    /// there is none), or of the next finer view when the last one was drawn.
+    fn follow(&mut self, eye: DVec3) -> Result<()> {
         let h = self.config.hysteresis;
         let moved = self
             .anchor
             .is_none_or(|a| (eye.x - a.x).abs() > h || (eye.z - a.z).abs() > h);
-        let rings = &self.config.rings;
         if moved {
             self.anchor = Some(eye);
-            let at = eye.to_array();
-            let finished = rings.coarse_first(0);
-            let keys = Self::keys(&finished, at);
-            // Chunks of the finished view drawn already (whatever their neighbours).
+            self.target = None;
+            return self.ask(self.config.rings.coarse_first(0));
+        }
+        if self.target.is_none()
+            && self.planning.is_none()
+            && let Some((finest, _)) = &self.drawn
+            && *finest > 0
+        {
+            return self.ask(self.config.rings.coarse_first(finest - 1));
+        }
+        Ok(())
+    }
+
+    /// Asks the worker for the chunks of view `rings` around the anchor.
+    fn ask(&mut self, rings: LevelRings) -> Result<()> {
+        let Some(at) = self.anchor else { return Ok(()) };
+        self.plans += 1;
+        self.planning = Some(self.plans);
+        self.jobs.send(Job::Plan(self.plans, rings, at.to_array()))
+    }
+
+    /// A plan came back: builds it, or, for a finished view of which little is drawn, asks
+    /// for its coarsest coarse-first view instead.
+    fn planned(&mut self, rings: LevelRings, keys: Vec<Key>) -> Result<()> {
+        if rings.finest == 0 && rings.coarsest > 0 {
             let drawn: HashSet<(u8, ChunkPos)> = self.drawn().collect();
             let kept = keys
                 .iter()
                 .filter(|&&(l, p, _)| drawn.contains(&(l, p)))
                 .count();
-            // Most of the view drawn already: build the finished one; else coarse first.
-            let finest = if kept * 2 >= keys.len() {
-                0
-            } else {
-                rings.coarsest
-            };
-            let plan = rings.coarse_first(finest);
-            let keys = Self::keys(&plan, at);
-            self.target = Some((plan, at, keys));
-        } else if self.target.is_none() {
-            // The target was drawn: go on one level finer.
-            if let (Some((finest, _)), Some(a)) = (&self.drawn, self.anchor)
-                && *finest > 0
-            {
-                let plan = rings.coarse_first(finest - 1);
-                let at = a.to_array();
-                let keys = Self::keys(&plan, at);
-                self.target = Some((plan, at, keys));
+            if kept * 2 < keys.len() {
+                return self.ask(self.config.rings.coarse_first(rings.coarsest));
             }
         }
+        let drawn = self.drawn.as_ref().map(|(_, d)| d);
+        let pending: HashSet<Key> = keys
+            .iter()
+            .filter(|k| !self.ready.contains_key(k) && !drawn.is_some_and(|d| d.contains(k)))
+            .copied()
+            .collect();
+        let send: Vec<Key> = keys
+            .iter()
+            .filter(|k| pending.contains(k) && !self.in_flight.contains(k))
+            .copied()
+            .collect();
+        let at = self.anchor.map_or([0.0; 3], |a| a.to_array());
+        for batch in send.chunks(self.config.batch) {
+            self.in_flight.extend(batch.iter().copied());
+            self.jobs
+                .send(Job::Mesh(rings.clone(), at, batch.to_vec()))?;
+        }
+        self.target = Some(Target {
+            rings,
+            keys,
+            pending,
+        });
+        Ok(())
     }
 
-    fn keys(rings: &LevelRings, eye: [f64; 3]) -> Vec<Key> {
-        rings
-            .all(eye)
-            .into_iter()
-            .map(|(l, p)| (l, p, rings.neighbours_held(l, p, eye)))
-            .collect()
-    }
-
-    /// Draws the view of `keys` in place of the drawn one; returns the bytes of quads
+    /// Draws the target view in place of the drawn one; returns the bytes of quads
     /// uploaded.
-    fn swap(&mut self, renderer: &mut Renderer, rings: &LevelRings, keys: &[Key]) -> Result<u64> {
-        let new: HashSet<Key> = keys.iter().copied().collect();
+    fn swap(&mut self, renderer: &mut Renderer) -> Result<u64> {
+        let Some(target) = self.target.take() else {
+            return Ok(0);
+        };
+        let new: HashSet<Key> = target.keys.iter().copied().collect();
         let old = self.drawn.take().map(|(_, d)| d).unwrap_or_default();
         // Removed first: a chunk kept under the same GPU key by both views (a level chunk
-        // whose neighbours changed) is replaced by the upload below.
+        // whose neighbours changed, or a coarse chunk and the first of the finer ones that
+        // replace it) is replaced by the upload below.
         for &(l, p, _) in old.difference(&new) {
             if let Some(k) = level_key(l, p) {
                 renderer.remove_chunk(k);
             }
         }
         let mut bytes = 0;
-        for k in keys {
+        for k in &target.keys {
             if old.contains(k) {
                 continue;
             }
@@ -363,9 +409,8 @@ impl FarField {
                 renderer.upload_level_chunk(k.0, k.1, &m)?;
             }
         }
-        self.drawn = Some((rings.finest, new));
-        self.target = None;
-        // Meshes of views no longer wanted go.
+        self.drawn = Some((target.rings.finest, new));
+        // Meshes of views no longer wanted go; those in flight stay wanted.
         self.ready.clear();
         Ok(bytes)
     }

@@ -207,14 +207,37 @@ impl LevelRings {
     }
 }
 
+/// Generated level chunks kept between calls of [`mesh_level_chunks_with`]: the
+/// neighbours one batch of chunks reads are mostly the chunks of the next, generated once.
+/// Holds at most [`LevelCache::LIMIT`] chunks (emptied when full).
+#[derive(Debug, Default)]
+pub struct LevelCache {
+    chunks: HashMap<(u8, ChunkPos), Arc<Chunk>>,
+}
+
+impl LevelCache {
+    /// The most chunks kept: about 64 MiB of generated terrain.
+    pub const LIMIT: usize = 4096;
+
+    /// Chunks held.
+    pub fn len(&self) -> usize {
+        self.chunks.len()
+    }
+
+    /// Whether it holds nothing.
+    pub fn is_empty(&self) -> bool {
+        self.chunks.is_empty()
+    }
+}
+
 /// The meshes of the level chunks `chunks` of generator `generator` (over `registry`), for
 /// rings `rings` and an eye at `eye`: each culled against its level's chunks around it where
-/// the rings hold them, and against only the water of the chunk across a level border
-/// (see the module docs). Generated and meshed in parallel (one after another on wasm32),
-/// with ambient occlusion at every level: a coarse cell's occlusion spans the cell, which
-/// darkens a far slope about as much as the fine steps it replaces do on average (without
-/// it the far ground came out 5.4/255 lighter than full detail; with it 1.4/255:
-/// `demo far --compare`).
+/// the rings hold them, against only the water of the chunk across a level border (see the
+/// module docs), and against air above and below the rings' heights. Generated and meshed
+/// in parallel (one after another on wasm32), with ambient occlusion at every level: a
+/// coarse cell's occlusion spans the cell, which darkens a far slope about as much as the
+/// fine steps it replaces do on average (without it the far ground came out 5.4/255 lighter
+/// than full detail; with it 1.4/255: `demo far --compare`).
 pub fn mesh_level_chunks(
     generator: &TerrainGenerator,
     registry: &BlockRegistry,
@@ -222,7 +245,21 @@ pub fn mesh_level_chunks(
     eye: [f64; 3],
     chunks: &[(u8, ChunkPos)],
 ) -> Result<Vec<(u8, ChunkPos, ChunkMeshes)>> {
-    // Every chunk a mesh reads: its own and its 26 neighbours, each at the mesh's level.
+    let mut cache = LevelCache::default();
+    mesh_level_chunks_with(&mut cache, generator, registry, rings, eye, chunks)
+}
+
+/// [`mesh_level_chunks`], generating only the chunks `cache` lacks (and keeping them).
+pub fn mesh_level_chunks_with(
+    cache: &mut LevelCache,
+    generator: &TerrainGenerator,
+    registry: &BlockRegistry,
+    rings: &LevelRings,
+    eye: [f64; 3],
+    chunks: &[(u8, ChunkPos)],
+) -> Result<Vec<(u8, ChunkPos, ChunkMeshes)>> {
+    // Every chunk a mesh reads: its own and its 26 neighbours within the rings' heights,
+    // each at the mesh's level.
     let mut needed: Vec<(u8, ChunkPos)> = chunks
         .iter()
         .flat_map(|&(l, p)| {
@@ -231,32 +268,43 @@ pub fn mesh_level_chunks(
                 .filter_map(move |&d| p.offset(d).map(|n| (l, n)))
                 .chain([(l, p)])
         })
+        .filter(|(_, p)| rings.y.contains(&p.y))
         .collect();
     needed.sort_unstable();
     needed.dedup();
+    let lacking: Vec<(u8, ChunkPos)> = needed
+        .iter()
+        .filter(|k| !cache.chunks.contains_key(k))
+        .copied()
+        .collect();
+    if cache.chunks.len() + lacking.len() > LevelCache::LIMIT {
+        cache.chunks.retain(|k, _| needed.binary_search(k).is_ok());
+    }
+    let make = |&(l, p): &(u8, ChunkPos)| ((l, p), Arc::new(generator.generate_level_chunk(l, p)));
+    #[cfg(not(target_arch = "wasm32"))]
+    cache
+        .chunks
+        .extend(lacking.par_iter().map(make).collect::<Vec<_>>());
+    #[cfg(target_arch = "wasm32")]
+    cache.chunks.extend(lacking.iter().map(make));
+
     let mut water = vec![false; registry.len()];
     for (id, d) in registry.iter() {
         if let Some(w) = water.get_mut(id.index()) {
             *w = d.class == RenderClass::Translucent && d.absorption > 0.0;
         }
     }
-    let make = |&(l, p): &(u8, ChunkPos)| {
-        let chunk = generator.generate_level_chunk(l, p);
-        // Across a level border (in x or z) only the water counts; above and below the
-        // rings' heights the chunk as it is (rock below, sky above).
-        let across = !rings.contains(l, p, eye) && rings.y.contains(&p.y);
-        let chunk = if across { only(&chunk, &water) } else { chunk };
-        ((l, p), Arc::new(chunk))
-    };
-    #[cfg(not(target_arch = "wasm32"))]
-    let made: HashMap<_, _> = needed.par_iter().map(make).collect();
-    #[cfg(target_arch = "wasm32")]
-    let made: HashMap<_, _> = needed.iter().map(make).collect();
-
+    // Across a level border (in x or z) only the water counts.
+    let across: HashMap<(u8, ChunkPos), Chunk> = needed
+        .iter()
+        .filter(|&&(l, p)| !rings.contains(l, p, eye))
+        .filter_map(|k| cache.chunks.get(k).map(|c| (*k, only(c, &water))))
+        .collect();
+    let made = &cache.chunks;
+    let get = |k: &(u8, ChunkPos)| across.get(k).or_else(|| made.get(k).map(|c| &**c));
     let mesh = |mesher: &mut Mesher, &(l, p): &(u8, ChunkPos)| {
-        let around =
-            Neighbourhood::from_fn(|d| p.offset(d).and_then(|n| made.get(&(l, n))).map(|c| &**c));
-        let meshes = match made.get(&(l, p)) {
+        let around = Neighbourhood::from_fn(|d| p.offset(d).and_then(|n| get(&(l, n))));
+        let meshes = match get(&(l, p)) {
             Some(c) => mesher.mesh(c, around)?,
             None => ChunkMeshes::default(),
         };
