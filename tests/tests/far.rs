@@ -303,6 +303,8 @@ fn a_far_field_is_built_coarse_first_off_the_frame_and_follows_the_eye() {
     let registry = Arc::new(BlockRegistry::default());
     let config = FarConfig {
         rings: LevelRings::reaching(4, 32),
+        // Small, so that a swap takes several updates, a square at a time.
+        upload_budget: 256 << 10,
         ..FarConfig::default()
     };
     assert_eq!(config.rings.coarsest, 3);
@@ -327,7 +329,7 @@ fn a_far_field_is_built_coarse_first_off_the_frame_and_follows_the_eye() {
             let s = field.update(renderer, eye).unwrap();
             longest = longest.max(t.elapsed().as_secs_f64() * 1e3);
             if s.swapped {
-                swaps.push((s.drawn_finest.unwrap(), s.uploaded_bytes));
+                swaps.push((s.drawn_finest.unwrap(), s.swap_bytes));
                 let drawn: Vec<_> = field.drawn().collect();
                 assert_tiles_once(&drawn, what);
                 // The renderer holds the field's chunks (those with a face: an empty mesh is

@@ -11,8 +11,11 @@
 //!   that goes back and forth across a level's chunk border does not rebuild the view each
 //!   time. The finer rings reach that much less far from the eye than from the anchor.
 //! - **Swaps**: while the next view is built, the drawn one stays; when every mesh of the
-//!   next view is ready, one [`FarField::update`] uploads the meshes it lacks and removes the
-//!   chunks it no longer has. A mesh depends on which of its neighbours the view holds
+//!   next view is ready, it is swapped in a square of the coarsest level at a time (nearest
+//!   first, whole squares up to [`FarConfig::upload_budget`] bytes an update): each square
+//!   changes from one tiling of its ground to the other in one update, so no frame draws a
+//!   hole or a place twice. (For the few frames of a swap, a mesh beside a square not swapped
+//!   yet was culled against its new neighbours: at most a skirt shows or is missing there.) A mesh depends on which of its neighbours the view holds
 //!   (water only across a level border), so meshes are kept by chunk and those neighbours,
 //!   and a chunk whose border changed is meshed again.
 
@@ -36,6 +39,9 @@ pub struct FarConfig {
     pub hysteresis: f64,
     /// Chunks meshed per job (at least 1). Default 256.
     pub batch: usize,
+    /// Bytes of quads a swap uploads per update at most (whole groups: at least one).
+    /// Default 4 MiB.
+    pub upload_budget: u64,
 }
 
 impl Default for FarConfig {
@@ -44,6 +50,7 @@ impl Default for FarConfig {
             rings: LevelRings::reaching(32, 512),
             hysteresis: 16.0,
             batch: 256,
+            upload_budget: 4 << 20,
         }
     }
 }
@@ -62,10 +69,12 @@ pub struct FarStatus {
     pub ready: usize,
     /// Chunks of the next view not meshed yet.
     pub missing: usize,
-    /// Whether this update swapped a view in.
+    /// Whether this update finished swapping a view in.
     pub swapped: bool,
     /// Bytes of quads uploaded by this update.
     pub uploaded_bytes: u64,
+    /// When `swapped`: the bytes of quads the whole swap uploaded.
+    pub swap_bytes: u64,
 }
 
 /// The levels of detail of generated terrain around a moving eye, on a [`Renderer`]'s GPU:
@@ -83,6 +92,8 @@ pub struct FarField {
     plans: u64,
     /// The view being built.
     target: Option<Target>,
+    /// The view being swapped in.
+    swapping: Option<Swap>,
     /// The view drawn: its finest level and chunks.
     drawn: Option<(u8, HashSet<Key>)>,
     /// Meshes made, by chunk and neighbours held.
@@ -255,6 +266,7 @@ impl FarField {
             planning: None,
             plans: 0,
             target: None,
+            swapping: None,
             drawn: None,
             ready: HashMap::new(),
             in_flight: HashSet::new(),
@@ -280,7 +292,8 @@ impl FarField {
     /// NaN eye is ignored (the drawn view stays).
     pub fn update(&mut self, renderer: &mut Renderer, eye: DVec3) -> Result<FarStatus> {
         let mut status = FarStatus::default();
-        if eye.is_finite() {
+        // A view being swapped in is finished before the eye is followed again.
+        if eye.is_finite() && self.swapping.is_none() {
             self.follow(eye)?;
         }
         for done in self.jobs.done(&self.generator, &self.registry) {
@@ -304,9 +317,14 @@ impl FarField {
                 }
             }
         }
-        if self.target.as_ref().is_some_and(|t| t.pending.is_empty()) {
-            status.uploaded_bytes = self.swap(renderer)?;
+        if self.swapping.is_none() && self.target.as_ref().is_some_and(|t| t.pending.is_empty()) {
+            self.start_swap();
+        }
+        let (bytes, swapped) = self.go_on_swapping(renderer)?;
+        status.uploaded_bytes = bytes;
+        if let Some(total) = swapped {
             status.swapped = true;
+            status.swap_bytes = total;
         }
         status.drawn_finest = self.drawn.as_ref().map(|(l, _)| *l);
         status.drawn_chunks = self.drawn.as_ref().map_or(0, |(_, d)| d.len());
@@ -383,35 +401,101 @@ impl FarField {
         Ok(())
     }
 
-    /// Draws the target view in place of the drawn one; returns the bytes of quads
-    /// uploaded.
-    fn swap(&mut self, renderer: &mut Renderer) -> Result<u64> {
+    /// Starts drawing the complete target view in place of the drawn one: the chunks to
+    /// remove and to upload, grouped by the coarsest level's chunk they lie in (each group
+    /// a tiling of its square in both views), nearest the anchor first.
+    fn start_swap(&mut self) {
         let Some(target) = self.target.take() else {
-            return Ok(0);
+            return;
         };
         let new: HashSet<Key> = target.keys.iter().copied().collect();
-        let old = self.drawn.take().map(|(_, d)| d).unwrap_or_default();
-        // Removed first: a chunk kept under the same GPU key by both views (a level chunk
-        // whose neighbours changed, or a coarse chunk and the first of the finer ones that
-        // replace it) is replaced by the upload below.
-        for &(l, p, _) in old.difference(&new) {
-            if let Some(k) = level_key(l, p) {
-                renderer.remove_chunk(k);
-            }
+        let old = self
+            .drawn
+            .as_ref()
+            .map(|(_, d)| d.clone())
+            .unwrap_or_default();
+        let k = self.config.rings.coarsest;
+        let cell = |&(l, p, _): &Key| {
+            let d = 1i64 << (k - l.min(k));
+            (i64::from(p.x).div_euclid(d), i64::from(p.z).div_euclid(d))
+        };
+        let mut groups: HashMap<(i64, i64), Group> = HashMap::new();
+        for key in old.difference(&new) {
+            groups.entry(cell(key)).or_default().0.push(*key);
         }
-        let mut bytes = 0;
-        for k in &target.keys {
-            if old.contains(k) {
+        for key in &target.keys {
+            if old.contains(key) {
                 continue;
             }
-            if let Some(m) = self.ready.remove(k) {
-                bytes += 8 * m.len() as u64;
-                renderer.upload_level_chunk(k.0, k.1, &m)?;
+            if let Some(m) = self.ready.remove(key) {
+                groups.entry(cell(key)).or_default().1.push((*key, m));
             }
         }
-        self.drawn = Some((target.rings.finest, new));
+        let a = self.anchor.unwrap_or_default();
+        let w = (voxel_core::CHUNK_SIZE as i64 * voxel_core::level_scale(k)) as f64;
+        let mut groups: Vec<_> = groups.into_iter().collect();
+        groups.sort_by(|(c, _), (d, _)| {
+            let dist = |c: &(i64, i64)| {
+                let (x, z) = ((c.0 as f64 + 0.5) * w - a.x, (c.1 as f64 + 0.5) * w - a.z);
+                x * x + z * z
+            };
+            dist(c).total_cmp(&dist(d)).then(c.cmp(d))
+        });
+        self.swapping = Some(Swap {
+            finest: target.rings.finest,
+            new,
+            groups: groups.into_iter().map(|(_, g)| g).rev().collect(),
+            bytes: 0,
+        });
+    }
+
+    /// Goes on with the swap in progress: whole groups until [`FarConfig::upload_budget`]
+    /// bytes are uploaded (at least one group). Returns the bytes uploaded, and the swap's
+    /// bytes when it ended.
+    fn go_on_swapping(&mut self, renderer: &mut Renderer) -> Result<(u64, Option<u64>)> {
+        let Some(swap) = &mut self.swapping else {
+            return Ok((0, None));
+        };
+        let mut bytes = 0;
+        while let Some((remove, upload)) = swap.groups.pop() {
+            // Removed first: a chunk kept under the same GPU key by both views (a level
+            // chunk whose neighbours changed, or a coarse chunk and the first of the finer
+            // ones that replace it) is replaced by the upload after.
+            for &(l, p, _) in &remove {
+                if let Some(k) = level_key(l, p) {
+                    renderer.remove_chunk(k);
+                }
+            }
+            for ((l, p, _), m) in &upload {
+                bytes += 8 * m.len() as u64;
+                renderer.upload_level_chunk(*l, *p, m)?;
+            }
+            if bytes >= self.config.upload_budget {
+                break;
+            }
+        }
+        swap.bytes += bytes;
+        if !swap.groups.is_empty() {
+            return Ok((bytes, None));
+        }
+        let total = swap.bytes;
+        if let Some(swap) = self.swapping.take() {
+            self.drawn = Some((swap.finest, swap.new));
+        }
         // Meshes of views no longer wanted go; those in flight stay wanted.
         self.ready.clear();
-        Ok(bytes)
+        Ok((bytes, Some(total)))
     }
+}
+
+/// The chunks of one square of the coarsest level a swap removes, and those it uploads.
+type Group = (Vec<Key>, Vec<(Key, ChunkMeshes)>);
+
+/// A view being swapped in, a group of chunks at a time: its finest level, its chunks, the
+/// groups left (removals and uploads; the next is last), and the bytes uploaded so far.
+struct Swap {
+    finest: u8,
+    new: HashSet<Key>,
+    groups: Vec<Group>,
+    bytes: u64,
 }
