@@ -4,17 +4,18 @@ use voxel_core::{Face, TerrainConfig, blocks};
 
 use super::*;
 
-/// A small deterministic generator of eyes (xorshift).
+/// `n` eyes spread over a square `spread` blocks wide (a fixed lattice stepped by a prime,
+/// off whole blocks), 30 blocks up.
 fn eyes(n: usize, spread: f64) -> Vec<[f64; 3]> {
-    let mut s = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let at = |i: usize, k: usize| ((i * k) % 1000) as f64 / 1000.0 - 0.5;
     (0..n)
-        .map(|_| [(next() - 0.5) * spread, 30.0, (next() - 0.5) * spread])
+        .map(|i| {
+            [
+                at(i, 7919) * spread + 0.37,
+                30.0,
+                at(i, 104_729) * spread - 0.61,
+            ]
+        })
         .collect()
 }
 
