@@ -577,7 +577,21 @@ impl TerrainGenerator {
             cells.sort_unstable();
             cells.dedup();
         }
-        self.trees(&cells, &sites, &mut boxes);
+        // A tree counts only where its canopy reaches a sample column (at level 0 and 1
+        // every tree near the chunk does): the others would place no cell, and their ground
+        // height is the dearest part of a coarse chunk.
+        let reaches = |o: i64, t: i64| {
+            let (a, b) = (
+                (t - CANOPY - o - scale / 2 + scale - 1)
+                    .div_euclid(scale)
+                    .max(0),
+                (t + CANOPY - o - scale / 2).div_euclid(scale).min(n - 1),
+            );
+            a <= b
+        };
+        self.trees(&cells, &sites, &mut boxes, |tx, tz| {
+            reaches(ox, tx) && reaches(oz, tz)
+        });
         for site in &sites {
             structure(site, &mut boxes);
         }
@@ -597,9 +611,15 @@ impl TerrainGenerator {
         chunk
     }
 
-    /// The trees of tree cells `cells`, as boxes (leaves first, so the trunk wins where
-    /// they overlap).
-    fn trees(&self, cells: &[(i64, i64)], sites: &[Site], out: &mut Vec<WorldBox>) {
+    /// The trees of tree cells `cells` whose trunk `reaches` (at `(tx, tz)`), as boxes
+    /// (leaves first, so the trunk wins where they overlap).
+    fn trees(
+        &self,
+        cells: &[(i64, i64)],
+        sites: &[Site],
+        out: &mut Vec<WorldBox>,
+        reaches: impl Fn(i64, i64) -> bool,
+    ) {
         let sea = self.sea();
         for &(cx, cz) in cells {
             let r = hash(self.config.seed, cx, cz, 1);
@@ -608,6 +628,9 @@ impl TerrainGenerator {
             }
             let tx = cx * TREE_CELL + 1 + ((r >> 16) % (TREE_CELL as u64 - 2)) as i64;
             let tz = cz * TREE_CELL + 1 + ((r >> 24) % (TREE_CELL as u64 - 2)) as i64;
+            if !reaches(tx, tz) {
+                continue;
+            }
             let near_site = sites.iter().any(|s| {
                 let [hx, hz] = s.half_extent();
                 (tx - s.center[0]).abs() <= hx + CLEARING
