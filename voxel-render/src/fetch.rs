@@ -281,6 +281,10 @@ pub(crate) struct Records {
     buffer: wgpu::Buffer,
     /// Bytes from one record to the next.
     stride: u64,
+    /// Whether a draw binds one record at a dynamic offset ([`QuadFetch::Instanced`]), not
+    /// the whole array: not told by the stride, which is a record's size where the
+    /// device's uniform offset alignment is (32 on some GL drivers).
+    one_record: bool,
 }
 
 /// Bytes of a chunk record (`ChunkUniforms`, checked by a test).
@@ -307,7 +311,11 @@ impl Records {
             usage: usage | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self { buffer, stride }
+        Self {
+            buffer,
+            stride,
+            one_record: fetch == QuadFetch::Instanced,
+        }
     }
 
     /// Records it holds.
@@ -340,7 +348,7 @@ impl Records {
     /// Its bind group resource: the whole array, or one record (the dynamic offset picks
     /// which).
     pub(crate) fn binding(&self) -> wgpu::BindingResource<'_> {
-        if self.stride == RECORD_BYTES as u64 {
+        if !self.one_record {
             return self.buffer.as_entire_binding();
         }
         wgpu::BindingResource::Buffer(wgpu::BufferBinding {
