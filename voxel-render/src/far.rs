@@ -27,7 +27,8 @@ use voxel_core::{BlockRegistry, ChunkPos, TerrainGenerator};
 use voxel_mesh::ChunkMeshes;
 use voxel_mesh::levels::{LevelCache, LevelRings, mesh_level_chunks_with};
 
-use crate::{Error, Renderer, Result, level_key};
+use crate::renderer::level_key;
+use crate::{Error, Renderer, Result};
 
 /// How a [`FarField`] follows the eye.
 #[derive(Clone, Debug, PartialEq)]

@@ -147,7 +147,7 @@ impl<'a> VisibleLayers<'a> {
     pub(crate) fn boxes(&self) -> impl Iterator<Item = (DVec3, DVec3)> + 'a {
         self.iter().filter_map(|(pos, level, planes)| {
             let origin = DVec3::from(pos.origin().map(|v| v as f64));
-            let scale = DVec3::from(crate::chunks::gpu_chunk::cell_scale(level));
+            let scale = DVec3::from(cell_scale(level));
             let (lo, hi) = bounds(planes)?;
             Some((
                 origin + lo.as_dvec3() * scale,
@@ -155,6 +155,13 @@ impl<'a> VisibleLayers<'a> {
             ))
         })
     }
+}
+
+/// Blocks per cell along x, y and z at level of detail `level` (a level's cells are
+/// `2^level` blocks wide in x and z, one high).
+pub(crate) fn cell_scale(level: u8) -> [f64; 3] {
+    let s = voxel_core::level_scale(level) as f64;
+    [s, 1.0, s]
 }
 
 #[cfg(test)]

@@ -348,7 +348,7 @@ impl Frustum {
 
     /// The size of a chunk of level `level`, blocks.
     fn extent(level: u8) -> DVec3 {
-        DVec3::from(super::gpu_chunk::cell_scale(level)) * CHUNK_SIZE as f64
+        DVec3::from(crate::layers::cell_scale(level)) * CHUNK_SIZE as f64
     }
 
     /// The chunk's lowest corner relative to the eye.

@@ -61,7 +61,7 @@ impl GpuChunk {
 
     /// Blocks per cell along x, y and z.
     pub(crate) fn scale(&self) -> [f64; 3] {
-        cell_scale(self.level)
+        crate::layers::cell_scale(self.level)
     }
 
     /// Whether the translucent mesh has a face of a volume (a block type with absorption,
@@ -166,10 +166,4 @@ pub(super) fn distinct_planes(layers: &[Plane]) -> Vec<(Face, u8)> {
 pub(super) fn layers_bounds(layers: &[Plane]) -> Option<([f64; 3], [f64; 3])> {
     let (lo, hi) = layers::bounds(layers)?;
     Some((lo.as_dvec3().to_array(), hi.as_dvec3().to_array()))
-}
-
-/// Blocks per cell along x, y and z at level of detail `level`.
-pub(crate) fn cell_scale(level: u8) -> [f64; 3] {
-    let s = voxel_core::level_scale(level) as f64;
-    [s, 1.0, s]
 }

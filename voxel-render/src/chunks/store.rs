@@ -272,7 +272,7 @@ impl ChunkStore {
     /// place until that frame is submitted ([`ChunkStore::frame_submitted`]).
     ///
     /// `level` is the chunk's level of detail (0: a chunk; see
-    /// [`crate::Renderer::upload_level_chunk`]), `pos` its key: the full-detail chunk where
+    /// `Renderer::upload_level_chunk`), `pos` its key: the full-detail chunk where
     /// it starts.
     pub(crate) fn upload(
         &mut self,

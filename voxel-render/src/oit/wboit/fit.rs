@@ -165,7 +165,7 @@ fn visible_planes<'a>(
     for (pos, level, planes) in layers {
         let origin = DVec3::from(pos.origin().map(|v| v as f64));
         // Chunk-local cells (a level of detail's are wider than a block in x and z).
-        let scale = crate::chunks::gpu_chunk::cell_scale(level);
+        let scale = crate::layers::cell_scale(level);
         let eye_local = (eye - origin) / DVec3::from(scale);
         let base = view_proj * (origin - eye).as_vec3().extend(1.0);
         let columns = [0, 1, 2].map(|a| columns[a] * scale[a] as f32);
