@@ -73,7 +73,15 @@ impl ChunkStore {
         volume_blocks: Arc<[bool]>,
     ) -> Self {
         let l = &ctx.caps.limits;
-        let infos = Records::new(&ctx.device, fetch, l, FIRST_SLOTS);
+        // The records array is bound whole from storage: no more slots at first than the
+        // device's binding holds (32-byte records: 512 under a 16 KiB binding).
+        let first = match fetch {
+            QuadFetch::Storage => FIRST_SLOTS.min(
+                (l.max_storage_buffer_binding_size as usize / crate::fetch::RECORD_BYTES).max(1),
+            ),
+            QuadFetch::Instanced => FIRST_SLOTS,
+        };
+        let infos = Records::new(&ctx.device, fetch, l, first);
         let indirect = Self::indirect_buffer(ctx, FIRST_SLOTS);
         Self {
             layout,
