@@ -189,7 +189,9 @@ pub(crate) struct ChunkUniforms {
     /// Blocks per cell along x and z: 1 for a chunk, `2^level` for a chunk of a level of
     /// detail ([`voxel_core::level_scale`]; its cells are one block high).
     pub scale: u32,
-    pub _pad: [u32; 3],
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// Layouts every chunk pipeline is built against.
@@ -322,6 +324,9 @@ mod tests {
                 field!(ChunkUniforms, origin),
                 field!(ChunkUniforms, alpha),
                 field!(ChunkUniforms, scale),
+                field!(ChunkUniforms, pad0),
+                field!(ChunkUniforms, pad1),
+                field!(ChunkUniforms, pad2),
             ],
         );
     }

@@ -678,7 +678,7 @@ fn record(pos: ChunkPos, level: u8, alpha: f32) -> ChunkUniforms {
         origin: pos.origin().map(|v| v as i32),
         alpha,
         scale: voxel_core::level_scale(level) as u32,
-        _pad: [0; 3],
+        ..ChunkUniforms::default()
     }
 }
 
