@@ -27,7 +27,7 @@ pub use error::{Error, Result};
 pub use light::{LIGHT_FALLOFF, Light, LightChunk, LightField, LightLayer, OddCells, light_blocks};
 pub use terrain::{
     MAX_LEVEL, Showcase, Site, SiteKind, TerrainBlocks, TerrainConfig, TerrainGenerator,
-    TerrainRole, level_origin, level_scale,
+    TerrainRole, level_cell, level_origin, level_scale,
 };
 pub use vox::{PaletteOverride, VoxError, VoxFile, VoxPlacement};
 pub use world::{

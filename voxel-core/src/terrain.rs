@@ -334,6 +334,27 @@ pub fn level_origin(level: u8, pos: ChunkPos) -> [i64; 3] {
     level_origin_scaled(level_scale(level), pos)
 }
 
+/// The chunk of level `level` and the cell in it (x, y, z within the chunk) that hold the
+/// world block at `block`: the cell whose *sample column* (see
+/// [`TerrainGenerator::generate_level_chunk`]) is the block's column. `None` where the
+/// block's column is no cell's sample column at that level (at level `k ≥ 1`, one column in
+/// `2^k` along each of x and z is), or the chunk lies outside [`ChunkPos::is_valid`]. Level
+/// 0 holds every block. What an edit of that block changes at each level.
+pub fn level_cell(level: u8, block: [i64; 3]) -> Option<(ChunkPos, [usize; 3])> {
+    let scale = level_scale(level);
+    let n = CHUNK_SIZE as i64;
+    let cell = |v: i64| {
+        let off = v - scale / 2;
+        (off.rem_euclid(scale) == 0).then(|| off.div_euclid(scale))
+    };
+    let (cx, cz) = (cell(block[0])?, cell(block[2])?);
+    let c = [cx, block[1], cz];
+    let chunk = c.map(|v| i32::try_from(v.div_euclid(n)).ok());
+    let pos = ChunkPos::new(chunk[0]?, chunk[1]?, chunk[2]?);
+    pos.is_valid()
+        .then(|| (pos, c.map(|v| v.rem_euclid(n) as usize)))
+}
+
 fn level_origin_scaled(scale: i64, pos: ChunkPos) -> [i64; 3] {
     let n = CHUNK_SIZE as i64;
     [
@@ -1113,5 +1134,43 @@ mod tests {
                 .check_invariants()
                 .unwrap();
         }
+    }
+
+    #[test]
+    fn level_cell_is_the_cell_whose_sample_column_is_the_block() {
+        let n = CHUNK_SIZE as i64;
+        for level in 0..=MAX_LEVEL {
+            let s = level_scale(level);
+            let mut held = 0;
+            for x in -3 * s..3 * s {
+                for (y, z) in [(-1, s / 2 + 5 * s), (40, s / 2 - 7 * s), (63, s / 2 + 1)] {
+                    match level_cell(level, [x, y, z]) {
+                        Some((pos, c)) => {
+                            held += 1;
+                            // The cell's sample column is the block's.
+                            let o = level_origin(level, pos);
+                            let sample = |o: i64, c: usize| o + c as i64 * s + s / 2;
+                            assert_eq!(
+                                [sample(o[0], c[0]), o[1] + c[1] as i64, sample(o[2], c[2])],
+                                [x, y, z],
+                                "level {level}"
+                            );
+                            assert!(c.iter().all(|&v| (v as i64) < n));
+                        }
+                        None => assert!(
+                            (x - s / 2).rem_euclid(s) != 0 || (z - s / 2).rem_euclid(s) != 0,
+                            "level {level}: ({x}, {z}) is a sample column"
+                        ),
+                    }
+                }
+            }
+            // One column in `s` along x, in the two rows whose z is a sample column (the
+            // third is one at level 0 only).
+            let rows = if level == 0 { 3 } else { 2 };
+            assert_eq!(held, 6 * rows, "level {level}");
+        }
+        // Level 0 holds every block; far outside the chunk coordinates, nothing.
+        assert!(level_cell(0, [5, -70, -9]).is_some());
+        assert_eq!(level_cell(0, [i64::MAX, 0, 0]), None);
     }
 }

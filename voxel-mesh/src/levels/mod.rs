@@ -22,8 +22,8 @@ use std::ops::RangeInclusive;
 use std::sync::Arc;
 
 use voxel_core::{
-    BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Neighbourhood, RenderClass, TerrainGenerator,
-    level_scale,
+    BlockId, BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, Neighbourhood, RenderClass,
+    TerrainGenerator, level_cell, level_scale,
 };
 
 use crate::{ChunkMeshes, Mesher, Result};
@@ -209,10 +209,14 @@ impl LevelRings {
 
 /// Generated level chunks kept between calls of [`mesh_level_chunks_with`]: the
 /// neighbours one batch of chunks reads are mostly the chunks of the next, generated once.
-/// Holds at most [`LevelCache::LIMIT`] chunks (emptied when full).
+/// Holds at most [`LevelCache::LIMIT`] chunks (emptied when full), and the edits made to the
+/// generated terrain ([`LevelCache::edit`]), which every chunk it generates carries.
 #[derive(Debug, Default)]
 pub struct LevelCache {
     chunks: HashMap<(u8, ChunkPos), Arc<Chunk>>,
+    /// Edited cells (within their chunk) by level chunk.
+    edits: HashMap<(u8, ChunkPos), HashMap<[usize; 3], BlockId>>,
+    edit_count: u64,
 }
 
 impl LevelCache {
@@ -228,6 +232,67 @@ impl LevelCache {
     pub fn is_empty(&self) -> bool {
         self.chunks.is_empty()
     }
+
+    /// Sets the world block at `block` to `id` in the terrain of every level that holds it
+    /// (every level whose cell samples that block's column: [`voxel_core::level_cell`]);
+    /// the chunks it generates from now on carry the edit, and those it held that the edit
+    /// changes are dropped. A later edit of the same block replaces it.
+    pub fn edit(&mut self, block: [i64; 3], id: BlockId) {
+        self.edit_count += 1;
+        for level in 0..=voxel_core::MAX_LEVEL {
+            if let Some((pos, cell)) = level_cell(level, block) {
+                self.edits.entry((level, pos)).or_default().insert(cell, id);
+                self.chunks.remove(&(level, pos));
+            }
+        }
+    }
+
+    /// How many edits [`LevelCache::edit`] took so far.
+    pub fn edit_count(&self) -> u64 {
+        self.edit_count
+    }
+
+    /// Chunk `pos` of level `level` of `generator`'s terrain with the edits made to it.
+    fn generate(&self, generator: &TerrainGenerator, level: u8, pos: ChunkPos) -> Chunk {
+        let mut chunk = generator.generate_level_chunk(level, pos);
+        if let Some(edits) = self.edits.get(&(level, pos)) {
+            for (&[x, y, z], &id) in edits {
+                // Cells of a chunk: always in range.
+                let _ = chunk.set(x, y, z, id);
+            }
+            chunk.pack();
+        }
+        chunk
+    }
+}
+
+/// The level chunks whose meshes an edit of the world block at `block` changes: at every
+/// level that holds it ([`voxel_core::level_cell`]), the chunk of its cell and those beside
+/// it that cull and shade against that cell (the cell on their border, diagonals included).
+pub fn chunks_an_edit_changes(block: [i64; 3]) -> Vec<(u8, ChunkPos)> {
+    let n = CHUNK_SIZE as i64;
+    let mut out = Vec::new();
+    for level in 0..=voxel_core::MAX_LEVEL {
+        let Some((pos, cell)) = level_cell(level, block) else {
+            continue;
+        };
+        // Per axis, the chunk offsets whose 1-cell margin holds the cell.
+        let reach = |c: usize| match c as i64 {
+            0 => -1..=0,
+            c if c == n - 1 => 0..=1,
+            _ => 0..=0,
+        };
+        for dx in reach(cell[0]) {
+            for dy in reach(cell[1]) {
+                for dz in reach(cell[2]) {
+                    if let Some(p) = pos.offset([dx, dy, dz]) {
+                        out.push((level, p));
+                    }
+                }
+            }
+        }
+    }
+    out
 }
 
 /// The meshes of the level chunks `chunks` of generator `generator` (over `registry`), for
@@ -280,13 +345,13 @@ pub fn mesh_level_chunks_with(
     if cache.chunks.len() + lacking.len() > LevelCache::LIMIT {
         cache.chunks.retain(|k, _| needed.binary_search(k).is_ok());
     }
-    let make = |&(l, p): &(u8, ChunkPos)| ((l, p), Arc::new(generator.generate_level_chunk(l, p)));
+    let made = &*cache;
+    let make = |&(l, p): &(u8, ChunkPos)| ((l, p), Arc::new(made.generate(generator, l, p)));
     #[cfg(not(target_arch = "wasm32"))]
-    cache
-        .chunks
-        .extend(lacking.par_iter().map(make).collect::<Vec<_>>());
+    let new: Vec<_> = lacking.par_iter().map(make).collect();
     #[cfg(target_arch = "wasm32")]
-    cache.chunks.extend(lacking.iter().map(make));
+    let new: Vec<_> = lacking.iter().map(make).collect();
+    cache.chunks.extend(new);
 
     let mut water = vec![false; registry.len()];
     for (id, d) in registry.iter() {

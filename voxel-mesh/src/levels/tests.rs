@@ -165,3 +165,74 @@ fn a_flat_sea_meets_itself_across_level_borders_and_the_ground_is_skirted() {
     }
     assert!(walls > 0, "no skirt where levels meet");
 }
+
+#[test]
+fn an_edit_reaches_every_level_that_holds_the_block() {
+    let generator = TerrainGenerator::new(TerrainConfig {
+        base_height: 18,
+        amplitude: 0.0,
+        tree_density: 0.0,
+        structures: false,
+        ..TerrainConfig::default()
+    });
+    let registry = BlockRegistry::default();
+    let rings = LevelRings {
+        radius: 2,
+        coarsest: 2,
+        finest: 0,
+        y: 0..=0,
+    };
+    let eye = [40.0, 30.0, -20.0];
+    // Above the sea, on a sample column of levels 0 and 2 (not 1), on no chunk border.
+    let block = [38, 28, -18];
+    let changed = chunks_an_edit_changes(block);
+    let levels: Vec<u8> = changed.iter().map(|&(l, _)| l).collect();
+    assert_eq!(levels, [0, 2], "{changed:?}");
+    // Each level meshed in a view that draws it (a column lies in one level of a view).
+    let views = [rings.clone(), rings.coarse_first(2)];
+    let chunks: Vec<Vec<(u8, ChunkPos)>> = [0, 2]
+        .map(|level| {
+            let control = (level, ChunkPos::new(3, 0, 3));
+            let mut c: Vec<_> = changed.iter().filter(|c| c.0 == level).copied().collect();
+            c.push(control);
+            c
+        })
+        .into();
+    let mut cache = LevelCache::default();
+    let mesh = |cache: &mut LevelCache| {
+        views
+            .iter()
+            .zip(&chunks)
+            .flat_map(|(view, c)| {
+                mesh_level_chunks_with(cache, &generator, &registry, view, eye, c).unwrap()
+            })
+            .collect::<Vec<_>>()
+    };
+    let before = mesh(&mut cache);
+    assert_eq!(cache.edit_count(), 0);
+    cache.edit(block, blocks::STONE);
+    assert_eq!(cache.edit_count(), 1);
+    let after = mesh(&mut cache);
+    for ((l, p, a), (_, _, b)) in before.iter().zip(&after) {
+        if changed.contains(&(*l, *p)) {
+            // A stone cell floating over the sea: its six faces (at level 2 a 4-block-wide
+            // cell, one high), its top over the block's column.
+            assert_eq!(b.opaque.len(), a.opaque.len() + 6, "level {l} chunk {p:?}");
+            let top = b
+                .opaque
+                .iter()
+                .map(|q| q.unpack().unwrap())
+                .find(|q| q.block == blocks::STONE && q.face == Face::PosY)
+                .expect("the stone's top");
+            let s = level_scale(*l);
+            let o = voxel_core::level_origin(*l, *p);
+            let at = [0, 2].map(|k| o[k] + i64::from(top.pos[k]) * s + s / 2);
+            assert_eq!(at, [block[0], block[2]], "level {l}");
+        } else {
+            assert_eq!(a, b, "level {l} chunk {p:?} changed");
+        }
+    }
+    // A second edit of the block puts the sea's air back.
+    cache.edit(block, voxel_core::BlockId::AIR);
+    assert_eq!(mesh(&mut cache), before);
+}
