@@ -406,3 +406,154 @@ fn a_far_field_is_built_coarse_first_off_the_frame_and_follows_the_eye() {
     assert!(!s.swapped);
     assert_eq!(field.drawn().collect::<Vec<_>>(), before);
 }
+
+#[test]
+fn an_edit_reaches_every_drawn_level_within_a_bounded_time_and_stays_through_rebuilds() {
+    use std::sync::Arc;
+    use voxel_core::{BlockId, WorldPos};
+    use voxel_render::far::{FarConfig, FarField};
+    let Some(ctx) = gpu() else { return };
+    let generator = Arc::new(TerrainGenerator::new(TerrainConfig::default()));
+    let registry = Arc::new(BlockRegistry::default());
+    let config = FarConfig {
+        rings: LevelRings::reaching(4, 32),
+        ..FarConfig::default()
+    };
+    let mut field = FarField::new(Arc::clone(&generator), Arc::clone(&registry), config).unwrap();
+    let (w, h) = (480, 270);
+    let mut renderer = Renderer::new(
+        &ctx,
+        &registry,
+        technique_config(Technique::SortedQuads, w, h),
+    )
+    .unwrap();
+    let camera = far::default_view(&generator).unwrap();
+    let target = Offscreen::new(&ctx, w, h);
+    let dir = out_dir("far/edit");
+    // Updates at `eye` until the field is idle, or 120 s; the updates it took, and seconds.
+    let settle = |field: &mut FarField, renderer: &mut Renderer, eye: DVec3| {
+        let start = std::time::Instant::now();
+        for n in 1.. {
+            let s = field.update(renderer, eye).unwrap();
+            if field.is_idle() {
+                assert_eq!(s.edit_chunks_pending, 0);
+                return (n, start.elapsed().as_secs_f64());
+            }
+            assert!(
+                start.elapsed().as_secs() < 120,
+                "not settled in 120 s: {s:?}"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
+        unreachable!()
+    };
+    settle(&mut field, &mut renderer, camera.eye);
+    // Every level holds quads, and the levels' chunks are the drawn ones.
+    let memory = field.memory();
+    assert_eq!(memory.len(), 4);
+    assert!(memory.iter().all(|m| m.quads > 0), "{memory:?}");
+    assert_eq!(
+        memory.iter().map(|m| m.chunks).sum::<usize>(),
+        field.drawn().count()
+    );
+    let before = far::picture(&ctx, &mut renderer, &target, &camera).unwrap();
+    before.save_png(&dir.join("before.png")).unwrap();
+
+    // An unknown block changes nothing.
+    assert!(
+        field
+            .set_block(WorldPos::new(0, 30, 0), BlockId(9999))
+            .is_err()
+    );
+    // Two stone pillars ahead of the eye: one in the full-detail ring, one 700 blocks away,
+    // on a sample column of the level drawn there.
+    let ahead = camera.forward.with_y(0.0).normalize();
+    let near = camera.eye + ahead * 40.0;
+    let far_at = camera.eye + ahead * 700.0;
+    let chunk_of =
+        |v: f64, level: u8| (v / (32.0 * voxel_core::level_scale(level) as f64)).floor() as i32;
+    let level = field
+        .drawn()
+        .find(|&(l, p)| p.x == chunk_of(far_at.x, l) && p.z == chunk_of(far_at.z, l))
+        .map(|(l, _)| l)
+        .unwrap();
+    assert!(level >= 2, "700 blocks away at level {level}");
+    let s = voxel_core::level_scale(level);
+    let sample = |v: f64| ((v / s as f64).floor() as i64 * s + s / 2) as i32;
+    let pillars = [
+        (near.x.floor() as i32, near.z.floor() as i32),
+        (sample(far_at.x), sample(far_at.z)),
+    ];
+    for (x, z) in pillars {
+        for y in 10..=62 {
+            field
+                .set_block(WorldPos::new(x, y, z), blocks::STONE)
+                .unwrap();
+        }
+    }
+    let (updates, secs) = settle(&mut field, &mut renderer, camera.eye);
+    let edited = far::picture(&ctx, &mut renderer, &target, &camera).unwrap();
+    edited.save_png(&dir.join("edited.png")).unwrap();
+    println!(
+        "the edits drawn after {updates} updates ({:.0} ms); level {level} 700 blocks away",
+        secs * 1e3
+    );
+    // Both pillars show: pixels changed around each one's place in the picture.
+    let vp = camera.view_proj(f64::from(w) / f64::from(h));
+    // Pixels changed in the screen box of the pillar at `p` (its top and its foot, 10
+    // pixels either side), clipped to the picture.
+    let changed_near = |p: DVec3| {
+        let screen = |y: f64| {
+            let c = vp * (p.with_y(y) - camera.eye).as_vec3().extend(1.0);
+            assert!(c.w > 0.0, "the pillar is behind the eye");
+            let ndc = c.truncate() / c.w;
+            (
+                ((ndc.x + 1.0) * 0.5 * w as f32) as i64,
+                ((1.0 - ndc.y) * 0.5 * h as f32) as i64,
+            )
+        };
+        let (top, foot) = (screen(62.0), screen(10.0));
+        let clip = |v: i64, n: u32| v.clamp(0, i64::from(n)) as u32;
+        let xs = clip(top.0.min(foot.0) - 10, w)..clip(top.0.max(foot.0) + 10, w);
+        let ys = clip(top.1.min(foot.1), h)..clip(top.1.max(foot.1), h);
+        let mut n = 0;
+        for y in ys {
+            for x in xs.clone() {
+                let i = ((y * w + x) * 4) as usize;
+                if (0..3).any(|c| before.rgba[i + c].abs_diff(edited.rgba[i + c]) > 8) {
+                    n += 1;
+                }
+            }
+        }
+        n
+    };
+    let (a, b) = (changed_near(near), changed_near(far_at));
+    println!("pixels changed by the near pillar {a}, by the far one {b}");
+    assert!(
+        a > 200,
+        "the near pillar: {a} pixels changed; see {}",
+        dir.display()
+    );
+    assert!(
+        b > 20,
+        "the far pillar: {b} pixels changed; see {}",
+        dir.display()
+    );
+
+    // The eye goes away (the view is rebuilt around it) and comes back: chunks meshed again
+    // carry the edits, and the picture is the edited one.
+    settle(
+        &mut field,
+        &mut renderer,
+        camera.eye + DVec3::new(300.0, 0.0, 300.0),
+    );
+    settle(&mut field, &mut renderer, camera.eye);
+    let back = far::picture(&ctx, &mut renderer, &target, &camera).unwrap();
+    back.save_png(&dir.join("back.png")).unwrap();
+    let d = diff(&back, &edited);
+    assert!(
+        d.over_one * 1000 < (w * h) as usize,
+        "after a rebuild {} pixels differ from the edited picture",
+        d.over_one
+    );
+}

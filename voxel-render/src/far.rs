@@ -18,14 +18,19 @@
 //!   yet was culled against its new neighbours: at most a skirt shows or is missing there.) A mesh depends on which of its neighbours the view holds
 //!   (water only across a level border), so meshes are kept by chunk and those neighbours,
 //!   and a chunk whose border changed is meshed again.
+//! - **Edits** ([`FarField::set_block`]) reach every level that holds the edited block
+//!   ([`voxel_core::level_cell`]): the worker keeps them and generates every chunk with
+//!   them, and the drawn chunks whose meshes they change are meshed again ahead of the
+//!   view being built and replaced in place (a mesh made before an edit it lacks is made
+//!   again).
 
-use std::collections::{HashMap, HashSet};
+use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::Arc;
 
 use glam::DVec3;
-use voxel_core::{BlockRegistry, ChunkPos, TerrainGenerator};
+use voxel_core::{BlockId, BlockRegistry, ChunkPos, TerrainGenerator, WorldPos};
 use voxel_mesh::ChunkMeshes;
-use voxel_mesh::levels::{LevelCache, LevelRings, mesh_level_chunks_with};
+use voxel_mesh::levels::{LevelCache, LevelRings, chunks_an_edit_changes, mesh_level_chunks_with};
 
 use crate::renderer::level_key;
 use crate::{Error, Renderer, Result};
@@ -76,6 +81,11 @@ pub struct FarStatus {
     pub uploaded_bytes: u64,
     /// When `swapped`: the bytes of quads the whole swap uploaded.
     pub swap_bytes: u64,
+    /// Drawn chunks this update replaced with their meshes after edits.
+    pub refreshed: usize,
+    /// Drawn chunks that edits changed and that are not drawn again yet (0: every edit
+    /// taken is drawn).
+    pub edit_chunks_pending: usize,
 }
 
 /// The levels of detail of generated terrain around a moving eye, on a [`Renderer`]'s GPU:
@@ -95,13 +105,43 @@ pub struct FarField {
     target: Option<Target>,
     /// The view being swapped in.
     swapping: Option<Swap>,
-    /// The view drawn: its finest level and chunks.
-    drawn: Option<(u8, HashSet<Key>)>,
+    /// The view drawn.
+    drawn: Option<View>,
     /// Meshes made, by chunk and neighbours held.
     ready: HashMap<Key, ChunkMeshes>,
     /// Chunks sent to be meshed and not back yet.
     in_flight: HashSet<Key>,
+    /// Edits taken and not sent to the worker yet.
+    new_edits: Vec<([i64; 3], BlockId)>,
+    /// Every edit sent to the worker, in order: a mesh made after the first `n` of them
+    /// lacks the rest.
+    edits: Vec<[i64; 3]>,
+    /// Drawn chunks being meshed again after edits, and their meshes that came back during
+    /// a swap (uploaded when it ends).
+    refreshing: HashSet<Key>,
+    refreshed: HashMap<Key, ChunkMeshes>,
+    /// Bytes of quads on the GPU by drawn chunk (level, position).
+    bytes: HashMap<(u8, ChunkPos), u64>,
     jobs: Jobs,
+}
+
+/// What one level of a far view holds on the GPU ([`FarField::memory`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LevelMemory {
+    /// The level (0: full detail).
+    pub level: u8,
+    /// Chunks drawn (with or without a face).
+    pub chunks: usize,
+    /// Quads uploaded, 8 bytes each.
+    pub quads: u64,
+}
+
+/// A whole view: its rings, the anchor it is planned around, its chunks.
+#[derive(Clone, Debug)]
+struct View {
+    rings: LevelRings,
+    at: [f64; 3],
+    keys: HashSet<Key>,
 }
 
 /// A view being built: its rings (a coarse-first view, or the finished one), the eye it is
@@ -109,6 +149,7 @@ pub struct FarField {
 #[derive(Debug)]
 struct Target {
     rings: LevelRings,
+    at: [f64; 3],
     keys: Vec<Key>,
     pending: HashSet<Key>,
 }
@@ -118,27 +159,58 @@ impl std::fmt::Debug for FarField {
         f.debug_struct("FarField")
             .field("config", &self.config)
             .field("anchor", &self.anchor)
-            .field("drawn", &self.drawn.as_ref().map(|(l, d)| (*l, d.len())))
+            .field(
+                "drawn",
+                &self.drawn.as_ref().map(|d| (d.rings.finest, d.keys.len())),
+            )
+            .field("edits", &self.edits.len())
             .field("ready", &self.ready.len())
             .field("in_flight", &self.in_flight.len())
             .finish_non_exhaustive()
     }
 }
 
-/// What the worker is asked: a view's chunks (plan number, rings, eye), or the meshes of
-/// some of them.
+/// What the worker is asked: a view's chunks (plan number, rings, eye), the meshes of
+/// some of them (for the view being built, or drawn chunks an edit changed), or an edit.
 enum Job {
     Plan(u64, LevelRings, [f64; 3]),
-    Mesh(LevelRings, [f64; 3], Vec<Key>),
+    Mesh(Purpose, LevelRings, [f64; 3], Vec<Key>),
+    Edit([i64; 3], BlockId),
 }
 
-/// What the worker answers.
+/// What meshes are for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Purpose {
+    /// The view being built.
+    View,
+    /// Drawn chunks that edits changed: the worker makes them before the others.
+    Refresh,
+}
+
+impl Job {
+    /// Whether the worker takes it before the jobs queued before it: edits, and meshes of
+    /// drawn chunks they changed (in the order sent), so that an edit is drawn after at
+    /// most the batch in progress.
+    fn urgent(&self) -> bool {
+        matches!(self, Job::Edit(..) | Job::Mesh(Purpose::Refresh, ..))
+    }
+}
+
+/// What the worker answers; meshes with the number of edits they carry.
 enum Done {
     Planned(u64, LevelRings, Vec<Key>),
     Meshed(
+        Purpose,
         Vec<Key>,
+        u64,
         std::result::Result<Vec<ChunkMeshes>, voxel_mesh::Error>,
     ),
+}
+
+/// Takes the next job from `queue`: the first urgent one, else the first.
+fn next_job(queue: &mut VecDeque<Job>) -> Option<Job> {
+    let i = queue.iter().position(Job::urgent).unwrap_or(0);
+    queue.remove(i)
 }
 
 /// Where planning and meshing run: a worker thread, or (wasm32) the updating thread.
@@ -148,7 +220,7 @@ struct Jobs {
     #[cfg(not(target_arch = "wasm32"))]
     receive: std::sync::mpsc::Receiver<Done>,
     #[cfg(target_arch = "wasm32")]
-    queue: std::collections::VecDeque<Job>,
+    queue: VecDeque<Job>,
     #[cfg(target_arch = "wasm32")]
     cache: LevelCache,
 }
@@ -158,7 +230,7 @@ fn run_job(
     generator: &TerrainGenerator,
     registry: &BlockRegistry,
     job: Job,
-) -> Done {
+) -> Option<Done> {
     match job {
         Job::Plan(n, rings, eye) => {
             let keys = rings
@@ -166,13 +238,17 @@ fn run_job(
                 .into_iter()
                 .map(|(l, p)| (l, p, rings.neighbours_held(l, p, eye)))
                 .collect();
-            Done::Planned(n, rings, keys)
+            Some(Done::Planned(n, rings, keys))
         }
-        Job::Mesh(rings, eye, keys) => {
+        Job::Mesh(purpose, rings, eye, keys) => {
             let chunks: Vec<(u8, ChunkPos)> = keys.iter().map(|&(l, p, _)| (l, p)).collect();
             let meshes = mesh_level_chunks_with(cache, generator, registry, &rings, eye, &chunks)
                 .map(|v| v.into_iter().map(|(_, _, m)| m).collect());
-            Done::Meshed(keys, meshes)
+            Some(Done::Meshed(purpose, keys, cache.edit_count(), meshes))
+        }
+        Job::Edit(block, id) => {
+            cache.edit(block, id);
+            None
         }
     }
 }
@@ -189,8 +265,21 @@ impl Jobs {
                 .name("far-field".into())
                 .spawn(move || {
                     let mut cache = LevelCache::default();
-                    for job in jobs {
-                        if done.send(run_job(&mut cache, &g, &r, job)).is_err() {
+                    let mut queue = VecDeque::new();
+                    loop {
+                        if queue.is_empty() {
+                            match jobs.recv() {
+                                Ok(job) => queue.push_back(job),
+                                Err(_) => break,
+                            }
+                        }
+                        queue.extend(jobs.try_iter());
+                        let Some(job) = next_job(&mut queue) else {
+                            continue;
+                        };
+                        if let Some(d) = run_job(&mut cache, &g, &r, job)
+                            && done.send(d).is_err()
+                        {
                             break;
                         }
                     }
@@ -202,7 +291,7 @@ impl Jobs {
         {
             let _ = (generator, registry);
             Self {
-                queue: std::collections::VecDeque::new(),
+                queue: VecDeque::new(),
                 cache: LevelCache::default(),
             }
         }
@@ -222,7 +311,8 @@ impl Jobs {
         }
     }
 
-    /// The jobs done since the last call (wasm32: runs one queued job).
+    /// The jobs done since the last call (wasm32: runs queued jobs up to the first that
+    /// answers).
     fn done(&mut self, _generator: &TerrainGenerator, _registry: &BlockRegistry) -> Vec<Done> {
         #[cfg(not(target_arch = "wasm32"))]
         {
@@ -230,11 +320,12 @@ impl Jobs {
         }
         #[cfg(target_arch = "wasm32")]
         {
-            self.queue
-                .pop_front()
-                .map(|job| run_job(&mut self.cache, _generator, _registry, job))
-                .into_iter()
-                .collect()
+            while let Some(job) = next_job(&mut self.queue) {
+                if let Some(d) = run_job(&mut self.cache, _generator, _registry, job) {
+                    return vec![d];
+                }
+            }
+            Vec::new()
         }
     }
 }
@@ -271,6 +362,11 @@ impl FarField {
             drawn: None,
             ready: HashMap::new(),
             in_flight: HashSet::new(),
+            new_edits: Vec::new(),
+            edits: Vec::new(),
+            refreshing: HashSet::new(),
+            refreshed: HashMap::new(),
+            bytes: HashMap::new(),
             jobs,
         })
     }
@@ -284,7 +380,148 @@ impl FarField {
     pub fn drawn(&self) -> impl Iterator<Item = (u8, ChunkPos)> + '_ {
         self.drawn
             .iter()
-            .flat_map(|(_, d)| d.iter().map(|&(l, p, _)| (l, p)))
+            .flat_map(|d| d.keys.iter().map(|&(l, p, _)| (l, p)))
+    }
+
+    /// Whether the view around the eye last given is drawn whole, at full detail, with
+    /// every edit taken: nothing is planned, meshed or swapped in.
+    pub fn is_idle(&self) -> bool {
+        self.drawn.as_ref().is_some_and(|d| d.rings.finest == 0)
+            && self.planning.is_none()
+            && self.target.is_none()
+            && self.swapping.is_none()
+            && self.new_edits.is_empty()
+            && self.refreshing.is_empty()
+            && self.refreshed.is_empty()
+    }
+
+    /// What each level of the drawn view holds on the GPU, finest first (the quads; the
+    /// arena's free room and the records are the renderer's, `Renderer::memory`).
+    pub fn memory(&self) -> Vec<LevelMemory> {
+        let mut out: Vec<LevelMemory> = (0..=self.config.rings.coarsest)
+            .map(|level| LevelMemory {
+                level,
+                ..LevelMemory::default()
+            })
+            .collect();
+        for (&(l, _), &b) in &self.bytes {
+            if let Some(m) = out.get_mut(usize::from(l)) {
+                m.chunks += 1;
+                m.quads += b / 8;
+            }
+        }
+        out
+    }
+
+    /// Uploads the meshes of chunk `pos` of level `level`, and counts them.
+    fn upload(
+        &mut self,
+        renderer: &mut Renderer,
+        level: u8,
+        pos: ChunkPos,
+        m: &ChunkMeshes,
+    ) -> Result<u64> {
+        renderer.upload_level_chunk(level, pos, m)?;
+        let b = 8 * m.len() as u64;
+        self.bytes.insert((level, pos), b);
+        Ok(b)
+    }
+
+    /// Sets the block at `pos` to `id` in the far view's terrain, at every level that
+    /// holds it (every level whose cell samples the block's column,
+    /// [`voxel_core::level_cell`]; level 0 always): the next [`FarField::update`] sends it
+    /// to the worker, which meshes the drawn chunks it changes before anything else, and
+    /// they are replaced as soon as they come back (so an edit is drawn after at most the
+    /// batch the worker is meshing and its own chunks: [`FarStatus::edit_chunks_pending`] says
+    /// when). Chunks made later carry it. A block id the registry does not hold is
+    /// [`voxel_core::Error::UnknownBlock`], and nothing changes.
+    pub fn set_block(&mut self, pos: WorldPos, id: BlockId) -> Result<()> {
+        self.registry.get(id)?;
+        self.new_edits
+            .push(([i64::from(pos.x), i64::from(pos.y), i64::from(pos.z)], id));
+        Ok(())
+    }
+
+    /// Whether the mesh of `key` made after the first `seen` edits lacks one of the others.
+    fn stale(&self, key: &Key, seen: usize) -> bool {
+        self.edits.get(seen..).is_some_and(|later| {
+            later
+                .iter()
+                .any(|&e| chunks_an_edit_changes(e).contains(&(key.0, key.1)))
+        })
+    }
+
+    /// Sends the edits taken since the last update to the worker, then the drawn chunks
+    /// (and those of a view being swapped in) they change to be meshed again; meshes made
+    /// for the view being built that they change are made again.
+    fn send_edits(&mut self) -> Result<()> {
+        if self.new_edits.is_empty() {
+            return Ok(());
+        }
+        let mut changed: HashSet<(u8, ChunkPos)> = HashSet::new();
+        for (block, id) in std::mem::take(&mut self.new_edits) {
+            self.jobs.send(Job::Edit(block, id))?;
+            self.edits.push(block);
+            changed.extend(chunks_an_edit_changes(block));
+        }
+        let hit = |k: &&Key| changed.contains(&(k.0, k.1));
+        let views: Vec<(LevelRings, [f64; 3], Vec<Key>)> = self
+            .drawn
+            .iter()
+            .chain(self.swapping.as_ref().map(|s| &s.view))
+            .map(|v| {
+                (
+                    v.rings.clone(),
+                    v.at,
+                    v.keys.iter().filter(hit).copied().collect(),
+                )
+            })
+            .collect();
+        for (rings, at, keys) in views {
+            self.refreshing.extend(keys.iter().copied());
+            for batch in keys.chunks(self.config.batch) {
+                self.jobs.send(Job::Mesh(
+                    Purpose::Refresh,
+                    rings.clone(),
+                    at,
+                    batch.to_vec(),
+                ))?;
+            }
+        }
+        let stale: Vec<Key> = self.ready.keys().filter(hit).copied().collect();
+        for k in &stale {
+            self.ready.remove(k);
+        }
+        if let Some(t) = &mut self.target {
+            let send: Vec<Key> = stale
+                .into_iter()
+                .filter(|k| t.keys.contains(k) && !self.in_flight.contains(k))
+                .collect();
+            t.pending.extend(send.iter().copied());
+            self.in_flight.extend(send.iter().copied());
+            let (rings, at) = (t.rings.clone(), t.at);
+            for batch in send.chunks(self.config.batch) {
+                self.jobs
+                    .send(Job::Mesh(Purpose::View, rings.clone(), at, batch.to_vec()))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Meshes of drawn chunks made again after edits came back: each replaces the drawn
+    /// one (kept until a swap in progress ends). Returns how many were drawn.
+    fn refresh(&mut self, renderer: &mut Renderer) -> Result<usize> {
+        if self.swapping.is_some() {
+            return Ok(0);
+        }
+        let mut n = 0;
+        for (key, m) in std::mem::take(&mut self.refreshed) {
+            if self.drawn.as_ref().is_some_and(|d| d.keys.contains(&key)) {
+                self.upload(renderer, key.0, key.1, &m)?;
+                n += 1;
+            }
+        }
+        Ok(n)
     }
 
     /// Follows the eye at `eye` (world blocks): asks for a new plan when the eye left the
@@ -297,6 +534,7 @@ impl FarField {
         if eye.is_finite() && self.swapping.is_none() {
             self.follow(eye)?;
         }
+        self.send_edits()?;
         for done in self.jobs.done(&self.generator, &self.registry) {
             match done {
                 Done::Planned(n, rings, keys) if self.planning == Some(n) => {
@@ -304,20 +542,15 @@ impl FarField {
                     self.planned(rings, keys)?;
                 }
                 Done::Planned(..) => {}
-                Done::Meshed(keys, meshes) => {
+                Done::Meshed(purpose, keys, seen, meshes) => {
                     let meshes = meshes.map_err(|e| {
                         Error::Unsupported(format!("the far field could not mesh a chunk: {e}"))
                     })?;
-                    for (k, m) in keys.into_iter().zip(meshes) {
-                        self.in_flight.remove(&k);
-                        if let Some(t) = &mut self.target {
-                            t.pending.remove(&k);
-                        }
-                        self.ready.insert(k, m);
-                    }
+                    self.meshed(purpose, keys, seen as usize, meshes)?;
                 }
             }
         }
+        status.refreshed = self.refresh(renderer)?;
         if self.swapping.is_none() && self.target.as_ref().is_some_and(|t| t.pending.is_empty()) {
             self.start_swap();
         }
@@ -327,11 +560,65 @@ impl FarField {
             status.swapped = true;
             status.swap_bytes = total;
         }
-        status.drawn_finest = self.drawn.as_ref().map(|(l, _)| *l);
-        status.drawn_chunks = self.drawn.as_ref().map_or(0, |(_, d)| d.len());
+        status.drawn_finest = self.drawn.as_ref().map(|d| d.rings.finest);
+        status.drawn_chunks = self.drawn.as_ref().map_or(0, |d| d.keys.len());
         status.ready = self.ready.len();
         status.missing = self.target.as_ref().map_or(0, |t| t.pending.len());
+        status.edit_chunks_pending = self.refreshing.len() + self.refreshed.len();
         Ok(status)
+    }
+
+    /// Meshes came back from the worker, made after its first `seen` edits: those an edit
+    /// sent since changes are made again (for the view being built) or dropped (a refresh:
+    /// that edit sent its own); the others go to the view being built, or replace drawn
+    /// chunks.
+    fn meshed(
+        &mut self,
+        purpose: Purpose,
+        keys: Vec<Key>,
+        seen: usize,
+        meshes: Vec<ChunkMeshes>,
+    ) -> Result<()> {
+        let mut again = Vec::new();
+        for (k, m) in keys.into_iter().zip(meshes) {
+            let stale = self.stale(&k, seen);
+            match purpose {
+                Purpose::View => {
+                    if stale {
+                        again.push(k);
+                        continue;
+                    }
+                    self.in_flight.remove(&k);
+                    if let Some(t) = &mut self.target {
+                        t.pending.remove(&k);
+                    }
+                    self.ready.insert(k, m);
+                }
+                Purpose::Refresh => {
+                    if stale {
+                        continue;
+                    }
+                    // Made with every edit that changes it.
+                    self.refreshing.remove(&k);
+                    self.refreshed.insert(k, m);
+                }
+            }
+        }
+        if again.is_empty() {
+            return Ok(());
+        }
+        match &self.target {
+            Some(t) => {
+                let (rings, at) = (t.rings.clone(), t.at);
+                self.jobs.send(Job::Mesh(Purpose::View, rings, at, again))?;
+            }
+            None => {
+                for k in &again {
+                    self.in_flight.remove(k);
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Asks for the plan of the finished view around the eye when it left the anchor (or
@@ -348,8 +635,8 @@ impl FarField {
         }
         if self.target.is_none()
             && self.planning.is_none()
-            && let Some((finest, _)) = &self.drawn
-            && *finest > 0
+            && let Some(finest) = self.drawn.as_ref().map(|d| d.rings.finest)
+            && finest > 0
         {
             return self.ask(self.config.rings.coarse_first(finest - 1));
         }
@@ -364,20 +651,24 @@ impl FarField {
         self.jobs.send(Job::Plan(self.plans, rings, at.to_array()))
     }
 
-    /// A plan came back: builds it, or, for a finished view of which little is drawn, asks
-    /// for its coarsest coarse-first view instead.
+    /// A plan came back: builds it, or, for a finished view whose horizon (its coarsest
+    /// level) is less than half drawn (the first view, or after a jump), asks for its
+    /// coarsest coarse-first view instead. (The horizon, not the whole view: a coarse-first
+    /// view drawn holds the finished view's horizon but not its finer levels, and the
+    /// finished view is its next step.)
     fn planned(&mut self, rings: LevelRings, keys: Vec<Key>) -> Result<()> {
         if rings.finest == 0 && rings.coarsest > 0 {
             let drawn: HashSet<(u8, ChunkPos)> = self.drawn().collect();
-            let kept = keys
-                .iter()
+            let horizon = keys.iter().filter(|k| k.0 == rings.coarsest);
+            let kept = horizon
+                .clone()
                 .filter(|&&(l, p, _)| drawn.contains(&(l, p)))
                 .count();
-            if kept * 2 < keys.len() {
+            if kept * 2 < horizon.count() {
                 return self.ask(self.config.rings.coarse_first(rings.coarsest));
             }
         }
-        let drawn = self.drawn.as_ref().map(|(_, d)| d);
+        let drawn = self.drawn.as_ref().map(|d| &d.keys);
         let pending: HashSet<Key> = keys
             .iter()
             .filter(|k| !self.ready.contains_key(k) && !drawn.is_some_and(|d| d.contains(k)))
@@ -392,10 +683,11 @@ impl FarField {
         for batch in send.chunks(self.config.batch) {
             self.in_flight.extend(batch.iter().copied());
             self.jobs
-                .send(Job::Mesh(rings.clone(), at, batch.to_vec()))?;
+                .send(Job::Mesh(Purpose::View, rings.clone(), at, batch.to_vec()))?;
         }
         self.target = Some(Target {
             rings,
+            at,
             keys,
             pending,
         });
@@ -413,7 +705,7 @@ impl FarField {
         let old = self
             .drawn
             .as_ref()
-            .map(|(_, d)| d.clone())
+            .map(|d| d.keys.clone())
             .unwrap_or_default();
         let k = self.config.rings.coarsest;
         let cell = |&(l, p, _): &Key| {
@@ -443,8 +735,11 @@ impl FarField {
             dist(c).total_cmp(&dist(d)).then(c.cmp(d))
         });
         self.swapping = Some(Swap {
-            finest: target.rings.finest,
-            new,
+            view: View {
+                rings: target.rings,
+                at: target.at,
+                keys: new,
+            },
             groups: groups.into_iter().map(|(_, g)| g).rev().collect(),
             bytes: 0,
         });
@@ -454,7 +749,7 @@ impl FarField {
     /// bytes are uploaded (at least one group). Returns the bytes uploaded, and the swap's
     /// bytes when it ended.
     fn go_on_swapping(&mut self, renderer: &mut Renderer) -> Result<(u64, Option<u64>)> {
-        let Some(swap) = &mut self.swapping else {
+        let Some(mut swap) = self.swapping.take() else {
             return Ok((0, None));
         };
         let mut bytes = 0;
@@ -466,10 +761,10 @@ impl FarField {
                 if let Some(k) = level_key(l, p) {
                     renderer.remove_chunk(k);
                 }
+                self.bytes.remove(&(l, p));
             }
             for ((l, p, _), m) in &upload {
-                bytes += 8 * m.len() as u64;
-                renderer.upload_level_chunk(*l, *p, m)?;
+                bytes += self.upload(renderer, *l, *p, m)?;
             }
             if bytes >= self.config.upload_budget {
                 break;
@@ -477,12 +772,11 @@ impl FarField {
         }
         swap.bytes += bytes;
         if !swap.groups.is_empty() {
+            self.swapping = Some(swap);
             return Ok((bytes, None));
         }
         let total = swap.bytes;
-        if let Some(swap) = self.swapping.take() {
-            self.drawn = Some((swap.finest, swap.new));
-        }
+        self.drawn = Some(swap.view);
         // Meshes of views no longer wanted go; those in flight stay wanted.
         self.ready.clear();
         Ok((bytes, Some(total)))
@@ -492,11 +786,10 @@ impl FarField {
 /// The chunks of one square of the coarsest level a swap removes, and those it uploads.
 type Group = (Vec<Key>, Vec<(Key, ChunkMeshes)>);
 
-/// A view being swapped in, a group of chunks at a time: its finest level, its chunks, the
-/// groups left (removals and uploads; the next is last), and the bytes uploaded so far.
+/// A view being swapped in, a group of chunks at a time: the view, the groups left
+/// (removals and uploads; the next is last), and the bytes uploaded so far.
 struct Swap {
-    finest: u8,
-    new: HashSet<Key>,
+    view: View,
     groups: Vec<Group>,
     bytes: u64,
 }
