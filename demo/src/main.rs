@@ -298,8 +298,9 @@ struct WindowArgs {
     /// Technique to start with.
     #[arg(long, value_parser = technique, default_value = "sorted-quads")]
     technique: Technique,
-    /// Chunks of terrain loaded around the eye, each way (1 to 32); they stream in as
-    /// the camera flies.
+    /// Chunks of terrain drawn around the eye, each way (1 to 512); to 32 they stream in
+    /// full detail as the camera flies, past 32 the terrain is drawn in levels of detail
+    /// (full detail to 32).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(demo::app::MAX_DEMO_VIEW_DISTANCE)), default_value_t = 8)]
     view_distance: u32,
     /// Start with the error map against the reference on.

@@ -303,3 +303,43 @@ fn the_window_draws_its_game_content_under_webgl2_limits() {
         );
     }
 }
+
+/// Past 32 chunks the window draws the terrain in levels of detail (a far field): the far
+/// picture shows ground where the streamed one ends, and an edit in a far view goes through.
+#[test]
+fn the_window_draws_a_far_view_past_the_streamed_distance() {
+    let Some(x) = vulkan_and_xvfb() else { return };
+    let dir = out_dir("window-far");
+    let shot = |vd: &str, extra: &[&str]| {
+        let path = dir.join(format!("view-distance-{vd}.png"));
+        let mut args = vec![
+            "--size",
+            "640x360",
+            "--frames",
+            "3",
+            "--view-distance",
+            vd,
+            "--screenshot",
+            path.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        demo(&x, &args);
+        Image::load_png(&path).unwrap()
+    };
+    let near = shot("4", &[]);
+    let far = shot("64", &["--edit"]);
+    let (a, b) = (view(&near), view(&far));
+    assert!(distinct(&b) > 200, "{} colours", distinct(&b));
+    // Where the near view shows sky past its 4 chunks, the far view shows land and sea.
+    let changed = a
+        .iter()
+        .zip(&b)
+        .filter(|(p, q)| (0..3).any(|c| p[c].abs_diff(q[c]) > 16))
+        .count();
+    assert!(
+        changed * 50 > a.len(),
+        "the far view differs from the near one on {changed} of {} pixels; see {}",
+        a.len(),
+        dir.display()
+    );
+}

@@ -1,6 +1,7 @@
 //! The interactive demo: a winit window with a wgpu surface, generated terrain (or a scene
 //! file or MagicaVoxel model, `--scene`) streamed around the eye (a [`ChunkStreamer`]: chunks generated, meshed and uploaded in the
-//! background, up to 32 chunks of view distance) and drawn by the voxel renderer, an egui
+//! background, up to 32 chunks of view distance; past that, to 512, the terrain in levels of
+//! detail, a [`FarField`]) and drawn by the voxel renderer, an egui
 //! side panel to switch techniques and settings, a fly camera, block edits remeshed in the
 //! background, live GPU timings and a live error map against the exact reference.
 //!
@@ -23,6 +24,8 @@ use voxel_lab::{chain, scene};
 
 use crate::{Error, Result};
 use voxel_mesh::ChunkMeshes;
+use voxel_mesh::levels::LevelRings;
+use voxel_render::far::{FarConfig, FarField, FarStatus};
 use voxel_render::{
     Camera, ChunkSink, ChunkStreamer, FrameStats, GpuContext, GpuTimes, Image, Lighting, OitConfig,
     Renderer, RendererConfig, StreamConfig, StreamFrame, Technique, readback,
@@ -50,7 +53,8 @@ pub struct DemoOptions {
     pub size: (u32, u32),
     /// Initial technique.
     pub technique: Technique,
-    /// Chunks of terrain loaded around the eye, each way (1 to [`MAX_DEMO_VIEW_DISTANCE`]).
+    /// Chunks of terrain drawn around the eye, each way (1 to [`MAX_DEMO_VIEW_DISTANCE`];
+    /// past [`STREAMED_VIEW_DISTANCE`] in levels of detail).
     pub view_distance: u32,
     /// Scripted: quit after this many frames (per technique with `cycle`).
     pub frames: Option<u64>,
@@ -94,8 +98,18 @@ impl Default for DemoOptions {
     }
 }
 
-/// The demo's largest view distance, in chunks (the streamer's own limit is higher).
-pub const MAX_DEMO_VIEW_DISTANCE: u32 = 32;
+/// The demo's largest view distance, in chunks: past [`STREAMED_VIEW_DISTANCE`] the
+/// generated terrain is drawn in levels of detail (a [`FarField`]; a scene stops at
+/// [`STREAMED_VIEW_DISTANCE`]).
+pub const MAX_DEMO_VIEW_DISTANCE: u32 = 512;
+
+/// The largest view distance the streamer draws, all in full detail (its own limit is
+/// higher); a far view keeps full detail to this distance.
+pub const STREAMED_VIEW_DISTANCE: u32 = 32;
+
+/// In a far view, the chunks the streamer keeps around the eye (not drawn: the far field
+/// draws), which edits aim at and the eye's medium is read from.
+const NEAR_WORLD: u32 = 4;
 
 /// Whether a window can be opened: an X11 or Wayland display is named in the environment.
 pub fn have_display() -> bool {
@@ -271,6 +285,52 @@ struct Streaming {
     streamer: ChunkStreamer,
     /// What the last update did, for the panel.
     last: StreamFrame,
+    /// Past [`STREAMED_VIEW_DISTANCE`]: the far view that draws the terrain, and what its
+    /// last update did; the streamer then keeps only the world near the eye, undrawn.
+    far: Option<(FarField, FarStatus)>,
+}
+
+impl Streaming {
+    /// The world of `seed` (or the opened scene) drawn to `view_distance` chunks.
+    fn new(seed: u32, view_distance: u32, scene: Option<&OpenScene>) -> Result<Self> {
+        if view_distance <= STREAMED_VIEW_DISTANCE || scene.is_some() {
+            return Ok(Self {
+                streamer: streamer(seed, view_distance.min(STREAMED_VIEW_DISTANCE), scene)?,
+                last: StreamFrame::default(),
+                far: None,
+            });
+        }
+        let field = FarField::new(
+            Arc::new(terrain(seed)),
+            Arc::new(BlockRegistry::default()),
+            FarConfig {
+                rings: LevelRings::reaching(STREAMED_VIEW_DISTANCE, view_distance),
+                ..FarConfig::default()
+            },
+        )?;
+        Ok(Self {
+            streamer: streamer(seed, NEAR_WORLD, None)?,
+            last: StreamFrame::default(),
+            far: Some((field, FarStatus::default())),
+        })
+    }
+
+    /// Whether everything within the view distance is drawn, edits included.
+    fn is_idle(&self) -> bool {
+        self.streamer.is_idle() && self.far.as_ref().is_none_or(|(f, _)| f.is_idle())
+    }
+}
+
+/// A sink that keeps nothing: the streamer's chunks in a far view, which the far field
+/// draws.
+struct Undrawn;
+
+impl ChunkSink for Undrawn {
+    fn upload(&mut self, _: ChunkPos, _: &ChunkMeshes) -> voxel_render::Result<()> {
+        Ok(())
+    }
+
+    fn remove(&mut self, _: ChunkPos) {}
 }
 
 /// The renderer, and the reference beside it when the error map is on: both get every
@@ -307,15 +367,17 @@ fn streamer(seed: u32, view_distance: u32, scene: Option<&OpenScene>) -> Result<
     };
     match scene {
         Some(s) => ChunkStreamer::new(s.world.registry().clone(), s.world.clone(), config),
-        None => {
-            let generator = TerrainGenerator::new(TerrainConfig {
-                seed,
-                ..TerrainConfig::default()
-            });
-            ChunkStreamer::new(Arc::new(BlockRegistry::default()), generator, config)
-        }
+        None => ChunkStreamer::new(Arc::new(BlockRegistry::default()), terrain(seed), config),
     }
     .map_err(Error::from)
+}
+
+/// The default terrain of `seed`.
+fn terrain(seed: u32) -> TerrainGenerator {
+    TerrainGenerator::new(TerrainConfig {
+        seed,
+        ..TerrainConfig::default()
+    })
 }
 
 /// A scene opened with `--scene`: its name and world (streamed like terrain).
@@ -393,7 +455,12 @@ impl Gfx {
                 None,
             ),
         };
-        let view_distance = opts.view_distance.clamp(1, MAX_DEMO_VIEW_DISTANCE);
+        let most = if open.is_some() {
+            STREAMED_VIEW_DISTANCE
+        } else {
+            MAX_DEMO_VIEW_DISTANCE
+        };
+        let view_distance = opts.view_distance.clamp(1, most);
         let (yaw, pitch) = cam.yaw_pitch();
         let settings = Settings {
             oit: OitConfig::with(opts.technique),
@@ -455,10 +522,7 @@ impl Gfx {
             post,
             frames,
             ui,
-            streaming: Streaming {
-                streamer: streamer(opts.seed, view_distance, open.as_ref())?,
-                last: StreamFrame::default(),
-            },
+            streaming: Streaming::new(opts.seed, view_distance, open.as_ref())?,
             input: Input {
                 fly: Fly {
                     eye: cam.eye,
@@ -496,14 +560,23 @@ impl Gfx {
         Ok(g)
     }
 
-    /// Streams one frame's worth around the eye into the renderer (and the reference).
+    /// Streams one frame's worth around the eye into the renderer (and the reference), or
+    /// in a far view, follows the eye with the far field.
     fn stream(&mut self) -> Result<()> {
         let eye = self.input.fly.eye;
-        let mut sinks = Sinks {
-            renderer: &mut self.renderer,
-            reference: self.reference.as_mut(),
+        let frame = match &mut self.streaming.far {
+            Some((field, last)) => {
+                *last = field.update(&mut self.renderer, eye)?;
+                self.streaming.streamer.update(eye, &mut Undrawn)?
+            }
+            None => {
+                let mut sinks = Sinks {
+                    renderer: &mut self.renderer,
+                    reference: self.reference.as_mut(),
+                };
+                self.streaming.streamer.update(eye, &mut sinks)?
+            }
         };
-        let frame = self.streaming.streamer.update(eye, &mut sinks)?;
         if let Some((pos, why)) = frame.failed.first() {
             self.status.message = format!("chunk {pos:?}: {why}");
         }
@@ -516,7 +589,7 @@ impl Gfx {
         let start = Instant::now();
         loop {
             self.stream()?;
-            if self.streaming.streamer.is_idle() {
+            if self.streaming.is_idle() {
                 return Ok(());
             }
             if start.elapsed() > limit {
@@ -659,6 +732,12 @@ impl Gfx {
         };
         if let Err(e) = self.streaming.streamer.set_block(pos, id) {
             self.status.message = chain(&e);
+            return;
+        }
+        if let Some((field, _)) = &mut self.streaming.far
+            && let Err(e) = field.set_block(pos, id)
+        {
+            self.status.message = chain(&e);
         }
     }
 
@@ -710,13 +789,31 @@ impl Gfx {
             self.input.fly.eye = cam.eye;
             self.input.fly.yaw = yaw;
             self.input.fly.pitch = pitch;
-            self.streaming.streamer = streamer(s.seed, s.view_distance, None)?;
             self.renderer.clear_chunks();
             if let Some(r) = &mut self.reference {
                 r.clear_chunks();
             }
+            self.streaming = Streaming::new(s.seed, s.view_distance, None)?;
         } else if s.view_distance != a.view_distance {
-            self.streaming.streamer.set_view_distance(s.view_distance)?;
+            let far = |d: u32| d > STREAMED_VIEW_DISTANCE && self.scene.is_none();
+            if far(s.view_distance) || far(a.view_distance) {
+                // Into, out of or within a far view: drawn again from nothing (the far
+                // view coarse first).
+                self.renderer.clear_chunks();
+                if let Some(r) = &mut self.reference {
+                    r.clear_chunks();
+                }
+                self.streaming = Streaming::new(s.seed, s.view_distance, self.scene.as_ref())?;
+            } else {
+                self.streaming.streamer.set_view_distance(s.view_distance)?;
+            }
+        }
+        if s.heatmap && self.streaming.far.is_some() {
+            // The reference renderer is fed the streamer's chunks only.
+            s.heatmap = false;
+            self.settings.heatmap = false;
+            self.status.message =
+                "the error map draws the streamed world: view distance 32 at most".into();
         }
         self.far = far_plane(s.view_distance).max(self.scene.as_ref().map_or(0.0, |s| s.far));
         if s.oit != a.oit {
@@ -933,7 +1030,7 @@ impl Gfx {
             return Ok(Flow::Continue);
         };
         // Edits are remeshed in the background: let them land before the last frame.
-        if self.status.frame_index < frames || !self.streaming.streamer.is_idle() {
+        if self.status.frame_index < frames || !self.streaming.is_idle() {
             return Ok(Flow::Continue);
         }
         if let Some(dir) = self.script.opts.cycle.clone() {

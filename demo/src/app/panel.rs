@@ -208,8 +208,14 @@ impl Gfx {
                 });
             }
         }
+        let most = if self.scene.is_some() {
+            super::STREAMED_VIEW_DISTANCE
+        } else {
+            super::MAX_DEMO_VIEW_DISTANCE
+        };
         ui.add(
-            egui::Slider::new(&mut s.view_distance, 1..=super::MAX_DEMO_VIEW_DISTANCE)
+            egui::Slider::new(&mut s.view_distance, 1..=most)
+                .logarithmic(true)
                 .text("view distance (chunks)"),
         );
         // The default lighting until the slider is moved; then the sun (or, at night, the
@@ -258,6 +264,26 @@ impl Gfx {
             last.jobs,
             last.uploads
         ));
+        if let Some((field, status)) = &self.streaming.far {
+            ui.label(format!(
+                "far view: {} chunks drawn{}",
+                status.drawn_chunks,
+                match status.drawn_finest {
+                    None => ", the horizon coming".to_owned(),
+                    Some(0) if field.is_idle() => String::new(),
+                    Some(l) => format!(", level {l} the finest so far, {} to mesh", status.missing),
+                }
+            ));
+            for m in field.memory() {
+                let s = voxel_core::level_scale(m.level);
+                ui.label(format!(
+                    "  level {} ({s}-block cells): {} chunks, {:.1} MiB of quads",
+                    m.level,
+                    m.chunks,
+                    (m.quads * 8) as f64 / f64::from(1 << 20)
+                ));
+            }
+        }
         let report = &st.technique;
         if let Some(sort) = report.sort {
             ui.label(format!(
