@@ -513,7 +513,7 @@ impl TerrainGenerator {
 
     /// Generates the chunk at `pos`. Never panics: positions near the `i32` limits work.
     pub fn generate_chunk(&self, pos: ChunkPos) -> Chunk {
-        self.generate_cells(pos, 1)
+        self.generate_level_chunk(0, pos)
     }
 
     /// Generates chunk `pos` of level of detail `level` (0 to [`MAX_LEVEL`]; larger levels
@@ -532,15 +532,45 @@ impl TerrainGenerator {
     /// ground they cover, not each one (a 5-block canopy shows in some cells of level 2's
     /// 4-block cells and not in others).
     pub fn generate_level_chunk(&self, level: u8, pos: ChunkPos) -> Chunk {
-        self.generate_cells(pos, level_scale(level))
+        let column = self.generate_level_column(level, pos.x, pos.z, pos.y..=pos.y);
+        column.into_iter().next().unwrap_or_default()
     }
 
-    /// The chunk of `scale`-block-wide cells at level position `pos`.
-    fn generate_cells(&self, pos: ChunkPos, scale: i64) -> Chunk {
+    /// The chunks of level `level` at x `x` and z `z` (the level's chunk coordinates), one
+    /// for each chunk height of `ys`, bottom first: each is
+    /// [`TerrainGenerator::generate_level_chunk`] of its position, made at the cost of
+    /// about one (the ground's heights, trees and structures are found once for the column).
+    pub fn generate_level_column(
+        &self,
+        level: u8,
+        x: i32,
+        z: i32,
+        ys: std::ops::RangeInclusive<i32>,
+    ) -> Vec<Chunk> {
+        let scale = level_scale(level);
         let n = CHUNK_SIZE as i64;
-        // World blocks: the chunk's first block, and a cell's sample column.
-        let [ox, oy, oz] = level_origin_scaled(scale, pos);
+        // World blocks: the column's first block, and a cell's sample column.
+        let [ox, _, oz] = level_origin_scaled(scale, ChunkPos::new(x, 0, z));
         let sample = |o: i64, c: usize| o + c as i64 * scale + scale / 2;
+        let heights: Vec<i64> = (0..CHUNK_SIZE * CHUNK_SIZE)
+            .map(|i| self.height_at(sample(ox, i / CHUNK_SIZE), sample(oz, i % CHUNK_SIZE)))
+            .collect();
+        let boxes = self.cell_boxes(ox, oz, scale);
+        ys.map(|y| self.fill_cells(&heights, &boxes, [ox, i64::from(y) * n, oz], scale))
+            .collect()
+    }
+
+    /// The chunk of `scale`-block-wide cells whose first block is `origin`, over the
+    /// ground's `heights` at its sample columns (x-major) and with the trees' and
+    /// structures' `boxes`.
+    fn fill_cells(
+        &self,
+        heights: &[i64],
+        boxes: &[WorldBox],
+        [ox, oy, oz]: [i64; 3],
+        scale: i64,
+    ) -> Chunk {
+        let n = CHUNK_SIZE as i64;
         let mut chunk = Chunk::default();
         let sea = self.sea();
         let local = |y: i64| (y - oy).clamp(0, n) as usize;
@@ -551,7 +581,7 @@ impl TerrainGenerator {
         // Ground and sea, a column run at a time.
         for x in 0..CHUNK_SIZE {
             for z in 0..CHUNK_SIZE {
-                let h = self.height_at(sample(ox, x), sample(oz, z));
+                let h = heights[x * CHUNK_SIZE + z];
                 let shore = h <= sea + 1;
                 let top = if shore { sand } else { grass };
                 let soil = if shore { sand } else { dirt };
@@ -569,7 +599,27 @@ impl TerrainGenerator {
                 }
             }
         }
+        // The cells whose sample column lies in a box's `[min, max]` on x and z (on y, the
+        // cells are blocks).
+        let first = |min: i64, o: i64| (min - o - scale / 2 + scale - 1).div_euclid(scale);
+        let last = |max: i64, o: i64| (max - o - scale / 2).div_euclid(scale);
+        for b in boxes {
+            let min = [first(b.min[0], ox), b.min[1] - oy, first(b.min[2], oz)].map(|v| v.max(0));
+            let max = [last(b.max[0], ox), b.max[1] - oy, last(b.max[2], oz)].map(|v| v.min(n - 1));
+            if min.iter().zip(&max).all(|(a, b)| a <= b) {
+                // Clipped to the chunk above, so always in range.
+                let id = b.role.map_or(BlockId::AIR, |r| self.block(r));
+                let _ = chunk.fill_box(min.map(|v| v as usize), max.map(|v| v as usize), id);
+            }
+        }
+        chunk
+    }
 
+    /// The boxes of the trees and structures that place a cell in the column of
+    /// `scale`-block-wide cells starting at world `(ox, oz)`.
+    fn cell_boxes(&self, ox: i64, oz: i64, scale: i64) -> Vec<WorldBox> {
+        let n = CHUNK_SIZE as i64;
+        let sample = |o: i64, c: usize| o + c as i64 * scale + scale / 2;
         let (w, margin) = (n * scale, CLEARING + 8);
         let sites = self.sites_in(ox - margin, oz - margin, ox + w + margin, oz + w + margin);
         let mut boxes = Vec::new();
@@ -616,20 +666,7 @@ impl TerrainGenerator {
         for site in &sites {
             structure(site, &mut boxes);
         }
-        // The cells whose sample column lies in a box's `[min, max]` on x and z (on y, the
-        // cells are blocks).
-        let first = |min: i64, o: i64| (min - o - scale / 2 + scale - 1).div_euclid(scale);
-        let last = |max: i64, o: i64| (max - o - scale / 2).div_euclid(scale);
-        for b in &boxes {
-            let min = [first(b.min[0], ox), b.min[1] - oy, first(b.min[2], oz)].map(|v| v.max(0));
-            let max = [last(b.max[0], ox), b.max[1] - oy, last(b.max[2], oz)].map(|v| v.min(n - 1));
-            if min.iter().zip(&max).all(|(a, b)| a <= b) {
-                // Clipped to the chunk above, so always in range.
-                let id = b.role.map_or(BlockId::AIR, |r| self.block(r));
-                let _ = chunk.fill_box(min.map(|v| v as usize), max.map(|v| v as usize), id);
-            }
-        }
-        chunk
+        boxes
     }
 
     /// The trees of tree cells `cells` whose trunk `reaches` (at `(tx, tz)`), as boxes
@@ -1172,5 +1209,30 @@ mod tests {
         // Level 0 holds every block; far outside the chunk coordinates, nothing.
         assert!(level_cell(0, [5, -70, -9]).is_some());
         assert_eq!(level_cell(0, [i64::MAX, 0, 0]), None);
+    }
+
+    #[test]
+    fn a_level_column_is_its_chunks_generated_one_by_one() {
+        let g = generator();
+        let site = g.sites_in(-768, -768, 768, 768)[0];
+        for level in [0, 1, 2, 4] {
+            let w = CHUNK_SIZE as i64 * level_scale(level);
+            let (x, z) = (
+                site.center[0].div_euclid(w) as i32,
+                site.center[2].div_euclid(w) as i32,
+            );
+            let column = g.generate_level_column(level, x, z, -1..=2);
+            assert_eq!(column.len(), 4);
+            for (y, c) in (-1..=2).zip(&column) {
+                assert_eq!(
+                    c.to_dense(),
+                    g.generate_level_chunk(level, ChunkPos::new(x, y, z))
+                        .to_dense(),
+                    "level {level} chunk height {y}"
+                );
+            }
+            // The column holds ground and more than ground (the site's blocks, trees).
+            assert!(column.iter().map(|c| c.palette().count()).sum::<usize>() > 4);
+        }
     }
 }

@@ -252,17 +252,31 @@ impl LevelCache {
         self.edit_count
     }
 
-    /// Chunk `pos` of level `level` of `generator`'s terrain with the edits made to it.
-    fn generate(&self, generator: &TerrainGenerator, level: u8, pos: ChunkPos) -> Chunk {
-        let mut chunk = generator.generate_level_chunk(level, pos);
-        if let Some(edits) = self.edits.get(&(level, pos)) {
-            for (&[x, y, z], &id) in edits {
-                // Cells of a chunk: always in range.
-                let _ = chunk.set(x, y, z, id);
-            }
-            chunk.pack();
-        }
-        chunk
+    /// The chunks of level `level` at x and z of `first`, from `first`'s height to
+    /// `last_y`, of `generator`'s terrain with the edits made to them (a column generated
+    /// at once: [`TerrainGenerator::generate_level_column`]).
+    fn generate(
+        &self,
+        generator: &TerrainGenerator,
+        level: u8,
+        first: ChunkPos,
+        last_y: i32,
+    ) -> Vec<((u8, ChunkPos), Arc<Chunk>)> {
+        let column = generator.generate_level_column(level, first.x, first.z, first.y..=last_y);
+        (first.y..=last_y)
+            .zip(column)
+            .map(|(y, mut chunk)| {
+                let pos = ChunkPos::new(first.x, y, first.z);
+                if let Some(edits) = self.edits.get(&(level, pos)) {
+                    for (&[x, y, z], &id) in edits {
+                        // Cells of a chunk: always in range.
+                        let _ = chunk.set(x, y, z, id);
+                    }
+                    chunk.pack();
+                }
+                ((level, pos), Arc::new(chunk))
+            })
+            .collect()
     }
 }
 
@@ -345,12 +359,26 @@ pub fn mesh_level_chunks_with(
     if cache.chunks.len() + lacking.len() > LevelCache::LIMIT {
         cache.chunks.retain(|k, _| needed.binary_search(k).is_ok());
     }
+    // Generated a column at a time (the heights and trees found once for the chunks
+    // above each other): runs of lacking chunks that differ only in y, adjacent once
+    // sorted by level, x, z and y.
+    let mut by_column = lacking;
+    by_column.sort_unstable_by_key(|&(l, p)| (l, p.x, p.z, p.y));
+    let mut columns: Vec<(u8, ChunkPos, i32)> = Vec::new();
+    for &(l, p) in &by_column {
+        match columns.last_mut() {
+            Some((cl, c, last)) if *cl == l && c.x == p.x && c.z == p.z && *last + 1 == p.y => {
+                *last = p.y;
+            }
+            _ => columns.push((l, p, p.y)),
+        }
+    }
     let made = &*cache;
-    let make = |&(l, p): &(u8, ChunkPos)| ((l, p), Arc::new(made.generate(generator, l, p)));
+    let make = |&(l, p, last): &(u8, ChunkPos, i32)| made.generate(generator, l, p, last);
     #[cfg(not(target_arch = "wasm32"))]
-    let new: Vec<_> = lacking.par_iter().map(make).collect();
+    let new: Vec<_> = columns.par_iter().flat_map_iter(make).collect();
     #[cfg(target_arch = "wasm32")]
-    let new: Vec<_> = lacking.iter().map(make).collect();
+    let new: Vec<_> = columns.iter().flat_map(make).collect();
     cache.chunks.extend(new);
 
     let mut water = vec![false; registry.len()];
