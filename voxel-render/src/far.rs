@@ -530,9 +530,14 @@ impl FarField {
     /// NaN eye is ignored (the drawn view stays).
     pub fn update(&mut self, renderer: &mut Renderer, eye: DVec3) -> Result<FarStatus> {
         let mut status = FarStatus::default();
-        // A view being swapped in is finished before the eye is followed again.
-        if eye.is_finite() && self.swapping.is_none() {
-            self.follow(eye)?;
+        // A view being swapped in is finished before the eye is followed again; the next
+        // finer view is built meanwhile.
+        if eye.is_finite() {
+            if self.swapping.is_none() {
+                self.follow(eye)?;
+            } else {
+                self.step_finer()?;
+            }
         }
         self.send_edits()?;
         for done in self.jobs.done(&self.generator, &self.registry) {
@@ -633,9 +638,23 @@ impl FarField {
             self.target = None;
             return self.ask(self.config.rings.coarse_first(0));
         }
+        self.step_finer()
+    }
+
+    /// The latest view: the one being swapped in, else the one drawn.
+    fn latest(&self) -> Option<&View> {
+        self.swapping
+            .as_ref()
+            .map(|s| &s.view)
+            .or(self.drawn.as_ref())
+    }
+
+    /// Asks for the plan of the next finer coarse-first view when the latest one (drawn,
+    /// or being swapped in) is not the finished view and nothing else is being built.
+    fn step_finer(&mut self) -> Result<()> {
         if self.target.is_none()
             && self.planning.is_none()
-            && let Some(finest) = self.drawn.as_ref().map(|d| d.rings.finest)
+            && let Some(finest) = self.latest().map(|d| d.rings.finest)
             && finest > 0
         {
             return self.ask(self.config.rings.coarse_first(finest - 1));
@@ -658,7 +677,11 @@ impl FarField {
     /// finished view is its next step.)
     fn planned(&mut self, rings: LevelRings, keys: Vec<Key>) -> Result<()> {
         if rings.finest == 0 && rings.coarsest > 0 {
-            let drawn: HashSet<(u8, ChunkPos)> = self.drawn().collect();
+            let drawn: HashSet<(u8, ChunkPos)> = self
+                .latest()
+                .into_iter()
+                .flat_map(|d| d.keys.iter().map(|&(l, p, _)| (l, p)))
+                .collect();
             let horizon = keys.iter().filter(|k| k.0 == rings.coarsest);
             let kept = horizon
                 .clone()
@@ -668,7 +691,8 @@ impl FarField {
                 return self.ask(self.config.rings.coarse_first(rings.coarsest));
             }
         }
-        let drawn = self.drawn.as_ref().map(|d| &d.keys);
+        // What the latest view holds is drawn, or will be when its swap ends.
+        let drawn = self.latest().map(|d| &d.keys);
         let pending: HashSet<Key> = keys
             .iter()
             .filter(|k| !self.ready.contains_key(k) && !drawn.is_some_and(|d| d.contains(k)))
@@ -777,8 +801,15 @@ impl FarField {
         }
         let total = swap.bytes;
         self.drawn = Some(swap.view);
-        // Meshes of views no longer wanted go; those in flight stay wanted.
-        self.ready.clear();
+        // Meshes of views no longer wanted go (those of the view being built stay); those
+        // in flight stay wanted.
+        match &self.target {
+            Some(t) => {
+                let wanted: HashSet<&Key> = t.keys.iter().collect();
+                self.ready.retain(|k, _| wanted.contains(k));
+            }
+            None => self.ready.clear(),
+        }
         Ok((bytes, Some(total)))
     }
 }
