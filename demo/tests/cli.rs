@@ -43,8 +43,8 @@ fn unknown_options_and_values_are_named() {
         &["wboit", "known"],
     );
     fails_saying(
-        &["window", "--view-distance", "40"],
-        &["--view-distance", "40"],
+        &["window", "--view-distance", "513"],
+        &["--view-distance", "513"],
     );
 }
 
