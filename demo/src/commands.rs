@@ -528,6 +528,7 @@ pub(crate) fn window(a: WindowArgs, device: DeviceArgs) -> Result<()> {
         screenshot: a.screenshot,
         cycle: a.cycle,
         heatmap: a.heatmap,
+        level_bands: a.level_bands,
         edit: a.edit,
         resize: a.resize,
         // Read before the window opens: a broken file is an error, not an empty window.

@@ -306,6 +306,9 @@ struct WindowArgs {
     /// Start with the error map against the reference on.
     #[arg(long)]
     heatmap: bool,
+    /// Start with the levels of detail shown as bands (odd levels darker; the L key).
+    #[arg(long)]
+    level_bands: bool,
     /// Show the game content (3 000 bubbles rising through the water, a turning glass
     /// cube crossing its surface, a boat) from the start: `true` or `false`. Default: on
     /// in an interactive run, off with --frames. The panel toggles each.

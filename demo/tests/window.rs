@@ -312,6 +312,7 @@ fn the_window_draws_a_far_view_past_the_streamed_distance() {
     let dir = out_dir("window-far");
     let shot = |vd: &str, extra: &[&str]| {
         let path = dir.join(format!("view-distance-{vd}.png"));
+        let vd = vd.trim_end_matches("-bands");
         let mut args = vec![
             "--size",
             "640x360",
@@ -342,4 +343,20 @@ fn the_window_draws_a_far_view_past_the_streamed_distance() {
         a.len(),
         dir.display()
     );
+    // With the levels as bands, level 1 (past 32 chunks) is drawn darker: the picture is
+    // darker where it differs, and only there (level 0 is the same).
+    let banded = view(&shot("64-bands", &["--level-bands"]));
+    let (mut darker, mut lighter) = (0, 0);
+    for (p, q) in b.iter().zip(&banded) {
+        let sum = |p: &[u8; 3]| p.iter().map(|&c| u32::from(c)).sum::<u32>();
+        if sum(q) + 12 < sum(p) {
+            darker += 1;
+        } else if sum(q) > sum(p) + 12 {
+            lighter += 1;
+        }
+    }
+    println!("with bands: {darker} pixels darker, {lighter} lighter");
+    // Level 1 is the strip at the horizon of this view (459 pixels at 640 × 360).
+    assert!(darker > 200, "level 1 not darker: {darker} pixels");
+    assert!(lighter * 10 < darker, "{lighter} pixels lighter with bands");
 }

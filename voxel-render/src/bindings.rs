@@ -129,8 +129,9 @@ pub(crate) struct FrameUniforms {
     pub ambient: f32,
     /// Sky colour, linear.
     pub sky: [f32; 3],
-    /// Padding (WGSL aligns `viewport` to 8 bytes after the vec3).
-    pub _pad: f32,
+    /// How much darker chunks of odd levels of detail are drawn (0: not at all;
+    /// `Renderer::set_level_bands`).
+    pub level_bands: f32,
     /// Render target size in pixels.
     pub viewport: [f32; 2],
     /// Block id of the translucent type the eye is inside, or `NO_MEDIUM` (`u32::MAX`).
@@ -303,6 +304,7 @@ mod tests {
                 field!(FrameUniforms, sun_dir),
                 field!(FrameUniforms, ambient),
                 field!(FrameUniforms, sky),
+                field!(FrameUniforms, level_bands),
                 field!(FrameUniforms, viewport),
                 field!(FrameUniforms, medium),
                 field!(FrameUniforms, ao_strength),

@@ -64,6 +64,8 @@ pub struct DemoOptions {
     pub cycle: Option<PathBuf>,
     /// Start with the error map on.
     pub heatmap: bool,
+    /// Start with the levels of detail shown as bands (odd levels darker).
+    pub level_bands: bool,
     /// Scripted: place a block in front of the camera on the second frame (remeshing test).
     pub edit: bool,
     /// Scripted: on frames 1 to 3, halve the window, get a zero size (what a minimised
@@ -90,6 +92,7 @@ impl Default for DemoOptions {
             screenshot: None,
             cycle: None,
             heatmap: false,
+            level_bands: false,
             edit: false,
             resize: false,
             scene: None,
@@ -257,6 +260,8 @@ struct Settings {
     seed: u32,
     view_distance: u32,
     heatmap: bool,
+    /// The levels of detail drawn as bands (`Renderer::set_level_bands`).
+    level_bands: bool,
     place: BlockId,
     /// Time of day in hours (`Lighting::daytime`), or `None` for the default lighting.
     hour: Option<f32>,
@@ -471,6 +476,7 @@ impl Gfx {
             seed: opts.seed,
             view_distance,
             heatmap: opts.heatmap,
+            level_bands: opts.level_bands,
             place: voxel_core::blocks::GLASS,
             hour: None,
             game: game::Toggles::all(opts.game.unwrap_or(opts.frames.is_none())),
@@ -488,6 +494,7 @@ impl Gfx {
             .as_ref()
             .map_or_else(BlockRegistry::default, |s| (**s.world.registry()).clone());
         let mut renderer = Renderer::new(&ctx, &registry, config)?;
+        renderer.set_level_bands(settings.level_bands);
         // Every real-time technique the device runs, built now: the number keys and the
         // panel switch without a hitch (the game's pipelines follow with its content).
         for t in Technique::supported(&ctx.caps) {
@@ -676,6 +683,7 @@ impl Gfx {
         match code {
             KeyCode::F2 | KeyCode::KeyP => self.request_screenshot(),
             KeyCode::KeyH => self.settings.heatmap = !self.settings.heatmap,
+            KeyCode::KeyL => self.settings.level_bands = !self.settings.level_bands,
             KeyCode::KeyE => self.edit(true),
             KeyCode::KeyQ => self.edit(false),
             _ => {}
@@ -839,6 +847,9 @@ impl Gfx {
             for r in std::iter::once(&mut self.renderer).chain(self.reference.as_mut()) {
                 r.set_lighting(lighting)?;
             }
+        }
+        if s.level_bands != a.level_bands {
+            self.renderer.set_level_bands(s.level_bands);
         }
         if s.heatmap && self.reference.is_none() {
             self.reference = Some(self.reference_renderer()?);

@@ -218,6 +218,9 @@ impl Gfx {
                 .logarithmic(true)
                 .text("view distance (chunks)"),
         );
+        if self.streaming.far.is_some() {
+            ui.checkbox(&mut s.level_bands, "levels of detail as bands (L)");
+        }
         // The default lighting until the slider is moved; then the sun (or, at night, the
         // moon) of that hour.
         let mut hour = s.hour.unwrap_or(DEFAULT_HOUR);

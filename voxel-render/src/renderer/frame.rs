@@ -12,6 +12,10 @@ use voxel_core::BlockId;
 use super::RendererConfig;
 use super::config::{OUTPUT_FORMATS, output_format, sun_unit};
 use super::targets::MSAA_SAMPLES;
+
+/// How much darker the chunks of odd levels of detail are drawn with
+/// [`Renderer::set_level_bands`].
+const LEVEL_BAND_DARKENING: f32 = 0.25;
 use super::{FrameStats, Renderer};
 use crate::bindings::{FrameUniforms, MEDIA_EYE, MEDIA_NONE, MEDIA_VOLUMES, MEDIA_WALK, NO_MEDIUM};
 use crate::chunks::{DrawList, DrawMode, FrameDraws, Frustum, GpuChunk, MeshKind};
@@ -684,6 +688,11 @@ impl Renderer {
             ambient: self.config.ambient,
             brightness: self.config.brightness,
             sky: self.config.sky,
+            level_bands: if self.level_bands {
+                LEVEL_BAND_DARKENING
+            } else {
+                0.0
+            },
             viewport: [w as f32, h as f32],
             medium: medium.map_or(NO_MEDIUM, |(b, _)| u32::from(b.0)),
             ao_strength: self.config.ao_strength,

@@ -97,6 +97,8 @@ pub struct Renderer {
     /// buffers kept between frames.
     interleaver: Interleaver,
     frame_index: u32,
+    /// Whether chunks of odd levels of detail are drawn darker ([`Renderer::set_level_bands`]).
+    level_bands: bool,
     /// Chunks fading in, with the frame they appeared.
     fading: PosMap<ChunkPos, u32>,
     /// The last frame's visible meshes (kept for the room of its lists).
@@ -263,6 +265,7 @@ impl Renderer {
             submissions: Submissions::default(),
             interleaver: Interleaver::default(),
             frame_index: 0,
+            level_bands: false,
             fading: PosMap::default(),
             culled: Culled::default(),
             builder: DrawBuilder::default(),
@@ -489,6 +492,13 @@ impl Renderer {
         self.config.brightness = lighting.brightness;
         self.config.sky = lighting.sky;
         Ok(())
+    }
+
+    /// Shows where the levels of detail lie (a debugging view): with `on`, every technique
+    /// draws the chunks of odd levels ([`Renderer::upload_level_chunk`]; cells 2, 8, 32
+    /// blocks wide) a quarter darker, so the rings show as bands. Applied at the next frame.
+    pub fn set_level_bands(&mut self, on: bool) {
+        self.level_bands = on;
     }
 
     /// Changes how many frames new chunks take to fade in (0: no fade).

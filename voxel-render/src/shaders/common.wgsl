@@ -194,6 +194,10 @@ fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool) -> VsOut {
         let sa = corner_shade(q, a);
         out.shade = sa + beta * (corner_shade(q, b) - sa) + gamma * (corner_shade(q, c) - sa);
     }
+    // The level rings as bands (`Renderer::set_level_bands`): odd levels darker.
+    if (countTrailingZeros(chunk.scale) & 1u) == 1u {
+        out.shade *= 1.0 - frame.level_bands;
+    }
     out.uv = uv;
     out.block = q.y & 0xffffu;
     out.flags = q.y >> 16u;

@@ -11,6 +11,8 @@ struct Frame {
     sun_dir: vec3<f32>,
     ambient: f32,
     sky: vec3<f32>,
+    // How much darker chunks of odd levels of detail are drawn (0: not at all).
+    level_bands: f32,
     viewport: vec2<f32>,
     // Block id of the translucent type the eye is inside, or NO_MEDIUM.
     medium: u32,
