@@ -294,29 +294,41 @@ fn assert_tiles_once(drawn: &[(u8, ChunkPos)], what: &str) {
     );
 }
 
-#[test]
-fn a_far_field_is_built_coarse_first_off_the_frame_and_follows_the_eye() {
+/// A far field of the default terrain with full detail to 4 chunks and levels to 32
+/// (`upload_budget` bytes a swap update), a `sorted-quads` renderer of `w` × `h` and the
+/// default far view.
+fn field_and_renderer(
+    ctx: &voxel_render::GpuContext,
+    upload_budget: u64,
+    (w, h): (u32, u32),
+) -> (voxel_render::far::FarField, Renderer, Camera) {
     use std::sync::Arc;
     use voxel_render::far::{FarConfig, FarField};
-    let Some(ctx) = gpu() else { return };
     let generator = Arc::new(TerrainGenerator::new(TerrainConfig::default()));
     let registry = Arc::new(BlockRegistry::default());
     let config = FarConfig {
         rings: LevelRings::reaching(4, 32),
-        // Small, so that a swap takes several updates, a square at a time.
-        upload_budget: 256 << 10,
+        upload_budget,
         ..FarConfig::default()
     };
     assert_eq!(config.rings.coarsest, 3);
-    let mut field = FarField::new(Arc::clone(&generator), Arc::clone(&registry), config).unwrap();
-    let (w, h) = (480, 270);
-    let mut renderer = Renderer::new(
-        &ctx,
+    let field = FarField::new(Arc::clone(&generator), Arc::clone(&registry), config).unwrap();
+    let renderer = Renderer::new(
+        ctx,
         &registry,
         technique_config(Technique::SortedQuads, w, h),
     )
     .unwrap();
-    let camera = far::default_view(&generator).unwrap();
+    (field, renderer, far::default_view(&generator).unwrap())
+}
+
+#[test]
+fn a_far_field_is_built_coarse_first_off_the_frame_and_follows_the_eye() {
+    use voxel_render::far::FarField;
+    let Some(ctx) = gpu() else { return };
+    let (w, h) = (480, 270);
+    // A small upload budget, so that a swap takes several updates, a square at a time.
+    let (mut field, mut renderer, camera) = field_and_renderer(&ctx, 256 << 10, (w, h));
     let dir = out_dir("far/field");
     // Updates until a view with `finest` level 0 is drawn, or 120 s; the finest level of
     // each view swapped in, and the updates' longest time.
@@ -409,25 +421,12 @@ fn a_far_field_is_built_coarse_first_off_the_frame_and_follows_the_eye() {
 
 #[test]
 fn an_edit_reaches_every_drawn_level_within_a_bounded_time_and_stays_through_rebuilds() {
-    use std::sync::Arc;
     use voxel_core::{BlockId, WorldPos};
     use voxel_render::far::{FarConfig, FarField};
     let Some(ctx) = gpu() else { return };
-    let generator = Arc::new(TerrainGenerator::new(TerrainConfig::default()));
-    let registry = Arc::new(BlockRegistry::default());
-    let config = FarConfig {
-        rings: LevelRings::reaching(4, 32),
-        ..FarConfig::default()
-    };
-    let mut field = FarField::new(Arc::clone(&generator), Arc::clone(&registry), config).unwrap();
     let (w, h) = (480, 270);
-    let mut renderer = Renderer::new(
-        &ctx,
-        &registry,
-        technique_config(Technique::SortedQuads, w, h),
-    )
-    .unwrap();
-    let camera = far::default_view(&generator).unwrap();
+    let budget = FarConfig::default().upload_budget;
+    let (mut field, mut renderer, camera) = field_and_renderer(&ctx, budget, (w, h));
     let target = Offscreen::new(&ctx, w, h);
     let dir = out_dir("far/edit");
     // Updates at `eye` until the field is idle, or 120 s; the updates it took, and seconds.

@@ -109,10 +109,9 @@ fn the_levels_tile_the_view_once_and_reach_the_view_distance() {
     assert_eq!(LevelRings::reaching(31, 10).coarsest, 0);
 }
 
-#[test]
-fn a_flat_sea_meets_itself_across_level_borders_and_the_ground_is_skirted() {
-    // A flat sea floor 6 blocks under the surface everywhere: the only faces are the sea's
-    // surface, the floor's top, and the ground's walls toward another level.
+/// A flat sea floor 6 blocks under the surface everywhere (no trees, no structures), three
+/// levels in rings two chunks wide, and an eye above it.
+fn flat_sea() -> (TerrainGenerator, BlockRegistry, LevelRings, [f64; 3]) {
     let generator = TerrainGenerator::new(TerrainConfig {
         base_height: 18,
         amplitude: 0.0,
@@ -120,14 +119,25 @@ fn a_flat_sea_meets_itself_across_level_borders_and_the_ground_is_skirted() {
         structures: false,
         ..TerrainConfig::default()
     });
-    let registry = BlockRegistry::default();
     let rings = LevelRings {
         radius: 2,
         coarsest: 2,
         finest: 0,
         y: 0..=0,
     };
-    let eye = [40.0, 30.0, -20.0];
+    (
+        generator,
+        BlockRegistry::default(),
+        rings,
+        [40.0, 30.0, -20.0],
+    )
+}
+
+#[test]
+fn a_flat_sea_meets_itself_across_level_borders_and_the_ground_is_skirted() {
+    // A flat sea floor 6 blocks under the surface everywhere: the only faces are the sea's
+    // surface, the floor's top, and the ground's walls toward another level.
+    let (generator, registry, rings, eye) = flat_sea();
     let chunks = rings.all(eye);
     let meshes = mesh_level_chunks(&generator, &registry, &rings, eye, &chunks).unwrap();
     assert_eq!(meshes.len(), chunks.len());
@@ -168,21 +178,7 @@ fn a_flat_sea_meets_itself_across_level_borders_and_the_ground_is_skirted() {
 
 #[test]
 fn an_edit_reaches_every_level_that_holds_the_block() {
-    let generator = TerrainGenerator::new(TerrainConfig {
-        base_height: 18,
-        amplitude: 0.0,
-        tree_density: 0.0,
-        structures: false,
-        ..TerrainConfig::default()
-    });
-    let registry = BlockRegistry::default();
-    let rings = LevelRings {
-        radius: 2,
-        coarsest: 2,
-        finest: 0,
-        y: 0..=0,
-    };
-    let eye = [40.0, 30.0, -20.0];
+    let (generator, registry, rings, eye) = flat_sea();
     // Above the sea, on a sample column of levels 0 and 2 (not 1), on no chunk border.
     let block = [38, 28, -18];
     let changed = chunks_an_edit_changes(block);
