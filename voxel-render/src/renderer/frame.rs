@@ -702,7 +702,6 @@ impl Renderer {
                 let [r, g, b] = look.color;
                 [r, g, b, look.fog]
             }),
-            ..FrameUniforms::default()
         }
     }
 
