@@ -194,8 +194,9 @@ fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool) -> VsOut {
         let sa = corner_shade(q, a);
         out.shade = sa + beta * (corner_shade(q, b) - sa) + gamma * (corner_shade(q, c) - sa);
     }
-    // The level rings as bands (`Renderer::set_level_bands`): odd levels darker.
-    if (countTrailingZeros(chunk.scale) & 1u) == 1u {
+    // The level rings as bands (`Renderer::set_level_bands`): odd levels darker (scales
+    // 2, 8 and 32: bits 1, 3 and 5; no countTrailingZeros, which GLSL 3.30 lacks).
+    if (chunk.scale & 42u) != 0u {
         out.shade *= 1.0 - frame.level_bands;
     }
     out.uv = uv;
