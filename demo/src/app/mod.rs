@@ -786,6 +786,17 @@ impl Gfx {
         i.fly.eye += v.normalize_or_zero() * i.fly.speed * fast * dt;
     }
 
+    /// Drops every chunk drawn (by the renderer and the reference) and streams the world
+    /// of `seed` (or the opened scene) to `view_distance` from nothing.
+    fn restart_world(&mut self, seed: u32, view_distance: u32) -> Result<()> {
+        self.renderer.clear_chunks();
+        if let Some(r) = &mut self.reference {
+            r.clear_chunks();
+        }
+        self.streaming = Streaming::new(seed, view_distance, self.scene.as_ref())?;
+        Ok(())
+    }
+
     /// Applies what the panel changed.
     fn apply_settings(&mut self) -> Result<()> {
         let mut s = self.settings.clone();
@@ -797,21 +808,13 @@ impl Gfx {
             self.input.fly.eye = cam.eye;
             self.input.fly.yaw = yaw;
             self.input.fly.pitch = pitch;
-            self.renderer.clear_chunks();
-            if let Some(r) = &mut self.reference {
-                r.clear_chunks();
-            }
-            self.streaming = Streaming::new(s.seed, s.view_distance, None)?;
+            self.restart_world(s.seed, s.view_distance)?;
         } else if s.view_distance != a.view_distance {
             let far = |d: u32| d > STREAMED_VIEW_DISTANCE && self.scene.is_none();
             if far(s.view_distance) || far(a.view_distance) {
                 // Into, out of or within a far view: drawn again from nothing (the far
                 // view coarse first).
-                self.renderer.clear_chunks();
-                if let Some(r) = &mut self.reference {
-                    r.clear_chunks();
-                }
-                self.streaming = Streaming::new(s.seed, s.view_distance, self.scene.as_ref())?;
+                self.restart_world(s.seed, s.view_distance)?;
             } else {
                 self.streaming.streamer.set_view_distance(s.view_distance)?;
             }
