@@ -353,7 +353,10 @@ pub fn run(ctx: &GpuContext, opts: &FarOptions) -> Result<FarReport> {
         flight_frames: opts.fly_frames,
         flight_swaps: swaps,
         flight_most_missing: most_missing,
-        gpu_buffer_bytes: memory.arena_bytes + memory.record_bytes + memory.indirect_bytes,
+        gpu_buffer_bytes: memory.arena_bytes
+            + memory.record_bytes
+            + memory.indirect_bytes
+            + memory.light_bytes,
         gpu_quad_bytes: memory.quad_bytes,
         pictures,
         compare,

@@ -367,7 +367,10 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
         submit_ms: Spread::of(&col(|r| r.submit_ms)),
         gpu_frame_ms_p50: (!gpu.is_empty()).then(|| Spread::of(&gpu).p50),
         upload_bytes_per_frame_p95: Spread::of(&col(|r| r.upload_bytes as f64)).p95,
-        gpu_buffer_bytes: memory.arena_bytes + memory.record_bytes + memory.indirect_bytes,
+        gpu_buffer_bytes: memory.arena_bytes
+            + memory.record_bytes
+            + memory.indirect_bytes
+            + memory.light_bytes,
         gpu_quad_bytes: memory.quad_bytes,
         quads: memory.quad_bytes / voxel_render::low_level::QUAD_BYTES,
         chunk_storage_bytes: streamer.memory_bytes() as u64,

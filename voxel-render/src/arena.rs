@@ -20,7 +20,7 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use voxel_mesh::PackedQuad;
+use voxel_mesh::{PackedQuad, QuadLight};
 
 use crate::Result;
 use crate::error::scoped;
@@ -103,6 +103,16 @@ impl Allocator {
         self.insert(start, len);
     }
 
+    /// Grows to `capacity` units (no smaller than now): the new units are free.
+    pub(crate) fn grow(&mut self, capacity: u32) {
+        if capacity > self.capacity {
+            let old = std::mem::replace(&mut self.capacity, capacity);
+            let used = self.used;
+            self.free(old, capacity - old);
+            self.used = used;
+        }
+    }
+
     /// Units in use.
     pub(crate) fn used(&self) -> u32 {
         self.used
@@ -149,6 +159,9 @@ pub struct Alloc {
 #[derive(Debug)]
 struct Page {
     buffer: wgpu::Buffer,
+    /// The light of each quad at the same index ([`voxel_mesh::QuadLight`], 8 bytes), once
+    /// the arena holds light ([`QuadArena::enable_light`]).
+    light: Option<wgpu::Buffer>,
     alloc: Allocator,
 }
 
@@ -163,6 +176,9 @@ pub(crate) struct ArenaStats {
     pub used_bytes: u64,
     /// Free ranges over all pages.
     pub fragments: usize,
+    /// Bytes of the pages' light (as many as their quads', once a chunk with light was
+    /// uploaded; 0 before).
+    pub light_bytes: u64,
 }
 
 /// The pages and their allocators.
@@ -174,6 +190,8 @@ pub(crate) struct QuadArena {
     max_page_quads: u32,
     /// The pages' usages (storage or vertex buffers, `crate::QuadFetch`).
     usage: wgpu::BufferUsages,
+    /// Whether every page has a light page beside it ([`QuadArena::enable_light`]).
+    lit: bool,
 }
 
 impl QuadArena {
@@ -187,7 +205,50 @@ impl QuadArena {
             pages: Vec::new(),
             max_page_quads: (max_binding / QUAD_BYTES).min(addressable) as u32,
             usage: usage | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            lit: false,
         }
+    }
+
+    /// Gives every page, and every page added from now on, a light page: the light of the
+    /// quad at each index ([`QuadArena::write_light`]). Returns whether pages changed
+    /// (bind groups over them must be remade); an error (and nothing changed) when the
+    /// device cannot make one.
+    pub(crate) fn enable_light(&mut self, device: &wgpu::Device) -> Result<bool> {
+        if self.lit {
+            return Ok(false);
+        }
+        let mut made = Vec::new();
+        for (i, p) in self.live() {
+            made.push((
+                i,
+                self.new_buffer(device, "quad_light_page", p.alloc.capacity())?,
+            ));
+        }
+        for (i, b) in made {
+            if let Some(Some(p)) = self.pages.get_mut(i) {
+                p.light = Some(b);
+            }
+        }
+        self.lit = true;
+        Ok(!self.pages.is_empty())
+    }
+
+    /// Whether the pages have light pages.
+    pub(crate) fn is_lit(&self) -> bool {
+        self.lit
+    }
+
+    /// A page buffer of `quads` 8-byte entries; out of memory comes back as an error, not
+    /// through the device's panicking handler.
+    fn new_buffer(&self, device: &wgpu::Device, label: &str, quads: u32) -> Result<wgpu::Buffer> {
+        scoped(device, "adding a quad arena page", || {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: u64::from(quads) * QUAD_BYTES,
+                usage: self.usage,
+                mapped_at_creation: false,
+            })
+        })
     }
 
     /// The most quads one mesh may have: a page as large as the adapter's storage binding.
@@ -238,20 +299,20 @@ impl QuadArena {
             .max(quads)
             .max(FIRST_PAGE_QUADS)
             .min(self.max_page_quads);
-        // Out of memory comes back as an error, not through the device's panicking handler.
-        let buffer = scoped(device, "adding a quad arena page", || {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("quad_arena_page"),
-                size: u64::from(size) * QUAD_BYTES,
-                usage: self.usage,
-                mapped_at_creation: false,
-            })
-        })?;
+        let buffer = self.new_buffer(device, "quad_arena_page", size)?;
+        let light = match self.lit {
+            true => Some(self.new_buffer(device, "quad_light_page", size)?),
+            false => None,
+        };
         let mut alloc = Allocator::new(size);
         let Some(offset) = alloc.alloc(quads) else {
             return Ok(None);
         };
-        let page = Some(Page { buffer, alloc });
+        let page = Some(Page {
+            buffer,
+            light,
+            alloc,
+        });
         // The first hole, else a new index.
         let index = match self.pages.iter().position(Option::is_none) {
             Some(i) => {
@@ -313,9 +374,31 @@ impl QuadArena {
         }
     }
 
+    /// Writes the light of the quads of `a` (as many as both hold), where the arena holds
+    /// light.
+    pub(crate) fn write_light(&self, to: &mut Upload<'_>, a: Alloc, light: &[QuadLight]) {
+        if let Some(Some(Page {
+            light: Some(buffer),
+            ..
+        })) = self.pages.get(a.page as usize)
+        {
+            let n = light.len().min(a.quads as usize);
+            to.write(
+                buffer,
+                u64::from(a.offset) * QUAD_BYTES,
+                bytemuck::cast_slice(&light[..n]),
+            );
+        }
+    }
+
     /// The buffer of page `i` (`None` for a page given back).
     pub(crate) fn page(&self, i: usize) -> Option<&wgpu::Buffer> {
         self.pages.get(i)?.as_ref().map(|p| &p.buffer)
+    }
+
+    /// The light page of page `i`, where the arena holds light.
+    pub(crate) fn light_page(&self, i: usize) -> Option<&wgpu::Buffer> {
+        self.pages.get(i)?.as_ref()?.light.as_ref()
     }
 
     /// One past the highest page index (pages given back below it leave holes).
@@ -333,6 +416,10 @@ impl QuadArena {
                 .map(|(_, p)| u64::from(p.alloc.used()) * QUAD_BYTES)
                 .sum(),
             fragments: self.live().map(|(_, p)| p.alloc.fragments()).sum(),
+            light_bytes: self
+                .live()
+                .filter_map(|(_, p)| Some(p.light.as_ref()?.size()))
+                .sum(),
         }
     }
 
@@ -388,13 +475,19 @@ impl QuadArena {
         let from = self.pages.get_mut(page as usize)?.take()?;
         for (a, to) in moving.iter().zip(&placed) {
             if let Some(Some(dst)) = self.pages.get(to.page as usize) {
-                encoder.copy_buffer_to_buffer(
-                    &from.buffer,
-                    u64::from(a.offset) * QUAD_BYTES,
-                    &dst.buffer,
-                    u64::from(to.offset) * QUAD_BYTES,
-                    u64::from(a.quads) * QUAD_BYTES,
-                );
+                let pairs = [
+                    Some((&from.buffer, &dst.buffer)),
+                    from.light.as_ref().zip(dst.light.as_ref()),
+                ];
+                for (src, dst) in pairs.into_iter().flatten() {
+                    encoder.copy_buffer_to_buffer(
+                        src,
+                        u64::from(a.offset) * QUAD_BYTES,
+                        dst,
+                        u64::from(to.offset) * QUAD_BYTES,
+                        u64::from(a.quads) * QUAD_BYTES,
+                    );
+                }
             }
         }
         while self.pages.last().is_some_and(Option::is_none) {
@@ -425,6 +518,20 @@ pub(crate) mod tests {
             s ^= s << 17;
             s
         }
+    }
+
+    #[test]
+    fn growing_frees_the_new_units_and_coalesces() {
+        let mut a = Allocator::new(8);
+        assert_eq!(a.alloc(6), Some(0));
+        assert_eq!(a.alloc(4), None);
+        a.grow(16);
+        assert_eq!((a.capacity(), a.used(), a.fragments()), (16, 6, 1));
+        // The free tail of the old range and the new units are one range.
+        assert_eq!(a.alloc(10), Some(6));
+        assert_eq!(a.used(), 16);
+        a.grow(4);
+        assert_eq!(a.capacity(), 16, "never shrinks");
     }
 
     #[test]

@@ -190,9 +190,12 @@ pub(crate) struct ChunkUniforms {
     /// Blocks per cell along x and z: 1 for a chunk, `2^level` for a chunk of a level of
     /// detail ([`voxel_core::level_scale`]; its cells are one block high).
     pub scale: u32,
+    /// Where the chunk's light palette starts in the palettes buffer (`chunks/light.rs`).
+    pub light_base: u32,
+    /// 1 for a lit chunk (its quads' light in the arena's light page), 0 for one drawn
+    /// unlit (full sky light, no block light: as before light existed).
+    pub lit: u32,
     pub pad0: u32,
-    pub pad1: u32,
-    pub pad2: u32,
 }
 
 /// Layouts every chunk pipeline is built against.
@@ -255,6 +258,9 @@ impl SharedLayouts {
                 vec![
                     buffer_entry(0, S::VERTEX, B::Storage { read_only: true }),
                     buffer_entry(1, S::VERTEX, B::Storage { read_only: true }),
+                    // The page's light and the light palettes (`chunks/light.rs`).
+                    buffer_entry(3, S::VERTEX, B::Storage { read_only: true }),
+                    buffer_entry(4, S::VERTEX, B::Storage { read_only: true }),
                 ]
             }
             QuadFetch::Instanced => {
@@ -326,9 +332,9 @@ mod tests {
                 field!(ChunkUniforms, origin),
                 field!(ChunkUniforms, alpha),
                 field!(ChunkUniforms, scale),
+                field!(ChunkUniforms, light_base),
+                field!(ChunkUniforms, lit),
                 field!(ChunkUniforms, pad0),
-                field!(ChunkUniforms, pad1),
-                field!(ChunkUniforms, pad2),
             ],
         );
     }

@@ -31,8 +31,8 @@ pub enum QuadFetch {
 pub(crate) const TABLE_WIDTH: u32 = 256;
 
 /// Storage buffers the vertex stage binds with [`QuadFetch::Storage`]: the page, the chunk
-/// records and the block layers.
-const VERTEX_STORAGE_BUFFERS: u64 = 3;
+/// records, the block layers, the page's light and the light palettes.
+const VERTEX_STORAGE_BUFFERS: u64 = 5;
 
 /// Textures the vertex stage binds with [`QuadFetch::Instanced`]: the block layers.
 const VERTEX_TEXTURES: u64 = 1;

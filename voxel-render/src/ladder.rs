@@ -180,12 +180,12 @@ pub fn check(what: &str, needs: &[Need], caps: &Capabilities) -> Result<()> {
 /// What the world's own passes need on every device, whichever way quads reach the
 /// vertex shader (`QuadFetch::needs` adds that way's needs): the HDR scene colour
 /// rendered to and blended into (the medium's fog, the composites, a game's overlays),
-/// and the chunk shaders' eight values passed from vertex to fragment (`VsOut` in
+/// and the chunk shaders' ten values passed from vertex to fragment (`VsOut` in
 /// `shaders/common.wgsl`), each bound where the shaders declare it.
 pub(crate) fn world_needs() -> Vec<Need> {
     vec![
         Need::BlendableTarget(crate::SCENE_FORMAT),
-        Need::Limit(Limit::InterStageShaderVariables, 8),
+        Need::Limit(Limit::InterStageShaderVariables, 10),
         Need::ShaderBindings,
     ]
 }

@@ -29,6 +29,8 @@ pub struct GpuChunk {
     pub(super) translucent_planes: Vec<(Face, u8)>,
     /// Whether a translucent quad is of a volume (a block type with absorption).
     pub(super) volume: bool,
+    /// Where its light lies, for a lit chunk (`None`: drawn unlit).
+    pub(super) light: Option<super::light::ChunkLight>,
     /// Changes with every upload of the chunk.
     pub(super) generation: u64,
     /// The mesher's order of the translucent quads while the GPU draws them in another

@@ -22,6 +22,7 @@ mod command;
 mod cull;
 mod draws;
 pub(crate) mod gpu_chunk;
+mod light;
 pub(crate) mod store;
 #[cfg(test)]
 mod tests;

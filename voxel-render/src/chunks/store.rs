@@ -9,11 +9,11 @@ use voxel_mesh::{ChunkMeshes, PackedQuad};
 use super::command::DrawCommand;
 use super::cull::{Culled, FarEntry, Frustum, NearEntry, Regions, near_key};
 use super::gpu_chunk::{GpuChunk, distinct_planes, layers_bounds};
+use super::light::{ChunkLight, Palettes};
 use super::{MeshKind, PosMap};
 use crate::arena::{Alloc, ArenaStats, QuadArena};
 use crate::bindings::ChunkUniforms;
 use crate::fetch::{QuadFetch, Records};
-use crate::gpu;
 use crate::layers;
 use crate::submission::{FrameWrites, Upload};
 use crate::{Error, GpuContext, Result};
@@ -48,6 +48,11 @@ pub struct ChunkStore {
     /// submitted, so that nothing written before its submit changes what it draws.
     retired: Vec<Alloc>,
     retired_slots: Vec<u32>,
+    /// Every lit chunk's light palette (with [`QuadFetch::Storage`]; `None` with
+    /// [`QuadFetch::Instanced`], which draws chunks unlit), and palettes freed while a
+    /// frame was in flight.
+    palettes: Option<Palettes>,
+    retired_palettes: Vec<(u32, u32)>,
     /// Opacity by block id, for the planes of translucent meshes.
     block_opacity: Arc<[f32]>,
     /// Whether each block id is a volume (has absorption).
@@ -100,6 +105,8 @@ impl ChunkStore {
             in_flight: false,
             retired: Vec::new(),
             retired_slots: Vec::new(),
+            palettes: (fetch == QuadFetch::Storage).then(|| Palettes::new(ctx)),
+            retired_palettes: Vec::new(),
             block_opacity,
             volume_blocks,
             writes: FrameWrites::default(),
@@ -144,15 +151,26 @@ impl ChunkStore {
         self.groups = (0..self.arena.pages())
             .map(|i| {
                 let page = self.arena.page(i)?;
-                Some(match &records {
-                    Some(group) => group.clone(),
-                    None => gpu::bind_group(
-                        device,
-                        "chunk_page",
-                        &self.layout,
-                        &[page.as_entire_binding(), self.infos.binding()],
-                    ),
-                })
+                if let Some(group) = &records {
+                    return Some(group.clone());
+                }
+                // The page's light and the palettes (where the arena holds no light, the
+                // palettes stand in for the light page: no unlit record reads it).
+                let palettes = self.palettes.as_ref()?.buffer();
+                let light = self.arena.light_page(i).unwrap_or(palettes);
+                let entries = [
+                    (0, page.as_entire_binding()),
+                    (1, self.infos.binding()),
+                    (3, light.as_entire_binding()),
+                    (4, palettes.as_entire_binding()),
+                ]
+                .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
+                crate::cost::created_bind_group();
+                Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("chunk_page"),
+                    layout: &self.layout,
+                    entries: &entries,
+                }))
             })
             .collect();
     }
@@ -212,6 +230,11 @@ impl ChunkStore {
             }
         }
         self.free_slots.append(&mut self.retired_slots);
+        if let Some(p) = self.palettes.as_mut() {
+            for (base, len) in self.retired_palettes.drain(..) {
+                p.free(base, len);
+            }
+        }
         if dropped {
             self.remake_groups(&ctx.device);
         }
@@ -311,6 +334,7 @@ impl ChunkStore {
             self.remove(ctx, pos);
             return Ok(());
         }
+        let light = self.place_light(ctx, pos, meshes)?;
         // Place the new meshes before freeing the old ones: a failure changes nothing, and
         // the old places (which a frame in flight may draw) are not reused by the new.
         let mut allocs = [None; 3];
@@ -327,6 +351,9 @@ impl ChunkStore {
                     let mut changed = false;
                     for a in allocs.into_iter().flatten() {
                         changed |= self.arena.free(a) && self.arena.drop_page(a.page);
+                    }
+                    if let (Some(p), Some(l)) = (self.palettes.as_mut(), &light) {
+                        p.free(l.palette.0, l.palette.1);
                     }
                     if changed {
                         self.remake_groups(&ctx.device);
@@ -355,7 +382,22 @@ impl ChunkStore {
                 (s, 1.0)
             }
         };
-        self.write_info(ctx, slot, record(pos, level, alpha), false);
+        if let Some(l) = &light {
+            let streams = &meshes.light;
+            for (a, stream) in
+                allocs
+                    .iter()
+                    .zip([&streams.opaque, &streams.cutout, &streams.translucent])
+            {
+                if let Some(a) = a {
+                    self.arena
+                        .write_light(&mut Upload::Queue(&ctx.queue), *a, stream);
+                }
+            }
+            debug_assert!(self.arena.is_lit() && l.palette.1 > 0);
+        }
+        let light_base = light.as_ref().map(|l| l.palette.0);
+        self.write_info(ctx, slot, record(pos, level, alpha, light_base), false);
         // One pass over the translucent quads; their box and distinct planes follow.
         let planes = layers::planes(&meshes.translucent, &self.block_opacity);
         self.regions.set(slot, pos, level, allocs, Some(&planes));
@@ -370,6 +412,7 @@ impl ChunkStore {
                 let block = q.unpack().map_or(0, |u| u.block.index());
                 self.volume_blocks.get(block).copied().unwrap_or(false)
             }),
+            light,
             generation: self.next_generation,
             mesher_order: None,
             set_aside: None,
@@ -379,8 +422,87 @@ impl ChunkStore {
         Ok(())
     }
 
+    /// Checks a chunk's light streams against its meshes and places its palette, giving the
+    /// arena light pages the first time: `None` for a chunk meshed without light, or with
+    /// [`QuadFetch::Instanced`] (drawn unlit). A stream whose length is not its mesh's, or
+    /// an index outside the palette, is an [`Error::InvalidSetting`].
+    fn place_light(
+        &mut self,
+        ctx: &GpuContext,
+        pos: ChunkPos,
+        meshes: &ChunkMeshes,
+    ) -> Result<Option<ChunkLight>> {
+        let streams = &meshes.light;
+        if streams.is_empty() && streams.palette.is_empty() {
+            return Ok(None);
+        }
+        for (kind, quads, light) in [
+            ("opaque", meshes.opaque.len(), &streams.opaque),
+            ("cutout", meshes.cutout.len(), &streams.cutout),
+            (
+                "translucent",
+                meshes.translucent.len(),
+                &streams.translucent,
+            ),
+        ] {
+            if light.len() != quads {
+                return Err(Error::InvalidSetting(format!(
+                    "chunk {pos:?}: its {kind} mesh has {quads} quads and {} light entries \
+                     (mesh it with `Mesher::mesh_lit`, or leave `ChunkMeshes::light` empty)",
+                    light.len()
+                )));
+            }
+            let n = streams.palette.len();
+            if let Some(bad) = light
+                .iter()
+                .flat_map(|l| l.corners())
+                .find(|&i| usize::from(i) >= n)
+            {
+                return Err(Error::InvalidSetting(format!(
+                    "chunk {pos:?}: a quad of its {kind} mesh names light {bad} of a palette \
+                     of {n}"
+                )));
+            }
+        }
+        let Some(palettes) = self.palettes.as_mut() else {
+            return Ok(None);
+        };
+        let (base, grew) = palettes.alloc(ctx, &streams.palette)?;
+        let len = streams.palette.len().max(1) as u32;
+        match self.arena.enable_light(&ctx.device) {
+            Ok(changed) => {
+                if changed || grew {
+                    self.remake_groups(&ctx.device);
+                }
+            }
+            Err(e) => {
+                if let Some(p) = self.palettes.as_mut() {
+                    p.free(base, len);
+                }
+                return Err(e);
+            }
+        }
+        Ok(Some(ChunkLight {
+            palette: (base, len),
+            translucent: meshes
+                .translucent
+                .iter()
+                .copied()
+                .zip(streams.translucent.iter().copied())
+                .collect(),
+        }))
+    }
+
     fn free_meshes(&mut self, ctx: &GpuContext, slot: u32) {
         if let Some(c) = self.slots.get_mut(slot as usize).and_then(Option::take) {
+            if let (Some(l), Some(p)) = (&c.light, self.palettes.as_mut()) {
+                let (base, len) = l.palette;
+                if self.in_flight {
+                    self.retired_palettes.push((base, len));
+                } else {
+                    p.free(base, len);
+                }
+            }
             let mut changed = false;
             for a in c.meshes.into_iter().flatten() {
                 changed |= self.free_place(a);
@@ -440,9 +562,15 @@ impl ChunkStore {
         self.slots.iter().flatten()
     }
 
-    /// What the arena holds, and the bytes of the chunk records.
-    pub(crate) fn memory(&self) -> (ArenaStats, u64) {
-        (self.arena.stats(), self.infos.bytes())
+    /// What the arena holds, the bytes of the chunk records and those of the light palettes.
+    pub(crate) fn memory(&self) -> (ArenaStats, u64, u64) {
+        // The palettes count once the arena holds light (before, the buffer is a
+        // stand-in of 32 KiB).
+        let palettes = match (&self.palettes, self.arena.is_lit()) {
+            (Some(p), true) => p.bytes(),
+            _ => 0,
+        };
+        (self.arena.stats(), self.infos.bytes(), palettes)
     }
 
     /// Bytes of the indirect command buffer.
@@ -534,8 +662,8 @@ impl ChunkStore {
         in_frame: bool,
     ) {
         if let Some(&slot) = self.by_pos.get(&pos) {
-            let level = self.by_slot(slot).map_or(0, |c| c.level);
-            let info = record(pos, level, alpha.clamp(0.0, 1.0));
+            let mut info = self.info_data[slot as usize];
+            info.alpha = alpha.clamp(0.0, 1.0);
             self.write_info(ctx, slot, info, in_frame);
         }
     }
@@ -666,18 +794,25 @@ fn write_order(
     match c.meshes[MeshKind::Translucent as usize] {
         Some(a) if quads.len() == a.quads as usize => {
             arena.write(&mut Upload::Frame(writes), a, &quads);
+            if let Some(l) = &c.light {
+                let light = l.translucent_stream(&quads);
+                arena.write_light(&mut Upload::Frame(writes), a, &light);
+            }
             Ok(std::mem::replace(&mut c.translucent, quads))
         }
         _ => Err(quads),
     }
 }
 
-/// The record of the chunk keyed `pos` (where it starts) of level `level`.
-fn record(pos: ChunkPos, level: u8, alpha: f32) -> ChunkUniforms {
+/// The record of the chunk keyed `pos` (where it starts) of level `level`, lit from the
+/// palette at `light_base` when given.
+fn record(pos: ChunkPos, level: u8, alpha: f32, light_base: Option<u32>) -> ChunkUniforms {
     ChunkUniforms {
         origin: pos.origin().map(|v| v as i32),
         alpha,
         scale: voxel_core::level_scale(level) as u32,
+        light_base: light_base.unwrap_or(0),
+        lit: u32::from(light_base.is_some()),
         ..ChunkUniforms::default()
     }
 }

@@ -71,6 +71,9 @@ pub struct ChunkMemory {
     pub pages: usize,
     /// Free ranges over all pages.
     pub free_ranges: usize,
+    /// Bytes of the chunks' light: the arena's light pages (as large as its pages, once a
+    /// lit chunk was uploaded) and the palettes (`docs/light.md`); 0 in a world drawn unlit.
+    pub light_bytes: u64,
 }
 
 /// Draws a voxel world. See the module docs for the passes.
@@ -451,7 +454,7 @@ impl Renderer {
     /// GPU bytes the chunks take: the quad arena (all pages, and the part holding quads)
     /// and the chunk records.
     pub fn chunk_memory(&self) -> ChunkMemory {
-        let (arena, records) = self.chunks.memory();
+        let (arena, records, palettes) = self.chunks.memory();
         ChunkMemory {
             arena_bytes: arena.bytes,
             quad_bytes: arena.used_bytes,
@@ -459,6 +462,7 @@ impl Renderer {
             indirect_bytes: self.chunks.indirect_bytes(),
             pages: arena.pages,
             free_ranges: arena.fragments,
+            light_bytes: arena.light_bytes + palettes,
         }
     }
 

@@ -17,9 +17,11 @@ struct ChunkInfo {
     // Blocks per cell along x and z: 1, or 2^level for a chunk of a level of detail (its
     // cells one block high).
     scale: u32,
+    // Where the chunk's light palette starts (`light_palette`), and 1 for a lit chunk (0:
+    // drawn with full sky light and no block light, as before light existed).
+    light_base: u32,
+    lit: u32,
     pad0: u32,
-    pad1: u32,
-    pad2: u32,
 };
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -58,6 +60,13 @@ struct ChunkInfo {
 @group(0) @binding(4) var<storage, read> block_layers: array<u32>;
 @group(1) @binding(0) var<storage, read> quads: array<vec2<u32>>;
 @group(1) @binding(1) var<storage, read> chunks: array<ChunkInfo>;
+// The light of each quad of the page at the quad's index (voxel-mesh's `QuadLight`: the
+// palette indices of its corners (u0,v0), (u1,v0) in word 0 and (u0,v1), (u1,v1) in word 1,
+// 16 bits each), and every lit chunk's palette (`PackedLight`: sky R, G, B in the bytes of
+// word 0, block R, G, B in those of word 1), from the chunk's `light_base`
+// (`chunks/light.rs`). The instanced fetch binds neither: its chunks are drawn unlit.
+@group(1) @binding(3) var<storage, read> quad_lights: array<vec2<u32>>;
+@group(1) @binding(4) var<storage, read> light_palette: array<vec2<u32>>;
 // Instanced: the block layers in a texture TABLE_WIDTH entries wide (`table_texel`), the
 // drawn chunk's record a uniform (bound at its dynamic offset for each draw), the quads the
 // instances' attribute.
@@ -82,7 +91,33 @@ struct VsOut {
     @location(6) shade: f32,
     // The block texture layer of the face: the block's top, bottom or sides.
     @location(7) @interpolate(flat) layer: u32,
+    // Sky and block light (linear, 0 to 1 per channel), interpolated from the quad's
+    // corners: the light field's (`docs/light.md`), or full sky and no block light for an
+    // unlit chunk.
+    @location(8) sky_light: vec3<f32>,
+    @location(9) block_light: vec3<f32>,
 };
+
+// The light of a quad's four corners, by corner u + 2v.
+struct CornerLights {
+    sky: array<vec3<f32>, 4>,
+    block: array<vec3<f32>, 4>,
+};
+
+// An unlit quad's: full sky light, no block light (what the shading gave before light).
+fn unlit_corners() -> CornerLights {
+    var out: CornerLights;
+    for (var i = 0u; i < 4u; i++) {
+        out.sky[i] = vec3<f32>(1.0);
+        out.block[i] = vec3<f32>(0.0);
+    }
+    return out;
+}
+
+// The three bytes of `w` (R, G, B from bit 0) as levels 0 to 1.
+fn light_levels(w: u32) -> vec3<f32> {
+    return vec3<f32>(f32(w & 255u), f32((w >> 8u) & 255u), f32((w >> 16u) & 255u)) / 255.0;
+}
 
 // Corners of the two triangles of a quad, counter-clockwise seen from the side the normal
 // points to (positive faces); negative faces take them in the other order. The triangles
@@ -129,12 +164,12 @@ const NORMALS = array<vec3<f32>, 6>(
     vec3(0.0, 0.0, 1.0), vec3(0.0, 0.0, -1.0),
 );
 
-// Expands vertex `k` (0..6) of quad `q` of `chunk` (the face's layer is the caller's:
+// Expands vertex `k` (0..6) of quad `q` of `chunk`, lit by `lights` (the face's layer is the caller's:
 // `layer_index` says which entry of its table). The quad is split along the
 // diagonal whose corners are brighter in sum (Sodium's rule), so that interpolated
 // occlusion is symmetric; with `grow` it grows by OPAQUE_EXPANSION_PX pixels along its
 // plane (opaque quads: no crack at T-junctions, `bindings.rs`).
-fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool) -> VsOut {
+fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool, lights: CornerLights) -> VsOut {
     let g = q.x;
     let face = min((g >> 25u) & 7u, 5u);
     let size = vec2<f32>(f32(((g >> 15u) & 31u) + 1u), f32(((g >> 20u) & 31u) + 1u));
@@ -161,6 +196,9 @@ fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool) -> VsOut {
     var out: VsOut;
     out.clip = frame.view_proj * vec4<f32>(rel, 1.0);
     out.shade = corner_shade(q, corner);
+    let slot = u32(corner.x) + 2u * u32(corner.y);
+    out.sky_light = lights.sky[slot];
+    out.block_light = lights.block[slot];
     if grow && out.clip.w > 0.0 {
         // So far along U and V (outward) that the vertex moves OPAQUE_EXPANSION_PX pixels
         // on screen along each, at most MAX_GROWTH blocks (a quad seen edge-on).
@@ -193,6 +231,14 @@ fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool) -> VsOut {
         let gamma = (e0.x * d.y - d.x * e0.y) / det;
         let sa = corner_shade(q, a);
         out.shade = sa + beta * (corner_shade(q, b) - sa) + gamma * (corner_shade(q, c) - sa);
+        // The light likewise.
+        let ia = u32(a.x) + 2u * u32(a.y);
+        let ib = u32(b.x) + 2u * u32(b.y);
+        let ic = u32(c.x) + 2u * u32(c.y);
+        let ka = lights.sky[ia];
+        out.sky_light = ka + beta * (lights.sky[ib] - ka) + gamma * (lights.sky[ic] - ka);
+        let la = lights.block[ia];
+        out.block_light = la + beta * (lights.block[ib] - la) + gamma * (lights.block[ic] - la);
     }
     // The level rings as bands (`Renderer::set_level_bands`): odd levels darker (scales
     // 2, 8 and 32: bits 1, 3 and 5; no countTrailingZeros, which GLSL 3.30 lacks).
@@ -222,10 +268,28 @@ fn layer_index(block: u32, face: u32) -> u32 {
     return block * 3u + select(2u, face - 2u, face == 2u || face == 3u);
 }
 
+// Storage: the light of quad `i` of the page, of `chunk`.
+fn pulled_lights(i: u32, chunk: ChunkInfo) -> CornerLights {
+    if chunk.lit == 0u {
+        return unlit_corners();
+    }
+    let l = quad_lights[i];
+    var out: CornerLights;
+    for (var s = 0u; s < 4u; s++) {
+        let word = select(l.x, l.y, s >= 2u);
+        let entry = light_palette[chunk.light_base + ((word >> (16u * (s & 1u))) & 0xffffu)];
+        out.sky[s] = light_levels(entry.x);
+        out.block[s] = light_levels(entry.y);
+    }
+    return out;
+}
+
 // Storage: vertex `vi` of the page's quads (a draw starts at its mesh's first quad times
 // 6), quad vi / 6, corner vi % 6, of the chunk in slot `slot`.
 fn pulled_vertex(vi: u32, slot: u32, grow: bool) -> VsOut {
-    var out = quad_vertex(quads[vi / 6u], chunks[slot], vi % 6u, grow);
+    let chunk = chunks[slot];
+    let i = vi / 6u;
+    var out = quad_vertex(quads[i], chunk, vi % 6u, grow, pulled_lights(i, chunk));
     out.layer = block_layers[layer_index(out.block, out.face)];
     return out;
 }
@@ -237,7 +301,7 @@ fn table_texel(i: u32) -> vec2<i32> {
 
 // Instanced: corner vi % 6 of the instance's quad `q`, of the drawn chunk.
 fn instanced_vertex(vi: u32, q: vec2<u32>, grow: bool) -> VsOut {
-    var out = quad_vertex(q, chunk_record, vi % 6u, grow);
+    var out = quad_vertex(q, chunk_record, vi % 6u, grow, unlit_corners());
     out.layer = textureLoad(block_layer_table, table_texel(layer_index(out.block, out.face)), 0).x;
     return out;
 }
@@ -283,10 +347,14 @@ fn albedo(in: VsOut) -> vec4<f32> {
     return textureSample(block_textures, block_sampler, image_uv(in.uv, in.face), in.layer);
 }
 
-// Lambert with the sun plus ambient, at the light's brightness, times the ambient occlusion.
+// The sky's light (Lambert with the sun plus ambient, at the light's brightness: day and
+// night) times the sky light that reaches the face, or the block light where that is
+// brighter (per channel, as Minecraft and Cubyz take the larger of the two), times the
+// ambient occlusion. An unlit chunk has full sky light and no block light.
 fn light(rgb: vec3<f32>, in: VsOut) -> vec3<f32> {
     let n_dot_l = max(dot(NORMALS[in.face], frame.sun_dir), 0.0);
-    return rgb * frame.brightness * (frame.ambient + (1.0 - frame.ambient) * n_dot_l) * in.shade;
+    let sky = frame.brightness * (frame.ambient + (1.0 - frame.ambient) * n_dot_l);
+    return rgb * max(in.sky_light * sky, in.block_light) * in.shade;
 }
 
 // Whether a translucent fragment counts (the model in `medium.rs`): every front face

@@ -1,0 +1,356 @@
+//! Light drawn (issue 51): chunks meshed with the light field's light (`Mesher::mesh_lit`)
+//! are shaded by it in every technique: sky light through a red pane tints the floor below
+//! by the pane's filter, a torch lights a closed cave by day and by night alike, an edit's
+//! light shows in the next frame, open sky looks as an unlit world does, and the instanced
+//! fetch (WebGL2) draws lit chunks unlit, as documented.
+
+#![allow(clippy::unwrap_used)] // test code: a failed unwrap is a failed test
+
+use std::sync::Arc;
+
+use glam::DVec3;
+use voxel_core::blocks::{GLASS, RED_GLASS, STONE};
+use voxel_core::light_blocks::TORCH;
+use voxel_core::{BlockId, BlockRegistry, LightField, World, WorldPos};
+use voxel_mesh::{mesh_chunks, mesh_chunks_lit, mesh_dirty_lit};
+use voxel_render::{
+    Camera, GpuContext, Image, Lighting, QuadFetch, Renderer, RendererConfig, Technique,
+};
+
+use tests::*;
+
+const W: u32 = 320;
+const H: u32 = 200;
+
+/// A closed stone room, x and z 0 to 10, floor y = 0, roof y = 7, with `roof` blocks in the
+/// roof over x and z 4 to 6 (a 3 × 3 pane), over the registry with light sources.
+fn room(roof: BlockId) -> World {
+    let mut world = World::new(Arc::new(BlockRegistry::with_lights()));
+    let fill = |w: &mut World, a: [i32; 3], b: [i32; 3], id| {
+        voxel_lab::scene::fill_box(w, a, b, id).unwrap();
+    };
+    fill(&mut world, [0, 0, 0], [10, 7, 10], STONE);
+    fill(&mut world, [1, 1, 1], [9, 6, 9], BlockId::AIR);
+    fill(&mut world, [4, 7, 4], [6, 7, 6], roof);
+    world
+}
+
+/// A renderer of `config` with every chunk of `world` uploaded, meshed with the light of a
+/// field lit from scratch (`lit`) or without light.
+fn renderer(ctx: &GpuContext, world: &World, config: RendererConfig, lit: bool) -> Renderer {
+    let mut r = Renderer::new(ctx, world.registry(), config).unwrap();
+    let positions: Vec<_> = world.iter().map(|(p, _)| p).collect();
+    let meshes = if lit {
+        mesh_chunks_lit(world, &LightField::new(world), &positions)
+    } else {
+        mesh_chunks(world, &positions)
+    };
+    for (pos, m) in meshes.unwrap() {
+        r.upload_chunk(pos, &m).unwrap();
+    }
+    r
+}
+
+fn config(technique: Technique) -> RendererConfig {
+    technique_config(technique, W, H)
+}
+
+/// Looking down at the floor from under the roof.
+fn floor_camera() -> Camera {
+    Camera::look_at(
+        DVec3::new(5.5, 5.5, 1.8),
+        DVec3::new(5.5, 1.0, 5.5),
+        60.0,
+        0.1,
+        100.0,
+    )
+    .unwrap()
+}
+
+/// The pixel a world point projects to.
+fn pixel(camera: &Camera, p: DVec3) -> (u32, u32) {
+    let vp = camera.view_proj(f64::from(W) / f64::from(H));
+    let clip = vp * (p - camera.eye).as_vec3().extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    let x = (ndc.x + 1.0) / 2.0 * W as f32;
+    let y = (1.0 - ndc.y) / 2.0 * H as f32;
+    (x as u32, y as u32)
+}
+
+fn to_linear(c: u8) -> f32 {
+    let c = f32::from(c) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn to_srgb(l: f32) -> f32 {
+    let l = l.clamp(0.0, 1.0);
+    255.0
+        * if l <= 0.003_130_8 {
+            l * 12.92
+        } else {
+            1.055 * l.powf(1.0 / 2.4) - 0.055
+        }
+}
+
+/// The pixel of `img` at the centre of the top face of floor block (x, 0, z).
+fn floor_pixel(img: &Image, camera: &Camera, x: i32, z: i32) -> [u8; 4] {
+    let (px, py) = pixel(
+        camera,
+        DVec3::new(f64::from(x) + 0.5, 1.0, f64::from(z) + 0.5),
+    );
+    img.pixel(px, py)
+}
+
+/// Under a red pane in the roof, the floor is lit by the sky light the pane lets through:
+/// the unlit picture's colour times the field's level there (210, 130, 130 of 255: the
+/// pane's filter 0.822, 0.511, 0.511 times full sky), per channel, in every technique; the
+/// floor where no beam falls is darker still.
+#[test]
+fn sky_light_through_a_red_pane_tints_the_floor_by_its_filter() {
+    let Some(ctx) = gpu() else { return };
+    let world = room(RED_GLASS);
+    let light = LightField::new(&world);
+    let level = light.get(WorldPos::new(5, 1, 5)).unwrap().sky;
+    assert_eq!(level, [210, 130, 130], "the pane's filter times full sky");
+    let camera = floor_camera();
+    let unlit = render_frame(&ctx, &world, config(Technique::SortedQuads), false, &camera);
+    let dir = out_dir("light");
+    unlit.save_png(&dir.join("red_pane_unlit.png")).unwrap();
+    let u = floor_pixel(&unlit, &camera, 5, 5);
+    assert!(u[0] > 40, "the unlit floor is lit by the sky: {u:?}");
+    for technique in Technique::ALL {
+        let lit = render_frame(&ctx, &world, config(technique), true, &camera);
+        lit.save_png(&dir.join(format!("red_pane_{}.png", technique.name())))
+            .unwrap();
+        let l = floor_pixel(&lit, &camera, 5, 5);
+        for ch in 0..3 {
+            let want = to_srgb(to_linear(u[ch]) * f32::from(level[ch]) / 255.0);
+            assert!(
+                (f32::from(l[ch]) - want).abs() <= 2.0,
+                "{}: channel {ch} of the floor under the pane is {} (unlit {}), want {want:.1}",
+                technique.name(),
+                l[ch],
+                u[ch]
+            );
+        }
+        // A floor block by the wall, away from the beam: lit only by what spreads from it
+        // (16 levels less a block).
+        let side = floor_pixel(&lit, &camera, 2, 5);
+        let under = l[0];
+        assert!(
+            side[0] < under,
+            "{}: the floor away from the pane ({side:?}) is darker than under it ({l:?})",
+            technique.name()
+        );
+    }
+}
+
+fn render_frame(
+    ctx: &GpuContext,
+    world: &World,
+    config: RendererConfig,
+    lit: bool,
+    camera: &Camera,
+) -> Image {
+    let mut r = renderer(ctx, world, config, lit);
+    frame(ctx, &mut r, camera)
+}
+
+/// A torch in a closed room lights its floor with its own warm colour, the same by day and by
+/// night (block light is not the sky's: night scales the sky light only), and where no
+/// light reaches the room is black.
+#[test]
+fn a_torch_lights_a_closed_room_by_day_and_by_night() {
+    let Some(ctx) = gpu() else { return };
+    let mut world = room(STONE);
+    voxel_lab::scene::fill_box(&mut world, [5, 1, 7], [5, 1, 7], TORCH).unwrap();
+    let camera = floor_camera();
+    let dark = room(STONE);
+    let black = render_frame(&ctx, &dark, config(Technique::SortedQuads), true, &camera);
+    let b = floor_pixel(&black, &camera, 5, 4);
+    assert_eq!(&b[..3], &[0, 0, 0], "a closed room without light is black");
+    let at = |hour: f32| {
+        let l = Lighting::daytime(hour);
+        RendererConfig {
+            sun_dir: l.sun_dir,
+            ambient: l.ambient,
+            brightness: l.brightness,
+            sky: l.sky,
+            ..config(Technique::SortedQuads)
+        }
+    };
+    let (day, night) = (at(12.0), at(0.0));
+    assert!(night.brightness < 0.5 * day.brightness);
+    let by_day = render_frame(&ctx, &world, day, true, &camera);
+    let by_night = render_frame(&ctx, &world, night, true, &camera);
+    let dir = out_dir("light");
+    by_day.save_png(&dir.join("torch_day.png")).unwrap();
+    by_night.save_png(&dir.join("torch_night.png")).unwrap();
+    let d = floor_pixel(&by_day, &camera, 5, 6);
+    assert!(
+        d[0] > 60 && d[0] > d[1] && d[1] > d[2],
+        "the floor by the torch is lit warm (255, 170, 90): {d:?}"
+    );
+    assert_eq!(
+        diff(&by_day, &by_night).max,
+        0,
+        "no sky light in a closed room: night changes nothing"
+    );
+    // Two blocks farther from the torch, the light has fallen off by 16 levels a block in
+    // every channel: the blue (90 at the torch) the most in proportion, the red the
+    // least (the stone's texture varies from pixel to pixel: its colour is grey).
+    let far = floor_pixel(&by_day, &camera, 5, 4);
+    let blue_to_red = |p: [u8; 4]| to_linear(p[2]) / to_linear(p[0]);
+    assert!(
+        blue_to_red(far) < 0.8 * blue_to_red(d),
+        "light falls off: {far:?} against {d:?}"
+    );
+}
+
+/// Open sky over flat ground: every level is full sky light and no block light, which is
+/// what an unlit chunk is drawn with, so the lit picture is the unlit one.
+#[test]
+fn open_sky_lit_is_the_unlit_picture() {
+    let Some(ctx) = gpu() else { return };
+    let mut world = World::new(Arc::new(BlockRegistry::with_lights()));
+    voxel_lab::scene::fill_box(&mut world, [-20, -2, -20], [20, 0, 20], STONE).unwrap();
+    voxel_lab::scene::fill_box(&mut world, [-3, 1, -3], [3, 1, 3], GLASS).unwrap();
+    let camera = Camera::look_at(
+        DVec3::new(0.5, 12.0, 14.0),
+        DVec3::new(0.5, 0.0, 0.0),
+        60.0,
+        0.1,
+        200.0,
+    )
+    .unwrap();
+    let unlit = render_frame(&ctx, &world, config(Technique::SortedQuads), false, &camera);
+    let lit = render_frame(&ctx, &world, config(Technique::SortedQuads), true, &camera);
+    assert!(distinct_colours(&unlit) > 20, "a picture, not a blank");
+    // The glass's own faces are lit by the cell in front (open air): full sky. The ground
+    // beside and under the glass loses a little to the glass's filter and the falloff.
+    let d = diff(&unlit, &lit);
+    let far = floor_pixel_world(&lit, &camera, [-15, 0, 5]);
+    assert_eq!(
+        far,
+        floor_pixel_world(&unlit, &camera, [-15, 0, 5]),
+        "open ground is drawn as unlit"
+    );
+    assert!(
+        d.differing < (W * H / 4) as usize,
+        "only around the glass may the light differ: {d:?}"
+    );
+}
+
+fn floor_pixel_world(img: &Image, camera: &Camera, b: [i32; 3]) -> [u8; 4] {
+    let (px, py) = pixel(
+        camera,
+        DVec3::new(
+            f64::from(b[0]) + 0.5,
+            f64::from(b[1]) + 1.0,
+            f64::from(b[2]) + 0.5,
+        ),
+    );
+    img.pixel(px, py)
+}
+
+/// A torch placed in a dark room, then removed: the light field's edit and the chunks it
+/// changed meshed again (`mesh_dirty_lit`) and uploaded show in the next frame.
+#[test]
+fn a_torch_placed_and_removed_shows_in_the_next_frame() {
+    let Some(ctx) = gpu() else { return };
+    let mut world = room(STONE);
+    let mut light = LightField::new(&world);
+    let camera = floor_camera();
+    let mut r = renderer(&ctx, &world, config(Technique::SortedQuads), true);
+    let before = frame(&ctx, &mut r, &camera);
+    let spot = WorldPos::new(5, 1, 5);
+    let mut step = |world: &mut World, light: &mut LightField, id| {
+        world.set_block_lit(light, spot, id).unwrap();
+        for (pos, m) in mesh_dirty_lit(world, light).unwrap() {
+            r.upload_chunk(pos, &m).unwrap();
+        }
+        frame(&ctx, &mut r, &camera)
+    };
+    let placed = step(&mut world, &mut light, TORCH);
+    let removed = step(&mut world, &mut light, BlockId::AIR);
+    let b = floor_pixel(&before, &camera, 5, 4);
+    let p = floor_pixel(&placed, &camera, 5, 4);
+    assert_eq!(&b[..3], &[0, 0, 0]);
+    assert!(p[0] > 60, "the torch's light shows at once: {p:?}");
+    assert_eq!(
+        diff(&before, &removed).max,
+        0,
+        "and is gone once it is removed"
+    );
+}
+
+/// Panes of red and clear glass across a torch-lit room, each pane's faces lit by the cell
+/// in front of it (light that differs pane by pane): every exact technique agrees with the
+/// A-buffer reference, `sorted-quads` too, which re-sorts the quads (a translucent quad's
+/// light follows it to its new place in the mesh).
+#[test]
+fn lit_panes_agree_with_the_reference_in_every_technique() {
+    let Some(ctx) = gpu() else { return };
+    let mut world = room(RED_GLASS);
+    let fill = |w: &mut World, a: [i32; 3], b: [i32; 3], id| {
+        voxel_lab::scene::fill_box(w, a, b, id).unwrap();
+    };
+    fill(&mut world, [8, 1, 8], [8, 1, 8], TORCH);
+    fill(&mut world, [1, 1, 6], [9, 4, 6], RED_GLASS);
+    fill(&mut world, [1, 1, 4], [9, 4, 4], GLASS);
+    fill(&mut world, [3, 1, 2], [7, 3, 2], RED_GLASS);
+    let camera = Camera::look_at(
+        DVec3::new(5.2, 3.5, 1.3),
+        DVec3::new(5.0, 1.5, 9.0),
+        70.0,
+        0.1,
+        100.0,
+    )
+    .unwrap();
+    let reference = render_frame(&ctx, &world, config(Technique::Reference), true, &camera);
+    let unlit = render_frame(&ctx, &world, config(Technique::Reference), false, &camera);
+    let dir = out_dir("light");
+    reference
+        .save_png(&dir.join("panes_reference.png"))
+        .unwrap();
+    unlit.save_png(&dir.join("panes_unlit.png")).unwrap();
+    assert!(
+        diff(&reference, &unlit).differing > (W * H / 4) as usize,
+        "the light changes the picture"
+    );
+    let exact = Technique::ALL
+        .into_iter()
+        .filter(|t| t.is_exact() && *t != Technique::Reference);
+    for technique in exact {
+        let img = render_frame(&ctx, &world, config(technique), true, &camera);
+        img.save_png(&dir.join(format!("panes_{}.png", technique.name())))
+            .unwrap();
+        let d = diff(&img, &reference);
+        assert!(
+            d.over_one * 200 < (W * H) as usize,
+            "{}: {d:?} against the reference",
+            technique.name()
+        );
+    }
+}
+
+/// With the instanced fetch (WebGL2 and GL 3.3 devices, whose vertex stage reads no storage
+/// buffer), lit chunks upload and are drawn unlit: the documented fallback.
+#[test]
+fn the_instanced_fetch_draws_lit_chunks_unlit() {
+    let Some(ctx) = gpu() else { return };
+    let world = room(RED_GLASS);
+    let camera = floor_camera();
+    let mut c = config(Technique::SortedQuads);
+    c.quad_fetch = Some(QuadFetch::Instanced);
+    let lit = render_frame(&ctx, &world, c.clone(), true, &camera);
+    let unlit = render_frame(&ctx, &world, c, false, &camera);
+    // Meshed with light, quads merge only where the light agrees too: other quads, whose
+    // edges may round a step differently.
+    let d = diff(&lit, &unlit);
+    assert_eq!(d.over_one, 0, "{d:?}");
+}

@@ -1,0 +1,136 @@
+//! The light of lit chunks on the GPU (issue 51): each quad's [`QuadLight`] in the arena's
+//! light page at the quad's own index ([`crate::arena::QuadArena::enable_light`]), and each
+//! chunk's palette of corner lights in one storage buffer here, at a base its record holds
+//! (`ChunkInfo::light_base` in `common.wgsl`). Only with [`crate::QuadFetch::Storage`]; the
+//! instanced fetch draws every chunk unlit (documented in `docs/light.md`).
+
+use std::collections::HashMap;
+
+use voxel_mesh::{PackedLight, PackedQuad, QuadLight};
+
+use crate::arena::{Allocator, QUAD_BYTES};
+use crate::error::scoped;
+use crate::{Error, GpuContext, Result};
+
+/// Entries of the palette buffer at first (32 KiB): some 30 a chunk on open terrain.
+const FIRST_ENTRIES: u32 = 4096;
+
+/// Every lit chunk's palette in one storage buffer (8 bytes an entry, `vec2<u32>` in WGSL),
+/// with a copy on the CPU that a larger buffer is filled from.
+#[derive(Debug)]
+pub(crate) struct Palettes {
+    buffer: wgpu::Buffer,
+    alloc: Allocator,
+    data: Vec<PackedLight>,
+    /// The largest buffer the device binds, in entries.
+    max_entries: u32,
+}
+
+impl Palettes {
+    /// An empty buffer of [`FIRST_ENTRIES`].
+    pub(crate) fn new(ctx: &GpuContext) -> Self {
+        let max = ctx.caps.limits.max_storage_buffer_binding_size / QUAD_BYTES;
+        let max_entries = max.min(u64::from(u32::MAX)) as u32;
+        let first = FIRST_ENTRIES.min(max_entries.max(1));
+        Self {
+            buffer: Self::make(&ctx.device, first),
+            alloc: Allocator::new(first),
+            data: vec![PackedLight::default(); first as usize],
+            max_entries,
+        }
+    }
+
+    fn make(device: &wgpu::Device, entries: u32) -> wgpu::Buffer {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("light_palettes"),
+            size: u64::from(entries.max(1)) * QUAD_BYTES,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// The buffer (bound whole in group 1).
+    pub(crate) fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
+    /// Bytes held.
+    pub(crate) fn bytes(&self) -> u64 {
+        self.buffer.size()
+    }
+
+    /// Places `palette` and writes it (at the next submit); returns its base and whether the
+    /// buffer was replaced by a larger one (bind groups over it must be remade). An error
+    /// when the device's storage binding cannot hold it or the device cannot make the
+    /// buffer; nothing changed then.
+    pub(crate) fn alloc(
+        &mut self,
+        ctx: &GpuContext,
+        palette: &[PackedLight],
+    ) -> Result<(u32, bool)> {
+        let n = u32::try_from(palette.len().max(1)).unwrap_or(u32::MAX);
+        let mut grew = false;
+        let base = match self.alloc.alloc(n) {
+            Some(b) => b,
+            None => {
+                let cap = self.alloc.capacity();
+                let want = cap.saturating_mul(2).max(cap.saturating_add(n));
+                if u64::from(self.alloc.used()) + u64::from(n) > u64::from(self.max_entries) {
+                    return Err(Error::TooLarge {
+                        what: "the light palettes of the chunks, in 8-byte entries,".into(),
+                        value: u64::from(self.alloc.used()) + u64::from(n),
+                        limit_name: "max_storage_buffer_binding_size (in 8-byte entries)",
+                        limit: u64::from(self.max_entries),
+                    });
+                }
+                let size = want.min(self.max_entries);
+                let buffer = scoped(&ctx.device, "growing the light palettes", || {
+                    Self::make(&ctx.device, size)
+                })?;
+                self.alloc.grow(size);
+                self.data.resize(size as usize, PackedLight::default());
+                self.buffer = buffer;
+                grew = true;
+                self.alloc
+                    .alloc(n)
+                    .ok_or_else(|| Error::Unsupported("the light palettes found no room".into()))?
+            }
+        };
+        let b = base as usize;
+        self.data[b..b + palette.len()].copy_from_slice(palette);
+        let (from, bytes) = if grew {
+            // A new buffer: all of it, from the CPU copy.
+            (0, bytemuck::cast_slice(&self.data[..]))
+        } else {
+            (b, bytemuck::cast_slice(palette))
+        };
+        ctx.queue
+            .write_buffer(&self.buffer, from as u64 * QUAD_BYTES, bytes);
+        Ok((base, grew))
+    }
+
+    /// Gives back a palette placed at `base` of `len` entries.
+    pub(crate) fn free(&mut self, base: u32, len: u32) {
+        self.alloc.free(base, len.max(1));
+    }
+}
+
+/// Where a lit chunk's palette lies, and the light of its translucent quads by quad, which a
+/// new order of those quads takes its light stream from.
+#[derive(Debug, Default)]
+pub(crate) struct ChunkLight {
+    /// Base and length in [`Palettes`].
+    pub palette: (u32, u32),
+    /// The light of each translucent quad.
+    pub translucent: HashMap<PackedQuad, QuadLight>,
+}
+
+impl ChunkLight {
+    /// The light stream of translucent quads `quads` (a permutation of the chunk's).
+    pub(crate) fn translucent_stream(&self, quads: &[PackedQuad]) -> Vec<QuadLight> {
+        quads
+            .iter()
+            .map(|q| self.translucent.get(q).copied().unwrap_or_default())
+            .collect()
+    }
+}
