@@ -137,14 +137,16 @@ pub(crate) fn render(a: RenderArgs, device: &headless::Device) -> Result<()> {
         .map_err(|e| Error::from(e).in_option("--layers"))?;
 
     let t = Instant::now();
-    let scene = match &a.scene {
+    let mut scene = match &a.scene {
         Some(path) => scene::Scene::load(path)?,
         None => scene::default_scene(a.seed)?,
     };
+    scene.light |= a.light;
     println!(
-        "scene: {} ({} chunks) built in {:.0} ms",
+        "scene: {} ({} chunks{}) built in {:.0} ms",
         scene.name,
         scene.world.len(),
+        if scene.light { ", lit" } else { "" },
         t.elapsed().as_secs_f64() * 1e3
     );
     let ctx = device.context()?;

@@ -410,6 +410,11 @@ struct RenderArgs {
     /// the renderer's default daylight).
     #[arg(long, value_parser = hour)]
     hour: Option<f32>,
+    /// Draw the world with its light field (sky light through glass and water, the light
+    /// of torches, lava and glowing glass: docs/light.md), as a scene file's `light = true`
+    /// does.
+    #[arg(long)]
+    light: bool,
     /// How quads reach the vertex shader: storage or instanced (default: the first the
     /// device can).
     #[arg(long, value_parser = quad_fetch)]

@@ -389,7 +389,7 @@ fn a_technique_the_device_lacks_is_refused_by_every_call_naming_the_capability()
     assert_names_capability(&e, "storage quad fetch under WebGL2 limits");
     assert!(
         e.to_string()
-            .contains("max_storage_buffers_per_shader_stage of at least 3 (this device: 0)"),
+            .contains("max_storage_buffers_per_shader_stage of at least 5 (this device: 0)"),
         "{e}"
     );
 }

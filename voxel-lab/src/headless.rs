@@ -165,7 +165,13 @@ pub fn renderer_for(
 ) -> Result<SceneRenderer> {
     let mut renderer = Renderer::new(ctx, scene.world.registry(), config)?;
     let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
-    for (pos, meshes) in mesh_chunks(&scene.world, &positions)? {
+    let meshes = if scene.light {
+        let light = voxel_core::LightField::new(&scene.world);
+        voxel_mesh::mesh_chunks_lit(&scene.world, &light, &positions)?
+    } else {
+        mesh_chunks(&scene.world, &positions)?
+    };
+    for (pos, meshes) in meshes {
         renderer.upload_chunk(pos, &meshes)?;
     }
     // The lab builds its content's pipelines when it renders (`render_and_submit`), so that

@@ -12,6 +12,11 @@ pub(super) struct SceneFile {
     pub(super) name: String,
     #[serde(default)]
     pub(super) description: String,
+    /// Whether the world is drawn with its light field (`docs/light.md`): sky light through
+    /// translucent blocks and the light of `torch`, `lava` and `glow_glass`, which the scene
+    /// may then name. Default false: drawn unlit.
+    #[serde(default)]
+    pub(super) light: bool,
     pub(super) size: Option<Spanned<Vec<u32>>>,
     pub(super) terrain: Option<Spanned<TerrainDef>>,
     #[serde(default)]

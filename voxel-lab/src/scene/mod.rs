@@ -8,6 +8,8 @@
 //! name = "Stained-glass corridor"
 //! description = "many layers of different colours"
 //! size = [640, 360]                 # output size when the command gives none
+//! light = true                     # drawn with the light field (docs/light.md); adds the
+//!                                   # blocks torch, lava and glow_glass
 //!
 //! [terrain]                         # generated terrain, chunk coordinates inclusive
 //! seed = 1
@@ -111,6 +113,9 @@ pub struct Scene {
     /// A game's particles and entities ([`voxel_render::content`]), drawn through the renderer's
     /// stages.
     pub content: Content,
+    /// Whether the world is drawn with its light field ([`voxel_core::LightField`], meshed
+    /// with `Mesher::mesh_lit`); false: unlit.
+    pub light: bool,
 }
 
 impl Scene {
@@ -126,6 +131,7 @@ impl Scene {
             paths: vec![None],
             size: None,
             content: Content::default(),
+            light: false,
         }
     }
 
@@ -285,6 +291,7 @@ pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene> {
         paths: vec![Some(eye + side * 6.0)],
         size: None,
         content: Content::default(),
+        light: false,
     })
 }
 

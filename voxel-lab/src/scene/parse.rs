@@ -130,7 +130,11 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene> {
         None => Error::scene(None, e.message().trim()),
     })?;
 
-    let mut registry = BlockRegistry::default();
+    let mut registry = if file.light {
+        BlockRegistry::with_lights()
+    } else {
+        BlockRegistry::default()
+    };
     for b in &file.blocks {
         let def = block_def(text, dir, b, &registry)?;
         registry
@@ -359,5 +363,6 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene> {
         paths,
         size,
         content,
+        light: file.light,
     })
 }
