@@ -198,6 +198,14 @@ pub(crate) fn render(a: RenderArgs, device: &headless::Device) -> Result<()> {
         stats.meshes_drawn[2],
         stats.translucent_quads
     );
+    let memory = renderer.chunk_memory();
+    let mib = |b: u64| b as f64 / (1024.0 * 1024.0);
+    println!(
+        "chunk memory: {:.2} MiB of quads in {:.2} MiB of arena pages, {:.2} MiB of light",
+        mib(memory.quad_bytes),
+        mib(memory.arena_bytes),
+        mib(memory.light_bytes)
+    );
     let report = &stats.technique;
     if let Some(layers) = report.peeling.and_then(|p| p.layers) {
         println!("layers peeled: {layers}");
