@@ -580,7 +580,7 @@ pub(crate) fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()>
         height: h,
         ..RendererConfig::default()
     };
-    let mut renderer = headless::renderer_for(&ctx, &scene, config)?;
+    let mut renderer = headless::renderer_for(&ctx, &scene, config.clone())?;
     let target = headless::Offscreen::new(&ctx, w, h);
     println!(
         "every technique's picture of the default scene ({w}x{h}) into {}:",
@@ -606,6 +606,19 @@ pub(crate) fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()>
     for line in wrote {
         println!("{line}");
     }
+    // Light through stained glass (docs/light.md): the cathedral window scene, lit.
+    let local = PathBuf::from("scenes/light/cathedral.toml");
+    let light_scene = if local.is_file() {
+        local
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/light/cathedral.toml")
+    };
+    let lit = scene::Scene::load(&light_scene)?;
+    let mut lit_renderer = headless::renderer_for(&ctx, &lit, config)?;
+    let img = headless::render_image(&ctx, &mut lit_renderer, &target, &lit.cameras[0])?;
+    let path = a.out.join("light.png");
+    img.save_png(&path)?;
+    println!("wrote {} ({}, lit)", path.display(), lit.name);
     let eval_out = a.out.join("eval");
     let size = if a.full { (480, 270) } else { QUICK_SIZE };
     println!(

@@ -433,7 +433,7 @@ fn a_bare_vox_model_renders_from_its_default_camera() {
 }
 
 /// The showcase (what `bash scripts/run.sh` runs without a display): every technique's
-/// picture of the default scene, then the chart of a few suite scenes, and where the whole
+/// picture of the default scene, the cathedral window lit, then the chart of a few suite scenes, and where the whole
 /// suite is (on lavapipe; skipped loudly without an adapter unless `CI` is set).
 #[test]
 fn the_showcase_draws_every_technique_and_a_small_chart() {
@@ -459,6 +459,10 @@ fn the_showcase_draws_every_technique_and_a_small_chart() {
         let img = voxel_render::Image::load_png(&dir.join(format!("{}.png", t.name()))).unwrap();
         assert_eq!((img.width, img.height), (160, 90), "{}", t.name());
     }
+    // The cathedral window, lit: not a black picture.
+    let lit = voxel_render::Image::load_png(&dir.join("light.png")).unwrap();
+    assert_eq!((lit.width, lit.height), (160, 90));
+    assert!(tests::distinct_colours(&lit) > 20, "light.png is a picture");
     assert!(dir.join("eval/speed_vs_accuracy.png").is_file());
     let summary = std::fs::read_to_string(dir.join("eval/summary.json")).unwrap();
     let records: Vec<serde_json::Value> = serde_json::from_str(&summary).unwrap();
