@@ -546,3 +546,45 @@ fn msaa_on_gl_falls_back_to_none() {
     let without = render(&gl, &scene, config);
     tests::assert_close("backends_gl_msaa", &with, &without, 0);
 }
+
+/// A registry of any size draws on wgpu's GL backend: the block textures' array never has a
+/// layer count GL takes for a cube map (1, or a multiple of 6: 18 layers, the default
+/// registry and three more blocks such as `BlockRegistry::with_lights`'s, drew black).
+#[test]
+fn registries_of_every_size_draw_on_gl() {
+    let Some(gl) = tests::gl() else { return };
+    for extra in 0..=9 {
+        let mut registry = voxel_core::BlockRegistry::default();
+        for i in 0..extra {
+            let def = voxel_core::BlockDef::new(&format!("extra_{i}"), [200, 100, 50], 1.0);
+            registry.register(def).unwrap();
+        }
+        let mut world = voxel_core::World::new(std::sync::Arc::new(registry));
+        scene::fill_box(
+            &mut world,
+            [-8, -1, -8],
+            [8, 0, 8],
+            voxel_core::blocks::STONE,
+        )
+        .unwrap();
+        let camera = voxel_render::Camera::look_at(
+            glam::DVec3::new(0.5, 6.0, 9.0),
+            glam::DVec3::new(0.5, 0.0, 0.0),
+            60.0,
+            0.1,
+            100.0,
+        )
+        .unwrap();
+        let scene = Scene::new("registry", world, camera);
+        let mut r =
+            renderer_for(&gl, &scene, technique_config(Technique::SortedQuads, W, H)).unwrap();
+        let target = Offscreen::new(&gl, W, H);
+        let img = render_image(&gl, &mut r, &target, &scene.cameras[0]).unwrap();
+        let centre = img.pixel(W / 2, H / 2);
+        assert!(
+            centre[0] > 40,
+            "{} blocks: the stone at the centre is {centre:?}",
+            13 + extra
+        );
+    }
+}

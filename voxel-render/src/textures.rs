@@ -353,12 +353,27 @@ pub struct BlockTextures {
     pub table: Vec<u32>,
 }
 
+/// Layers of the block textures' array for `needed` layers: one more where wgpu's GL backend
+/// (GLES, WebGL2) would take the square array for a cube map, which it does for 1 layer
+/// (a plain 2D texture) and for every multiple of 6 (a cube map array), so that the shaders'
+/// `texture_2d_array` sampled nothing there and the world was black (a registry of 16
+/// blocks, the default and `BlockRegistry::with_lights`'s three, has 18 layers). The spare
+/// layer is never sampled.
+pub(crate) fn array_layers(needed: u32) -> u32 {
+    if needed <= 1 || needed.is_multiple_of(6) {
+        needed.max(1) + 1
+    } else {
+        needed
+    }
+}
+
 impl BlockTextures {
-    /// Builds and uploads the textures of `registry` ([`TextureSet::new`]). More layers
-    /// than the adapter's texture arrays hold is an error.
+    /// Builds and uploads the textures of `registry` ([`TextureSet::new`]), in an array of
+    /// [`array_layers`] layers. More layers than the adapter's texture arrays hold is an
+    /// error.
     pub fn new(ctx: &GpuContext, registry: &BlockRegistry, flat: bool) -> Result<Self> {
         let set = TextureSet::new(registry, flat);
-        let layers = set.layer_count() as u32;
+        let layers = array_layers(set.layer_count() as u32);
         if layers > ctx.caps.limits.max_texture_array_layers {
             return Err(Error::Unsupported(format!(
                 "{layers} distinct block face textures, but the adapter allows {} texture array layers",
@@ -613,6 +628,19 @@ mod tests {
     fn srgb_round_trips() {
         for v in [0u8, 1, 10, 128, 200, 255] {
             assert_eq!(linear_to_srgb(srgb_to_linear(v)), v);
+        }
+    }
+
+    #[test]
+    fn the_array_is_never_one_layer_or_a_multiple_of_six() {
+        assert_eq!(array_layers(0), 2);
+        assert_eq!(array_layers(1), 2);
+        assert_eq!(array_layers(15), 15);
+        assert_eq!(array_layers(18), 19);
+        assert_eq!(array_layers(6), 7);
+        for n in 0..200 {
+            let a = array_layers(n);
+            assert!(a >= n && a > 1 && !a.is_multiple_of(6), "{n} -> {a}");
         }
     }
 
