@@ -265,7 +265,8 @@ impl SharedLayouts {
             }
             QuadFetch::Instanced => {
                 scene_entries.push(fetch::table_entry(5));
-                vec![fetch::record_entry(2)]
+                // The record, and the light palettes as a table texture.
+                vec![fetch::record_entry(2), fetch::table_entry(5)]
             }
         };
         Self {

@@ -34,8 +34,9 @@ pub(crate) const TABLE_WIDTH: u32 = 256;
 /// records, the block layers, the page's light and the light palettes.
 const VERTEX_STORAGE_BUFFERS: u64 = 5;
 
-/// Textures the vertex stage binds with [`QuadFetch::Instanced`]: the block layers.
-const VERTEX_TEXTURES: u64 = 1;
+/// Textures the vertex stage binds with [`QuadFetch::Instanced`]: the block layers and the
+/// light palettes.
+const VERTEX_TEXTURES: u64 = 2;
 
 impl QuadFetch {
     /// Both, the faster first (on lavapipe, `cargo bench -p voxel-lab --bench quad_fetch`):
@@ -61,8 +62,9 @@ impl QuadFetch {
                 Need::Limit(Limit::StorageBufferBindingSize, QUAD_BYTES),
             ],
             QuadFetch::Instanced => vec![
-                Need::Limit(Limit::VertexBuffers, 1),
-                Need::Limit(Limit::VertexAttributes, 1),
+                // The page's quads and their light (`chunks/light.rs`).
+                Need::Limit(Limit::VertexBuffers, 2),
+                Need::Limit(Limit::VertexAttributes, 2),
                 Need::Limit(Limit::VertexBufferArrayStride, QUAD_BYTES),
                 Need::Limit(Limit::SampledTexturesPerStage, VERTEX_TEXTURES),
                 Need::Limit(Limit::DynamicUniformBuffers, 1),
@@ -117,11 +119,11 @@ impl QuadFetch {
     }
 
     /// The vertex buffers of chunk pipelines: none, or the page as one 8-byte attribute
-    /// per instance.
+    /// per instance and its light page as another.
     pub(crate) fn vertex_buffers(self) -> &'static [Option<wgpu::VertexBufferLayout<'static>>] {
         match self {
             QuadFetch::Storage => &[],
-            QuadFetch::Instanced => &[Some(QUAD_INSTANCES)],
+            QuadFetch::Instanced => &[Some(QUAD_INSTANCES), Some(LIGHT_INSTANCES)],
         }
     }
 
@@ -178,6 +180,18 @@ const QUAD_INSTANCES: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayo
         format: wgpu::VertexFormat::Uint32x2,
         offset: 0,
         shader_location: 0,
+    }],
+};
+
+/// One `vec2<u32>` per instance at location 1: the light page beside the page, each quad's
+/// corner light (`voxel_mesh::QuadLight`).
+const LIGHT_INSTANCES: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: QUAD_BYTES,
+    step_mode: wgpu::VertexStepMode::Instance,
+    attributes: &[wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Uint32x2,
+        offset: 0,
+        shader_location: 1,
     }],
 };
 

@@ -1,8 +1,9 @@
 //! The light of lit chunks on the GPU (issue 51): each quad's [`QuadLight`] in the arena's
-//! light page at the quad's own index ([`crate::arena::QuadArena::enable_light`]), and each
-//! chunk's palette of corner lights in one storage buffer here, at a base its record holds
-//! (`ChunkInfo::light_base` in `common.wgsl`). Only with [`crate::QuadFetch::Storage`]; the
-//! instanced fetch draws every chunk unlit (documented in `docs/light.md`).
+//! light page at the quad's own index ([`crate::arena::QuadArena::enable_light`]; a storage
+//! buffer, or with [`QuadFetch::Instanced`] a second instance attribute), and each chunk's
+//! palette of corner lights here, at a base its record holds (`ChunkInfo::light_base` in
+//! `common.wgsl`): one storage buffer, or with [`QuadFetch::Instanced`] a table texture
+//! (WebGL2's vertex stage reads no storage buffer).
 
 use std::collections::HashMap;
 
@@ -10,53 +11,91 @@ use voxel_mesh::{PackedLight, PackedQuad, QuadLight};
 
 use crate::arena::{Allocator, QUAD_BYTES};
 use crate::error::scoped;
-use crate::{Error, GpuContext, Result};
+use crate::fetch::{TABLE_WIDTH, TableTexture};
+use crate::{Error, GpuContext, QuadFetch, Result};
 
 /// Entries of the palette buffer at first (32 KiB): some 30 a chunk on open terrain.
 const FIRST_ENTRIES: u32 = 4096;
 
-/// Every lit chunk's palette in one storage buffer (8 bytes an entry, `vec2<u32>` in WGSL),
-/// with a copy on the CPU that a larger buffer is filled from.
+/// Every lit chunk's palette (8 bytes an entry, `vec2<u32>` in WGSL), with a copy on the
+/// CPU that a larger buffer or table is filled from.
 #[derive(Debug)]
 pub(crate) struct Palettes {
-    buffer: wgpu::Buffer,
+    store: Store,
     alloc: Allocator,
     data: Vec<PackedLight>,
-    /// The largest buffer the device binds, in entries.
+    /// The most entries the device binds.
     max_entries: u32,
 }
 
+/// Where the palettes lie on the GPU.
+#[derive(Debug)]
+pub(crate) enum Store {
+    /// A storage buffer ([`QuadFetch::Storage`]).
+    Buffer(wgpu::Buffer),
+    /// A table texture of `Rg32Uint` texels ([`QuadFetch::Instanced`]).
+    Table(TableTexture),
+}
+
 impl Palettes {
-    /// An empty buffer of [`FIRST_ENTRIES`].
-    pub(crate) fn new(ctx: &GpuContext) -> Self {
-        let max = ctx.caps.limits.max_storage_buffer_binding_size / QUAD_BYTES;
+    /// Room for [`FIRST_ENTRIES`], as `fetch` reads them.
+    pub(crate) fn new(ctx: &GpuContext, fetch: QuadFetch) -> Self {
+        let l = &ctx.caps.limits;
+        let max = match fetch {
+            QuadFetch::Storage => l.max_storage_buffer_binding_size / QUAD_BYTES,
+            QuadFetch::Instanced => u64::from(TABLE_WIDTH) * u64::from(l.max_texture_dimension_2d),
+        };
         let max_entries = max.min(u64::from(u32::MAX)) as u32;
         let first = FIRST_ENTRIES.min(max_entries.max(1));
         Self {
-            buffer: Self::make(&ctx.device, first),
+            store: Self::make(&ctx.device, fetch, first),
             alloc: Allocator::new(first),
             data: vec![PackedLight::default(); first as usize],
             max_entries,
         }
     }
 
-    fn make(device: &wgpu::Device, entries: u32) -> wgpu::Buffer {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("light_palettes"),
-            size: u64::from(entries.max(1)) * QUAD_BYTES,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
+    fn make(device: &wgpu::Device, fetch: QuadFetch, entries: u32) -> Store {
+        match fetch {
+            QuadFetch::Storage => Store::Buffer(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("light_palettes"),
+                size: u64::from(entries.max(1)) * QUAD_BYTES,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })),
+            QuadFetch::Instanced => Store::Table(TableTexture::new(
+                device,
+                "light_palettes",
+                wgpu::TextureFormat::Rg32Uint,
+                entries as usize,
+            )),
+        }
     }
 
-    /// The buffer (bound whole in group 1).
-    pub(crate) fn buffer(&self) -> &wgpu::Buffer {
-        &self.buffer
+    fn fetch(&self) -> QuadFetch {
+        match self.store {
+            Store::Buffer(_) => QuadFetch::Storage,
+            Store::Table(_) => QuadFetch::Instanced,
+        }
+    }
+
+    /// Where they lie (bound in group 1).
+    pub(crate) fn store(&self) -> &Store {
+        &self.store
     }
 
     /// Bytes held.
     pub(crate) fn bytes(&self) -> u64 {
-        self.buffer.size()
+        self.alloc.capacity() as u64 * QUAD_BYTES
+    }
+
+    /// Writes entries `first..` from the CPU copy, `n` of them.
+    fn upload(&self, queue: &wgpu::Queue, first: usize, n: usize) {
+        let bytes = bytemuck::cast_slice(&self.data[first..first + n]);
+        match &self.store {
+            Store::Buffer(b) => queue.write_buffer(b, first as u64 * QUAD_BYTES, bytes),
+            Store::Table(t) => t.write(queue, first, bytes),
+        }
     }
 
     /// Places `palette` and writes it (at the next submit); returns its base and whether the
@@ -84,12 +123,12 @@ impl Palettes {
                     });
                 }
                 let size = want.min(self.max_entries);
-                let buffer = scoped(&ctx.device, "growing the light palettes", || {
-                    Self::make(&ctx.device, size)
+                let store = scoped(&ctx.device, "growing the light palettes", || {
+                    Self::make(&ctx.device, self.fetch(), size)
                 })?;
                 self.alloc.grow(size);
                 self.data.resize(size as usize, PackedLight::default());
-                self.buffer = buffer;
+                self.store = store;
                 grew = true;
                 self.alloc
                     .alloc(n)
@@ -98,14 +137,12 @@ impl Palettes {
         };
         let b = base as usize;
         self.data[b..b + palette.len()].copy_from_slice(palette);
-        let (from, bytes) = if grew {
+        if grew {
             // A new buffer: all of it, from the CPU copy.
-            (0, bytemuck::cast_slice(&self.data[..]))
+            self.upload(&ctx.queue, 0, self.data.len());
         } else {
-            (b, bytemuck::cast_slice(palette))
-        };
-        ctx.queue
-            .write_buffer(&self.buffer, from as u64 * QUAD_BYTES, bytes);
+            self.upload(&ctx.queue, b, palette.len());
+        }
         Ok((base, grew))
     }
 

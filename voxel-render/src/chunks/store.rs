@@ -9,7 +9,7 @@ use voxel_mesh::{ChunkMeshes, PackedQuad};
 use super::command::DrawCommand;
 use super::cull::{Culled, FarEntry, Frustum, NearEntry, Regions, near_key};
 use super::gpu_chunk::{GpuChunk, distinct_planes, layers_bounds};
-use super::light::{ChunkLight, Palettes};
+use super::light::{ChunkLight, Palettes, Store};
 use super::{MeshKind, PosMap};
 use crate::arena::{Alloc, ArenaStats, QuadArena};
 use crate::bindings::ChunkUniforms;
@@ -48,10 +48,8 @@ pub struct ChunkStore {
     /// submitted, so that nothing written before its submit changes what it draws.
     retired: Vec<Alloc>,
     retired_slots: Vec<u32>,
-    /// Every lit chunk's light palette (with [`QuadFetch::Storage`]; `None` with
-    /// [`QuadFetch::Instanced`], which draws chunks unlit), and palettes freed while a
-    /// frame was in flight.
-    palettes: Option<Palettes>,
+    /// Every lit chunk's light palette, and palettes freed while a frame was in flight.
+    palettes: Palettes,
     retired_palettes: Vec<(u32, u32)>,
     /// Opacity by block id, for the planes of translucent meshes.
     block_opacity: Arc<[f32]>,
@@ -105,7 +103,7 @@ impl ChunkStore {
             in_flight: false,
             retired: Vec::new(),
             retired_slots: Vec::new(),
-            palettes: (fetch == QuadFetch::Storage).then(|| Palettes::new(ctx)),
+            palettes: Palettes::new(ctx, fetch),
             retired_palettes: Vec::new(),
             block_opacity,
             volume_blocks,
@@ -137,15 +135,21 @@ impl ChunkStore {
     /// [`QuadFetch::Instanced`] the group holds a record only (the page is a vertex
     /// buffer; each draw picks its chunk's record), the same for every page.
     fn remake_groups(&mut self, device: &wgpu::Device) {
-        let records = match self.fetch {
-            QuadFetch::Storage => None,
-            QuadFetch::Instanced => Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let records = match self.palettes.store() {
+            Store::Buffer(_) => None,
+            Store::Table(table) => Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("chunk_record"),
                 layout: &self.layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: self.infos.binding(),
-                }],
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: self.infos.binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: wgpu::BindingResource::TextureView(&table.view),
+                    },
+                ],
             })),
         };
         self.groups = (0..self.arena.pages())
@@ -156,7 +160,9 @@ impl ChunkStore {
                 }
                 // The page's light and the palettes (where the arena holds no light, the
                 // palettes stand in for the light page: no unlit record reads it).
-                let palettes = self.palettes.as_ref()?.buffer();
+                let Store::Buffer(palettes) = self.palettes.store() else {
+                    return None;
+                };
                 let light = self.arena.light_page(i).unwrap_or(palettes);
                 let entries = [
                     (0, page.as_entire_binding()),
@@ -187,7 +193,13 @@ impl ChunkStore {
         };
         match self.fetch {
             QuadFetch::Storage => pass.set_bind_group(1, group, &[]),
-            QuadFetch::Instanced => pass.set_vertex_buffer(0, buffer.slice(..)),
+            QuadFetch::Instanced => {
+                pass.set_vertex_buffer(0, buffer.slice(..));
+                // The quads' light (the page itself stands in where the arena holds no
+                // light: no unlit record reads it).
+                let light = self.arena.light_page(page as usize).unwrap_or(buffer);
+                pass.set_vertex_buffer(1, light.slice(..));
+            }
         }
         true
     }
@@ -230,10 +242,8 @@ impl ChunkStore {
             }
         }
         self.free_slots.append(&mut self.retired_slots);
-        if let Some(p) = self.palettes.as_mut() {
-            for (base, len) in self.retired_palettes.drain(..) {
-                p.free(base, len);
-            }
+        for (base, len) in self.retired_palettes.drain(..) {
+            self.palettes.free(base, len);
         }
         if dropped {
             self.remake_groups(&ctx.device);
@@ -352,8 +362,8 @@ impl ChunkStore {
                     for a in allocs.into_iter().flatten() {
                         changed |= self.arena.free(a) && self.arena.drop_page(a.page);
                     }
-                    if let (Some(p), Some(l)) = (self.palettes.as_mut(), &light) {
-                        p.free(l.palette.0, l.palette.1);
+                    if let Some(l) = &light {
+                        self.palettes.free(l.palette.0, l.palette.1);
                     }
                     if changed {
                         self.remake_groups(&ctx.device);
@@ -423,9 +433,9 @@ impl ChunkStore {
     }
 
     /// Checks a chunk's light streams against its meshes and places its palette, giving the
-    /// arena light pages the first time: `None` for a chunk meshed without light, or with
-    /// [`QuadFetch::Instanced`] (drawn unlit). A stream whose length is not its mesh's, or
-    /// an index outside the palette, is an [`Error::InvalidSetting`].
+    /// arena light pages the first time: `None` for a chunk meshed without light. A stream
+    /// whose length is not its mesh's, or an index outside the palette, is an
+    /// [`Error::InvalidSetting`].
     fn place_light(
         &mut self,
         ctx: &GpuContext,
@@ -464,10 +474,7 @@ impl ChunkStore {
                 )));
             }
         }
-        let Some(palettes) = self.palettes.as_mut() else {
-            return Ok(None);
-        };
-        let (base, grew) = palettes.alloc(ctx, &streams.palette)?;
+        let (base, grew) = self.palettes.alloc(ctx, &streams.palette)?;
         let len = streams.palette.len().max(1) as u32;
         match self.arena.enable_light(&ctx.device) {
             Ok(changed) => {
@@ -476,9 +483,7 @@ impl ChunkStore {
                 }
             }
             Err(e) => {
-                if let Some(p) = self.palettes.as_mut() {
-                    p.free(base, len);
-                }
+                self.palettes.free(base, len);
                 return Err(e);
             }
         }
@@ -495,12 +500,12 @@ impl ChunkStore {
 
     fn free_meshes(&mut self, ctx: &GpuContext, slot: u32) {
         if let Some(c) = self.slots.get_mut(slot as usize).and_then(Option::take) {
-            if let (Some(l), Some(p)) = (&c.light, self.palettes.as_mut()) {
+            if let Some(l) = &c.light {
                 let (base, len) = l.palette;
                 if self.in_flight {
                     self.retired_palettes.push((base, len));
                 } else {
-                    p.free(base, len);
+                    self.palettes.free(base, len);
                 }
             }
             let mut changed = false;
@@ -566,9 +571,9 @@ impl ChunkStore {
     pub(crate) fn memory(&self) -> (ArenaStats, u64, u64) {
         // The palettes count once the arena holds light (before, the buffer is a
         // stand-in of 32 KiB).
-        let palettes = match (&self.palettes, self.arena.is_lit()) {
-            (Some(p), true) => p.bytes(),
-            _ => 0,
+        let palettes = match self.arena.is_lit() {
+            true => self.palettes.bytes(),
+            false => 0,
         };
         (self.arena.stats(), self.infos.bytes(), palettes)
     }

@@ -64,7 +64,7 @@ struct ChunkInfo {
 // palette indices of its corners (u0,v0), (u1,v0) in word 0 and (u0,v1), (u1,v1) in word 1,
 // 16 bits each), and every lit chunk's palette (`PackedLight`: sky R, G, B in the bytes of
 // word 0, block R, G, B in those of word 1), from the chunk's `light_base`
-// (`chunks/light.rs`). The instanced fetch binds neither: its chunks are drawn unlit.
+// (`chunks/light.rs`). The instanced fetch reads them as below.
 @group(1) @binding(3) var<storage, read> quad_lights: array<vec2<u32>>;
 @group(1) @binding(4) var<storage, read> light_palette: array<vec2<u32>>;
 // Instanced: the block layers in a texture TABLE_WIDTH entries wide (`table_texel`), the
@@ -72,6 +72,9 @@ struct ChunkInfo {
 // instances' attribute.
 @group(0) @binding(5) var block_layer_table: texture_2d<u32>;
 @group(1) @binding(2) var<uniform> chunk_record: ChunkInfo;
+// The light palettes as a table (`table_texel`), each entry a `PackedLight`; the quads'
+// light the second instance attribute.
+@group(1) @binding(5) var light_palette_table: texture_2d<u32>;
 
 struct VsOut {
     // Invariant: the same quad gets bit-identical depths in every pipeline, which depth
@@ -268,6 +271,13 @@ fn layer_index(block: u32, face: u32) -> u32 {
     return block * 3u + select(2u, face - 2u, face == 2u || face == 3u);
 }
 
+// Where corner `s` (u + 2v) of a quad whose light is `l` (a `QuadLight`) lies in the
+// palettes, for `chunk`.
+fn palette_index(l: vec2<u32>, s: u32, chunk: ChunkInfo) -> u32 {
+    let word = select(l.x, l.y, s >= 2u);
+    return chunk.light_base + ((word >> (16u * (s & 1u))) & 0xffffu);
+}
+
 // Storage: the light of quad `i` of the page, of `chunk`.
 fn pulled_lights(i: u32, chunk: ChunkInfo) -> CornerLights {
     if chunk.lit == 0u {
@@ -276,8 +286,22 @@ fn pulled_lights(i: u32, chunk: ChunkInfo) -> CornerLights {
     let l = quad_lights[i];
     var out: CornerLights;
     for (var s = 0u; s < 4u; s++) {
-        let word = select(l.x, l.y, s >= 2u);
-        let entry = light_palette[chunk.light_base + ((word >> (16u * (s & 1u))) & 0xffffu)];
+        let entry = light_palette[palette_index(l, s, chunk)];
+        out.sky[s] = light_levels(entry.x);
+        out.block[s] = light_levels(entry.y);
+    }
+    return out;
+}
+
+// Instanced: the light of the instance's quad, `l` its light attribute, of the drawn chunk.
+fn instanced_lights(l: vec2<u32>) -> CornerLights {
+    if chunk_record.lit == 0u {
+        return unlit_corners();
+    }
+    var out: CornerLights;
+    for (var s = 0u; s < 4u; s++) {
+        let texel = table_texel(palette_index(l, s, chunk_record));
+        let entry = textureLoad(light_palette_table, texel, 0).xy;
         out.sky[s] = light_levels(entry.x);
         out.block[s] = light_levels(entry.y);
     }
@@ -299,9 +323,9 @@ fn table_texel(i: u32) -> vec2<i32> {
     return vec2<i32>(i32(i % TABLE_WIDTH), i32(i / TABLE_WIDTH));
 }
 
-// Instanced: corner vi % 6 of the instance's quad `q`, of the drawn chunk.
-fn instanced_vertex(vi: u32, q: vec2<u32>, grow: bool) -> VsOut {
-    var out = quad_vertex(q, chunk_record, vi % 6u, grow, unlit_corners());
+// Instanced: corner vi % 6 of the instance's quad `q` (its light `l`), of the drawn chunk.
+fn instanced_vertex(vi: u32, q: vec2<u32>, l: vec2<u32>, grow: bool) -> VsOut {
+    var out = quad_vertex(q, chunk_record, vi % 6u, grow, instanced_lights(l));
     out.layer = textureLoad(block_layer_table, table_texel(layer_index(out.block, out.face)), 0).x;
     return out;
 }
@@ -320,13 +344,21 @@ fn vs_solid(@builtin(vertex_index) vi: u32, @builtin(instance_index) slot: u32) 
 
 // The same two, the quads as instances.
 @vertex
-fn vs_main_instanced(@builtin(vertex_index) vi: u32, @location(0) q: vec2<u32>) -> VsOut {
-    return instanced_vertex(vi, q, false);
+fn vs_main_instanced(
+    @builtin(vertex_index) vi: u32,
+    @location(0) q: vec2<u32>,
+    @location(1) l: vec2<u32>,
+) -> VsOut {
+    return instanced_vertex(vi, q, l, false);
 }
 
 @vertex
-fn vs_solid_instanced(@builtin(vertex_index) vi: u32, @location(0) q: vec2<u32>) -> VsOut {
-    return instanced_vertex(vi, q, true);
+fn vs_solid_instanced(
+    @builtin(vertex_index) vi: u32,
+    @location(0) q: vec2<u32>,
+    @location(1) l: vec2<u32>,
+) -> VsOut {
+    return instanced_vertex(vi, q, l, true);
 }
 
 // Image coordinates of face coordinates `uv` (along the face's U and V axes): side faces
