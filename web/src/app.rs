@@ -107,8 +107,7 @@ pub(crate) fn run(
     }
     let meshes = match &page.blocks {
         Blocks::World(world) => {
-            let positions: Vec<_> = world.iter().map(|(p, _)| p).collect();
-            voxel_mesh::mesh_chunks(world, &positions).map_err(|e| e.to_string())?
+            crate::scene::mesh_world(world, page.light).map_err(|e| e.to_string())?
         }
         Blocks::Stream(_) => Vec::new(),
     };

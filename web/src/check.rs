@@ -18,6 +18,9 @@ pub const TEST_FRAMES: u32 = 2;
 pub const TEST_RADIUS: i32 = 2;
 /// The seed of the test's scene.
 pub const TEST_SEED: u32 = 1;
+/// Whether the test's scene is drawn with its light field (as the page draws it by
+/// default: `docs/light.md`).
+pub const TEST_LIGHT: bool = true;
 
 /// What became of a technique.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -80,6 +80,9 @@ pub struct GamePage {
     pub content: Content,
     /// What moves them.
     pub on_frame: Option<OnFrame>,
+    /// Whether a [`Blocks::World`] is drawn with its light field (`docs/light.md`): sky
+    /// light through glass and water, torches. Default false.
+    pub light: bool,
 }
 
 impl GamePage {
@@ -91,7 +94,14 @@ impl GamePage {
             camera,
             content: Content::default(),
             on_frame: None,
+            light: false,
         }
+    }
+
+    /// With its world drawn with its light field ([`GamePage::light`]).
+    pub fn with_light(mut self, light: bool) -> Self {
+        self.light = light;
+        self
     }
 
     /// With `content` at the start.

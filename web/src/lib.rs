@@ -49,6 +49,9 @@ pub enum Error {
     /// The world generator or the world.
     #[error("world: {0}")]
     World(#[from] voxel_core::Error),
+    /// The mesher.
+    #[error("mesher: {0}")]
+    Mesh(#[from] voxel_mesh::Error),
     /// The renderer (a bad camera among others).
     #[error("renderer: {0}")]
     Render(#[from] voxel_render::Error),

@@ -45,12 +45,12 @@ async fn own_page() -> Result<(), String> {
     let seed = if options.test { TEST_SEED } else { 1 };
     let scene = default_scene(seed, options.radius).map_err(|e| e.to_string())?;
     if options.test {
-        let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
-        let meshes =
-            voxel_mesh::mesh_chunks(&scene.world, &positions).map_err(|e| e.to_string())?;
+        let meshes = crate::scene::mesh_world(&scene.world, crate::check::TEST_LIGHT)
+            .map_err(|e| e.to_string())?;
         return test(&gpu, &scene.world, &meshes, &scene.camera).await;
     }
-    let mut page = GamePage::new("voxel-oit", Blocks::World(scene.world), scene.camera);
+    let mut page = GamePage::new("voxel-oit", Blocks::World(scene.world), scene.camera)
+        .with_light(options.light);
     page.title = String::new();
     crate::app::run(gpu, fell_back, page, options)
 }

@@ -43,6 +43,8 @@ pub(crate) struct Options {
     pub(crate) report: bool,
     /// Destroy the device after this many frames (`?lose=N`).
     pub(crate) lose_after: Option<u64>,
+    /// Draw the world with its light field (`?light=0` turns it off; default on).
+    pub(crate) light: bool,
 }
 
 impl Options {
@@ -90,6 +92,7 @@ impl Options {
             technique,
             report: params.get("report").is_some_and(|v| v == "1"),
             lose_after,
+            light: params.get("light").is_none_or(|v| v != "0"),
         })
     }
 }

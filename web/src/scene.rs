@@ -4,7 +4,8 @@
 //! not build for a browser.
 
 use glam::DVec3;
-use voxel_core::{TerrainConfig, TerrainGenerator, World};
+use voxel_core::{ChunkPos, LightField, TerrainConfig, TerrainGenerator, World};
+use voxel_mesh::ChunkMeshes;
 use voxel_render::Camera;
 
 use crate::{Error, Result};
@@ -42,6 +43,19 @@ pub fn default_scene(seed: u32, radius: i32) -> Result<DefaultScene> {
     )?
     .in_medium(world.medium_at(view.eye));
     Ok(DefaultScene { world, camera })
+}
+
+/// Every chunk of `world` meshed, with the light of a field lit from scratch
+/// (`docs/light.md`) when `light`: what the page uploads, and what the browser test draws
+/// natively to compare.
+pub fn mesh_world(world: &World, light: bool) -> Result<Vec<(ChunkPos, ChunkMeshes)>> {
+    let positions: Vec<_> = world.iter().map(|(p, _)| p).collect();
+    let meshes = if light {
+        voxel_mesh::mesh_chunks_lit(world, &LightField::new(world), &positions)
+    } else {
+        voxel_mesh::mesh_chunks(world, &positions)
+    };
+    Ok(meshes?)
 }
 
 #[cfg(all(test, not(target_arch = "wasm32")))]

@@ -26,7 +26,7 @@ use voxel_render::{
     GpuContext, Image, NoGame, OitConfig, Renderer, RendererConfig, Technique, readback, stages,
 };
 use voxel_web::check::{
-    Kind, Report, TEST_FRAMES, TEST_RADIUS, TEST_SEED, TEST_SIZE, parse_report_path,
+    Kind, Report, TEST_FRAMES, TEST_LIGHT, TEST_RADIUS, TEST_SEED, TEST_SIZE, parse_report_path,
 };
 
 /// Mean difference to the native picture a technique may show, in 1/255 steps: the target
@@ -105,8 +105,8 @@ fn native(ctx: &GpuContext, technique: Technique, single: bool) -> Image {
         ..RendererConfig::default()
     };
     let mut r = Renderer::new(ctx, scene.world.registry(), config).unwrap();
-    let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
-    for (pos, meshes) in voxel_mesh::mesh_chunks(&scene.world, &positions).unwrap() {
+    let meshes = voxel_web::scene::mesh_world(&scene.world, TEST_LIGHT).unwrap();
+    for (pos, meshes) in meshes {
         r.upload_chunk(pos, &meshes).unwrap();
     }
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
@@ -152,7 +152,7 @@ fn the_page_draws_like_native_on_webgpu_and_webgl2() {
     let (w, h) = TEST_SIZE;
     let mut natives: HashMap<(Technique, bool), Image> = HashMap::new();
     let mut table = format!(
-        "# Browser × technique\n\nThe default scene (seed {TEST_SEED}, {TEST_RADIUS} chunks each way) at {w}×{h} in headless Chromium, each technique's picture against the native one on lavapipe (Vulkan): mean and largest channel difference, 1/255 steps. Made by `cargo test --release -p voxel-web --test browser`.\n\n| browser | technique | runs | error vs native (mean / max) | pixels off by > 3/255 |\n|---|---|---|---|---:|\n"
+        "# Browser × technique\n\nThe default scene (seed {TEST_SEED}, {TEST_RADIUS} chunks each way, lit: {TEST_LIGHT}) at {w}×{h} in headless Chromium, each technique's picture against the native one on lavapipe (Vulkan): mean and largest channel difference, 1/255 steps. Made by `cargo test --release -p voxel-web --test browser`.\n\n| browser | technique | runs | error vs native (mean / max) | pixels off by > 3/255 |\n|---|---|---|---|---:|\n"
     );
     let mut failures = Vec::new();
     for backend in ["webgpu", "webgl2"] {
