@@ -556,7 +556,7 @@ fn registries_of_every_size_draw_on_gl() {
     for extra in 0..=9 {
         let mut registry = voxel_core::BlockRegistry::default();
         for i in 0..extra {
-            let def = voxel_core::BlockDef::new(&format!("extra_{i}"), [200, 100, 50], 1.0);
+            let def = voxel_core::BlockDef::new(format!("extra_{i}"), [200, 100, 50], 1.0);
             registry.register(def).unwrap();
         }
         let mut world = voxel_core::World::new(std::sync::Arc::new(registry));

@@ -378,3 +378,91 @@ fn the_instanced_fetch_and_webgl2_limits_draw_the_same_light() {
         }
     }
 }
+
+/// The scenes of `scenes/light/` (drawn with their light field), by day and at night: the
+/// A-buffer reference with flat textures against the lab's CPU ray march computing the
+/// same light from the field by the documented rules (no mesh, no GPU), and every
+/// technique's picture against the ray march's, mean error per scene in
+/// `target/test-output/light/reference.md`.
+#[test]
+fn lit_scenes_agree_with_the_ray_march() {
+    use voxel_lab::raymarch::{RayMarcher, Shading};
+    let Some(ctx) = gpu() else { return };
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/light");
+    let files = voxel_lab::scene::scene_files(&dir).unwrap();
+    assert!(files.len() >= 3, "{files:?}");
+    let size = (320, 180);
+    let mut table = String::from(
+        "| scene | hour | reference: pixels off edges beyond 1/255 (max) | technique: mean error against the ray march, 1/255 |\n|---|---|---|---|\n",
+    );
+    for file in files {
+        let scene = voxel_lab::scene::Scene::load(&file).unwrap();
+        assert!(scene.light, "{}: a light scene", scene.name);
+        let field = Arc::new(LightField::new(&scene.world));
+        let marcher = RayMarcher::with_content(&scene.world, &scene.content).with_light(field);
+        let camera = scene.cameras[0];
+        for hour in [12.0, 0.0] {
+            let l = Lighting::daytime(hour);
+            let config = |t: Technique| RendererConfig {
+                flat_textures: true,
+                sun_dir: l.sun_dir,
+                ambient: l.ambient,
+                brightness: l.brightness,
+                sky: l.sky,
+                ..technique_config(t, size.0, size.1)
+            };
+            let reference = config(Technique::Reference);
+            let shading = Shading::of(&reference);
+            let mut r = voxel_lab::headless::renderer_for(&ctx, &scene, reference).unwrap();
+            let gpu_image = frame(&ctx, &mut r, &camera);
+            let drawn = r.drawn_camera(&camera);
+            let ray = marcher.render(&drawn, size.0, size.1, &shading);
+            let name = format!("{}_{hour}", file.file_stem().unwrap().to_string_lossy());
+            ray.image
+                .save_png(&out_dir("light").join(format!("{name}_raymarch.png")))
+                .unwrap();
+            let c = marcher.compare(&ray, &drawn, &shading, &gpu_image, None);
+            assert!(
+                distinct_colours(&ray.image) > 20,
+                "{name}: the ray march drew a picture"
+            );
+            assert_eq!(
+                (c.differing, c.cracks),
+                (0, 0),
+                "{name}: {} pixels off edges differ (max {}/255): {:?}",
+                c.differing,
+                c.max_abs_err_off_edges,
+                c.worst
+            );
+            let mut errors = Vec::new();
+            for t in Technique::ALL {
+                let img = render_with(&ctx, &scene, config(t));
+                let mean = mean_error(&img, &ray.image);
+                if t.is_exact() {
+                    assert!(mean <= 3.0, "{name}: {} {mean:.2}/255", t.name());
+                }
+                errors.push(format!("{} {mean:.2}", t.name()));
+            }
+            table += &format!(
+                "| {} | {hour} | {} ({}) | {} |\n",
+                scene.name,
+                c.differing,
+                c.max_abs_err_off_edges,
+                errors.join(", ")
+            );
+        }
+    }
+    std::fs::write(out_dir("light").join("reference.md"), &table).unwrap();
+    eprintln!("{table}");
+}
+
+/// The mean absolute channel difference (RGB) of two pictures, in 1/255 steps.
+fn mean_error(a: &Image, b: &Image) -> f64 {
+    let sum: u64 = a
+        .rgba
+        .chunks_exact(4)
+        .zip(b.rgba.chunks_exact(4))
+        .map(|(p, q)| (0..3).map(|i| u64::from(p[i].abs_diff(q[i]))).sum::<u64>())
+        .sum();
+    sum as f64 / (a.rgba.len() / 4 * 3) as f64
+}

@@ -434,7 +434,11 @@ pub fn raymarch_check(
     let depth = voxel_render::readback::read_depth(ctx, renderer.scene_depth())?;
     let drawn = renderer.drawn_camera(camera);
     let start = std::time::Instant::now();
-    let marcher = raymarch::RayMarcher::with_content(&scene.world, &scene.content);
+    let mut marcher = raymarch::RayMarcher::with_content(&scene.world, &scene.content);
+    if scene.light {
+        let field = voxel_core::LightField::new(&scene.world);
+        marcher = marcher.with_light(std::sync::Arc::new(field));
+    }
     let ray = marcher.render(&drawn, size.0, size.1, &shading);
     let seconds = start.elapsed().as_secs_f64();
     let comparison = marcher.compare(&ray, &drawn, &shading, &gpu, Some(&depth));

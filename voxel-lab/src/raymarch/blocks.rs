@@ -19,6 +19,33 @@ fn ao_brightness(value: u8, strength: f64) -> f64 {
     1.0 - strength * f64::from(voxel_render::low_level::AO_DEPTH) * f64::from(3 - value) / 3.0
 }
 
+/// Whether the renderer splits a face of corner AO values `v` (in the order of
+/// [`RayMarcher::ao_values`]) along the diagonal (1,0)-(0,1): where those corners are
+/// brighter in sum (`quad_vertex` in `common.wgsl`).
+pub(super) fn flipped(v: [u8; 4]) -> bool {
+    u16::from(v[1]) + u16::from(v[2]) > u16::from(v[0]) + u16::from(v[3])
+}
+
+/// A value given at the corners (u0, v0), (u1, v0), (u0, v1), (u1, v1) at face coordinates
+/// `(s, t)` (0 to 1), interpolated over the two triangles the renderer draws the face as.
+pub(super) fn interpolate(c: [f64; 4], flip: bool, s: f64, t: f64) -> f64 {
+    let [b00, b10, b01, b11] = c;
+    if flip {
+        // Diagonal (1,0)-(0,1).
+        if s + t <= 1.0 {
+            b00 + s * (b10 - b00) + t * (b01 - b00)
+        } else {
+            b11 + (1.0 - s) * (b01 - b11) + (1.0 - t) * (b10 - b11)
+        }
+    } else if s >= t {
+        // Diagonal (0,0)-(1,1): triangle (00, 10, 11).
+        b00 + s * (b10 - b00) + t * (b11 - b10)
+    } else {
+        // Triangle (00, 11, 01).
+        b00 + t * (b01 - b00) + s * (b11 - b01)
+    }
+}
+
 impl RayMarcher {
     /// The blocks of the chunk at chunk coordinates `c`, if it holds any.
     pub(super) fn chunk_blocks(&self, c: [i64; 3]) -> Option<&[BlockId]> {
@@ -87,6 +114,14 @@ impl RayMarcher {
         if strength == 0.0 {
             return 1.0;
         }
+        let values = self.ao_values(b, face);
+        let [b00, b10, b01, b11] = values.map(|v| ao_brightness(v, strength));
+        interpolate([b00, b10, b01, b11], flipped(values), s, t)
+    }
+
+    /// The AO values (3 open .. 0) of the corners (u0, v0), (u1, v0), (u0, v1), (u1, v1) of
+    /// face `face` of the block at `b`.
+    pub(super) fn ao_values(&self, b: [i64; 3], face: Face) -> [u8; 4] {
         let axis = face.axis();
         let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
         let n = face.normal();
@@ -105,25 +140,55 @@ impl RayMarcher {
                 3 - u8::from(s1) - u8::from(s2) - u8::from(c)
             }
         };
-        let v00 = value(-1, -1);
-        let v10 = value(1, -1);
-        let v01 = value(-1, 1);
-        let v11 = value(1, 1);
-        let [b00, b10, b01, b11] = [v00, v10, v01, v11].map(|v| ao_brightness(v, strength));
-        if u16::from(v10) + u16::from(v01) > u16::from(v00) + u16::from(v11) {
-            // Diagonal (1,0)-(0,1).
-            if s + t <= 1.0 {
-                b00 + s * (b10 - b00) + t * (b01 - b00)
-            } else {
-                b11 + (1.0 - s) * (b01 - b11) + (1.0 - t) * (b10 - b11)
+        [value(-1, -1), value(1, -1), value(-1, 1), value(1, 1)]
+    }
+
+    /// The light of the corners (u0, v0), (u1, v0), (u0, v1), (u1, v1) of face `face` of the
+    /// block at `b` (`id`), sky then block channels, by the lit mesher's rules
+    /// (`docs/light.md`, "Meshing light"), read from `field`: a translucent face takes its
+    /// front cell's at every corner; another the mean (rounded half up) of the cells in
+    /// front around the corner that are not opaque and are lit (the diagonal not when both
+    /// sides are opaque), 0 where none is.
+    pub(super) fn corner_lights(
+        &self,
+        field: &voxel_core::LightField,
+        b: [i64; 3],
+        face: Face,
+        id: BlockId,
+    ) -> [[u16; 6]; 4] {
+        let axis = face.axis();
+        let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
+        let n = face.normal();
+        let front = [0, 1, 2].map(|a| b[a] + i64::from(n[a]));
+        let counted = |p: [i64; 3]| -> Option<[u16; 6]> {
+            if self.opaque(p) {
+                return None;
             }
-        } else if s >= t {
-            // Diagonal (0,0)-(1,1): triangle (00, 10, 11).
-            b00 + s * (b10 - b00) + t * (b11 - b10)
-        } else {
-            // Triangle (00, 11, 01).
-            b00 + t * (b01 - b00) + s * (b11 - b01)
+            let [x, y, z] = p.map(|v| i32::try_from(v).ok());
+            let l = field.get(voxel_core::WorldPos::new(x?, y?, z?))?;
+            let [sr, sg, sb] = l.sky.map(u16::from);
+            let [br, bg, bb] = l.block.map(u16::from);
+            Some([sr, sg, sb, br, bg, bb])
+        };
+        if self.class(id) == RenderClass::Translucent {
+            return [counted(front).unwrap_or([0; 6]); 4];
         }
+        [(-1, -1), (1, -1), (-1, 1), (1, 1)].map(|(du, dv)| {
+            let mut s1 = front;
+            s1[ua] += du;
+            let mut s2 = front;
+            s2[va] += dv;
+            let mut c = s1;
+            c[va] += dv;
+            let walled = self.opaque(s1) && self.opaque(s2);
+            let cells = [Some(front), Some(s1), Some(s2), (!walled).then_some(c)];
+            let lit: Vec<[u16; 6]> = cells.into_iter().flatten().filter_map(counted).collect();
+            if lit.is_empty() {
+                return [0; 6];
+            }
+            let k = lit.len() as u16;
+            std::array::from_fn(|ch| (lit.iter().map(|l| l[ch]).sum::<u16>() + k / 2) / k)
+        })
     }
 
     /// The block whose medium a cutout block `id` stands in.

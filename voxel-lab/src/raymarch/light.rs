@@ -5,6 +5,7 @@ use glam::DVec3;
 use voxel_core::RenderClass;
 use voxel_render::Camera;
 
+use super::blocks::{flipped, interpolate};
 use super::{RayMarcher, Shading, Surface};
 use crate::content::{face_light, particle_light};
 
@@ -38,22 +39,31 @@ impl RayMarcher {
     ) -> [f64; 3] {
         let face = surface.face;
         let n = face.normal();
-        let light = light.on(DVec3::from(n.map(f64::from)));
+        let sky = light.on(DVec3::from(n.map(f64::from)));
         let translucent = self.class(surface.id) == RenderClass::Translucent;
+        let axis = face.axis();
+        let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
+        let s = (p[ua] - surface.block[ua] as f64).clamp(0.0, 1.0);
+        let t = (p[va] - surface.block[va] as f64).clamp(0.0, 1.0);
         let shade = if translucent {
             1.0
         } else {
-            let axis = face.axis();
-            let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
-            let s = (p[ua] - surface.block[ua] as f64).clamp(0.0, 1.0);
-            let t = (p[va] - surface.block[va] as f64).clamp(0.0, 1.0);
             self.ao(surface.block, face, s, t, f64::from(shading.ao_strength))
         };
-        [
-            a[0] * light * shade,
-            a[1] * light * shade,
-            a[2] * light * shade,
-        ]
+        // The light field's sky and block light at the point (full sky light and no block
+        // light unlit), then `light()` of `common.wgsl`.
+        let levels: [f64; 6] = match &self.light {
+            None => [1.0, 1.0, 1.0, 0.0, 0.0, 0.0],
+            Some(field) => {
+                let c = self.corner_lights(field, surface.block, face, surface.id);
+                let flip = flipped(self.ao_values(surface.block, face));
+                std::array::from_fn(|ch| {
+                    let corners = c.map(|l| f64::from(l[ch]) / 255.0);
+                    interpolate(corners, flip, s, t)
+                })
+            }
+        };
+        std::array::from_fn(|ch| a[ch] * (levels[ch] * sky).max(levels[ch + 3]) * shade)
     }
 }
 

@@ -168,6 +168,8 @@ pub struct RayMarcher {
     medium_of: Vec<Option<BlockId>>,
     /// A game's particles and entities ([`voxel_render::content`]).
     content: Content,
+    /// The world's light field, when it is drawn lit ([`RayMarcher::with_light`]).
+    light: Option<Arc<voxel_core::LightField>>,
 }
 
 impl RayMarcher {
@@ -232,6 +234,19 @@ impl RayMarcher {
                 })
                 .collect(),
             content: Content::default(),
+            light: None,
+        }
+    }
+
+    /// Lit by `light`, the world's light field (`docs/light.md`): each face takes the light
+    /// of its corners by the lit mesher's rules, read from the field here (the mean of the
+    /// open, known cells in front around each corner; a translucent face its front cell's),
+    /// interpolated over the face as the renderer's triangles do, and shades with
+    /// `max(sky light × the sky's light, block light)`.
+    pub fn with_light(self, light: Arc<voxel_core::LightField>) -> Self {
+        Self {
+            light: Some(light),
+            ..self
         }
     }
 
