@@ -185,6 +185,16 @@ pub fn read_hdr(ctx: &GpuContext, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
         .collect()
 }
 
+/// The pixel of a `size` picture of `camera` that world point `p` projects to.
+pub fn project(camera: &Camera, size: (u32, u32), p: DVec3) -> (u32, u32) {
+    let vp = camera.view_proj(f64::from(size.0) / f64::from(size.1));
+    let clip = vp * (p - camera.eye).as_vec3().extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    let x = (ndc.x + 1.0) / 2.0 * size.0 as f32;
+    let y = (1.0 - ndc.y) / 2.0 * size.1 as f32;
+    (x as u32, y as u32)
+}
+
 /// Renders with `renderer` into a fresh target and returns the picture.
 pub fn frame(ctx: &GpuContext, renderer: &mut Renderer, camera: &Camera) -> Image {
     let (w, h) = renderer.size();

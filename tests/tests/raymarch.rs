@@ -130,13 +130,7 @@ fn terrace() -> Scene {
 
 /// The pixel a world point projects to.
 fn pixel(camera: &Camera, size: (u32, u32), p: DVec3) -> (u32, u32) {
-    let vp = camera.view_proj(f64::from(size.0) / f64::from(size.1));
-    let rel = (p - camera.eye).as_vec3();
-    let clip = vp * rel.extend(1.0);
-    let ndc = clip.truncate() / clip.w;
-    let x = (ndc.x + 1.0) / 2.0 * size.0 as f32;
-    let y = (1.0 - ndc.y) / 2.0 * size.1 as f32;
-    (x as u32, y as u32)
+    tests::project(camera, size, p)
 }
 
 #[test]

@@ -33,12 +33,7 @@ fn config(technique: Technique) -> RendererConfig {
 
 /// The pixel a world point projects to.
 fn pixel(camera: &Camera, p: DVec3) -> (u32, u32) {
-    let vp = camera.view_proj(f64::from(W) / f64::from(H));
-    let clip = vp * (p - camera.eye).as_vec3().extend(1.0);
-    let ndc = clip.truncate() / clip.w;
-    let x = (ndc.x + 1.0) / 2.0 * W as f32;
-    let y = (1.0 - ndc.y) / 2.0 * H as f32;
-    (x as u32, y as u32)
+    project(camera, (W, H), p)
 }
 
 /// The mean RGB (0–255) of the 5 × 5 pixels around `(x, y)`.

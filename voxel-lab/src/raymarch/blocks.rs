@@ -19,6 +19,26 @@ fn ao_brightness(value: u8, strength: f64) -> f64 {
     1.0 - strength * f64::from(voxel_render::low_level::AO_DEPTH) * f64::from(3 - value) / 3.0
 }
 
+/// The cell in front of face `face` of the block at `b`, and for each of the face's corners
+/// (u0, v0), (u1, v0), (u0, v1), (u1, v1) the cells around it in front of the face: the two
+/// sides (along U, along V) and the diagonal, what ambient occlusion and smooth light read.
+fn corner_cells(b: [i64; 3], face: Face) -> ([i64; 3], [[[i64; 3]; 3]; 4]) {
+    let axis = face.axis();
+    let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
+    let n = face.normal();
+    let front = [0, 1, 2].map(|a| b[a] + i64::from(n[a]));
+    let corners = [(-1, -1), (1, -1), (-1, 1), (1, 1)].map(|(du, dv)| {
+        let mut s1 = front;
+        s1[ua] += du;
+        let mut s2 = front;
+        s2[va] += dv;
+        let mut c = s1;
+        c[va] += dv;
+        [s1, s2, c]
+    });
+    (front, corners)
+}
+
 /// Whether the renderer splits a face of corner AO values `v` (in the order of
 /// [`RayMarcher::ao_values`]) along the diagonal (1,0)-(0,1): where those corners are
 /// brighter in sum (`quad_vertex` in `common.wgsl`).
@@ -122,25 +142,14 @@ impl RayMarcher {
     /// The AO values (3 open .. 0) of the corners (u0, v0), (u1, v0), (u0, v1), (u1, v1) of
     /// face `face` of the block at `b`.
     pub(super) fn ao_values(&self, b: [i64; 3], face: Face) -> [u8; 4] {
-        let axis = face.axis();
-        let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
-        let n = face.normal();
-        let front = [0, 1, 2].map(|a| b[a] + i64::from(n[a]));
-        let value = |du: i64, dv: i64| -> u8 {
-            let mut s1 = front;
-            s1[ua] += du;
-            let mut s2 = front;
-            s2[va] += dv;
-            let mut c = s1;
-            c[va] += dv;
+        corner_cells(b, face).1.map(|[s1, s2, c]| {
             let (s1, s2, c) = (self.opaque(s1), self.opaque(s2), self.opaque(c));
             if s1 && s2 {
                 0
             } else {
                 3 - u8::from(s1) - u8::from(s2) - u8::from(c)
             }
-        };
-        [value(-1, -1), value(1, -1), value(-1, 1), value(1, 1)]
+        })
     }
 
     /// The light of the corners (u0, v0), (u1, v0), (u0, v1), (u1, v1) of face `face` of the
@@ -156,10 +165,7 @@ impl RayMarcher {
         face: Face,
         id: BlockId,
     ) -> [[u16; 6]; 4] {
-        let axis = face.axis();
-        let (ua, va) = ((axis + 1) % 3, (axis + 2) % 3);
-        let n = face.normal();
-        let front = [0, 1, 2].map(|a| b[a] + i64::from(n[a]));
+        let (front, corners) = corner_cells(b, face);
         let counted = |p: [i64; 3]| -> Option<[u16; 6]> {
             if self.opaque(p) {
                 return None;
@@ -173,13 +179,7 @@ impl RayMarcher {
         if self.class(id) == RenderClass::Translucent {
             return [counted(front).unwrap_or([0; 6]); 4];
         }
-        [(-1, -1), (1, -1), (-1, 1), (1, 1)].map(|(du, dv)| {
-            let mut s1 = front;
-            s1[ua] += du;
-            let mut s2 = front;
-            s2[va] += dv;
-            let mut c = s1;
-            c[va] += dv;
+        corners.map(|[s1, s2, c]| {
             let walled = self.opaque(s1) && self.opaque(s2);
             let cells = [Some(front), Some(s1), Some(s2), (!walled).then_some(c)];
             let lit: Vec<[u16; 6]> = cells.into_iter().flatten().filter_map(counted).collect();
