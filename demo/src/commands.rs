@@ -245,12 +245,20 @@ pub(crate) fn render(a: RenderArgs, device: &headless::Device) -> Result<()> {
     Ok(())
 }
 
+/// The `scenes/` folder: the working directory's, else the repository's.
+fn scenes_dir() -> PathBuf {
+    let local = PathBuf::from("scenes");
+    if local.is_dir() {
+        local
+    } else {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")
+    }
+}
+
 /// The scene files named on the command line (files or folders), or the `scenes/` folder.
 pub(crate) fn scene_paths(given: &[PathBuf]) -> Result<Vec<PathBuf>> {
     let given: Vec<PathBuf> = if given.is_empty() {
-        let local = PathBuf::from("scenes");
-        let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
-        vec![if local.is_dir() { local } else { repo }]
+        vec![scenes_dir()]
     } else {
         given.to_vec()
     };
@@ -607,13 +615,7 @@ pub(crate) fn showcase(a: ShowcaseArgs, device: &headless::Device) -> Result<()>
         println!("{line}");
     }
     // Light through stained glass (docs/light.md): the cathedral window scene, lit.
-    let local = PathBuf::from("scenes/light/cathedral.toml");
-    let light_scene = if local.is_file() {
-        local
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/light/cathedral.toml")
-    };
-    let lit = scene::Scene::load(&light_scene)?;
+    let lit = scene::Scene::load(&scenes_dir().join("light/cathedral.toml"))?;
     let mut lit_renderer = headless::renderer_for(&ctx, &lit, config)?;
     let img = headless::render_image(&ctx, &mut lit_renderer, &target, &lit.cameras[0])?;
     let path = a.out.join("light.png");

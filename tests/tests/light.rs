@@ -12,7 +12,7 @@ use glam::DVec3;
 use voxel_core::blocks::{GLASS, RED_GLASS, STONE};
 use voxel_core::light_blocks::TORCH;
 use voxel_core::{BlockId, BlockRegistry, LightField, World, WorldPos};
-use voxel_mesh::{mesh_chunks, mesh_chunks_lit, mesh_dirty_lit};
+use voxel_mesh::{mesh_dirty_lit, mesh_world};
 use voxel_render::{
     Camera, GpuContext, Image, Lighting, QuadFetch, Renderer, RendererConfig, Technique,
 };
@@ -39,13 +39,8 @@ fn room(roof: BlockId) -> World {
 /// field lit from scratch (`lit`) or without light.
 fn renderer(ctx: &GpuContext, world: &World, config: RendererConfig, lit: bool) -> Renderer {
     let mut r = Renderer::new(ctx, world.registry(), config).unwrap();
-    let positions: Vec<_> = world.iter().map(|(p, _)| p).collect();
-    let meshes = if lit {
-        mesh_chunks_lit(world, &LightField::new(world), &positions)
-    } else {
-        mesh_chunks(world, &positions)
-    };
-    for (pos, m) in meshes.unwrap() {
+    let field = lit.then(|| LightField::new(world));
+    for (pos, m) in mesh_world(world, field.as_ref()).unwrap() {
         r.upload_chunk(pos, &m).unwrap();
     }
     r

@@ -2,7 +2,6 @@
 
 use crate::{Error, Result};
 
-use voxel_mesh::mesh_chunks;
 use voxel_render::{
     Camera, FrameStats, GpuContext, Image, LimitsPreset, NoGame, Renderer, RendererConfig, readback,
 };
@@ -164,14 +163,10 @@ pub fn renderer_for(
     config: RendererConfig,
 ) -> Result<SceneRenderer> {
     let mut renderer = Renderer::new(ctx, scene.world.registry(), config)?;
-    let positions: Vec<_> = scene.world.iter().map(|(p, _)| p).collect();
-    let meshes = if scene.light {
-        let light = voxel_core::LightField::new(&scene.world);
-        voxel_mesh::mesh_chunks_lit(&scene.world, &light, &positions)?
-    } else {
-        mesh_chunks(&scene.world, &positions)?
-    };
-    for (pos, meshes) in meshes {
+    let light = scene
+        .light
+        .then(|| voxel_core::LightField::new(&scene.world));
+    for (pos, meshes) in voxel_mesh::mesh_world(&scene.world, light.as_ref())? {
         renderer.upload_chunk(pos, &meshes)?;
     }
     // The lab builds its content's pipelines when it renders (`render_and_submit`), so that

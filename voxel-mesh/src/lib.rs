@@ -29,7 +29,7 @@ pub use light::{LightStreams, PackedLight, QuadLight};
 pub use mesher::{ChunkMeshes, MeshOptions, Mesher, Neighbours};
 pub use quad::{FLAG_INTERFACE, PackedQuad, Quad, UV_AXES};
 pub use voxel_core::Neighbourhood;
-pub use world::{mesh_chunks, mesh_chunks_lit, mesh_dirty, mesh_dirty_lit};
+pub use world::{mesh_chunks, mesh_chunks_lit, mesh_dirty, mesh_dirty_lit, mesh_world};
 
 use voxel_core::BlockId;
 

@@ -23,6 +23,16 @@ pub fn mesh_chunks_lit(
     mesh_positions(world, Some(light), positions)
 }
 
+/// Every loaded chunk of `world` meshed, with the light of `light` when given: what a
+/// whole scene uploads ([`mesh_chunks`], [`mesh_chunks_lit`]).
+pub fn mesh_world(
+    world: &World,
+    light: Option<&LightField>,
+) -> Result<Vec<(ChunkPos, ChunkMeshes)>> {
+    let positions: Vec<_> = world.iter().map(|(p, _)| p).collect();
+    mesh_positions(world, light, &positions)
+}
+
 fn mesh_positions(
     world: &World,
     light: Option<&LightField>,

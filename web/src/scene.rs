@@ -49,13 +49,8 @@ pub fn default_scene(seed: u32, radius: i32) -> Result<DefaultScene> {
 /// (`docs/light.md`) when `light`: what the page uploads, and what the browser test draws
 /// natively to compare.
 pub fn mesh_world(world: &World, light: bool) -> Result<Vec<(ChunkPos, ChunkMeshes)>> {
-    let positions: Vec<_> = world.iter().map(|(p, _)| p).collect();
-    let meshes = if light {
-        voxel_mesh::mesh_chunks_lit(world, &LightField::new(world), &positions)
-    } else {
-        voxel_mesh::mesh_chunks(world, &positions)
-    };
-    Ok(meshes?)
+    let field = light.then(|| LightField::new(world));
+    Ok(voxel_mesh::mesh_world(world, field.as_ref())?)
 }
 
 #[cfg(all(test, not(target_arch = "wasm32")))]

@@ -24,8 +24,9 @@ pub(crate) struct Palettes {
     store: Store,
     alloc: Allocator,
     data: Vec<PackedLight>,
-    /// The most entries the device binds.
+    /// The most entries the device binds, and the limit that sets it.
     max_entries: u32,
+    limit_name: &'static str,
 }
 
 /// Where the palettes lie on the GPU.
@@ -41,9 +42,15 @@ impl Palettes {
     /// Room for [`FIRST_ENTRIES`], as `fetch` reads them.
     pub(crate) fn new(ctx: &GpuContext, fetch: QuadFetch) -> Self {
         let l = &ctx.caps.limits;
-        let max = match fetch {
-            QuadFetch::Storage => l.max_storage_buffer_binding_size / QUAD_BYTES,
-            QuadFetch::Instanced => u64::from(TABLE_WIDTH) * u64::from(l.max_texture_dimension_2d),
+        let (max, limit_name) = match fetch {
+            QuadFetch::Storage => (
+                l.max_storage_buffer_binding_size / QUAD_BYTES,
+                "max_storage_buffer_binding_size (in 8-byte entries)",
+            ),
+            QuadFetch::Instanced => (
+                u64::from(TABLE_WIDTH) * u64::from(l.max_texture_dimension_2d),
+                "256 × max_texture_dimension_2d (entries of the palette table)",
+            ),
         };
         let max_entries = max.min(u64::from(u32::MAX)) as u32;
         let first = FIRST_ENTRIES.min(max_entries.max(1));
@@ -52,6 +59,7 @@ impl Palettes {
             alloc: Allocator::new(first),
             data: vec![PackedLight::default(); first as usize],
             max_entries,
+            limit_name,
         }
     }
 
@@ -98,15 +106,15 @@ impl Palettes {
         }
     }
 
-    /// Places `palette` and writes it (at the next submit); returns its base and whether the
-    /// buffer was replaced by a larger one (bind groups over it must be remade). An error
-    /// when the device's storage binding cannot hold it or the device cannot make the
-    /// buffer; nothing changed then.
+    /// Places `palette` and writes it (at the next submit); returns where it lies (base and
+    /// entries, what [`Palettes::free`] takes) and whether the store was replaced by a
+    /// larger one (bind groups over it must be remade). An error when the device's binding
+    /// cannot hold it or the device cannot make the store; nothing changed then.
     pub(crate) fn alloc(
         &mut self,
         ctx: &GpuContext,
         palette: &[PackedLight],
-    ) -> Result<(u32, bool)> {
+    ) -> Result<((u32, u32), bool)> {
         let n = u32::try_from(palette.len().max(1)).unwrap_or(u32::MAX);
         let mut grew = false;
         let base = match self.alloc.alloc(n) {
@@ -118,7 +126,7 @@ impl Palettes {
                     return Err(Error::TooLarge {
                         what: "the light palettes of the chunks, in 8-byte entries,".into(),
                         value: u64::from(self.alloc.used()) + u64::from(n),
-                        limit_name: "max_storage_buffer_binding_size (in 8-byte entries)",
+                        limit_name: self.limit_name,
                         limit: u64::from(self.max_entries),
                     });
                 }
@@ -143,12 +151,12 @@ impl Palettes {
         } else {
             self.upload(&ctx.queue, b, palette.len());
         }
-        Ok((base, grew))
+        Ok(((base, n), grew))
     }
 
     /// Gives back a palette placed at `base` of `len` entries.
     pub(crate) fn free(&mut self, base: u32, len: u32) {
-        self.alloc.free(base, len.max(1));
+        self.alloc.free(base, len);
     }
 }
 

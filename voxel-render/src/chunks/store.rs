@@ -474,8 +474,7 @@ impl ChunkStore {
                 )));
             }
         }
-        let (base, grew) = self.palettes.alloc(ctx, &streams.palette)?;
-        let len = streams.palette.len().max(1) as u32;
+        let ((base, len), grew) = self.palettes.alloc(ctx, &streams.palette)?;
         match self.arena.enable_light(&ctx.device) {
             Ok(changed) => {
                 if changed || grew {
