@@ -142,11 +142,16 @@ pub(crate) fn render(a: RenderArgs, device: &headless::Device) -> Result<()> {
         None => scene::default_scene(a.seed)?,
     };
     scene.light |= a.light;
+    scene.sun_shadows &= !a.no_sun_shadows;
     println!(
         "scene: {} ({} chunks{}) built in {:.0} ms",
         scene.name,
         scene.world.len(),
-        if scene.light { ", lit" } else { "" },
+        match (scene.light, scene.sun_shadows) {
+            (false, _) => "",
+            (true, false) => ", lit",
+            (true, true) => ", lit, sun shadows",
+        },
         t.elapsed().as_secs_f64() * 1e3
     );
     let ctx = device.context()?;
@@ -161,6 +166,12 @@ pub(crate) fn render(a: RenderArgs, device: &headless::Device) -> Result<()> {
             .collect::<Vec<_>>()
             .join(", ")
     );
+    if let Some(r) = renderer.sun_region() {
+        println!(
+            "sun shadows over {} x {} x {} chunks from chunk ({}, {}, {})",
+            r.chunks[0], r.chunks[1], r.chunks[2], r.min.x, r.min.y, r.min.z
+        );
+    }
     let target = headless::Offscreen::new(&ctx, width, height);
     let camera = scene.cameras[0];
     let frames = a.frames as usize;

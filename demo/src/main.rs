@@ -415,6 +415,10 @@ struct RenderArgs {
     /// does.
     #[arg(long)]
     light: bool,
+    /// With light: no sun shadows (the sky light stands for the sun's; docs/light.md),
+    /// as a scene file's `sun_shadows = false` does.
+    #[arg(long)]
+    no_sun_shadows: bool,
     /// How quads reach the vertex shader: storage or instanced (default: the first the
     /// device can).
     #[arg(long, value_parser = quad_fetch)]

@@ -18,6 +18,7 @@ const RENDER: &[&str] = &[
     "timing",
     "cost",
     "fetch",
+    "sun",
     "gpu",
     "bindings",
     "textures",

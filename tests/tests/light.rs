@@ -11,10 +11,11 @@ use std::sync::Arc;
 use glam::DVec3;
 use voxel_core::blocks::{GLASS, RED_GLASS, STONE};
 use voxel_core::light_blocks::TORCH;
-use voxel_core::{BlockId, BlockRegistry, LightField, World, WorldPos};
+use voxel_core::{BlockId, BlockRegistry, LightField, SunFilters, SunMarch, World, WorldPos};
 use voxel_mesh::{mesh_dirty_lit, mesh_world};
 use voxel_render::{
-    Camera, GpuContext, Image, Lighting, QuadFetch, Renderer, RendererConfig, Technique,
+    Camera, GpuContext, Image, Lighting, MAX_SUN_CHUNKS, QuadFetch, Renderer, RendererConfig,
+    SunRegion, Technique,
 };
 
 use tests::*;
@@ -389,7 +390,10 @@ fn lit_scenes_agree_with_the_ray_march() {
         let scene = voxel_lab::scene::Scene::load(&file).unwrap();
         assert!(scene.light, "{}: a light scene", scene.name);
         let field = Arc::new(LightField::new(&scene.world));
-        let marcher = RayMarcher::with_content(&scene.world, &scene.content).with_light(field);
+        let mut marcher = RayMarcher::with_content(&scene.world, &scene.content).with_light(field);
+        if voxel_lab::headless::sun_region(&scene).is_some() {
+            marcher = marcher.with_sun_shadows(scene.world.registry());
+        }
         let camera = scene.cameras[0];
         for hour in [12.0, 0.0] {
             let l = Lighting::daytime(hour);
@@ -455,4 +459,241 @@ fn mean_error(a: &Image, b: &Image) -> f64 {
         .map(|(p, q)| (0..3).map(|i| u64::from(p[i].abs_diff(q[i]))).sum::<u64>())
         .sum();
     sum as f64 / (a.rgba.len() / 4 * 3) as f64
+}
+
+/// The sun in +x, rising two blocks a block: lit pictures with sun shadows.
+const SUN: [f32; 3] = [1.0, 2.0, 0.0];
+
+fn slanted_sun(technique: Technique) -> RendererConfig {
+    RendererConfig {
+        sun_dir: SUN,
+        ..config(technique)
+    }
+}
+
+/// `renderer` with sun shadows over all of `world`.
+fn shadowed(ctx: &GpuContext, world: &World, config: RendererConfig) -> Renderer {
+    let mut r = renderer(ctx, world, config, true);
+    let region = SunRegion::around(world, WorldPos::new(0, 0, 0)).unwrap();
+    r.set_sun_shadows(world, region).unwrap();
+    assert_eq!(r.sun_region(), Some(region));
+    r
+}
+
+/// What a floor pixel drawn without sun shadows (`off`, sRGB) becomes with them, the sun's
+/// share of the light reaching it `t` (linear), its sky level `sky` (of 255): without, the
+/// sky light scales the ambient and the sun's share alike; with, the sun's share is `t`.
+fn with_sun(off: [u8; 4], sky: [u8; 3], t: [f32; 3], c: &RendererConfig) -> [f32; 3] {
+    let n_dot_l = glam::Vec3::from(c.sun_dir).normalize().y;
+    let a = c.ambient;
+    std::array::from_fn(|ch| {
+        let s = f32::from(sky[ch]) / 255.0;
+        let was = s * (a + (1.0 - a) * n_dot_l);
+        let now = a * s + (1.0 - a) * n_dot_l * t[ch];
+        to_srgb(to_linear(off[ch]) * now / was)
+    })
+}
+
+/// Sun shadows through a red pane in the roof. The sun slanted: its light falls through the
+/// pane onto the floor along its ray, three blocks in -x of the pane's foot, tinted by the
+/// pane's filter (the CPU twin `SunMarch` gives the filter there), and under the pane the
+/// roof's stone now hides the sun. The sun straight up: the patch lies under the pane. In
+/// every technique each floor pixel is what the same pixel drawn without shadows (the sky
+/// light standing for the sun's) becomes with the sun's share replaced (`with_sun`), within
+/// 2/255.
+#[test]
+fn the_sun_through_a_red_pane_throws_a_red_patch_along_its_ray() {
+    let Some(ctx) = gpu() else { return };
+    let world = room(RED_GLASS);
+    let light = LightField::new(&world);
+    let march = SunMarch::new(&world);
+    let red = SunFilters::new(world.registry())
+        .get(RED_GLASS)
+        .unwrap()
+        .enter;
+    let camera = floor_camera();
+    let dir_out = out_dir("light");
+    // From the floor's top (y = 1) the slanted ray reaches the roof (y = 7) 3 blocks on in
+    // +x: the pane over x 4 to 6 lights the floor over x 1 to 3.
+    for (sun, patch, hidden) in [(SUN, (2, 5), (5, 5)), ([0.0, 1.0, 0.0], (5, 5), (2, 5))] {
+        let t = |(x, z): (i32, i32)| {
+            let from = [f64::from(x) + 0.5, 1.001, f64::from(z) + 0.5];
+            march.transmittance(from, sun.map(f64::from))
+        };
+        assert_eq!(
+            t(patch),
+            red,
+            "{sun:?}: the ray from the patch crosses the pane"
+        );
+        assert_eq!(
+            t(hidden),
+            [0.0; 3],
+            "{sun:?}: the ray meets the roof's stone"
+        );
+        for technique in Technique::ALL {
+            let c = RendererConfig {
+                sun_dir: sun,
+                ..config(technique)
+            };
+            let off = render_frame(&ctx, &world, c.clone(), true, &camera);
+            let mut r = shadowed(&ctx, &world, c.clone());
+            let on = frame(&ctx, &mut r, &camera);
+            on.save_png(&dir_out.join(format!("sun_{}_{}.png", sun[0], technique.name())))
+                .unwrap();
+            for (x, z) in [patch, hidden] {
+                let sky = light.get(WorldPos::new(x, 1, z)).unwrap().sky;
+                let want = with_sun(floor_pixel(&off, &camera, x, z), sky, t((x, z)), &c);
+                let got = floor_pixel(&on, &camera, x, z);
+                for ch in 0..3 {
+                    assert!(
+                        (f32::from(got[ch]) - want[ch]).abs() <= 2.0,
+                        "{} {sun:?}: floor ({x}, {z}) with sun shadows {got:?}, want {want:?}",
+                        technique.name()
+                    );
+                }
+            }
+            let p = floor_pixel(&on, &camera, patch.0, patch.1);
+            assert!(
+                p[0] > p[1] + 15 && p[0] > p[2] + 15,
+                "{} {sun:?}: the patch is red: {p:?}",
+                technique.name()
+            );
+        }
+    }
+}
+
+/// A stone pillar placed on open ground casts its shadow in the next frame once the edited
+/// chunks are read again (`Renderer::update_sun_shadows`), and the shadow is gone once the
+/// pillar is removed: the picture is the one before, bit for bit.
+#[test]
+fn an_edit_casts_its_shadow_in_the_next_frame() {
+    let Some(ctx) = gpu() else { return };
+    let mut world = World::new(Arc::new(BlockRegistry::with_lights()));
+    voxel_lab::scene::fill_box(&mut world, [-20, -2, -20], [20, 0, 20], STONE).unwrap();
+    let mut light = LightField::new(&world);
+    let camera = Camera::look_at(
+        DVec3::new(-3.5, 9.0, 8.0),
+        DVec3::new(-3.5, 0.0, 0.5),
+        60.0,
+        0.1,
+        200.0,
+    )
+    .unwrap();
+    let mut r = shadowed(&ctx, &world, slanted_sun(Technique::SortedQuads));
+    let before = frame(&ctx, &mut r, &camera);
+    let mut edit = |world: &mut World, light: &mut LightField, id| {
+        for y in 1..=4 {
+            world
+                .set_block_lit(light, WorldPos::new(0, y, 0), id)
+                .unwrap();
+        }
+        let meshes = mesh_dirty_lit(world, light).unwrap();
+        for (pos, m) in &meshes {
+            r.upload_chunk(*pos, m).unwrap();
+        }
+        let chunks: Vec<_> = meshes.iter().map(|(p, _)| *p).collect();
+        r.update_sun_shadows(world, &chunks);
+        frame(&ctx, &mut r, &camera)
+    };
+    let placed = edit(&mut world, &mut light, STONE);
+    placed
+        .save_png(&out_dir("light").join("sun_pillar.png"))
+        .unwrap();
+    // The sun rises two blocks a block: the pillar, 4 high, shades the ground 2 blocks in -x
+    // of it; the ground at x = -1 lies in its shadow, x = -5 does not.
+    let ground = |img: &Image, x| floor_pixel_world(img, &camera, [x, 0, 0]);
+    let (b, p) = (ground(&before, -1), ground(&placed, -1));
+    assert!(p[0] + 20 < b[0], "the pillar's shadow: {p:?}, before {b:?}");
+    assert_eq!(
+        ground(&before, -5),
+        ground(&placed, -5),
+        "beyond the shadow"
+    );
+    let removed = edit(&mut world, &mut light, BlockId::AIR);
+    assert_eq!(
+        diff(&before, &removed).max,
+        0,
+        "the shadow is gone with the pillar"
+    );
+}
+
+/// A region the shadow volume cannot hold, or a world over another registry, is an error
+/// that changes nothing; sun shadows off again draw as before they were on.
+#[test]
+fn bad_sun_regions_are_errors_and_shadows_turn_off() {
+    let Some(ctx) = gpu() else { return };
+    let world = room(RED_GLASS);
+    let camera = floor_camera();
+    let c = slanted_sun(Technique::SortedQuads);
+    let mut r = renderer(&ctx, &world, c.clone(), true);
+    let off = frame(&ctx, &mut r, &camera);
+    let too_big = SunRegion {
+        min: voxel_core::ChunkPos::new(0, 0, 0),
+        chunks: [MAX_SUN_CHUNKS + 1, 1, 1],
+    };
+    let e = r.set_sun_shadows(&world, too_big).unwrap_err();
+    assert!(e.to_string().contains("chunks an axis"), "{e}");
+    let other = World::new(Arc::new(BlockRegistry::default()));
+    let region = SunRegion::around(&world, WorldPos::new(0, 0, 0)).unwrap();
+    let e = r.set_sun_shadows(&other, region).unwrap_err();
+    assert!(e.to_string().contains("registry"), "{e}");
+    assert_eq!(r.sun_region(), None);
+    assert_eq!(diff(&off, &frame(&ctx, &mut r, &camera)).max, 0);
+    r.set_sun_shadows(&world, region).unwrap();
+    assert!(
+        diff(&off, &frame(&ctx, &mut r, &camera)).max > 20,
+        "shadows drawn"
+    );
+    r.clear_sun_shadows();
+    assert_eq!(r.sun_region(), None);
+    assert_eq!(
+        diff(&off, &frame(&ctx, &mut r, &camera)).max,
+        0,
+        "and off again"
+    );
+}
+
+/// Sun shadows under the instanced fetch, WebGL2's limits and wgpu's GL backend (llvmpipe's
+/// GLES 3.2, with its own limits and WebGL2's): the same red patch and the same shade under
+/// the pane as on Vulkan, in every technique the device runs (the shadow volume is one more
+/// 3D texture in the frame's group, within WebGL2's 16 a stage).
+#[test]
+fn sun_shadows_draw_the_same_on_every_fetch_and_backend() {
+    let Some(ctx) = gpu() else { return };
+    let world = room(RED_GLASS);
+    let camera = floor_camera();
+    let shadows = |ctx: &GpuContext, c: RendererConfig| {
+        let mut r = shadowed(ctx, &world, c);
+        frame(ctx, &mut r, &camera)
+    };
+    let storage = shadows(&ctx, slanted_sun(Technique::SortedQuads));
+    let mut c = slanted_sun(Technique::SortedQuads);
+    c.quad_fetch = Some(QuadFetch::Instanced);
+    let d = diff(&shadows(&ctx, c), &storage);
+    assert_eq!(d.over_one, 0, "instanced against storage: {d:?}");
+    let Some(w2) = webgl2() else { return };
+    let d = diff(&shadows(&w2, slanted_sun(Technique::SortedQuads)), &storage);
+    assert_eq!(d.over_one, 0, "WebGL2's limits against storage: {d:?}");
+    for (name, gl) in [("gl", gl()), ("gl with WebGL2's limits", gl_webgl2())] {
+        let Some(gl) = gl else { return };
+        let mut drawn = 0;
+        for technique in Technique::supported(&gl.caps) {
+            let img = shadows(&gl, slanted_sun(technique));
+            drawn += 1;
+            for (x, z) in [(2, 5), (5, 5)] {
+                let (got, want) = (
+                    floor_pixel(&img, &camera, x, z),
+                    floor_pixel(&storage, &camera, x, z),
+                );
+                for ch in 0..3 {
+                    assert!(
+                        got[ch].abs_diff(want[ch]) <= 2,
+                        "{name}, {}: floor ({x}, {z}) is {got:?}, on Vulkan {want:?}",
+                        technique.name()
+                    );
+                }
+            }
+        }
+        assert!(drawn >= 3, "{name}: {drawn} techniques");
+    }
 }

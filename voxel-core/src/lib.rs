@@ -24,7 +24,10 @@ pub use chunk::{
     column_index, row_index,
 };
 pub use error::{Error, Result};
-pub use light::{LIGHT_FALLOFF, Light, LightChunk, LightField, LightLayer, OddCells, light_blocks};
+pub use light::{
+    LIGHT_FALLOFF, Light, LightChunk, LightField, LightLayer, OddCells, SunCell, SunFilters,
+    SunMarch, light_blocks,
+};
 pub use terrain::{
     MAX_LEVEL, Showcase, Site, SiteKind, TerrainBlocks, TerrainConfig, TerrainGenerator,
     TerrainRole, level_cell, level_origin, level_scale,

@@ -439,6 +439,9 @@ pub fn raymarch_check(
         let field = voxel_core::LightField::new(&scene.world);
         marcher = marcher.with_light(std::sync::Arc::new(field));
     }
+    if crate::headless::sun_region(scene).is_some() {
+        marcher = marcher.with_sun_shadows(scene.world.registry());
+    }
     let ray = marcher.render(&drawn, size.0, size.1, &shading);
     let seconds = start.elapsed().as_secs_f64();
     let comparison = marcher.compare(&ray, &drawn, &shading, &gpu, Some(&depth));

@@ -169,6 +169,9 @@ pub fn renderer_for(
     for (pos, meshes) in voxel_mesh::mesh_world(&scene.world, light.as_ref())? {
         renderer.upload_chunk(pos, &meshes)?;
     }
+    if let Some(region) = sun_region(scene) {
+        renderer.set_sun_shadows(&scene.world, region)?;
+    }
     // The lab builds its content's pipelines when it renders (`render_and_submit`), so that
     // its tests see the renderer refuse pipelines built for another contract.
     let content = if scene.content.is_empty() {
@@ -179,6 +182,21 @@ pub fn renderer_for(
         Some(stages)
     };
     Ok(SceneRenderer { renderer, content })
+}
+
+/// The region `scene`'s sun shadows cover: its world, or the chunks of it nearest its first
+/// camera; `None` for a scene drawn unlit or without sun shadows.
+pub fn sun_region(scene: &Scene) -> Option<voxel_render::SunRegion> {
+    let eye = scene.cameras.first().map_or([0.0; 3], |c| c.eye.to_array());
+    let eye = eye.map(|v| v.floor().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32);
+    (scene.light && scene.sun_shadows)
+        .then(|| {
+            voxel_render::SunRegion::around(
+                &scene.world,
+                voxel_core::WorldPos::new(eye[0], eye[1], eye[2]),
+            )
+        })
+        .flatten()
 }
 
 /// Renders `camera` into `target` and reads the picture back.

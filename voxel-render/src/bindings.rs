@@ -14,6 +14,11 @@ pub(crate) fn common_wgsl() -> String {
     gpu::WgslConsts::default()
         .u32("NO_MEDIUM", NO_MEDIUM)
         .u32("FLAG_INTERFACE", FLAG_INTERFACE)
+        .u32("FLAG_LIT", FLAG_LIT)
+        .u32("SUN_STOP", u32::from(crate::sun::SUN_STOP))
+        .u32("MAX_SUN_STEPS", crate::sun::MAX_SUN_STEPS)
+        .i32("SUN_TILE", crate::sun::SUN_TILE as i32)
+        .f32("SUN_NUDGE", crate::sun::SUN_NUDGE)
         .f32("AO_DEPTH", AO_DEPTH)
         .f32("OPAQUE_EXPANSION_PX", OPAQUE_EXPANSION_PX)
         .f32("MAX_GROWTH", MAX_GROWTH)
@@ -111,7 +116,7 @@ pub const TONEMAP_SHOULDER: f32 = 0.8;
 
 /// Per-frame uniforms every pass uses (`Frame` in WGSL).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub(crate) struct FrameUniforms {
     /// Camera-relative view × reverse-Z projection.
     pub view_proj: [[f32; 4]; 4],
@@ -150,6 +155,19 @@ pub(crate) struct FrameUniforms {
     pub brightness: f32,
     /// The look of the medium the eye is in: linear colour and absorption, zero for none.
     pub medium_look: [f32; 4],
+    /// Sun shadows (`crate::sun`): the eye's integer part minus the shadow volume's first
+    /// block, so that a fragment's block in the volume is `pos + eye_frac + sun_offset`.
+    pub sun_offset: [i32; 3],
+    /// 1 while the renderer has sun shadows, else 0.
+    pub sun_on: u32,
+    /// The volume's size in blocks.
+    pub sun_size: [u32; 3],
+    /// Where the sun filters of class 1 start in the media table (`block_media`): two
+    /// entries a class, the filter of a cell entered from another kind, then from its own.
+    pub sun_table: u32,
+    /// Per tile of the volume (8 × 8 columns of blocks; x + 32 z): the highest cell
+    /// (volume y) holding anything but air, -1 for none.
+    pub sun_tops: crate::sun::SunTops,
 }
 
 // A record is one texel of the records' table texture (`fetch.rs`).
@@ -178,6 +196,9 @@ pub(crate) const NO_MEDIUM: u32 = u32::MAX;
 /// Quad flag (bit 16 of word 1 of a [`voxel_mesh::PackedQuad`]): a translucent face toward
 /// another translucent type (`FLAG_INTERFACE` in WGSL).
 pub(crate) const FLAG_INTERFACE: u32 = 1;
+/// `VsOut::flags` bit set by the vertex stage for a quad of a lit chunk (above the 16 bits
+/// the quad's word 1 gives it).
+pub(crate) const FLAG_LIT: u32 = 1 << 16;
 
 /// A chunk's record in the records array, by slot (`ChunkInfo` in WGSL).
 #[repr(C)]
@@ -249,6 +270,17 @@ impl SharedLayouts {
             gpu::texture_entry(12, gpu::DEPTH_READ),
             gpu::texture_entry(13, gpu::DEPTH_READ),
             gpu::texture_entry(14, wgpu::TextureSampleType::Float { filterable: false }),
+            // What the sun's ray crosses in each cell of the shadow volume (`sun.rs`).
+            wgpu::BindGroupLayoutEntry {
+                binding: 15,
+                visibility: S::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
+                    view_dimension: wgpu::TextureViewDimension::D3,
+                    multisampled: false,
+                },
+                count: None,
+            },
         ];
         // Group 0's block layers (read where the quad is expanded) and group 1, as
         // `common.wgsl` declares them for each way of fetching quads.
@@ -319,6 +351,11 @@ mod tests {
                 field!(FrameUniforms, volumes),
                 field!(FrameUniforms, brightness),
                 field!(FrameUniforms, medium_look),
+                field!(FrameUniforms, sun_offset),
+                field!(FrameUniforms, sun_on),
+                field!(FrameUniforms, sun_size),
+                field!(FrameUniforms, sun_table),
+                field!(FrameUniforms, sun_tops),
             ],
         );
         let tonemap = include_str!("shaders/tonemap.wgsl");

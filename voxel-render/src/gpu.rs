@@ -72,6 +72,12 @@ impl WgslConsts {
         self
     }
 
+    /// An `i32` constant.
+    pub(crate) fn i32(mut self, name: &str, value: i32) -> Self {
+        self.0 += &format!("const {name}: i32 = {value}i;\n");
+        self
+    }
+
     /// An `f32` constant.
     pub(crate) fn f32(mut self, name: &str, value: f32) -> Self {
         self.0 += &format!("const {name}: f32 = {value:?};\n");

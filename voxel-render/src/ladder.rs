@@ -185,7 +185,7 @@ pub fn check(what: &str, needs: &[Need], caps: &Capabilities) -> Result<()> {
 pub(crate) fn world_needs() -> Vec<Need> {
     vec![
         Need::BlendableTarget(crate::SCENE_FORMAT),
-        Need::Limit(Limit::InterStageShaderVariables, 10),
+        Need::Limit(Limit::InterStageShaderVariables, 11),
         Need::ShaderBindings,
     ]
 }

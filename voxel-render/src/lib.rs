@@ -28,7 +28,8 @@
 //!
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `ladder`
 //! (what each pass needs of a device), `camera`, `readback`, `submission`, `timing`,
-//! `cost` (what a frame asks of the GPU, counted), `fetch` (how quads reach the vertex shader) → `gpu` (pass and pipeline plumbing) →
+//! `cost` (what a frame asks of the GPU, counted), `fetch` (how quads reach the vertex shader),
+//! `sun` (the sun shadows' volume) → `gpu` (pass and pipeline plumbing) →
 //! `bindings` (what every chunk pipeline binds), `textures`, `arena` (the quad arena),
 //! `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
 //! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` →
@@ -60,6 +61,7 @@ mod renderer;
 pub mod stages;
 mod stream;
 mod submission;
+mod sun;
 pub mod textures;
 mod timing;
 #[cfg(test)]
@@ -90,6 +92,7 @@ pub use stream::{
     ChunkStreamer, config::StreamConfig, schedule::StreamFrame, source::ChunkSink,
     source::ChunkSource,
 };
+pub use sun::{MAX_SUN_CHUNKS, SunRegion};
 pub use timing::{GpuPass, GpuTimes};
 
 /// Depth format of every pass: 32-bit float, reverse-Z (1 near, 0 far).

@@ -21,6 +21,7 @@ pub use crate::oit::{
 };
 pub use crate::renderer::ChunkMemory;
 pub use crate::stream::{config::MAX_VIEW_DISTANCE, edits::EDIT_BYTES, edits::EDITED_CHUNK_BYTES};
+pub use crate::sun::SUN_NUDGE;
 
 /// The chunks `renderer` holds on the GPU (the store's meshes, their places in the arena and
 /// their generations).

@@ -229,6 +229,7 @@ pub(crate) fn renderer(
     for (pos, m) in meshes {
         r.upload_chunk(*pos, m)?;
     }
+    crate::scene::sun_shadows(&mut r, world, meshes)?;
     Ok(r)
 }
 

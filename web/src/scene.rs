@@ -4,7 +4,7 @@
 //! not build for a browser.
 
 use glam::DVec3;
-use voxel_core::{ChunkPos, LightField, TerrainConfig, TerrainGenerator, World};
+use voxel_core::{ChunkPos, LightField, TerrainConfig, TerrainGenerator, World, WorldPos};
 use voxel_mesh::ChunkMeshes;
 use voxel_render::Camera;
 
@@ -51,6 +51,31 @@ pub fn default_scene(seed: u32, radius: i32) -> Result<DefaultScene> {
 pub fn mesh_world(world: &World, light: bool) -> Result<Vec<(ChunkPos, ChunkMeshes)>> {
     let field = light.then(|| LightField::new(world));
     Ok(voxel_mesh::mesh_world(world, field.as_ref())?)
+}
+
+/// Sun shadows (`docs/light.md`) over the chunks of `world` nearest its middle, when
+/// `meshes` are lit: what the page draws, and the browser test natively.
+pub fn sun_shadows(
+    renderer: &mut voxel_render::Renderer,
+    world: &World,
+    meshes: &[(ChunkPos, ChunkMeshes)],
+) -> voxel_render::Result<()> {
+    if meshes.iter().all(|(_, m)| m.light.is_empty()) || world.is_empty() {
+        return Ok(());
+    }
+    let n = world.len() as i64;
+    let sum = world.iter().fold([0i64; 3], |s, (p, _)| {
+        [
+            s[0] + i64::from(p.x),
+            s[1] + i64::from(p.y),
+            s[2] + i64::from(p.z),
+        ]
+    });
+    let middle = sum.map(|v| (v / n * voxel_core::CHUNK_SIZE as i64) as i32);
+    match voxel_render::SunRegion::around(world, WorldPos::new(middle[0], middle[1], middle[2])) {
+        Some(region) => renderer.set_sun_shadows(world, region),
+        None => Ok(()),
+    }
 }
 
 #[cfg(all(test, not(target_arch = "wasm32")))]

@@ -106,9 +106,10 @@ fn native(ctx: &GpuContext, technique: Technique, single: bool) -> Image {
     };
     let mut r = Renderer::new(ctx, scene.world.registry(), config).unwrap();
     let meshes = voxel_web::scene::mesh_world(&scene.world, TEST_LIGHT).unwrap();
-    for (pos, meshes) in meshes {
-        r.upload_chunk(pos, &meshes).unwrap();
+    for (pos, meshes) in &meshes {
+        r.upload_chunk(*pos, meshes).unwrap();
     }
+    voxel_web::scene::sun_shadows(&mut r, &scene.world, &meshes).unwrap();
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let target = stages::target(&ctx.device, "native", format, usage, (w, h));

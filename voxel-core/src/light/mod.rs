@@ -56,6 +56,7 @@ mod edit;
 mod engine;
 mod props;
 mod store;
+mod sun;
 #[cfg(test)]
 mod tests;
 
@@ -63,6 +64,7 @@ use std::collections::{BTreeSet, HashMap, HashSet};
 use std::sync::Arc;
 
 pub use store::{Light, LightChunk, LightLayer, OddCells};
+pub use sun::{SunCell, SunFilters, SunMarch};
 
 use crate::{BlockDef, BlockId, BlockRegistry, ChunkPos, Error, Result, World, WorldPos};
 use engine::Entry;

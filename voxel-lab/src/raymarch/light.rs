@@ -63,6 +63,25 @@ impl RayMarcher {
                 })
             }
         };
+        // Sun shadows: the sky light lights the ambient share, the sun's own light what
+        // reaches the point along its ray.
+        let n = DVec3::from(n.map(f64::from));
+        let n_dot_l = n.dot(light.sun).max(0.0);
+        if let (Some(_), Some(sun), true) = (&self.light, &self.sun, n_dot_l > 0.0) {
+            let from = p + n * f64::from(voxel_render::low_level::SUN_NUDGE);
+            let t = sun.march(
+                self.bounds,
+                |c| self.get(c),
+                from.to_array(),
+                light.sun.to_array(),
+            );
+            return std::array::from_fn(|ch| {
+                let sky = light.brightness
+                    * (light.ambient * levels[ch]
+                        + (1.0 - light.ambient) * n_dot_l * f64::from(t[ch]));
+                a[ch] * sky.max(levels[ch + 3]) * shade
+            });
+        }
         std::array::from_fn(|ch| a[ch] * (levels[ch] * sky).max(levels[ch + 3]) * shade)
     }
 }

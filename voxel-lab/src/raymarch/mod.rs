@@ -170,6 +170,8 @@ pub struct RayMarcher {
     content: Content,
     /// The world's light field, when it is drawn lit ([`RayMarcher::with_light`]).
     light: Option<Arc<voxel_core::LightField>>,
+    /// With sun shadows ([`RayMarcher::with_sun_shadows`]): the blocks' sun filters.
+    sun: Option<voxel_core::SunFilters>,
 }
 
 impl RayMarcher {
@@ -235,6 +237,7 @@ impl RayMarcher {
                 .collect(),
             content: Content::default(),
             light: None,
+            sun: None,
         }
     }
 
@@ -246,6 +249,17 @@ impl RayMarcher {
     pub fn with_light(self, light: Arc<voxel_core::LightField>) -> Self {
         Self {
             light: Some(light),
+            ..self
+        }
+    }
+
+    /// With sun shadows (`Renderer::set_sun_shadows`, on a lit world): the sun's share of
+    /// a lit face's light is what reaches the point along the ray toward the sun, marched
+    /// through the world's blocks by [`voxel_core::SunFilters::march`] from the point moved
+    /// a thousandth of a block along the face's normal, instead of the sky light.
+    pub fn with_sun_shadows(self, registry: &voxel_core::BlockRegistry) -> Self {
+        Self {
+            sun: Some(voxel_core::SunFilters::new(registry)),
             ..self
         }
     }

@@ -6,6 +6,10 @@ use toml::Spanned;
 use super::blocks::BlockDefFile;
 use super::fields::{exact, exact_opt};
 
+fn yes() -> bool {
+    true
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct SceneFile {
@@ -17,6 +21,10 @@ pub(super) struct SceneFile {
     /// may then name. Default false: drawn unlit.
     #[serde(default)]
     pub(super) light: bool,
+    /// With `light`: whether the sun casts shadows (`Renderer::set_sun_shadows`). Default
+    /// true.
+    #[serde(default = "yes")]
+    pub(super) sun_shadows: bool,
     pub(super) size: Option<Spanned<Vec<u32>>>,
     pub(super) terrain: Option<Spanned<TerrainDef>>,
     #[serde(default)]

@@ -10,6 +10,7 @@
 //! size = [640, 360]                 # output size when the command gives none
 //! light = true                     # drawn with the light field (docs/light.md); adds the
 //!                                   # blocks torch, lava and glow_glass
+//! sun_shadows = false               # with light: no sun shadows (default true)
 //!
 //! [terrain]                         # generated terrain, chunk coordinates inclusive
 //! seed = 1
@@ -116,6 +117,9 @@ pub struct Scene {
     /// Whether the world is drawn with its light field ([`voxel_core::LightField`], meshed
     /// with `Mesher::mesh_lit`); false: unlit.
     pub light: bool,
+    /// With `light`: whether the sun casts shadows over the whole world (or the chunks of
+    /// it nearest the first camera that fit: [`voxel_render::SunRegion::around`]).
+    pub sun_shadows: bool,
 }
 
 impl Scene {
@@ -132,6 +136,7 @@ impl Scene {
             size: None,
             content: Content::default(),
             light: false,
+            sun_shadows: true,
         }
     }
 
@@ -292,6 +297,7 @@ pub fn default_scene_with_radius(seed: u32, radius: i32) -> Result<Scene> {
         size: None,
         content: Content::default(),
         light: false,
+        sun_shadows: true,
     })
 }
 

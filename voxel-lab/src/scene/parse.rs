@@ -364,5 +364,6 @@ pub fn parse_in(text: &str, dir: &Path) -> Result<Scene> {
         size,
         content,
         light: file.light,
+        sun_shadows: file.sun_shadows,
     })
 }

@@ -11,7 +11,7 @@ mod tests;
 
 use std::sync::Arc;
 
-use voxel_core::{BlockRegistry, ChunkPos};
+use voxel_core::{BlockRegistry, ChunkPos, World};
 use voxel_mesh::ChunkMeshes;
 use wgpu::util::DeviceExt;
 
@@ -26,6 +26,7 @@ use crate::medium::{self, MediumLook, MediumPass};
 use crate::oit::sorted::interleave::Interleaver;
 use crate::oit::{OitConfig, OitManager, Setup, Technique, TechniqueReport};
 use crate::submission::{FrameWrites, Outcome, Submissions};
+use crate::sun::{SunRegion, SunVolume};
 use crate::textures::BlockTextures;
 use crate::timing::{GpuTimes, Timer};
 use crate::{Error, GpuContext, Result};
@@ -199,12 +200,8 @@ impl Renderer {
             t
         });
         let looks = medium::looks(registry);
-        let media = TableTexture::new(
-            device,
-            "block_media",
-            wgpu::TextureFormat::Rgba32Float,
-            looks.len(),
-        );
+        let sun = SunVolume::new(device, registry);
+        // Each block's look as a medium, then the sun filters (`sun.rs`).
         let media_data: Vec<[f32; 4]> = looks
             .iter()
             .map(|l| {
@@ -212,17 +209,26 @@ impl Renderer {
                     [l.color[0], l.color[1], l.color[2], l.absorption]
                 })
             })
+            .chain(sun.filters().iter().copied())
             .collect();
+        let media = TableTexture::new(
+            device,
+            "block_media",
+            wgpu::TextureFormat::Rgba32Float,
+            media_data.len(),
+        );
         media.write(&ctx.queue, 0, bytemuck::cast_slice(&media_data));
         let scene = SceneResources {
             frame_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("frame_uniforms"),
-                contents: bytemuck::bytes_of(&FrameUniforms::default()),
+                contents: bytemuck::bytes_of(&<FrameUniforms as bytemuck::Zeroable>::zeroed()),
                 usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             }),
             textures,
             layer_table,
             media,
+            sun_table: looks.len() as u32,
+            sun,
             depth_sampler: gpu::depth_sampler(device),
         };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
@@ -329,6 +335,45 @@ impl Renderer {
     /// Output size in pixels.
     pub fn size(&self) -> (u32, u32) {
         self.targets.size
+    }
+
+    /// Turns sun shadows on over `region` (see [`SunRegion::around`]), its cells read from
+    /// `world` now: the sun's light on the lit chunks' faces in the region is dimmed and
+    /// tinted by the blocks along its ray, per fragment, in every technique
+    /// (`docs/light.md`, "Sun shadows"). Faces outside the region, and chunks drawn unlit,
+    /// keep the sky light for the sun's. A region the adapter cannot hold (more than
+    /// [`MAX_SUN_CHUNKS`] chunks an axis, or its largest 3D texture) or a world over another
+    /// registry is an [`Error::InvalidSetting`] that changes nothing. Edits reach the
+    /// shadows through [`Renderer::update_sun_shadows`].
+    pub fn set_sun_shadows(&mut self, world: &World, region: SunRegion) -> Result<()> {
+        self.ctx.check_device()?;
+        let ctx = &self.ctx;
+        let sun = &mut self.scene.sun;
+        scoped(&ctx.device, "sun shadows", || {
+            sun.set(&ctx.device, &ctx.queue, world, region)
+        })??;
+        self.targets = self.targets_for(self.size(), self.config.msaa, self.targets.volumes);
+        Ok(())
+    }
+
+    /// Reads chunks `chunks` of `world` again into the sun shadows (the chunks an edit
+    /// changed: [`World::take_dirty`]'s, before meshing); chunks outside the region, or
+    /// without sun shadows, are skipped. An unloaded chunk reads as air.
+    pub fn update_sun_shadows(&mut self, world: &World, chunks: &[ChunkPos]) {
+        for &pos in chunks {
+            self.scene.sun.update(&self.ctx.queue, world, pos);
+        }
+    }
+
+    /// Turns sun shadows off (frees the volume).
+    pub fn clear_sun_shadows(&mut self) {
+        self.scene.sun.clear(&self.ctx.device);
+        self.targets = self.targets_for(self.size(), self.config.msaa, self.targets.volumes);
+    }
+
+    /// The region the sun shadows cover, if on.
+    pub fn sun_region(&self) -> Option<SunRegion> {
+        self.scene.sun.region()
     }
 
     /// Uploads or replaces a chunk's meshes; empty meshes remove it. A chunk that was not

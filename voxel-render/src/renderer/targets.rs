@@ -10,6 +10,7 @@ use crate::bindings::SharedLayouts;
 use crate::fetch::TableTexture;
 use crate::gpu::{self, FullscreenPipeline, Target};
 use crate::medium;
+use crate::sun::SunVolume;
 use crate::textures::BlockTextures;
 use crate::{DEPTH_FORMAT, GpuContext, SCENE_FORMAT};
 
@@ -23,6 +24,10 @@ pub(super) struct SceneResources {
     /// Per block id, its look as a medium (`block_media` in `common.wgsl`): linear colour
     /// and absorption.
     pub(super) media: TableTexture,
+    /// Where the sun filters start in `media`.
+    pub(super) sun_table: u32,
+    /// The sun shadows' volume (`sun_cells` in `common.wgsl`).
+    pub(super) sun: SunVolume,
     /// The nearest sampler every depth texture is read with (`gpu::DEPTH_READ`).
     pub(super) depth_sampler: wgpu::Sampler,
 }
@@ -268,6 +273,7 @@ impl SceneTargets {
                 (12, wgpu::BindingResource::TextureView(&far.view)),
                 (13, wgpu::BindingResource::TextureView(&entry2.0.view)),
                 (14, wgpu::BindingResource::TextureView(entry2.1)),
+                (15, wgpu::BindingResource::TextureView(&scene.sun.view)),
             ];
             let entries =
                 resources.map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });

@@ -50,6 +50,10 @@ struct ChunkInfo {
 @group(0) @binding(12) var volume_far: texture_2d<f32>;
 @group(0) @binding(13) var volume_entry2: texture_2d<f32>;
 @group(0) @binding(14) var entry2_look: texture_2d<f32>;
+// Sun shadows (`sun.rs`): per block of the shadow volume, how the sun's ray crosses it: 0
+// air, SUN_STOP a block that stops it, else a class whose filters lie in `block_media`
+// from `frame.sun_table` (`sun_transmittance`).
+@group(0) @binding(15) var sun_cells: texture_3d<u32>;
 
 // How quads and their tables reach the vertex stage (`fetch.rs`); a pipeline uses one of
 // the two, and binds only that one's resources.
@@ -99,6 +103,9 @@ struct VsOut {
     // unlit chunk.
     @location(8) sky_light: vec3<f32>,
     @location(9) block_light: vec3<f32>,
+    // Position relative to the eye's integer part minus its fraction (`frame.eye_int`,
+    // `frame.eye_frac`): what sun shadows march from.
+    @location(10) pos: vec3<f32>,
 };
 
 // The light of a quad's four corners, by corner u + 2v.
@@ -198,6 +205,7 @@ fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool, lights: Corne
     let rel = vec3<f32>(chunk.origin - frame.eye_int) + p - frame.eye_frac;
     var out: VsOut;
     out.clip = frame.view_proj * vec4<f32>(rel, 1.0);
+    out.pos = rel;
     out.shade = corner_shade(q, corner);
     let slot = u32(corner.x) + 2u * u32(corner.y);
     out.sky_light = lights.sky[slot];
@@ -219,6 +227,7 @@ fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool, lights: Corne
         offset[u_axis] = grown.x;
         offset[v_axis] = grown.y;
         out.clip += frame.view_proj * vec4<f32>(offset, 0.0);
+        out.pos += offset;
         uv += grown;
         // The shade the vertex's triangle extends to the grown corner, so that every
         // point of the quad keeps the shade it had.
@@ -250,7 +259,7 @@ fn quad_vertex(q: vec2<u32>, chunk: ChunkInfo, k: u32, grow: bool, lights: Corne
     }
     out.uv = uv;
     out.block = q.y & 0xffffu;
-    out.flags = q.y >> 16u;
+    out.flags = (q.y >> 16u) | select(0u, FLAG_LIT, chunk.lit != 0u);
     out.alpha = chunk.alpha;
     out.face = face;
     // Reverse-Z perspective: clip.w is the view depth.
@@ -385,8 +394,120 @@ fn albedo(in: VsOut) -> vec4<f32> {
 // ambient occlusion. An unlit chunk has full sky light and no block light.
 fn light(rgb: vec3<f32>, in: VsOut) -> vec3<f32> {
     let n_dot_l = max(dot(NORMALS[in.face], frame.sun_dir), 0.0);
+    if n_dot_l > 0.0 {
+        let sun = sun_transmittance(in);
+        if sun.w > 0.0 {
+            // Sun shadows: the sky light lights the ambient share, the sun's own light what
+            // reaches the fragment along its ray.
+            let sky = frame.brightness
+                * (frame.ambient * in.sky_light + (1.0 - frame.ambient) * n_dot_l * sun.xyz);
+            return rgb * max(sky, in.block_light) * in.shade;
+        }
+    }
     let sky = frame.brightness * (frame.ambient + (1.0 - frame.ambient) * n_dot_l);
     return rgb * max(in.sky_light * sky, in.block_light) * in.shade;
+}
+
+// Sun shadows (`sun.rs`, `docs/light.md`): the share of the sun's light, per channel, that
+// reaches a fragment of a lit chunk along the ray toward the sun, .w = 1; .w = 0 where it
+// is not marched (no shadow volume, an unlit chunk, a fragment outside the volume), and
+// the sky light stands for it. A voxel march (Amanatides-Woo) from the fragment's cell (the
+// cell in front of its face) to where the ray leaves the volume: each cell entered
+// multiplies by its filter (`voxel_core::SunMarch`, the CPU twin), a cell that stops the
+// sun ends it dark. Air above every block of a tile of 8 × 8 columns is crossed in one
+// step.
+fn sun_transmittance(in: VsOut) -> vec4<f32> {
+    if frame.sun_on == 0u || (in.flags & FLAG_LIT) == 0u {
+        return vec4<f32>(0.0);
+    }
+    let dir = frame.sun_dir;
+    if dir.y <= 0.0 {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    let size = vec3<i32>(frame.sun_size);
+    let o = in.pos + frame.eye_frac + vec3<f32>(frame.sun_offset) + NORMALS[in.face] * SUN_NUDGE;
+    var cell = vec3<i32>(floor(o));
+    if any(cell < vec3<i32>(0)) || any(cell >= size) {
+        return vec4<f32>(0.0);
+    }
+    let positive = dir > vec3<f32>(0.0);
+    let moving = abs(dir) > vec3<f32>(0.0);
+    let step = select(vec3<i32>(-1), vec3<i32>(1), positive);
+    let delta = select(vec3<f32>(1e30), 1.0 / abs(dir), moving);
+    var next = sun_boundaries(cell, o, dir, positive, moving);
+    var prev = textureLoad(sun_cells, cell, 0).x;
+    if prev == SUN_STOP {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    var t = vec3<f32>(1.0);
+    for (var i = 0u; i < MAX_SUN_STEPS; i++) {
+        let tile = cell.x / SUN_TILE + 32 * (cell.z / SUN_TILE);
+        if prev == 0u && cell.y > frame.sun_tops[tile / 4][tile % 4] {
+            // Nothing but air from here to where the ray leaves the tile's columns (it
+            // rises): on into the next tile.
+            let lo = vec2<f32>(vec2<i32>(cell.x, cell.z) / SUN_TILE * SUN_TILE);
+            let d = vec2<f32>(dir.x, dir.z);
+            let p = vec2<f32>(o.x, o.z);
+            let wall = select(lo, lo + f32(SUN_TILE), d > vec2<f32>(0.0));
+            let ts = select(vec2<f32>(1e30), (wall - p) / d, abs(d) > vec2<f32>(0.0));
+            if min(ts.x, ts.y) >= 1e29 {
+                // Straight up: air to the sky.
+                break;
+            }
+            if ts.x <= ts.y {
+                cell.x = select(i32(lo.x) - 1, i32(lo.x) + SUN_TILE, d.x > 0.0);
+                cell.z = i32(floor(o.z + dir.z * ts.x));
+                cell.y = i32(floor(o.y + dir.y * ts.x));
+            } else {
+                cell.z = select(i32(lo.y) - 1, i32(lo.y) + SUN_TILE, d.y > 0.0);
+                cell.x = i32(floor(o.x + dir.x * ts.y));
+                cell.y = i32(floor(o.y + dir.y * ts.y));
+            }
+            next = sun_boundaries(cell, o, dir, positive, moving);
+        } else {
+            // The axis whose boundary comes first (x, then y, then z on ties).
+            var a = 2;
+            if next.x <= next.y && next.x <= next.z {
+                a = 0;
+            } else if next.y <= next.z {
+                a = 1;
+            }
+            cell[a] += step[a];
+            next[a] += delta[a];
+        }
+        let outside = any(cell < vec3<i32>(0)) || any(cell >= size);
+        var here = 0u;
+        if !outside {
+            here = textureLoad(sun_cells, cell, 0).x;
+        }
+        if here == SUN_STOP {
+            return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        }
+        // The light enters the previous cell from this one: through its surface too when
+        // this one is of another kind.
+        if prev != 0u {
+            let entry = frame.sun_table + 2u * (prev - 1u) + select(0u, 1u, here == prev);
+            t *= textureLoad(block_media, table_texel(entry), 0).xyz;
+        }
+        if outside {
+            break;
+        }
+        prev = here;
+    }
+    return vec4<f32>(t, 1.0);
+}
+
+// Where the ray from `o` along `dir` leaves `cell` on each axis (its parameter; 1e30 on an
+// axis it does not move along).
+fn sun_boundaries(
+    cell: vec3<i32>,
+    o: vec3<f32>,
+    dir: vec3<f32>,
+    positive: vec3<bool>,
+    moving: vec3<bool>,
+) -> vec3<f32> {
+    let wall = vec3<f32>(cell) + select(vec3<f32>(0.0), vec3<f32>(1.0), positive);
+    return select(vec3<f32>(1e30), (wall - o) / dir, moving);
 }
 
 // Whether a translucent fragment counts (the model in `medium.rs`): every front face

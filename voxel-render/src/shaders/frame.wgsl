@@ -29,6 +29,15 @@ struct Frame {
     brightness: f32,
     // The look of the medium the eye is in (linear colour, absorption), or zero.
     medium_look: vec4<f32>,
+    // Sun shadows (`sun.rs`, `sun_transmittance` in common.wgsl): the eye's integer part
+    // minus the shadow volume's first block; 1 while on; the volume's size in blocks; where
+    // the sun filters start in `block_media`; per tile of 8 × 8 columns (x + 32 z) the
+    // highest cell holding anything but air (-1: none).
+    sun_offset: vec3<i32>,
+    sun_on: u32,
+    sun_size: vec3<u32>,
+    sun_table: u32,
+    sun_tops: array<vec4<i32>, 256>,
 };
 
 // The light a medium's colour is lit by, the same for the fog around the eye and for a

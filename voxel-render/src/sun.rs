@@ -1,0 +1,416 @@
+//! Sun shadows: the sun's light dimmed and tinted by the blocks along the ray toward the sun,
+//! per fragment, by a voxel march in the shaders (`sun_transmittance` in `common.wgsl`)
+//! through a volume of the world's cells around a point the game chooses
+//! (`Renderer::set_sun_shadows`). Each cell of the volume is a byte: 0 air,
+//! [`SUN_STOP`] a block that stops the sun (opaque and cutout blocks), else the class of a
+//! translucent block, whose two filters (entered from another kind, from its own) are
+//! [`voxel_core::SunFilters`]'s: the light field's filters, the colours that tint the view.
+//! The CPU twin is [`voxel_core::SunMarch`].
+
+use voxel_core::{BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, SunFilters, World, WorldPos};
+
+use crate::error::{Error, Result};
+
+/// The class of a cell that stops the sun.
+pub(crate) const SUN_STOP: u8 = 255;
+/// The most chunks the volume spans along an axis (256 blocks: WebGL2's largest 3D texture;
+/// the frame's uniforms keep a top per tile, 32 × 32).
+pub const MAX_SUN_CHUNKS: u32 = 8;
+/// Steps a march takes at most (a ray crosses at most 3 × 256 cells of the volume).
+pub(crate) const MAX_SUN_STEPS: u32 = 1024;
+/// Columns of blocks a tile spans along x and z: per tile the volume keeps its highest cell
+/// that is not air, and a ray above it crosses the rest of the tile in one step.
+pub(crate) const SUN_TILE: u32 = 8;
+/// Tiles a chunk spans along x and z.
+const TILES: usize = CHUNK_SIZE / SUN_TILE as usize;
+/// Tiles the volume spans along x and z at most.
+const MAX_TILES: usize = MAX_SUN_CHUNKS as usize * TILES;
+/// How far along its face's normal a fragment's march starts (blocks): inside the cell in
+/// front of the face.
+pub const SUN_NUDGE: f32 = 1e-3;
+
+/// The chunks a renderer's sun shadows cover: `chunks` along x, y and z from `min`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SunRegion {
+    /// The first chunk.
+    pub min: ChunkPos,
+    /// How many chunks along x, y and z (1 to [`MAX_SUN_CHUNKS`]).
+    pub chunks: [u32; 3],
+}
+
+impl SunRegion {
+    /// The loaded chunks of `world`, or the [`MAX_SUN_CHUNKS`] along each axis nearest
+    /// `around` where they span more; `None` for a world with no chunk.
+    pub fn around(world: &World, around: WorldPos) -> Option<Self> {
+        let mut lo = [i32::MAX; 3];
+        let mut hi = [i32::MIN; 3];
+        for (pos, _) in world.iter() {
+            let p = [pos.x, pos.y, pos.z];
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        if lo[0] > hi[0] {
+            return None;
+        }
+        let (centre, _) = around.split();
+        let centre = [centre.x, centre.y, centre.z];
+        let max = MAX_SUN_CHUNKS as i32;
+        let mut min = [0; 3];
+        let mut chunks = [0; 3];
+        for a in 0..3 {
+            let span = hi[a] - lo[a] + 1;
+            if span <= max {
+                min[a] = lo[a];
+                chunks[a] = span as u32;
+            } else {
+                min[a] = (centre[a] - max / 2).clamp(lo[a], hi[a] - max + 1);
+                chunks[a] = MAX_SUN_CHUNKS;
+            }
+        }
+        Some(Self {
+            min: ChunkPos::new(min[0], min[1], min[2]),
+            chunks,
+        })
+    }
+
+    /// Whether chunk `pos` lies in the region.
+    pub fn contains(&self, pos: ChunkPos) -> bool {
+        self.local(pos).is_some()
+    }
+
+    /// The region's first block.
+    pub fn first_block(&self) -> [i64; 3] {
+        self.min.origin()
+    }
+
+    /// `pos`'s chunk coordinates in the region.
+    fn local(&self, pos: ChunkPos) -> Option<[u32; 3]> {
+        let d = [
+            i64::from(pos.x) - i64::from(self.min.x),
+            i64::from(pos.y) - i64::from(self.min.y),
+            i64::from(pos.z) - i64::from(self.min.z),
+        ];
+        (0..3)
+            .all(|a| (0..i64::from(self.chunks[a])).contains(&d[a]))
+            .then(|| d.map(|v| v as u32))
+    }
+
+    fn blocks(&self) -> [u32; 3] {
+        self.chunks.map(|c| c * CHUNK_SIZE as u32)
+    }
+}
+
+/// The shadow volume on the GPU and what the shaders need to read it.
+#[derive(Debug)]
+pub(crate) struct SunVolume {
+    /// Per block id its class.
+    classes: Vec<u8>,
+    /// The filters of classes 1.. in order, two per class: what the media table appends.
+    filters: Vec<[f32; 4]>,
+    texture: wgpu::Texture,
+    pub(crate) view: wgpu::TextureView,
+    region: Option<SunRegion>,
+    /// Per chunk of the region (x fastest, then y, then z), per tile of it (x + 4 z): its
+    /// highest cell holding anything but air, in volume y, -1 for none.
+    tops: Vec<[i32; TILES * TILES]>,
+}
+
+impl SunVolume {
+    /// No volume yet (a 1-block placeholder) for a renderer of `registry`.
+    pub(crate) fn new(device: &wgpu::Device, registry: &BlockRegistry) -> Self {
+        let (classes, filters) = classes(&SunFilters::new(registry));
+        let texture = Self::texture(device, [1; 3]);
+        Self {
+            classes,
+            filters,
+            view: texture.create_view(&wgpu::TextureViewDescriptor::default()),
+            texture,
+            region: None,
+            tops: Vec::new(),
+        }
+    }
+
+    fn texture(device: &wgpu::Device, size: [u32; 3]) -> wgpu::Texture {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("sun_cells"),
+            size: wgpu::Extent3d {
+                width: size[0],
+                height: size[1],
+                depth_or_array_layers: size[2],
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::R8Uint,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        })
+    }
+
+    /// The filters the media table holds after the looks.
+    pub(crate) fn filters(&self) -> &[[f32; 4]] {
+        &self.filters
+    }
+
+    /// The region covered, if any.
+    pub(crate) fn region(&self) -> Option<SunRegion> {
+        self.region
+    }
+
+    /// Covers `region` with `world`'s cells (a new texture: the scene groups must be made
+    /// again).
+    pub(crate) fn set(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        world: &World,
+        region: SunRegion,
+    ) -> Result<()> {
+        if world.registry().len() != self.classes.len() {
+            return Err(Error::InvalidSetting(format!(
+                "sun shadows: the world's registry has {} blocks, the renderer's {}",
+                world.registry().len(),
+                self.classes.len()
+            )));
+        }
+        let largest = device.limits().max_texture_dimension_3d;
+        if region.chunks.iter().any(|&c| c == 0 || c > MAX_SUN_CHUNKS)
+            || region.blocks().iter().any(|&b| b > largest)
+            || !region.min.is_valid()
+        {
+            return Err(Error::InvalidSetting(format!(
+                "sun shadows over {region:?}: 1 to {MAX_SUN_CHUNKS} chunks an axis, at most \
+                 {largest} blocks (the adapter's largest 3D texture)"
+            )));
+        }
+        self.texture = Self::texture(device, region.blocks());
+        self.view = self
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        self.region = Some(region);
+        let [cx, cy, cz] = region.chunks;
+        self.tops = vec![[-1; TILES * TILES]; (cx * cy * cz) as usize];
+        for z in 0..cz as i32 {
+            for y in 0..cy as i32 {
+                for x in 0..cx as i32 {
+                    let pos = ChunkPos::new(region.min.x + x, region.min.y + y, region.min.z + z);
+                    if let Some(chunk) = world.chunk(pos) {
+                        self.write(queue, pos, chunk);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes chunk `pos` again from `world` (air where it is not loaded), if the region
+    /// holds it.
+    pub(crate) fn update(&mut self, queue: &wgpu::Queue, world: &World, pos: ChunkPos) {
+        if self.region.is_some_and(|r| r.contains(pos)) {
+            match world.chunk(pos) {
+                Some(chunk) => self.write(queue, pos, chunk),
+                None => self.write(queue, pos, &Chunk::default()),
+            }
+        }
+    }
+
+    /// Drops the volume.
+    pub(crate) fn clear(&mut self, device: &wgpu::Device) {
+        self.texture = Self::texture(device, [1; 3]);
+        self.view = self
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        self.region = None;
+        self.tops.clear();
+    }
+
+    fn write(&mut self, queue: &wgpu::Queue, pos: ChunkPos, chunk: &Chunk) {
+        let Some(region) = self.region else { return };
+        let Some([lx, ly, lz]) = region.local(pos) else {
+            return;
+        };
+        let (cells, tops) = cells(chunk, &self.classes);
+        let [cx, cy, _] = region.chunks;
+        self.tops[(lx + cx * (ly + cy * lz)) as usize] =
+            tops.map(|t| t.map_or(-1, |t| (ly as usize * CHUNK_SIZE + t) as i32));
+        let s = CHUNK_SIZE as u32;
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d {
+                    x: lx * s,
+                    y: ly * s,
+                    z: lz * s,
+                },
+                aspect: wgpu::TextureAspect::All,
+            },
+            &cells,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(s),
+                rows_per_image: Some(s),
+            },
+            wgpu::Extent3d {
+                width: s,
+                height: s,
+                depth_or_array_layers: s,
+            },
+        );
+    }
+
+    /// The frame uniforms' sun fields for an eye whose integer part is `eye_int`: offset,
+    /// on, size, and the tops per tile (x + 32 z); all zero without a volume or for an eye
+    /// so far from it that its blocks are not exact in `f32`.
+    pub(crate) fn uniforms(&self, eye_int: [i64; 3]) -> ([i32; 3], u32, [u32; 3], SunTops) {
+        let none = [[-1; 4]; MAX_TILES * MAX_TILES / 4];
+        let Some(region) = self.region else {
+            return ([0; 3], 0, [0; 3], none);
+        };
+        let first = region.first_block();
+        let offset: [i64; 3] = std::array::from_fn(|a| eye_int[a] - first[a]);
+        const EXACT: i64 = 1 << 24;
+        if offset.iter().any(|o| o.abs() >= EXACT) {
+            return ([0; 3], 0, [0; 3], none);
+        }
+        let [cx, cy, cz] = region.chunks.map(|c| c as usize);
+        let mut tops = none;
+        for z in 0..cz {
+            for x in 0..cx {
+                for t in 0..TILES * TILES {
+                    let top = (0..cy)
+                        .map(|y| self.tops[x + cx * (y + cy * z)][t])
+                        .max()
+                        .unwrap_or(-1);
+                    let i = x * TILES + t % TILES + MAX_TILES * (z * TILES + t / TILES);
+                    tops[i / 4][i % 4] = top;
+                }
+            }
+        }
+        (offset.map(|o| o as i32), 1, region.blocks(), tops)
+    }
+}
+
+/// Per block id its class, and the filters of classes 1.. (two each).
+fn classes(sun: &SunFilters) -> (Vec<u8>, Vec<[f32; 4]>) {
+    let mut classes = Vec::with_capacity(sun.cells().len());
+    let mut filters = Vec::new();
+    let mut full = false;
+    for cell in sun.cells() {
+        classes.push(match cell {
+            None => SUN_STOP,
+            Some(c) if c.kind == 0 => 0,
+            Some(c) => {
+                let class = filters.len() / 2 + 1;
+                if class >= usize::from(SUN_STOP) {
+                    full = true;
+                    SUN_STOP
+                } else {
+                    let [r, g, b] = c.enter;
+                    filters.push([r, g, b, 0.0]);
+                    let [r, g, b] = c.within;
+                    filters.push([r, g, b, 0.0]);
+                    class as u8
+                }
+            }
+        });
+    }
+    if full {
+        log::warn!(
+            "sun shadows: more than {} translucent block types; the rest stop the sun",
+            SUN_STOP - 1
+        );
+    }
+    (classes, filters)
+}
+
+/// The tops of every tile of the volume, four to a vector (`sun_tops` in `frame.wgsl`).
+pub(crate) type SunTops = [[i32; 4]; MAX_TILES * MAX_TILES / 4];
+
+/// A chunk's cells as the volume holds them (x fastest, then y, then z), and per tile of its
+/// columns (x + 4 z) its highest cell holding anything but air (local y).
+fn cells(chunk: &Chunk, classes: &[u8]) -> (Vec<u8>, [Option<usize>; TILES * TILES]) {
+    let s = CHUNK_SIZE;
+    let class =
+        |id: voxel_core::BlockId| classes.get(usize::from(id.0)).copied().unwrap_or(SUN_STOP);
+    if let Some(id) = chunk.as_uniform() {
+        let c = class(id);
+        return (
+            vec![c; s * s * s],
+            [(c != 0).then_some(s - 1); TILES * TILES],
+        );
+    }
+    let dense = chunk.to_dense();
+    let mut out = vec![0u8; s * s * s];
+    let mut tops = [None; TILES * TILES];
+    let tile = SUN_TILE as usize;
+    for x in 0..s {
+        for z in 0..s {
+            for y in 0..s {
+                let c = class(dense[Chunk::dense_index(x, y, z)]);
+                if c != 0 {
+                    out[x + s * (y + s * z)] = c;
+                    let t = &mut tops[x / tile + TILES * (z / tile)];
+                    *t = (*t).max(Some(y));
+                }
+            }
+        }
+    }
+    (out, tops)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use voxel_core::blocks;
+
+    use super::*;
+
+    #[test]
+    fn a_region_covers_a_small_world_and_the_nearest_chunks_of_a_large_one() {
+        let mut w = World::new(Arc::new(BlockRegistry::default()));
+        assert_eq!(SunRegion::around(&w, WorldPos::new(0, 0, 0)), None);
+        w.set_block(WorldPos::new(-40, 0, 5), blocks::STONE)
+            .unwrap();
+        w.set_block(WorldPos::new(40, 70, 5), blocks::STONE)
+            .unwrap();
+        let r = SunRegion::around(&w, WorldPos::new(0, 0, 0)).unwrap();
+        assert_eq!(r.min, ChunkPos::new(-2, 0, 0));
+        assert_eq!(r.chunks, [4, 3, 1]);
+        w.set_block(WorldPos::new(32 * 20, 0, 5), blocks::STONE)
+            .unwrap();
+        let r = SunRegion::around(&w, WorldPos::new(32 * 19, 0, 0)).unwrap();
+        assert_eq!((r.min.x, r.chunks[0]), (13, 8));
+        let r = SunRegion::around(&w, WorldPos::new(-1000, 0, 0)).unwrap();
+        assert_eq!((r.min.x, r.chunks[0]), (-2, 8));
+        assert!(r.contains(ChunkPos::new(5, 1, 0)) && !r.contains(ChunkPos::new(6, 1, 0)));
+    }
+
+    #[test]
+    fn cells_hold_the_classes_in_texture_order() {
+        let r = BlockRegistry::default();
+        let (classes, filters) = classes(&SunFilters::new(&r));
+        let water_class = classes[usize::from(blocks::WATER.0)];
+        let water = SunFilters::new(&r).get(blocks::WATER).unwrap();
+        let at = 2 * (usize::from(water_class) - 1);
+        assert_eq!(filters[at][..3], water.enter);
+        assert_eq!(filters[at + 1][..3], water.within);
+        let mut chunk = Chunk::default();
+        chunk.set(3, 7, 9, blocks::STONE).unwrap();
+        chunk.set(4, 8, 9, blocks::WATER).unwrap();
+        let (cells, tops) = cells(&chunk, &classes);
+        assert_eq!(cells[3 + 32 * (7 + 32 * 9)], SUN_STOP);
+        let water = cells[4 + 32 * (8 + 32 * 9)];
+        assert!(water != 0 && water != SUN_STOP);
+        assert_eq!(cells.iter().filter(|&&c| c != 0).count(), 2);
+        // Tile (0, 1) holds both blocks (x 3 and 4, z 9), the others nothing.
+        assert_eq!(tops[TILES], Some(8));
+        assert_eq!(tops.iter().flatten().count(), 1);
+        // Leaves stop the sun as they stop the sky's beam.
+        assert_eq!(classes[usize::from(blocks::LEAVES.0)], SUN_STOP);
+        assert_eq!(classes[usize::from(blocks::AIR.0)], 0);
+    }
+}
