@@ -697,3 +697,63 @@ fn sun_shadows_draw_the_same_on_every_fetch_and_backend() {
         assert!(drawn >= 3, "{name}: {drawn} techniques");
     }
 }
+
+/// Sun shadows that follow a moving player: a floor 16 chunks across with stone pillars in a
+/// row, the volume 4 × 1 × 4 chunks. As the eye walks along the row, `follow_sun_shadows`
+/// reads only the chunks that come into the volume (4 a chunk crossed, none while the eye
+/// stays in its chunk), and the picture at the end is, bit for bit, that of a renderer whose
+/// volume was read whole at that place; the pillars there cast their shadows.
+#[test]
+fn sun_shadows_follow_the_eye_reading_only_the_chunks_that_come_in() {
+    let Some(ctx) = gpu() else { return };
+    let mut world = World::new(Arc::new(BlockRegistry::with_lights()));
+    voxel_lab::scene::fill_box(&mut world, [-256, 0, -16], [255, 0, 15], STONE).unwrap();
+    for x in (-250..250).step_by(12) {
+        voxel_lab::scene::fill_box(&mut world, [x, 1, -1], [x, 6, 1], STONE).unwrap();
+    }
+    let camera_at = |x: f64| {
+        Camera::look_at(
+            DVec3::new(x, 14.0, 12.0),
+            DVec3::new(x, 0.0, 0.5),
+            60.0,
+            0.1,
+            300.0,
+        )
+        .unwrap()
+    };
+    let start = SunRegion {
+        min: voxel_core::ChunkPos::new(-2, 0, -2),
+        chunks: [4, 1, 4],
+    };
+    let c = slanted_sun(Technique::SortedQuads);
+    let mut walker = renderer(&ctx, &world, c.clone(), true);
+    walker.set_sun_shadows(&world, start).unwrap();
+    let mut reads = Vec::new();
+    for step in 0..=40 {
+        let x = 0.5 + f64::from(step) * 4.0;
+        reads.push(walker.follow_sun_shadows(&world, WorldPos::new(x as i32, 1, 0)));
+    }
+    // 160 blocks walked: 5 chunks crossed, 4 chunks read at each.
+    assert_eq!(reads.iter().sum::<usize>(), 5 * 4, "{reads:?}");
+    assert!(reads.iter().all(|&r| r == 0 || r == 4), "{reads:?}");
+    let end = walker.sun_region().unwrap();
+    assert_eq!(end.min, voxel_core::ChunkPos::new(3, 0, -2));
+    let camera = camera_at(160.5);
+    let walked = frame(&ctx, &mut walker, &camera);
+    let mut fresh = renderer(&ctx, &world, c.clone(), true);
+    fresh.set_sun_shadows(&world, end).unwrap();
+    let direct = frame(&ctx, &mut fresh, &camera);
+    walked
+        .save_png(&out_dir("light").join("sun_follow.png"))
+        .unwrap();
+    assert_eq!(
+        diff(&walked, &direct).max,
+        0,
+        "the walked volume is the one read whole"
+    );
+    let unshaded = frame(&ctx, &mut renderer(&ctx, &world, c, true), &camera);
+    assert!(
+        diff(&walked, &unshaded).differing > 300,
+        "the pillars cast shadows there"
+    );
+}

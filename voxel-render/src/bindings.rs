@@ -165,6 +165,10 @@ pub(crate) struct FrameUniforms {
     /// Where the sun filters of class 1 start in the media table (`block_media`): two
     /// entries a class, the filter of a cell entered from another kind, then from its own.
     pub sun_table: u32,
+    /// Where the volume's first block lies in its texture (a torus: a block at its world
+    /// position modulo the size).
+    pub sun_wrap: [u32; 3],
+    pub sun_pad: u32,
     /// Per tile of the volume (8 × 8 columns of blocks; x + 32 z): the highest cell
     /// (volume y) holding anything but air, -1 for none.
     pub sun_tops: crate::sun::SunTops,
@@ -355,6 +359,8 @@ mod tests {
                 field!(FrameUniforms, sun_on),
                 field!(FrameUniforms, sun_size),
                 field!(FrameUniforms, sun_table),
+                field!(FrameUniforms, sun_wrap),
+                field!(FrameUniforms, sun_pad),
                 field!(FrameUniforms, sun_tops),
             ],
         );

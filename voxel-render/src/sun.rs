@@ -7,6 +7,8 @@
 //! [`voxel_core::SunFilters`]'s: the light field's filters, the colours that tint the view.
 //! The CPU twin is [`voxel_core::SunMarch`].
 
+use std::collections::HashMap;
+
 use voxel_core::{BlockRegistry, CHUNK_SIZE, Chunk, ChunkPos, SunFilters, World, WorldPos};
 
 use crate::error::{Error, Result};
@@ -100,6 +102,32 @@ impl SunRegion {
     fn blocks(&self) -> [u32; 3] {
         self.chunks.map(|c| c * CHUNK_SIZE as u32)
     }
+
+    /// The last chunk.
+    fn max(&self) -> ChunkPos {
+        let last = |m: i32, n: u32| m.saturating_add(n as i32 - 1);
+        ChunkPos::new(
+            last(self.min.x, self.chunks[0]),
+            last(self.min.y, self.chunks[1]),
+            last(self.min.z, self.chunks[2]),
+        )
+    }
+
+    /// Every chunk of the region.
+    fn positions(self) -> impl Iterator<Item = ChunkPos> {
+        let [cx, cy, cz] = self.chunks.map(|c| c as i32);
+        (0..cz).flat_map(move |z| {
+            (0..cy).flat_map(move |y| {
+                (0..cx).map(move |x| ChunkPos::new(self.min.x + x, self.min.y + y, self.min.z + z))
+            })
+        })
+    }
+
+    /// Where chunk `pos`'s cells lie in the torus, in chunks.
+    fn slot(&self, pos: ChunkPos) -> [u32; 3] {
+        let p = [pos.x, pos.y, pos.z];
+        std::array::from_fn(|a| p[a].rem_euclid(self.chunks[a] as i32) as u32)
+    }
 }
 
 /// The shadow volume on the GPU and what the shaders need to read it.
@@ -112,9 +140,9 @@ pub(crate) struct SunVolume {
     texture: wgpu::Texture,
     pub(crate) view: wgpu::TextureView,
     region: Option<SunRegion>,
-    /// Per chunk of the region (x fastest, then y, then z), per tile of it (x + 4 z): its
-    /// highest cell holding anything but air, in volume y, -1 for none.
-    tops: Vec<[i32; TILES * TILES]>,
+    /// Per chunk of the region, per tile of it (x + 4 z): its highest cell holding anything
+    /// but air (the chunk's y), -1 for none.
+    tops: HashMap<ChunkPos, [i32; TILES * TILES]>,
 }
 
 impl SunVolume {
@@ -128,7 +156,7 @@ impl SunVolume {
             view: texture.create_view(&wgpu::TextureViewDescriptor::default()),
             texture,
             region: None,
-            tops: Vec::new(),
+            tops: HashMap::new(),
         }
     }
 
@@ -190,19 +218,39 @@ impl SunVolume {
             .texture
             .create_view(&wgpu::TextureViewDescriptor::default());
         self.region = Some(region);
-        let [cx, cy, cz] = region.chunks;
-        self.tops = vec![[-1; TILES * TILES]; (cx * cy * cz) as usize];
-        for z in 0..cz as i32 {
-            for y in 0..cy as i32 {
-                for x in 0..cx as i32 {
-                    let pos = ChunkPos::new(region.min.x + x, region.min.y + y, region.min.z + z);
-                    if let Some(chunk) = world.chunk(pos) {
-                        self.write(queue, pos, chunk);
-                    }
-                }
+        self.tops.clear();
+        for pos in region.positions() {
+            if let Some(chunk) = world.chunk(pos) {
+                self.write(queue, pos, chunk);
             }
         }
         Ok(())
+    }
+
+    /// Moves the region so that its x and z centre on chunk `centre`, its size and heights
+    /// kept, and reads the chunks that come into it from `world` (air where not loaded):
+    /// the volume is a torus (a chunk's cells lie at its position modulo the size), so the
+    /// chunks that stay are not touched. Returns how many chunks were read.
+    pub(crate) fn follow(&mut self, queue: &wgpu::Queue, world: &World, centre: ChunkPos) -> usize {
+        let Some(old) = self.region else { return 0 };
+        let half = |n: u32| (n / 2) as i32;
+        let min = ChunkPos::new(
+            centre.x.saturating_sub(half(old.chunks[0])),
+            old.min.y,
+            centre.z.saturating_sub(half(old.chunks[2])),
+        );
+        let new = SunRegion { min, ..old };
+        if new == old || !new.min.is_valid() || !new.max().is_valid() {
+            return 0;
+        }
+        self.region = Some(new);
+        self.tops.retain(|&pos, _| new.contains(pos));
+        let mut read = 0;
+        for pos in new.positions().filter(|&p| !old.contains(p)) {
+            self.update(queue, world, pos);
+            read += 1;
+        }
+        read
     }
 
     /// Writes chunk `pos` again from `world` (air where it is not loaded), if the region
@@ -228,22 +276,23 @@ impl SunVolume {
 
     fn write(&mut self, queue: &wgpu::Queue, pos: ChunkPos, chunk: &Chunk) {
         let Some(region) = self.region else { return };
-        let Some([lx, ly, lz]) = region.local(pos) else {
+        if !region.contains(pos) {
             return;
-        };
+        }
         let (cells, tops) = cells(chunk, &self.classes);
-        let [cx, cy, _] = region.chunks;
-        self.tops[(lx + cx * (ly + cy * lz)) as usize] =
-            tops.map(|t| t.map_or(-1, |t| (ly as usize * CHUNK_SIZE + t) as i32));
+        self.tops
+            .insert(pos, tops.map(|t| t.map_or(-1, |t| t as i32)));
+        // The chunk's slot in the torus.
+        let [sx, sy, sz] = region.slot(pos);
         let s = CHUNK_SIZE as u32;
         queue.write_texture(
             wgpu::TexelCopyTextureInfo {
                 texture: &self.texture,
                 mip_level: 0,
                 origin: wgpu::Origin3d {
-                    x: lx * s,
-                    y: ly * s,
-                    z: lz * s,
+                    x: sx * s,
+                    y: sy * s,
+                    z: sz * s,
                 },
                 aspect: wgpu::TextureAspect::All,
             },
@@ -261,35 +310,50 @@ impl SunVolume {
         );
     }
 
-    /// The frame uniforms' sun fields for an eye whose integer part is `eye_int`: offset,
-    /// on, size, and the tops per tile (x + 32 z); all zero without a volume or for an eye
-    /// so far from it that its blocks are not exact in `f32`.
-    pub(crate) fn uniforms(&self, eye_int: [i64; 3]) -> ([i32; 3], u32, [u32; 3], SunTops) {
-        let none = [[-1; 4]; MAX_TILES * MAX_TILES / 4];
+    /// The frame uniforms' sun fields for an eye whose integer part is `eye_int`; all zero
+    /// without a volume or for an eye so far from it that its blocks are not exact in
+    /// `f32`.
+    pub(crate) fn uniforms(&self, eye_int: [i64; 3]) -> SunUniforms {
+        let none = SunUniforms {
+            offset: [0; 3],
+            on: 0,
+            size: [0; 3],
+            wrap: [0; 3],
+            tops: [[-1; 4]; MAX_TILES * MAX_TILES / 4],
+        };
         let Some(region) = self.region else {
-            return ([0; 3], 0, [0; 3], none);
+            return none;
         };
         let first = region.first_block();
         let offset: [i64; 3] = std::array::from_fn(|a| eye_int[a] - first[a]);
         const EXACT: i64 = 1 << 24;
         if offset.iter().any(|o| o.abs() >= EXACT) {
-            return ([0; 3], 0, [0; 3], none);
+            return none;
         }
-        let [cx, cy, cz] = region.chunks.map(|c| c as usize);
-        let mut tops = none;
-        for z in 0..cz {
-            for x in 0..cx {
-                for t in 0..TILES * TILES {
-                    let top = (0..cy)
-                        .map(|y| self.tops[x + cx * (y + cy * z)][t])
-                        .max()
-                        .unwrap_or(-1);
-                    let i = x * TILES + t % TILES + MAX_TILES * (z * TILES + t / TILES);
-                    tops[i / 4][i % 4] = top;
-                }
+        let mut tops = none.tops;
+        for (&pos, chunk_tops) in &self.tops {
+            let Some([x, y, z]) = region.local(pos) else {
+                continue;
+            };
+            let [x, y, z] = [x, y, z].map(|v| v as usize);
+            for (t, &top) in chunk_tops.iter().enumerate() {
+                let i = x * TILES + t % TILES + MAX_TILES * (z * TILES + t / TILES);
+                let top = if top < 0 {
+                    -1
+                } else {
+                    (y * CHUNK_SIZE) as i32 + top
+                };
+                tops[i / 4][i % 4] = tops[i / 4][i % 4].max(top);
             }
         }
-        (offset.map(|o| o as i32), 1, region.blocks(), tops)
+        let size = region.blocks();
+        SunUniforms {
+            offset: offset.map(|o| o as i32),
+            on: 1,
+            size,
+            wrap: std::array::from_fn(|a| first[a].rem_euclid(i64::from(size[a])) as u32),
+            tops,
+        }
     }
 }
 
@@ -328,6 +392,21 @@ fn classes(sun: &SunFilters) -> (Vec<u8>, Vec<[f32; 4]>) {
 
 /// The tops of every tile of the volume, four to a vector (`sun_tops` in `frame.wgsl`).
 pub(crate) type SunTops = [[i32; 4]; MAX_TILES * MAX_TILES / 4];
+
+/// The frame uniforms' sun fields ([`crate::bindings::FrameUniforms`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SunUniforms {
+    /// The eye's integer part minus the region's first block.
+    pub(crate) offset: [i32; 3],
+    /// 1 with a volume.
+    pub(crate) on: u32,
+    /// The region's size in blocks.
+    pub(crate) size: [u32; 3],
+    /// Where the region's first block lies in the torus.
+    pub(crate) wrap: [u32; 3],
+    /// Per tile of the region (x + 32 z, from its first block), its top.
+    pub(crate) tops: SunTops,
+}
 
 /// A chunk's cells as the volume holds them (x fastest, then y, then z), and per tile of its
 /// columns (x + 4 z) its highest cell holding anything but air (local y).

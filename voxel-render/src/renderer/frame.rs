@@ -678,7 +678,7 @@ impl Renderer {
         let (w, h) = self.size();
         let tan_y = (camera.fov_y_deg.to_radians() / 2.0).tan();
         let tan_x = tan_y * f64::from(w) / f64::from(h);
-        let (sun_offset, sun_on, sun_size, sun_tops) = self.scene.sun.uniforms(eye_int);
+        let shadows = self.scene.sun.uniforms(eye_int);
         FrameUniforms {
             view_proj: view_proj.to_cols_array_2d(),
             eye_int: eye_int.map(|v| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32),
@@ -703,11 +703,13 @@ impl Renderer {
                 let [r, g, b] = look.color;
                 [r, g, b, look.fog]
             }),
-            sun_offset,
-            sun_on,
-            sun_size,
+            sun_offset: shadows.offset,
+            sun_on: shadows.on,
+            sun_size: shadows.size,
             sun_table: self.scene.sun_table,
-            sun_tops,
+            sun_wrap: shadows.wrap,
+            sun_pad: 0,
+            sun_tops: shadows.tops,
         }
     }
 

@@ -11,7 +11,7 @@ mod tests;
 
 use std::sync::Arc;
 
-use voxel_core::{BlockRegistry, ChunkPos, World};
+use voxel_core::{BlockRegistry, ChunkPos, World, WorldPos};
 use voxel_mesh::ChunkMeshes;
 use wgpu::util::DeviceExt;
 
@@ -363,6 +363,17 @@ impl Renderer {
         for &pos in chunks {
             self.scene.sun.update(&self.ctx.queue, world, pos);
         }
+    }
+
+    /// Moves the sun shadows' region so that its x and z centre on the chunk of `eye` (a
+    /// player's position, each frame or when it changes chunk), its size and heights kept,
+    /// and reads only the chunks that come into it from `world` (32 KiB each; the volume
+    /// is a torus, the chunks that stay are not touched). Returns how many chunks were
+    /// read: 0 while the eye stays in its chunk, or without sun shadows. Chunks loaded
+    /// later into the region reach it through [`Renderer::update_sun_shadows`].
+    pub fn follow_sun_shadows(&mut self, world: &World, eye: WorldPos) -> usize {
+        let (centre, _) = eye.split();
+        self.scene.sun.follow(&self.ctx.queue, world, centre)
     }
 
     /// Turns sun shadows off (frees the volume).

@@ -435,7 +435,7 @@ fn sun_transmittance(in: VsOut) -> vec4<f32> {
     let step = select(vec3<i32>(-1), vec3<i32>(1), positive);
     let delta = select(vec3<f32>(1e30), 1.0 / abs(dir), moving);
     var next = sun_boundaries(cell, o, dir, positive, moving);
-    var prev = textureLoad(sun_cells, cell, 0).x;
+    var prev = textureLoad(sun_cells, sun_texel(cell), 0).x;
     if prev == SUN_STOP {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
     }
@@ -478,7 +478,7 @@ fn sun_transmittance(in: VsOut) -> vec4<f32> {
         let outside = any(cell < vec3<i32>(0)) || any(cell >= size);
         var here = 0u;
         if !outside {
-            here = textureLoad(sun_cells, cell, 0).x;
+            here = textureLoad(sun_cells, sun_texel(cell), 0).x;
         }
         if here == SUN_STOP {
             return vec4<f32>(0.0, 0.0, 0.0, 1.0);
@@ -495,6 +495,11 @@ fn sun_transmittance(in: VsOut) -> vec4<f32> {
         prev = here;
     }
     return vec4<f32>(t, 1.0);
+}
+
+// The texel of the volume's cell `cell` (the volume is a torus, `sun.rs`).
+fn sun_texel(cell: vec3<i32>) -> vec3<i32> {
+    return vec3<i32>((vec3<u32>(cell) + frame.sun_wrap) % frame.sun_size);
 }
 
 // Where the ray from `o` along `dir` leaves `cell` on each axis (its parameter; 1e30 on an

@@ -37,6 +37,10 @@ struct Frame {
     sun_on: u32,
     sun_size: vec3<u32>,
     sun_table: u32,
+    // Where the volume's first block lies in `sun_cells` (a torus: a block at its world
+    // position modulo the size).
+    sun_wrap: vec3<u32>,
+    sun_pad: u32,
     sun_tops: array<vec4<i32>, 256>,
 };
 
