@@ -207,6 +207,7 @@ impl SunVolume {
         if region.chunks.iter().any(|&c| c == 0 || c > MAX_SUN_CHUNKS)
             || region.blocks().iter().any(|&b| b > largest)
             || !region.min.is_valid()
+            || !region.max().is_valid()
         {
             return Err(Error::InvalidSetting(format!(
                 "sun shadows over {region:?}: 1 to {MAX_SUN_CHUNKS} chunks an axis, at most \

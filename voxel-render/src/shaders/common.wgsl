@@ -432,7 +432,9 @@ fn sun_transmittance(in: VsOut) -> vec4<f32> {
     }
     let positive = dir > vec3<f32>(0.0);
     let moving = abs(dir) > vec3<f32>(0.0);
-    let step = select(vec3<i32>(-1), vec3<i32>(1), positive);
+    // (An integer vector `select` is GLSL's `mix` of integers, which GLSL ES 3.00 and
+    // GLSL 3.30 lack; an axis the ray does not move along is never stepped.)
+    let step = vec3<i32>(sign(dir));
     let delta = select(vec3<f32>(1e30), 1.0 / abs(dir), moving);
     var next = sun_boundaries(cell, o, dir, positive, moving);
     var prev = textureLoad(sun_cells, sun_texel(cell), 0).x;
