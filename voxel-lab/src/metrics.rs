@@ -113,11 +113,36 @@ pub fn mean_abs_diff(a: &Image, b: &Image) -> f64 {
     total as f64 / (3.0 * f64::from(a.width) * f64::from(a.height))
 }
 
-/// Temporal flicker of a technique beyond the reference's own change between two frames:
-/// per pixel and channel, how much more the technique's picture changed than the
-/// reference's did (never below zero), averaged, in 1/255 steps.
-pub fn excess_change(prev: &Image, cur: &Image, ref_prev: &Image, ref_cur: &Image) -> f64 {
+/// How far beyond the reference's own change a pixel's channel must change between two
+/// frames for the step to count toward a pop (of 255).
+pub const POP_LEVEL: u8 = 32;
+/// A step pops when more than this share of its pixels change by more than [`POP_LEVEL`]
+/// beyond the reference (issue 54's target: a player sees it).
+pub const POP_SHARE: f64 = 0.001;
+
+/// One step of a camera path: how much more a technique's picture changed than the
+/// reference's did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepExcess {
+    /// Per pixel and channel, the change beyond the reference's (never below zero),
+    /// averaged, in 1/255 steps.
+    pub mean: f64,
+    /// The share of pixels (0 to 1) with a channel more than [`POP_LEVEL`] beyond.
+    pub over: f64,
+}
+
+impl StepExcess {
+    /// Whether the step pops ([`POP_SHARE`]).
+    pub fn pops(&self) -> bool {
+        self.over > POP_SHARE
+    }
+}
+
+/// Temporal flicker of a technique beyond the reference's own change between two frames
+/// ([`StepExcess`]).
+pub fn step_excess(prev: &Image, cur: &Image, ref_prev: &Image, ref_cur: &Image) -> StepExcess {
     let mut total = 0.0f64;
+    let mut over = 0usize;
     for (((p, q), r), s) in prev
         .rgba
         .chunks_exact(4)
@@ -125,13 +150,26 @@ pub fn excess_change(prev: &Image, cur: &Image, ref_prev: &Image, ref_cur: &Imag
         .zip(ref_prev.rgba.chunks_exact(4))
         .zip(ref_cur.rgba.chunks_exact(4))
     {
+        let mut most = 0.0f64;
         for c in 0..3 {
             let own = f64::from(p[c].abs_diff(q[c]));
             let truth = f64::from(r[c].abs_diff(s[c]));
-            total += (own - truth).max(0.0);
+            let excess = (own - truth).max(0.0);
+            total += excess;
+            most = most.max(excess);
         }
+        over += usize::from(most > f64::from(POP_LEVEL));
     }
-    total / (3.0 * f64::from(cur.width) * f64::from(cur.height))
+    let pixels = f64::from(cur.width) * f64::from(cur.height);
+    StepExcess {
+        mean: total / (3.0 * pixels),
+        over: over as f64 / pixels,
+    }
+}
+
+/// [`StepExcess::mean`] of [`step_excess`].
+pub fn excess_change(prev: &Image, cur: &Image, ref_prev: &Image, ref_cur: &Image) -> f64 {
+    step_excess(prev, cur, ref_prev, ref_cur).mean
 }
 
 /// `img` scaled down (box filter) to `width` pixels wide, or as it is if not wider.
@@ -238,5 +276,31 @@ mod tests {
         assert!((excess_change(&a, &b, &a, &a) - 10.0 / 6.0).abs() < 1e-12);
         // The same change as the reference: none of it is.
         assert_eq!(excess_change(&a, &b, &a, &b), 0.0);
+    }
+
+    #[test]
+    fn a_step_pops_when_a_thousandth_of_its_pixels_jump_beyond_the_reference() {
+        // 2000 pixels, of which `n` jump by 40 in red where the reference stays.
+        let still = img(2000, 1, |_, _| [10, 10, 10, 255]);
+        let jump = |n: u32| {
+            img(2000, 1, move |x, _| {
+                if x < n {
+                    [50, 10, 10, 255]
+                } else {
+                    [10, 10, 10, 255]
+                }
+            })
+        };
+        let two = step_excess(&still, &jump(2), &still, &still);
+        assert_eq!(two.over, 0.001);
+        assert!(!two.pops(), "0.1 % is not more than 0.1 %");
+        assert!(step_excess(&still, &jump(3), &still, &still).pops());
+        // The reference jumps too: no excess, no pop.
+        let both = step_excess(&still, &jump(3), &still, &jump(3));
+        assert_eq!((both.mean, both.over), (0.0, 0.0));
+        // Below the level: excess, but no pop.
+        let small = img(2000, 1, |_, _| [40, 10, 10, 255]);
+        let s = step_excess(&still, &small, &still, &still);
+        assert!(s.mean > 9.0 && s.over == 0.0, "{s:?}");
     }
 }

@@ -533,21 +533,58 @@ fn stability_section(s: &mut String, st: &Stability) {
         }
         let _ = writeln!(s);
     }
+    if !st.flicker.is_empty() {
+        flicker_summary(s, &st.flicker);
+    }
     for f in &st.flicker {
         let _ = writeln!(
             s,
-            "### Flicker along a {}-frame camera path: {}\n\nThe reference itself changes by {:.3}/255 per frame on average; the table gives what each technique changes beyond that.\n\n![flicker](stability/flicker_{1}.png)\n",
-            f.frames, f.scene, f.reference_change
+            "### Flicker along a {}-frame camera path: {}\n\nThe reference itself changes by {:.3}/255 per frame on average; the table gives what each technique changes beyond that: the mean over the path's steps, the largest step, the steps that pop (more than {} % of the pixels more than {}/255 beyond the reference) and the largest share of a step's pixels that far beyond.\n\n![flicker](stability/flicker_{1}.png)\n",
+            f.frames,
+            f.scene,
+            f.reference_change,
+            crate::metrics::POP_SHARE * 100.0,
+            crate::metrics::POP_LEVEL
         );
         let _ = writeln!(
             s,
-            "| technique | excess change per frame (1/255) |\n|---|---|"
+            "| technique | excess change per frame (1/255) | largest step (1/255) | pops | worst step's pixels beyond {}/255 (%) |\n|---|---|---|---|---|",
+            crate::metrics::POP_LEVEL
         );
-        for (t, e) in &f.excess {
-            let _ = writeln!(s, "| {t} | {e:.3} |");
+        for (i, (t, e)) in f.excess.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "| {t} | {e:.3} | {:.3} | {} | {:.3} |",
+                f.max_step[i].1, f.pops[i].1, f.worst_pop[i].1
+            );
         }
         let _ = writeln!(s);
     }
+}
+
+/// Every path at once: per technique, the steps that pop over all of them and on how many
+/// paths, the largest step, the worst share of pixels and the mean excess.
+fn flicker_summary(s: &mut String, flicker: &[crate::stability::Flicker]) {
+    let _ = writeln!(
+        s,
+        "### Pops over every camera path\n\n{} paths in one run. A step pops when more than {} % of its pixels change by more than {}/255 beyond the reference's own change.\n\n| technique | steps that pop | paths with a pop | largest step (1/255) | worst step's pixels beyond (%) | mean excess (1/255) |\n|---|---|---|---|---|---|",
+        flicker.len(),
+        crate::metrics::POP_SHARE * 100.0,
+        crate::metrics::POP_LEVEL
+    );
+    let Some(first) = flicker.first() else { return };
+    for (i, (t, _)) in first.excess.iter().enumerate() {
+        let steps: usize = flicker.iter().map(|f| f.pops[i].1).sum();
+        let paths = flicker.iter().filter(|f| f.pops[i].1 > 0).count();
+        let largest = flicker.iter().map(|f| f.max_step[i].1).fold(0.0, f64::max);
+        let worst = flicker.iter().map(|f| f.worst_pop[i].1).fold(0.0, f64::max);
+        let mean = flicker.iter().map(|f| f.excess[i].1).sum::<f64>() / flicker.len() as f64;
+        let _ = writeln!(
+            s,
+            "| {t} | {steps} | {paths} | {largest:.3} | {worst:.3} | {mean:.3} |"
+        );
+    }
+    let _ = writeln!(s);
 }
 
 /// The report of a random evaluation: the distribution table, the charts, where each

@@ -45,6 +45,15 @@ pub struct Flicker {
     pub reference_change: f64,
     /// Per technique: mean change beyond the reference's, in 1/255 steps.
     pub excess: Vec<(String, f64)>,
+    /// Per technique: the largest change beyond the reference's in one step (the step's
+    /// mean, 1/255): a one-frame flash the mean over the path hides.
+    pub max_step: Vec<(String, f64)>,
+    /// Per technique: the steps that pop (more than [`metrics::POP_SHARE`] of the pixels
+    /// change by more than [`metrics::POP_LEVEL`]/255 beyond the reference).
+    pub pops: Vec<(String, usize)>,
+    /// Per technique: the largest share of one step's pixels changing by more than
+    /// [`metrics::POP_LEVEL`]/255 beyond the reference, percent.
+    pub worst_pop: Vec<(String, f64)>,
 }
 
 /// All stability results.
@@ -261,26 +270,17 @@ pub fn run(ctx: &GpuContext, opts: &EvalOptions) -> Result<Stability> {
     Ok(result)
 }
 
-/// The scenes whose camera paths measure flicker: the greenhouse and the corridor when in
-/// the suite, else the first scene with a path.
+/// The scenes whose camera paths measure flicker: every scene of the run with a path
+/// (`path_to` of its first camera).
 fn flicker_scenes(opts: &EvalOptions) -> Result<Vec<(String, Scene)>> {
     let mut out = Vec::new();
-    let stem = |p: &std::path::PathBuf| {
-        p.file_stem()
-            .map_or(String::new(), |s| s.to_string_lossy().into_owned())
-    };
-    for want in ["terrain_greenhouse", "stained_glass_corridor"] {
-        if let Some(p) = opts.scenes.iter().find(|p| stem(p) == want) {
-            out.push((want.to_owned(), Scene::load(p)?));
-        }
-    }
-    if out.is_empty() {
-        for p in &opts.scenes {
-            let s = Scene::load(p)?;
-            if s.paths[0].is_some() {
-                out.push((stem(p), s));
-                break;
-            }
+    for p in &opts.scenes {
+        let s = Scene::load(p)?;
+        if s.paths.first().copied().flatten().is_some() {
+            let stem = p
+                .file_stem()
+                .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+            out.push((stem, s));
         }
     }
     Ok(out)
@@ -297,10 +297,11 @@ fn flicker_path(
     let start = scene.cameras[0];
     let end = scene.paths[0].unwrap_or(start.eye + DVec3::X * 2.0);
     let frames = opts.flicker_frames.max(2);
+    // The eye's medium follows it (a path may cross a water surface).
     let cameras: Vec<Camera> = (0..frames)
-        .map(|i| Camera {
-            eye: start.eye.lerp(end, i as f64 / (frames - 1) as f64),
-            ..start
+        .map(|i| {
+            let eye = start.eye.lerp(end, i as f64 / (frames - 1) as f64);
+            Camera { eye, ..start }.in_medium(scene.world.medium_at(eye.to_array()))
         })
         .collect();
     let mut renderer = make_renderer(ctx, scene, size)?;
@@ -339,24 +340,43 @@ fn flicker_path(
             .sum::<f64>()
             / (v.len() - 1) as f64
     };
-    let mut excess = Vec::new();
+    let (mut excess, mut max_step, mut pops, mut worst_pop) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &t in techniques {
         let mut previous: Option<voxel_render::Image> = None;
-        let mut sum = 0.0;
+        let mut steps = Vec::with_capacity(cameras.len());
         path(&mut renderer, t, &mut |i, img| {
             if let Some(p) = &previous {
-                sum += metrics::excess_change(p, &img, &reference[i - 1], &reference[i]);
+                steps.push(metrics::step_excess(
+                    p,
+                    &img,
+                    &reference[i - 1],
+                    &reference[i],
+                ));
             }
             previous = Some(img);
         })?;
-        let e = sum / (cameras.len() - 1) as f64;
-        excess.push((t.name().to_owned(), e));
+        let name = t.name().to_owned();
+        let mean = steps.iter().map(|s| s.mean).sum::<f64>() / steps.len().max(1) as f64;
+        excess.push((name.clone(), mean));
+        max_step.push((
+            name.clone(),
+            steps.iter().map(|s| s.mean).fold(0.0, f64::max),
+        ));
+        pops.push((name.clone(), steps.iter().filter(|s| s.pops()).count()));
+        worst_pop.push((
+            name,
+            100.0 * steps.iter().map(|s| s.over).fold(0.0, f64::max),
+        ));
     }
     Ok(Flicker {
         scene: stem.to_owned(),
         frames,
         reference_change: change(&reference),
         excess,
+        max_step,
+        pops,
+        worst_pop,
     })
 }
 
