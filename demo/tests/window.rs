@@ -360,3 +360,67 @@ fn the_window_draws_a_far_view_past_the_streamed_distance() {
     assert!(darker > 200, "level 1 not darker: {darker} pixels");
     assert!(lighter * 10 < darker, "{lighter} pixels lighter with bands");
 }
+
+/// A lit scene (`light = true`) opened in the window is drawn with its light and its sun
+/// shadows (docs/light.md): the cathedral's hall is dark where no light reaches (a fifth of
+/// the view and more; unlit, daylight would fill it), and without sun shadows
+/// (`sun_shadows = false`) the picture differs wherever the sun's light falls or is hidden.
+#[test]
+fn the_window_draws_a_lit_scene_with_its_light_and_sun_shadows() {
+    let Some(x) = vulkan_and_xvfb() else { return };
+    let dir = out_dir("window-light");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/light/cathedral.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(text.contains("\nlight = true\n"), "a lit scene");
+    let flat = dir.join("cathedral_no_sun_shadows.toml");
+    std::fs::write(
+        &flat,
+        text.replace("\nlight = true\n", "\nlight = true\nsun_shadows = false\n"),
+    )
+    .unwrap();
+    let shot = |scene: &Path, name: &str| {
+        let path = dir.join(name);
+        demo(
+            &x,
+            &[
+                "--size",
+                "960x540",
+                "--frames",
+                "3",
+                "--scene",
+                scene.to_str().unwrap(),
+                "--screenshot",
+                path.to_str().unwrap(),
+            ],
+        );
+        // The view right of the panel (the hall is too dark for `panel_edge`).
+        let img = Image::load_png(&path).unwrap();
+        let mut v = Vec::new();
+        for y in 0..img.height {
+            for x in img.width * 2 / 5..img.width {
+                let p = img.pixel(x, y);
+                v.push([p[0], p[1], p[2]]);
+            }
+        }
+        v
+    };
+    let lit = shot(&scene, "cathedral.png");
+    let no_shadows = shot(&flat, "cathedral_no_sun_shadows.png");
+    assert!(distinct(&lit) > 100, "{} colours", distinct(&lit));
+    let dark = lit.iter().filter(|p| p.iter().all(|&c| c < 40)).count();
+    assert!(
+        dark * 5 > lit.len(),
+        "lit: {dark} of {} pixels dark",
+        lit.len()
+    );
+    let differ = lit
+        .iter()
+        .zip(&no_shadows)
+        .filter(|(p, q)| (0..3).any(|c| p[c].abs_diff(q[c]) > 8))
+        .count();
+    assert!(
+        differ * 20 > lit.len(),
+        "sun shadows: {differ} of {} pixels differ",
+        lit.len()
+    );
+}

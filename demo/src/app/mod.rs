@@ -343,10 +343,17 @@ impl ChunkSink for Undrawn {
 struct Sinks<'a> {
     renderer: &'a mut Renderer,
     reference: Option<&'a mut Renderer>,
+    /// A lit scene: every chunk the streamer uploads goes up meshed with its light.
+    lit: Option<&'a SceneLight>,
 }
 
 impl ChunkSink for Sinks<'_> {
     fn upload(&mut self, pos: ChunkPos, meshes: &ChunkMeshes) -> voxel_render::Result<()> {
+        let lit = match self.lit {
+            Some(l) => Some(l.meshes(pos)?),
+            None => None,
+        };
+        let meshes = lit.as_ref().unwrap_or(meshes);
         self.renderer.upload_chunk(pos, meshes)?;
         if let Some(r) = self.reference.as_deref_mut() {
             r.upload_chunk(pos, meshes)?;
@@ -391,6 +398,52 @@ struct OpenScene {
     world: voxel_core::World,
     /// The far plane of its camera: the window's never comes nearer.
     far: f64,
+    /// Drawn with its light field (`light = true`), and with sun shadows.
+    light: bool,
+    sun_shadows: bool,
+}
+
+/// A lit scene's light (`docs/light.md`): a copy of its world that every edit reaches too,
+/// and its light field. The streamer serves the scene's blocks as for any scene; each mesh
+/// it uploads is replaced by the lit mesh of the same chunk ([`Sinks`]), and an edit
+/// re-meshes the chunks whose light it changed.
+struct SceneLight {
+    world: voxel_core::World,
+    field: voxel_core::LightField,
+    sun_shadows: bool,
+}
+
+impl SceneLight {
+    fn new(scene: &OpenScene) -> Option<Self> {
+        scene.light.then(|| Self {
+            field: voxel_core::LightField::new(&scene.world),
+            world: scene.world.clone(),
+            sun_shadows: scene.sun_shadows,
+        })
+    }
+
+    /// Chunk `pos` meshed with its light.
+    fn meshes(&self, pos: ChunkPos) -> voxel_render::Result<ChunkMeshes> {
+        let meshed = voxel_mesh::mesh_chunks_lit(&self.world, &self.field, &[pos])
+            .map_err(|e| voxel_render::Error::InvalidSetting(format!("lighting {pos:?}: {e}")))?;
+        Ok(meshed
+            .into_iter()
+            .next()
+            .map_or_else(ChunkMeshes::default, |(_, m)| m))
+    }
+
+    /// Sun shadows over the chunks nearest `eye` in `renderer`, when the scene has them.
+    fn shadow(&self, renderer: &mut Renderer, eye: DVec3) -> Result<()> {
+        let eye = eye.to_array().map(|v| v.floor().clamp(-1e9, 1e9) as i32);
+        let around = voxel_core::WorldPos::new(eye[0], eye[1], eye[2]);
+        if let (true, Some(region)) = (
+            self.sun_shadows,
+            voxel_render::SunRegion::around(&self.world, around),
+        ) {
+            renderer.set_sun_shadows(&self.world, region)?;
+        }
+        Ok(())
+    }
 }
 
 /// The far plane for a view distance: its chunks and a little more.
@@ -421,6 +474,8 @@ struct Gfx {
     renderer: Renderer,
     /// The exact reference, drawn beside for the error map.
     reference: Option<Renderer>,
+    /// A lit scene's light.
+    lit: Option<SceneLight>,
     post: Post,
     frames: Frames,
     ui: Ui,
@@ -452,6 +507,8 @@ impl Gfx {
                     name: s.name.clone(),
                     world: s.world.clone(),
                     far: s.cameras[0].far,
+                    light: s.light,
+                    sun_shadows: s.sun_shadows,
                 };
                 (s.cameras[0], Some(open))
             }
@@ -495,6 +552,10 @@ impl Gfx {
             .map_or_else(BlockRegistry::default, |s| (**s.world.registry()).clone());
         let mut renderer = Renderer::new(&ctx, &registry, config)?;
         renderer.set_level_bands(settings.level_bands);
+        let lit = open.as_ref().and_then(SceneLight::new);
+        if let Some(l) = &lit {
+            l.shadow(&mut renderer, cam.eye)?;
+        }
         // Every real-time technique the device runs, built now: the number keys and the
         // panel switch without a hitch (the game's pipelines follow with its content).
         for t in Technique::supported(&ctx.caps) {
@@ -526,6 +587,7 @@ impl Gfx {
             ctx,
             renderer,
             reference: None,
+            lit,
             post,
             frames,
             ui,
@@ -580,12 +642,22 @@ impl Gfx {
                 let mut sinks = Sinks {
                     renderer: &mut self.renderer,
                     reference: self.reference.as_mut(),
+                    lit: self.lit.as_ref(),
                 };
                 self.streaming.streamer.update(eye, &mut sinks)?
             }
         };
         if let Some((pos, why)) = frame.failed.first() {
             self.status.message = format!("chunk {pos:?}: {why}");
+        }
+        // A lit scene's sun shadows follow the eye (a scene wider than the volume).
+        if let Some(l) = &self.lit {
+            let e = eye.to_array().map(|v| v.floor().clamp(-1e9, 1e9) as i32);
+            let at = voxel_core::WorldPos::new(e[0], e[1], e[2]);
+            self.renderer.follow_sun_shadows(&l.world, at);
+            if let Some(r) = &mut self.reference {
+                r.follow_sun_shadows(&l.world, at);
+            }
         }
         self.streaming.last = frame;
         Ok(())
@@ -742,11 +814,40 @@ impl Gfx {
             self.status.message = chain(&e);
             return;
         }
+        if let Err(e) = self.relight(pos, id) {
+            self.status.message = chain(&e);
+        }
         if let Some((field, _)) = &mut self.streaming.far
             && let Err(e) = field.set_block(pos, id)
         {
             self.status.message = chain(&e);
         }
+    }
+
+    /// A lit scene: the edit in the light field, and the chunks whose light it changed
+    /// meshed again and uploaded (those the streamer draws), the sun shadows read again.
+    fn relight(&mut self, pos: voxel_core::WorldPos, id: BlockId) -> Result<()> {
+        let Some(lit) = &mut self.lit else {
+            return Ok(());
+        };
+        lit.field.set_block(&mut lit.world, pos, id)?;
+        let drawn: HashSet<ChunkPos> = self.streaming.streamer.uploaded().collect();
+        let meshed = voxel_mesh::mesh_dirty_lit(&mut lit.world, &mut lit.field)?;
+        let mut changed = Vec::with_capacity(meshed.len());
+        for (p, m) in meshed {
+            changed.push(p);
+            if drawn.contains(&p) {
+                self.renderer.upload_chunk(p, &m)?;
+                if let Some(r) = &mut self.reference {
+                    r.upload_chunk(p, &m)?;
+                }
+            }
+        }
+        self.renderer.update_sun_shadows(&lit.world, &changed);
+        if let Some(r) = &mut self.reference {
+            r.update_sun_shadows(&lit.world, &changed);
+        }
+        Ok(())
     }
 
     fn fly(&mut self, dt: f64) {
@@ -876,10 +977,18 @@ impl Gfx {
         let streamer = &self.streaming.streamer;
         let world = streamer.world();
         let mut r = Renderer::new(&self.ctx, world.registry(), config)?;
-        // What the renderer draws, meshed at once (the same meshes the streamer made).
+        // What the renderer draws, meshed at once (the same meshes the streamer made, or a
+        // lit scene's).
         let positions: Vec<ChunkPos> = streamer.uploaded().collect();
-        for (pos, m) in voxel_mesh::mesh_chunks(world, &positions)? {
+        let meshed = match &self.lit {
+            Some(l) => voxel_mesh::mesh_chunks_lit(&l.world, &l.field, &positions)?,
+            None => voxel_mesh::mesh_chunks(world, &positions)?,
+        };
+        for (pos, m) in meshed {
             r.upload_chunk(pos, &m)?;
+        }
+        if let (Some(l), Some(region)) = (&self.lit, self.renderer.sun_region()) {
+            r.set_sun_shadows(&l.world, region)?;
         }
         Ok(r)
     }
