@@ -250,6 +250,14 @@ pub struct VoxelWorld {
     source: Source,
     /// Every chunk is sent again (a new world).
     reset: bool,
+    /// A fixed world drawn with its light ([`VoxelWorld::with_light`]).
+    light: Option<LitWorld>,
+}
+
+/// A fixed world's light field, and whether the sun casts shadows.
+struct LitWorld {
+    field: voxel_core::LightField,
+    sun_shadows: bool,
 }
 
 impl std::fmt::Debug for VoxelWorld {
@@ -272,7 +280,37 @@ impl VoxelWorld {
         Self {
             source: Source::Fixed(world),
             reset: true,
+            light: None,
         }
+    }
+
+    /// Drawn with its light (`docs/light.md`): sky and block light through glass and water
+    /// from a `LightField` lit now, meshed into every chunk, and the sun's shadows through
+    /// them over the chunks nearest the first [`VoxelCamera`] (`Renderer::set_sun_shadows`,
+    /// following the camera); edits ([`VoxelWorld::set_block`]) relight what they change.
+    /// A fixed world only: a streamed world is drawn unlit (lighting chunks as they
+    /// stream is not done yet), with a warning.
+    pub fn with_light(mut self) -> Self {
+        match &self.source {
+            Source::Fixed(w) => {
+                self.light = Some(LitWorld {
+                    field: voxel_core::LightField::new(w),
+                    sun_shadows: true,
+                });
+            }
+            Source::Streamed(_) => {
+                log::warn!("voxel-bevy: a streamed world is drawn unlit");
+            }
+        }
+        self
+    }
+
+    /// With light, no sun shadows: the sky light stands for the sun's.
+    pub fn without_sun_shadows(mut self) -> Self {
+        if let Some(l) = &mut self.light {
+            l.sun_shadows = false;
+        }
+        self
     }
 
     /// The generator's terrain over the default registry, `radius` chunks around the origin
@@ -300,6 +338,7 @@ impl VoxelWorld {
         Ok(Self {
             source: Source::Streamed(Mutex::new(ChunkStreamer::new(registry, source, config)?)),
             reset: true,
+            light: None,
         })
     }
 
@@ -331,7 +370,10 @@ impl VoxelWorld {
     /// of a fixed world, first thing for a streamed one); returns the block it replaced.
     pub fn set_block(&mut self, pos: WorldPos, id: BlockId) -> voxel_render::Result<BlockId> {
         match &mut self.source {
-            Source::Fixed(w) => Ok(w.set_block(pos, id)?),
+            Source::Fixed(w) => match &mut self.light {
+                Some(l) => Ok(l.field.set_block(w, pos, id)?),
+                None => Ok(w.set_block(pos, id)?),
+            },
             Source::Streamed(s) => s
                 .get_mut()
                 .unwrap_or_else(PoisonError::into_inner)
@@ -364,6 +406,13 @@ enum ChunkOp {
     Reset(Arc<BlockRegistry>),
     Upload(ChunkPos, ChunkMeshes),
     Remove(ChunkPos),
+    /// A lit world's blocks for the sun shadows: all of them over the chunks nearest `eye`
+    /// (`changed` `None`), or again for the chunks `changed`.
+    Sun {
+        world: Arc<World>,
+        changed: Option<Vec<ChunkPos>>,
+        eye: DVec3,
+    },
 }
 
 /// A queue shared by the main and render worlds (one per app, made by the plugin).
@@ -481,6 +530,7 @@ fn update_world(
         return;
     };
     let world = &mut *world;
+    let reset = world.reset;
     if world.reset {
         world.reset = false;
         push(&queue.0, ChunkOp::Reset(world.world().registry().clone()));
@@ -491,25 +541,40 @@ fn update_world(
             }
         }
     }
+    let eye = cameras.iter().next().map(|t| dvec3(t.translation()));
     match &mut world.source {
         Source::Fixed(w) => {
             if w.dirty().is_empty() {
                 return;
             }
-            match voxel_mesh::mesh_dirty(w) {
+            let meshed = match &mut world.light {
+                Some(l) => voxel_mesh::mesh_dirty_lit(w, &mut l.field),
+                None => voxel_mesh::mesh_dirty(w),
+            };
+            match meshed {
                 Ok(meshes) => {
+                    let changed: Vec<ChunkPos> = meshes.iter().map(|(p, _)| *p).collect();
                     for (pos, m) in meshes {
                         push(&queue.0, ChunkOp::Upload(pos, m));
+                    }
+                    if world.light.as_ref().is_some_and(|l| l.sun_shadows) {
+                        push(
+                            &queue.0,
+                            ChunkOp::Sun {
+                                world: Arc::new(w.clone()),
+                                changed: (!reset).then_some(changed),
+                                eye: eye.unwrap_or(DVec3::ZERO),
+                            },
+                        );
                     }
                 }
                 Err(e) => report_error(&mut messages, format!("meshing: {e}")),
             }
         }
         Source::Streamed(s) => {
-            let Some(eye) = cameras.iter().next() else {
+            let Some(eye) = eye else {
                 return;
             };
-            let eye = dvec3(eye.translation());
             let s = s.get_mut().unwrap_or_else(PoisonError::into_inner);
             if let Err(e) = s.update(eye, &mut QueueSink(&queue.0)) {
                 report_error(&mut messages, format!("streaming: {e}"));

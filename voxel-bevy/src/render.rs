@@ -54,6 +54,8 @@ struct VoxelRender {
     /// Each camera's composite bind groups (by its main-world entity), kept while they
     /// read the same textures.
     bindings: HashMap<Entity, Binding>,
+    /// A lit world's blocks, which the sun shadows follow the camera over.
+    sun_world: Option<Arc<voxel_core::World>>,
 }
 
 pub(crate) fn build(app: &mut App, plugin: VoxelPlugin, chunks: ChunkQueue, reports: ReportQueue) {
@@ -128,6 +130,7 @@ fn prepare(
                 state.lighting = None;
                 state.content_generation = None;
                 state.reported = None;
+                state.sun_world = None;
                 let config = RendererConfig {
                     width: 64,
                     height: 64,
@@ -157,7 +160,35 @@ fn prepare(
                     r.remove_chunk(pos);
                 }
             }
+            ChunkOp::Sun {
+                world,
+                changed,
+                eye,
+            } => {
+                if let Some(r) = &mut state.renderer {
+                    match changed {
+                        Some(chunks) => r.update_sun_shadows(&world, &chunks),
+                        None => {
+                            let at = world_pos(eye);
+                            if let Some(region) = voxel_render::SunRegion::around(&world, at)
+                                && let Err(e) = r.set_sun_shadows(&world, region)
+                            {
+                                message(reports, VoxelMessage::Error(format!("sun shadows: {e}")));
+                            }
+                        }
+                    }
+                }
+                state.sun_world = Some(world);
+            }
         }
+    }
+    // The sun shadows follow the (first) camera.
+    if let (Some(r), Some(w), Some(c)) = (
+        &mut state.renderer,
+        &state.sun_world,
+        frame.cameras.values().next(),
+    ) {
+        r.follow_sun_shadows(w, world_pos(c.eye));
     }
     let Some(renderer) = &mut state.renderer else {
         return;
@@ -307,4 +338,12 @@ fn voxel_pass(
         }
         Err(e) => message(&reports, VoxelMessage::Error(format!("frame: {e}"))),
     }
+}
+
+/// The block holding point `p` (clamped to the `i32` world).
+fn world_pos(p: glam::DVec3) -> voxel_core::WorldPos {
+    let b = p
+        .to_array()
+        .map(|v| v.floor().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32);
+    voxel_core::WorldPos::new(b[0], b[1], b[2])
 }

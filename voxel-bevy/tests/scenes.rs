@@ -21,13 +21,15 @@ fn scene(name: &str) -> Scene {
 }
 
 /// Renders `name` through Bevy with every real-time technique and compares each picture with
-/// the crate's own render of the plugin's camera on Bevy's device.
+/// the crate's own render of the plugin's camera on Bevy's device (a lit scene lit on both
+/// sides, with sun shadows).
 fn matches_the_crate(name: &str, hdr: bool) {
     let s = scene(name);
     let cam = s.cameras[0];
     let size = (160, 120);
+    let world = VoxelWorld::from_world(s.world.clone());
     let mut h = Harness::new(
-        VoxelWorld::from_world(s.world.clone()),
+        if s.light { world.with_light() } else { world },
         cam.eye,
         cam.forward,
         cam.fov_y_deg,
@@ -42,6 +44,7 @@ fn matches_the_crate(name: &str, hdr: bool) {
     let camera = h.camera();
     let mut reference_scene = Scene::new(name, s.world.clone(), camera);
     reference_scene.content = s.content.clone();
+    reference_scene.light = s.light;
     for t in Technique::REAL_TIME {
         h.app.insert_resource(VoxelTechnique::Use(t));
         let bevy = h.frames(2);
@@ -59,6 +62,16 @@ fn matches_the_crate(name: &str, hdr: bool) {
         );
         assert!(tests::distinct_colours(&bevy) > 20, "{tag}: a flat picture");
     }
+}
+
+/// The cathedral window (`light = true`): light through stained glass, a torch behind blue
+/// glass, the sun's coloured patches on the floor (`VoxelWorld::with_light`).
+#[test]
+fn a_lit_scene_matches_the_crate_with_its_light_and_sun_shadows() {
+    if !have_gpu() {
+        return;
+    }
+    matches_the_crate("light/cathedral", false);
 }
 
 #[test]

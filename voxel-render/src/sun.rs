@@ -394,7 +394,7 @@ fn classes(sun: &SunFilters) -> (Vec<u8>, Vec<[f32; 4]>) {
 /// The tops of every tile of the volume, four to a vector (`sun_tops` in `frame.wgsl`).
 pub(crate) type SunTops = [[i32; 4]; MAX_TILES * MAX_TILES / 4];
 
-/// The frame uniforms' sun fields ([`crate::bindings::FrameUniforms`]).
+/// The frame uniforms' sun fields (`FrameUniforms` in `bindings.rs`).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct SunUniforms {
     /// The eye's integer part minus the region's first block.
