@@ -169,7 +169,7 @@ fn prepare(
                     match changed {
                         Some(chunks) => r.update_sun_shadows(&world, &chunks),
                         None => {
-                            let at = world_pos(eye);
+                            let at = voxel_core::WorldPos::containing(eye.to_array());
                             if let Some(region) = voxel_render::SunRegion::around(&world, at)
                                 && let Err(e) = r.set_sun_shadows(&world, region)
                             {
@@ -188,7 +188,7 @@ fn prepare(
         &state.sun_world,
         frame.cameras.values().next(),
     ) {
-        r.follow_sun_shadows(w, world_pos(c.eye));
+        r.follow_sun_shadows(w, voxel_core::WorldPos::containing(c.eye.to_array()));
     }
     let Some(renderer) = &mut state.renderer else {
         return;
@@ -338,12 +338,4 @@ fn voxel_pass(
         }
         Err(e) => message(&reports, VoxelMessage::Error(format!("frame: {e}"))),
     }
-}
-
-/// The block holding point `p` (clamped to the `i32` world).
-fn world_pos(p: glam::DVec3) -> voxel_core::WorldPos {
-    let b = p
-        .to_array()
-        .map(|v| v.floor().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32);
-    voxel_core::WorldPos::new(b[0], b[1], b[2])
 }

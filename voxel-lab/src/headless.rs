@@ -188,13 +188,9 @@ pub fn renderer_for(
 /// camera; `None` for a scene drawn unlit or without sun shadows.
 pub fn sun_region(scene: &Scene) -> Option<voxel_render::SunRegion> {
     let eye = scene.cameras.first().map_or([0.0; 3], |c| c.eye.to_array());
-    let eye = eye.map(|v| v.floor().clamp(f64::from(i32::MIN), f64::from(i32::MAX)) as i32);
     (scene.light && scene.sun_shadows)
         .then(|| {
-            voxel_render::SunRegion::around(
-                &scene.world,
-                voxel_core::WorldPos::new(eye[0], eye[1], eye[2]),
-            )
+            voxel_render::SunRegion::around(&scene.world, voxel_core::WorldPos::containing(eye))
         })
         .flatten()
 }

@@ -44,18 +44,8 @@ impl SunRegion {
     /// The loaded chunks of `world`, or the [`MAX_SUN_CHUNKS`] along each axis nearest
     /// `around` where they span more; `None` for a world with no chunk.
     pub fn around(world: &World, around: WorldPos) -> Option<Self> {
-        let mut lo = [i32::MAX; 3];
-        let mut hi = [i32::MIN; 3];
-        for (pos, _) in world.iter() {
-            let p = [pos.x, pos.y, pos.z];
-            for a in 0..3 {
-                lo[a] = lo[a].min(p[a]);
-                hi[a] = hi[a].max(p[a]);
-            }
-        }
-        if lo[0] > hi[0] {
-            return None;
-        }
+        let (lo, hi) = world.chunk_bounds()?;
+        let (lo, hi) = ([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]);
         let (centre, _) = around.split();
         let centre = [centre.x, centre.y, centre.z];
         let max = MAX_SUN_CHUNKS as i32;
@@ -143,6 +133,9 @@ pub(crate) struct SunVolume {
     /// Per chunk of the region, per tile of it (x + 4 z): its highest cell holding anything
     /// but air (the chunk's y), -1 for none.
     tops: HashMap<ChunkPos, [i32; TILES * TILES]>,
+    /// `tops` per tile of the region as the frame's uniforms hold them
+    /// ([`SunVolume::gather_tops`], after each change: not every frame).
+    tiles: SunTops,
 }
 
 impl SunVolume {
@@ -157,6 +150,7 @@ impl SunVolume {
             texture,
             region: None,
             tops: HashMap::new(),
+            tiles: NO_TOPS,
         }
     }
 
@@ -196,9 +190,11 @@ impl SunVolume {
         world: &World,
         region: SunRegion,
     ) -> Result<()> {
-        if world.registry().len() != self.classes.len() {
+        let (world_classes, world_filters) = classes(&SunFilters::new(world.registry()));
+        if world_classes != self.classes || world_filters != self.filters {
             return Err(Error::InvalidSetting(format!(
-                "sun shadows: the world's registry has {} blocks, the renderer's {}",
+                "sun shadows: the world's registry ({} blocks) is not the renderer's ({}): \
+                 its blocks cross the sun otherwise",
                 world.registry().len(),
                 self.classes.len()
             )));
@@ -225,6 +221,7 @@ impl SunVolume {
                 self.write(queue, pos, chunk);
             }
         }
+        self.gather_tops();
         Ok(())
     }
 
@@ -246,23 +243,22 @@ impl SunVolume {
         }
         self.region = Some(new);
         self.tops.retain(|&pos, _| new.contains(pos));
-        let mut read = 0;
-        for pos in new.positions().filter(|&p| !old.contains(p)) {
-            self.update(queue, world, pos);
-            read += 1;
-        }
-        read
+        let entering: Vec<ChunkPos> = new.positions().filter(|&p| !old.contains(p)).collect();
+        self.update(queue, world, &entering);
+        entering.len()
     }
 
-    /// Writes chunk `pos` again from `world` (air where it is not loaded), if the region
-    /// holds it.
-    pub(crate) fn update(&mut self, queue: &wgpu::Queue, world: &World, pos: ChunkPos) {
-        if self.region.is_some_and(|r| r.contains(pos)) {
+    /// Writes chunks `chunks` again from `world` (air where not loaded), those the region
+    /// holds.
+    pub(crate) fn update(&mut self, queue: &wgpu::Queue, world: &World, chunks: &[ChunkPos]) {
+        let Some(region) = self.region else { return };
+        for &pos in chunks.iter().filter(|&&p| region.contains(p)) {
             match world.chunk(pos) {
                 Some(chunk) => self.write(queue, pos, chunk),
                 None => self.write(queue, pos, &Chunk::default()),
             }
         }
+        self.gather_tops();
     }
 
     /// Drops the volume.
@@ -273,6 +269,7 @@ impl SunVolume {
             .create_view(&wgpu::TextureViewDescriptor::default());
         self.region = None;
         self.tops.clear();
+        self.tiles = NO_TOPS;
     }
 
     fn write(&mut self, queue: &wgpu::Queue, pos: ChunkPos, chunk: &Chunk) {
@@ -311,27 +308,11 @@ impl SunVolume {
         );
     }
 
-    /// The frame uniforms' sun fields for an eye whose integer part is `eye_int`; all zero
-    /// without a volume or for an eye so far from it that its blocks are not exact in
-    /// `f32`.
-    pub(crate) fn uniforms(&self, eye_int: [i64; 3]) -> SunUniforms {
-        let none = SunUniforms {
-            offset: [0; 3],
-            on: 0,
-            size: [0; 3],
-            wrap: [0; 3],
-            tops: [[-1; 4]; MAX_TILES * MAX_TILES / 4],
-        };
-        let Some(region) = self.region else {
-            return none;
-        };
-        let first = region.first_block();
-        let offset: [i64; 3] = std::array::from_fn(|a| eye_int[a] - first[a]);
-        const EXACT: i64 = 1 << 24;
-        if offset.iter().any(|o| o.abs() >= EXACT) {
-            return none;
-        }
-        let mut tops = none.tops;
+    /// `tiles` from `tops`: per tile of the region (x + 32 z from its first block) the
+    /// highest top of its chunks' tiles, in volume y.
+    fn gather_tops(&mut self) {
+        self.tiles = NO_TOPS;
+        let Some(region) = self.region else { return };
         for (&pos, chunk_tops) in &self.tops {
             let Some([x, y, z]) = region.local(pos) else {
                 continue;
@@ -344,8 +325,30 @@ impl SunVolume {
                 } else {
                     (y * CHUNK_SIZE) as i32 + top
                 };
-                tops[i / 4][i % 4] = tops[i / 4][i % 4].max(top);
+                self.tiles[i / 4][i % 4] = self.tiles[i / 4][i % 4].max(top);
             }
+        }
+    }
+
+    /// The frame uniforms' sun fields for an eye whose integer part is `eye_int`; all zero
+    /// without a volume or for an eye so far from it that its blocks are not exact in
+    /// `f32`.
+    pub(crate) fn uniforms(&self, eye_int: [i64; 3]) -> SunUniforms {
+        let none = SunUniforms {
+            offset: [0; 3],
+            on: 0,
+            size: [0; 3],
+            wrap: [0; 3],
+            tops: NO_TOPS,
+        };
+        let Some(region) = self.region else {
+            return none;
+        };
+        let first = region.first_block();
+        let offset: [i64; 3] = std::array::from_fn(|a| eye_int[a] - first[a]);
+        const EXACT: i64 = 1 << 24;
+        if offset.iter().any(|o| o.abs() >= EXACT) {
+            return none;
         }
         let size = region.blocks();
         SunUniforms {
@@ -353,7 +356,7 @@ impl SunVolume {
             on: 1,
             size,
             wrap: std::array::from_fn(|a| first[a].rem_euclid(i64::from(size[a])) as u32),
-            tops,
+            tops: self.tiles,
         }
     }
 }
@@ -393,6 +396,9 @@ fn classes(sun: &SunFilters) -> (Vec<u8>, Vec<[f32; 4]>) {
 
 /// The tops of every tile of the volume, four to a vector (`sun_tops` in `frame.wgsl`).
 pub(crate) type SunTops = [[i32; 4]; MAX_TILES * MAX_TILES / 4];
+
+/// No tile holds anything.
+const NO_TOPS: SunTops = [[-1; 4]; MAX_TILES * MAX_TILES / 4];
 
 /// The frame uniforms' sun fields (`FrameUniforms` in `bindings.rs`).
 #[derive(Clone, Copy, Debug)]

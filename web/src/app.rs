@@ -278,9 +278,8 @@ impl App {
         // A lit world's sun shadows follow the eye (the page's world is wider than their
         // volume; nothing is read while the eye stays in its chunk).
         if let Blocks::World(world) = &self.blocks {
-            let b = eye.to_array().map(|v| v.floor().clamp(-1e9, 1e9) as i32);
             self.renderer
-                .follow_sun_shadows(world, voxel_core::WorldPos::new(b[0], b[1], b[2]));
+                .follow_sun_shadows(world, voxel_core::WorldPos::containing(eye.to_array()));
         }
         let medium = self.blocks.world().medium_at(eye.to_array());
         let camera = self.fly.camera(medium)?;

@@ -434,8 +434,7 @@ impl SceneLight {
 
     /// Sun shadows over the chunks nearest `eye` in `renderer`, when the scene has them.
     fn shadow(&self, renderer: &mut Renderer, eye: DVec3) -> Result<()> {
-        let eye = eye.to_array().map(|v| v.floor().clamp(-1e9, 1e9) as i32);
-        let around = voxel_core::WorldPos::new(eye[0], eye[1], eye[2]);
+        let around = voxel_core::WorldPos::containing(eye.to_array());
         if let (true, Some(region)) = (
             self.sun_shadows,
             voxel_render::SunRegion::around(&self.world, around),
@@ -652,8 +651,7 @@ impl Gfx {
         }
         // A lit scene's sun shadows follow the eye (a scene wider than the volume).
         if let Some(l) = &self.lit {
-            let e = eye.to_array().map(|v| v.floor().clamp(-1e9, 1e9) as i32);
-            let at = voxel_core::WorldPos::new(e[0], e[1], e[2]);
+            let at = voxel_core::WorldPos::containing(eye.to_array());
             self.renderer.follow_sun_shadows(&l.world, at);
             if let Some(r) = &mut self.reference {
                 r.follow_sun_shadows(&l.world, at);

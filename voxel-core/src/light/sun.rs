@@ -157,16 +157,10 @@ pub struct SunMarch<'w> {
 impl<'w> SunMarch<'w> {
     /// A march over `world` as it is now (its loaded chunks bound the walk).
     pub fn new(world: &'w World) -> Self {
-        let s = CHUNK_SIZE as i64;
-        let mut min = [i64::MAX; 3];
-        let mut max = [i64::MIN; 3];
-        for (pos, _) in world.iter() {
-            let o = pos.origin();
-            for a in 0..3 {
-                min[a] = min[a].min(o[a]);
-                max[a] = max[a].max(o[a] + s - 1);
-            }
-        }
+        let (min, max) = match world.chunk_bounds() {
+            Some((lo, hi)) => (lo.origin(), hi.origin().map(|o| o + CHUNK_SIZE as i64 - 1)),
+            None => ([i64::MAX; 3], [i64::MIN; 3]),
+        };
         Self {
             world,
             filters: SunFilters::new(world.registry()),

@@ -75,6 +75,13 @@ impl WorldPos {
         Self { x, y, z }
     }
 
+    /// The block holding `point` (world units; each coordinate saturates at the `i32`
+    /// world's edge, NaN reads as 0).
+    pub fn containing(point: [f64; 3]) -> Self {
+        let [x, y, z] = point.map(|v| v.floor() as i32);
+        Self { x, y, z }
+    }
+
     /// The block's lowest corner, in world units (the block fills it to `corner + 1`).
     pub fn corner(self) -> [f64; 3] {
         [self.x, self.y, self.z].map(f64::from)

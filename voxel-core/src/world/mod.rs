@@ -57,8 +57,7 @@ impl World {
         if !point.iter().all(|&v| inside(v)) {
             return None;
         }
-        let p = point.map(|v| v.floor() as i32);
-        let id = self.get_block(WorldPos::new(p[0], p[1], p[2]));
+        let id = self.get_block(WorldPos::containing(point));
         let def = self.registry.get(id).ok()?;
         // A block standing in a medium (waterlogged kelp) is in that medium.
         def.medium
@@ -253,6 +252,19 @@ impl World {
     /// Number of loaded chunks.
     pub fn len(&self) -> usize {
         self.chunks.len()
+    }
+
+    /// The smallest and largest coordinates, per axis, of the loaded chunks; `None` for a
+    /// world with no chunk.
+    pub fn chunk_bounds(&self) -> Option<(ChunkPos, ChunkPos)> {
+        let mut it = self.chunks.keys();
+        let first = *it.next()?;
+        Some(it.fold((first, first), |(lo, hi), p| {
+            (
+                ChunkPos::new(lo.x.min(p.x), lo.y.min(p.y), lo.z.min(p.z)),
+                ChunkPos::new(hi.x.max(p.x), hi.y.max(p.y), hi.z.max(p.z)),
+            )
+        }))
     }
 
     /// Whether no chunk is loaded.

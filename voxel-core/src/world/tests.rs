@@ -256,3 +256,23 @@ fn the_medium_at_a_point_is_its_translucent_block() {
     assert_eq!(w.medium_at([f64::NAN, 0.0, 0.0]), None);
     assert_eq!(w.medium_at([3e9, 0.0, 0.0]), None);
 }
+
+#[test]
+fn the_block_holding_a_point_and_the_loaded_chunks_bounds() {
+    assert_eq!(
+        WorldPos::containing([0.5, -0.5, 31.99]),
+        WorldPos::new(0, -1, 31)
+    );
+    assert_eq!(
+        WorldPos::containing([f64::NAN, 1e12, -1e12]),
+        WorldPos::new(0, i32::MAX, i32::MIN)
+    );
+    let mut w = world();
+    assert_eq!(w.chunk_bounds(), None);
+    w.set_block(WorldPos::new(-40, 5, 70), STONE).unwrap();
+    w.set_block(WorldPos::new(10, -3, 0), STONE).unwrap();
+    assert_eq!(
+        w.chunk_bounds(),
+        Some((ChunkPos::new(-2, -1, 0), ChunkPos::new(0, 0, 2)))
+    );
+}

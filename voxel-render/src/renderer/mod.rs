@@ -360,9 +360,7 @@ impl Renderer {
     /// changed: [`World::take_dirty`]'s, before meshing); chunks outside the region, or
     /// without sun shadows, are skipped. An unloaded chunk reads as air.
     pub fn update_sun_shadows(&mut self, world: &World, chunks: &[ChunkPos]) {
-        for &pos in chunks {
-            self.scene.sun.update(&self.ctx.queue, world, pos);
-        }
+        self.scene.sun.update(&self.ctx.queue, world, chunks);
     }
 
     /// Moves the sun shadows' region so that its x and z centre on the chunk of `eye` (a
