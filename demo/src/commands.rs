@@ -376,6 +376,7 @@ pub(crate) fn stream(a: StreamArgs, device: &headless::Device) -> Result<()> {
         size: a.size,
         seed: a.seed,
         teleport_at: a.teleport_at,
+        light: a.light,
         out: a.out.clone(),
     };
     opts.validate()?;
@@ -407,11 +408,14 @@ pub(crate) fn stream(a: StreamArgs, device: &headless::Device) -> Result<()> {
         r.hitches
     );
     println!(
-        "memory: GPU {:.1} MiB ({} quads), blocks {:.1} MiB ({:.2}x a packed-index palette); wrote {}",
+        "memory: GPU {:.1} MiB ({} quads), blocks {:.1} MiB ({:.2}x a packed-index palette), \
+         light {:.1} MiB; {:.2} meshes per chunk; wrote {}",
         mib(r.gpu_buffer_bytes),
         r.quads,
         mib(r.chunk_storage_bytes),
         r.chunk_storage_bytes as f64 / r.packed_index_bytes.max(1) as f64,
+        mib(r.light_bytes),
+        r.meshes_per_chunk,
         a.out.join("stream.json").display()
     );
     if let Some(t) = r.teleport {
@@ -563,6 +567,7 @@ pub(crate) fn window(a: WindowArgs, device: DeviceArgs) -> Result<()> {
         // Read before the window opens: a broken file is an error, not an empty window.
         scene: a.scene.as_deref().map(scene::Scene::load).transpose()?,
         game: a.game,
+        light: a.light,
     })
 }
 

@@ -199,6 +199,10 @@ struct StreamArgs {
     /// the streamer: it drops and reloads within its per-frame budgets).
     #[arg(long, value_name = "FRAME")]
     teleport_at: Option<usize>,
+    /// Light the chunks as they stream (sky light, light sources; on the streamer's
+    /// workers).
+    #[arg(long)]
+    light: bool,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
@@ -323,6 +327,11 @@ struct WindowArgs {
     /// Scripted: step through every technique, saving DIR/<technique>.png for each.
     #[arg(long, requires = "frames")]
     cycle: Option<PathBuf>,
+    /// Light the generated terrain as it streams (sky light through glass and water,
+    /// light sources; docs/light.md), to view distance 32. A scene is lit by its own
+    /// `light = true`.
+    #[arg(long)]
+    light: bool,
     /// Scripted: place a block in front of the camera on the second frame.
     #[arg(long, requires = "frames")]
     edit: bool,

@@ -424,3 +424,53 @@ fn the_window_draws_a_lit_scene_with_its_light_and_sun_shadows() {
         lit.len()
     );
 }
+
+/// `--light` lights the generated terrain as it streams (on the streamer's workers): the
+/// scripted frames wait for the light as for the meshes, and the picture is the unlit
+/// one where the open sky lights everything alike, darker where the sky's light is
+/// dimmed (the sea floor under the water, the ground under trees and overhangs).
+#[test]
+fn the_window_lights_the_terrain_as_it_streams() {
+    let Some(x) = vulkan_and_xvfb() else { return };
+    let dir = out_dir("window-lit-terrain");
+    let shot = |name: &str, extra: &[&str]| {
+        let path = dir.join(name);
+        let mut args = vec![
+            "--size",
+            "640x360",
+            "--frames",
+            "3",
+            "--view-distance",
+            "4",
+            "--screenshot",
+            path.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        demo(&x, &args);
+        view(&Image::load_png(&path).unwrap())
+    };
+    let unlit = shot("unlit.png", &[]);
+    let lit = shot("lit.png", &["--light"]);
+    assert!(distinct(&lit) > 100, "{} colours", distinct(&lit));
+    let sum = |p: &[u8; 3]| p.iter().map(|&c| u32::from(c)).sum::<u32>();
+    let (mut darker, mut lighter) = (0, 0);
+    for (p, q) in unlit.iter().zip(&lit) {
+        if sum(q) + 12 < sum(p) {
+            darker += 1;
+        } else if sum(q) > sum(p) + 12 {
+            lighter += 1;
+        }
+    }
+    println!(
+        "lit: {darker} pixels darker, {lighter} lighter of {}",
+        lit.len()
+    );
+    assert!(darker * 100 > lit.len(), "only {darker} pixels darker lit");
+    assert!(lighter * 20 < lit.len(), "{lighter} pixels lighter lit");
+    // Not a view gone dark (chunks drawn unlit or not at all).
+    assert!(
+        darker * 2 < lit.len(),
+        "{darker} of {} pixels darker",
+        lit.len()
+    );
+}

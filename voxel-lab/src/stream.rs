@@ -45,6 +45,9 @@ pub struct StreamOptions {
     pub seed: u32,
     /// At this frame the eye jumps 10 000 chunks (along +z) and flies on from there.
     pub teleport_at: Option<usize>,
+    /// Chunks lit as they stream ([`ChunkStreamer::set_light`]), with the light
+    /// sources' registry.
+    pub light: bool,
     /// Output folder.
     pub out: PathBuf,
 }
@@ -63,6 +66,7 @@ impl Default for StreamOptions {
             size: (640, 360),
             seed: 1,
             teleport_at: None,
+            light: false,
             out: PathBuf::from("stream-out"),
         }
     }
@@ -173,6 +177,13 @@ pub struct StreamFrameRecord {
 pub struct StreamReport {
     /// Adapter.
     pub adapter: String,
+    /// Whether chunks were lit as they streamed.
+    pub light: bool,
+    /// Bytes of the light of the resident chunks at the end (0 without light).
+    pub light_bytes: u64,
+    /// Meshes made per chunk meshed (at the end): above 1 where chunks were meshed again
+    /// (light that changed as neighbours came in, chunks that unloaded and came back).
+    pub meshes_per_chunk: f64,
     /// Horizontal view distance in chunks.
     pub view_distance: u32,
     /// Vertical view distance in chunks.
@@ -269,7 +280,11 @@ fn camera_at(generator: &TerrainGenerator, opts: &StreamOptions, frame: usize) -
 pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
     opts.validate()?;
     std::fs::create_dir_all(&opts.out).map_err(Error::io(&opts.out))?;
-    let registry = Arc::new(BlockRegistry::default());
+    let registry = Arc::new(if opts.light {
+        BlockRegistry::with_lights()
+    } else {
+        BlockRegistry::default()
+    });
     let generator = TerrainGenerator::new(TerrainConfig {
         seed: opts.seed,
         ..TerrainConfig::default()
@@ -280,6 +295,7 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
         ..StreamConfig::default()
     };
     let mut streamer = ChunkStreamer::new(registry.clone(), generator.clone(), config)?;
+    streamer.set_light(opts.light);
     let (w, h) = opts.size;
     let mut renderer = Renderer::new(
         ctx,
@@ -297,9 +313,12 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
     // The first load, untimed per frame.
     let start = Instant::now();
     let first = camera_at(&generator, opts, 0)?;
+    let (mut meshed, mut chunks_meshed) = (0, std::collections::HashSet::new());
     while !streamer.is_idle() {
         let f = streamer.update(first.eye, &mut renderer)?;
         failed += f.failed.len();
+        meshed += f.uploaded.len();
+        chunks_meshed.extend(f.uploaded.iter().copied());
         std::thread::sleep(std::time::Duration::from_micros(500));
     }
     let prefill_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -312,6 +331,8 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
         let f = streamer.update(camera.eye, &mut renderer)?;
         let stream_ms = t0.elapsed().as_secs_f64() * 1e3;
         failed += f.failed.len();
+        meshed += f.uploaded.len();
+        chunks_meshed.extend(f.uploaded.iter().copied());
         let mut encoder = ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -339,6 +360,9 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
             draw_calls: stats.draw_calls,
         });
         progress.step(&format!("frame {i}"));
+        if i % 30 == 0 {
+            eprintln!("{streamer:?}");
+        }
     }
     progress.finish();
 
@@ -350,6 +374,9 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
     let world = streamer.world();
     let report = StreamReport {
         adapter: ctx.caps.adapter_name.clone(),
+        light: opts.light,
+        light_bytes: streamer.light_bytes() as u64,
+        meshes_per_chunk: meshed as f64 / chunks_meshed.len().max(1) as f64,
         view_distance: opts.view_distance,
         vertical_distance: opts.vertical_distance,
         frames: opts.frames,

@@ -77,6 +77,10 @@ pub struct DemoOptions {
     /// Show the game content (bubbles, the glass cube, the boat) from the start; `None`:
     /// on in an interactive run, off in a scripted one (whose pictures tests compare).
     pub game: Option<bool>,
+    /// Generated terrain lit as it streams (`ChunkStreamer::set_light`: sky light and
+    /// light sources, on the streamer's workers), to [`STREAMED_VIEW_DISTANCE`]. A scene
+    /// is lit by its own `light = true`.
+    pub light: bool,
 }
 
 impl Default for DemoOptions {
@@ -97,6 +101,7 @@ impl Default for DemoOptions {
             resize: false,
             scene: None,
             game: None,
+            light: false,
         }
     }
 }
@@ -296,11 +301,19 @@ struct Streaming {
 }
 
 impl Streaming {
-    /// The world of `seed` (or the opened scene) drawn to `view_distance` chunks.
-    fn new(seed: u32, view_distance: u32, scene: Option<&OpenScene>) -> Result<Self> {
+    /// The world of `seed` (or the opened scene) drawn to `view_distance` chunks; the
+    /// terrain lit as it streams with `light` (not a scene: it has its own light, nor a
+    /// far view).
+    fn new(seed: u32, view_distance: u32, scene: Option<&OpenScene>, light: bool) -> Result<Self> {
         if view_distance <= STREAMED_VIEW_DISTANCE || scene.is_some() {
+            let view_distance = view_distance.min(STREAMED_VIEW_DISTANCE);
+            let streamer = if light && scene.is_none() {
+                lit_terrain(seed, view_distance)?
+            } else {
+                streamer(seed, view_distance, scene)?
+            };
             return Ok(Self {
-                streamer: streamer(seed, view_distance.min(STREAMED_VIEW_DISTANCE), scene)?,
+                streamer,
                 last: StreamFrame::default(),
                 far: None,
             });
@@ -382,6 +395,17 @@ fn streamer(seed: u32, view_distance: u32, scene: Option<&OpenScene>) -> Result<
         None => ChunkStreamer::new(Arc::new(BlockRegistry::default()), terrain(seed), config),
     }
     .map_err(Error::from)
+}
+
+/// [`streamer`] of `seed`'s terrain with the light sources' registry, lit as it streams.
+fn lit_terrain(seed: u32, view_distance: u32) -> Result<ChunkStreamer> {
+    let config = StreamConfig {
+        view_distance,
+        vertical_distance: 4,
+        ..StreamConfig::default()
+    };
+    let registry = Arc::new(BlockRegistry::with_lights());
+    Ok(ChunkStreamer::new(registry, terrain(seed), config)?.with_light())
 }
 
 /// The default terrain of `seed`.
@@ -488,6 +512,8 @@ struct Gfx {
     script: Script,
     /// The scene shown instead of terrain, if any.
     scene: Option<OpenScene>,
+    /// The terrain lit as it streams ([`DemoOptions::light`]).
+    light: bool,
     /// The game's own content, drawn through the renderer's stages.
     game: game::Game,
     /// Seconds of animation: real time in an interactive run, 1/60 s a frame in a
@@ -590,7 +616,7 @@ impl Gfx {
             post,
             frames,
             ui,
-            streaming: Streaming::new(opts.seed, view_distance, open.as_ref())?,
+            streaming: Streaming::new(opts.seed, view_distance, open.as_ref(), opts.light)?,
             input: Input {
                 fly: Fly {
                     eye: cam.eye,
@@ -608,6 +634,7 @@ impl Gfx {
             settings,
             status: Status::default(),
             last: Instant::now(),
+            light: opts.light,
             script: Script {
                 opts,
                 cycle,
@@ -892,7 +919,7 @@ impl Gfx {
         if let Some(r) = &mut self.reference {
             r.clear_chunks();
         }
-        self.streaming = Streaming::new(seed, view_distance, self.scene.as_ref())?;
+        self.streaming = Streaming::new(seed, view_distance, self.scene.as_ref(), self.light)?;
         Ok(())
     }
 

@@ -1,5 +1,7 @@
 //! Lighting every loaded chunk of a world from scratch.
 
+use std::sync::Arc;
+
 use super::LightField;
 use super::engine::{Cell, Engine, Entry, NONE, level, step, step_beam};
 use super::store::{Beam, Levels, LightChunk, local};
@@ -23,7 +25,7 @@ impl LightField {
         }
         self.entries.push(Entry {
             pos,
-            light: LightChunk::uniform([0; 6]),
+            light: Arc::new(LightChunk::uniform([0; 6])),
             beam_in: Beam::Uniform([0.0; 3]),
             neigh,
         });
@@ -69,7 +71,7 @@ impl LightField {
                 let chunk = world.chunk(pos);
                 self.entries[i].beam_in = Beam::from_columns(&beam);
                 self.fill_chunk(chunk, &mut beam, &mut kinds, &mut cells);
-                self.entries[i].light = LightChunk::from_cells(&cells);
+                self.entries[i].light = Arc::new(LightChunk::from_cells(&cells));
             }
         }
         // Flood from every cell that can raise a neighbour.
@@ -95,7 +97,31 @@ impl LightField {
         kinds: &mut [u16; CHUNK_AREA],
         cells: &mut [Levels],
     ) {
-        let ids = match chunk.and_then(Chunk::as_uniform) {
+        let uniform = match chunk {
+            None => Some(BlockId::AIR),
+            Some(c) => c.as_uniform(),
+        };
+        if let Some(id) = uniform
+            && beam.iter().all(|b| *b == beam[0])
+            && kinds.iter().all(|k| *k == kinds[0])
+        {
+            // One block type under the same beam everywhere (sky, rock): every column
+            // is the first.
+            let p = self.props.get(id.index()).unwrap_or(&self.props[0]);
+            let (mut b, mut kind) = (beam[0], kinds[0]);
+            for y in (0..CHUNK_SIZE).rev() {
+                b = step_beam(b, p, kind);
+                kind = p.kind;
+                let s = b.map(level);
+                let levels = [s[0], s[1], s[2], p.emit[0], p.emit[1], p.emit[2]];
+                let at = usize::from(local(0, y, 0));
+                cells[at..at + CHUNK_AREA].fill(levels);
+            }
+            beam.fill(b);
+            kinds.fill(kind);
+            return;
+        }
+        let ids = match uniform {
             Some(id) => vec![id; CHUNK_VOLUME],
             None => chunk.map_or_else(|| vec![BlockId::AIR; CHUNK_VOLUME], Chunk::to_dense),
         };

@@ -2,6 +2,7 @@
 //! goes.
 
 use std::collections::HashSet;
+use std::sync::Arc;
 
 use super::LightField;
 use super::engine::{Cell, Engine, NONE, Scratch, level};
@@ -79,55 +80,81 @@ impl LightField {
         if world.chunk(pos).is_none() {
             return Ok(false);
         }
-        let replaced = self.index.contains_key(&pos);
+        if !self.index.contains_key(&pos) {
+            let mut sky = Vec::new();
+            let ci = self.insert_new(world, pos, &mut sky);
+            let mut flood: [Vec<Cell>; 6] = Default::default();
+            self.seeds_of(ci, &mut flood);
+            let around = self.around(ci);
+            for f in &mut flood {
+                f.extend_from_slice(&around);
+            }
+            let mut engine = Engine::new(&mut self.entries, &self.props, world);
+            run(
+                &mut engine,
+                &[],
+                &sky,
+                &flood,
+                &mut self.scratch,
+                &mut self.changed,
+            );
+            return Ok(true);
+        }
+        // Replaced.
         let below = self.below(pos);
         let before = self.column_levels(world, &below);
         let ci = self.insert_entry(pos);
         let beam = self.beam_from_above(world, pos);
         self.entries[ci as usize].beam_in = beam;
         let mut sky = self.changed_below(world, ci, &below, &before);
-        if replaced
-            && below
-                .first()
-                .is_some_and(|&b| self.entries[b as usize].pos.y == pos.y - 1)
+        if below
+            .first()
+            .is_some_and(|&b| self.entries[b as usize].pos.y == pos.y - 1)
         {
             // Its old bottom blocks are gone: what the beam below was is unknown.
             sky.extend((0..CHUNK_VOLUME).map(|l| (below[0], l as Local)));
         }
-        if replaced {
-            // Its old light may have gone anywhere from any of its cells.
-            let all: Vec<Cell> = (0..CHUNK_VOLUME).map(|l| (ci, l as Local)).collect();
-            let mut engine = Engine::new(&mut self.entries, &self.props, world);
-            run(
-                &mut engine,
-                &all,
-                &sky,
-                &NO_FLOOD,
-                &mut self.scratch,
-                &mut self.changed,
-            );
-            return Ok(true);
-        }
-        // Dark, and nothing came through it: its sources as a full light writes them,
-        // then a flood from its cells that can raise a neighbour and from the cells
-        // around it.
-        let mut beam = [[0.0; 3]; CHUNK_AREA];
-        let mut kinds = [0; CHUNK_AREA];
-        {
-            let engine = Engine::new(&mut self.entries, &self.props, world);
-            for col in 0..CHUNK_AREA {
-                beam[col] = engine.entries[ci as usize].beam_in.get(col);
-                kinds[col] = engine.props_of(engine.above(ci, col)).kind;
-            }
-        }
-        let mut cells = vec![[0; 6]; CHUNK_VOLUME];
-        self.fill_chunk(world.chunk(pos), &mut beam, &mut kinds, &mut cells);
-        self.entries[ci as usize].light = LightChunk::from_cells(&cells);
+        // Its old light may have gone anywhere from any of its cells.
+        let all: Vec<Cell> = (0..CHUNK_VOLUME).map(|l| (ci, l as Local)).collect();
+        let mut engine = Engine::new(&mut self.entries, &self.props, world);
+        run(
+            &mut engine,
+            &all,
+            &sky,
+            &NO_FLOOD,
+            &mut self.scratch,
+            &mut self.changed,
+        );
+        Ok(true)
+    }
+
+    /// [`LightField::add_chunk`] for each of `positions` (chunks streamed in), with one
+    /// flood for all the new ones: the same light as adding them one at a time, for less
+    /// work where many come in together (their common borders are flooded once). A
+    /// position the world holds no chunk at is skipped; one lit already is relit. Fails
+    /// on a world over another registry, lighting none.
+    pub fn add_chunks(&mut self, world: &World, positions: &[ChunkPos]) -> Result<()> {
+        self.check(world)?;
+        let (relit, mut new): (Vec<ChunkPos>, Vec<ChunkPos>) = positions
+            .iter()
+            .copied()
+            .filter(|p| world.chunk(*p).is_some())
+            .partition(|p| self.index.contains_key(p));
+        // A column from the top down: each chunk's beam comes from the one placed above.
+        new.sort_unstable_by_key(|p| (p.x, p.z, std::cmp::Reverse(p.y)));
+        new.dedup();
+        let mut sky = Vec::new();
+        let placed: Vec<u32> = new
+            .iter()
+            .map(|&pos| self.insert_new(world, pos, &mut sky))
+            .collect();
         let mut flood: [Vec<Cell>; 6] = Default::default();
-        self.seeds_of(ci, &mut flood);
-        let around = self.around(ci);
-        for f in &mut flood {
-            f.extend_from_slice(&around);
+        for &ci in &placed {
+            self.seeds_of(ci, &mut flood);
+            let around = self.around(ci);
+            for f in &mut flood {
+                f.extend_from_slice(&around);
+            }
         }
         let mut engine = Engine::new(&mut self.entries, &self.props, world);
         run(
@@ -138,8 +165,64 @@ impl LightField {
             &mut self.scratch,
             &mut self.changed,
         );
+        for p in relit {
+            self.add_chunk(world, p)?;
+        }
+        Ok(())
+    }
+
+    /// Lights the chunk at `pos` (not lit yet) with its sources as a full light writes
+    /// them (dark, nothing come through it yet: the flood is the caller's), sets the beam
+    /// below it, adds to `sky` the cells below whose beam changed, and marks it changed.
+    /// Returns its entry.
+    fn insert_new(&mut self, world: &World, pos: ChunkPos, sky: &mut Vec<Cell>) -> u32 {
+        let beam_in = self.beam_from_above(world, pos);
+        // The kinds of the blocks just above its columns: air unless a lit chunk lies
+        // directly above.
+        let air = self.props[0].kind;
+        let lit_above = self
+            .index
+            .contains_key(&ChunkPos::new(pos.x, pos.y + 1, pos.z));
+        let o = pos.origin();
+        let mut kinds = [air; CHUNK_AREA];
+        let mut beam = [[0.0; 3]; CHUNK_AREA];
+        for (col, (k, b)) in kinds.iter_mut().zip(&mut beam).enumerate() {
+            *b = beam_in.get(col);
+            if lit_above {
+                let id = world.get_block(WorldPos::new(
+                    (o[0] + (col >> 5) as i64) as i32,
+                    (o[1] + CHUNK_SIZE as i64) as i32,
+                    (o[2] + (col & 31) as i64) as i32,
+                ));
+                *k = self.props.get(id.index()).unwrap_or(&self.props[0]).kind;
+            }
+        }
+        let mut cells = vec![[0; 6]; CHUNK_VOLUME];
+        self.fill_chunk(world.chunk(pos), &mut beam, &mut kinds, &mut cells);
+        // The chunks below see the beam leaving its bottom (and, the one right below,
+        // its bottom blocks): where that is what they saw before, nothing below changes
+        // (a chunk of sky coming in above the top of a column), and walking them is
+        // skipped.
+        let below = self.below(pos);
+        let same_below = below.first().is_none_or(|&b| {
+            let e = &self.entries[b as usize];
+            let adjacent = e.pos.y == pos.y - 1;
+            (0..CHUNK_AREA)
+                .all(|col| e.beam_in.get(col) == beam[col] && (!adjacent || kinds[col] == air))
+        });
+        let before = if same_below {
+            Vec::new()
+        } else {
+            self.column_levels(world, &below)
+        };
+        let ci = self.insert_entry(pos);
+        self.entries[ci as usize].beam_in = beam_in;
+        if !same_below {
+            sky.extend(self.changed_below(world, ci, &below, &before));
+        }
+        self.entries[ci as usize].light = Arc::new(LightChunk::from_cells(&cells));
         self.changed.insert(pos);
-        Ok(true)
+        ci
     }
 
     /// Unlights the chunk at `pos`: light that came through it leaves its neighbours, and

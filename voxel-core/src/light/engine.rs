@@ -3,6 +3,7 @@
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::Arc;
 
 use super::props::{ONE, Props};
 use super::store::{Beam, LightChunk, Local, local};
@@ -11,12 +12,13 @@ use crate::{BlockId, CHUNK_SIZE, Chunk, ChunkPos, LIGHT_FALLOFF, World, WorldPos
 /// No chunk there (not lit).
 pub(super) const NONE: u32 = u32::MAX;
 
-/// A lit chunk: its light, the beam entering it from above, its six lit neighbours (in
-/// [`crate::Face`] order, [`NONE`] where none).
+/// A lit chunk: its light (shared with the snapshots [`super::LightField::shared`] hands
+/// out, copied on the first write after one), the beam entering it from above, its six
+/// lit neighbours (in [`crate::Face`] order, [`NONE`] where none).
 #[derive(Clone, Debug)]
 pub(super) struct Entry {
     pub pos: ChunkPos,
-    pub light: LightChunk,
+    pub light: Arc<LightChunk>,
     pub beam_in: Beam,
     pub neigh: [u32; 6],
 }
@@ -106,7 +108,7 @@ impl<'a> Engine<'a> {
         if self.get((c, l), ch) == v {
             return;
         }
-        self.entries[c as usize].light.set_channel(l, ch, v);
+        Arc::make_mut(&mut self.entries[c as usize].light).set_channel(l, ch, v);
         if self.touched.last() != Some(&c) && !self.touched.contains(&c) {
             self.touched.push(c);
         }

@@ -152,7 +152,16 @@ impl LightField {
     pub fn chunk(&self, pos: ChunkPos) -> Option<&LightChunk> {
         self.index
             .get(&pos)
-            .map(|&i| &self.entries[i as usize].light)
+            .map(|&i| &*self.entries[i as usize].light)
+    }
+
+    /// The light of the chunk at `pos`, if lit, as a snapshot: it stays as it is now while
+    /// the field goes on (the field copies the chunk on its next write to it). What a
+    /// mesher on another thread reads ([`crate::LightChunk`] is `Send + Sync`).
+    pub fn shared(&self, pos: ChunkPos) -> Option<Arc<LightChunk>> {
+        self.index
+            .get(&pos)
+            .map(|&i| self.entries[i as usize].light.clone())
     }
 
     /// Whether the chunk at `pos` is lit.
@@ -194,7 +203,20 @@ impl LightField {
     /// the layers they touch in the 6 KiB form, as cheap to edit again).
     pub fn compact(&mut self) {
         for e in &mut self.entries {
-            e.light.compact();
+            // A snapshot handed out is copied only where there is something to compact.
+            if e.light.compactable() {
+                Arc::make_mut(&mut e.light).compact();
+            }
+        }
+    }
+
+    /// [`LightField::compact`] for the chunk at `pos` only.
+    pub fn compact_chunk(&mut self, pos: ChunkPos) {
+        if let Some(&i) = self.index.get(&pos) {
+            let e = &mut self.entries[i as usize];
+            if e.light.compactable() {
+                Arc::make_mut(&mut e.light).compact();
+            }
         }
     }
 

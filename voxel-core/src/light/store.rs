@@ -215,6 +215,13 @@ impl LightChunk {
         }
     }
 
+    /// Whether a dense layer's cells all agree ([`LightChunk::compact`] has work).
+    pub(super) fn compactable(&self) -> bool {
+        self.layers
+            .iter()
+            .any(|l| matches!(l, Layer::Dense(d) if d.cells.iter().all(|c| *c == d.cells[0])))
+    }
+
     /// Turns dense layers whose cells all agree back into uniform ones.
     pub(super) fn compact(&mut self) {
         for layer in &mut self.layers {

@@ -588,3 +588,48 @@ fn odd_cells_follow_the_edits() {
         check(&f);
     }
 }
+
+/// Chunks lit in batches ([`LightField::add_chunks`]: some stacked in one column, some
+/// beside lit ones, some above and below lit ones, one lit already) give what lighting
+/// the whole world gives.
+#[test]
+fn chunks_lit_in_batches_equal_a_full_light() {
+    let terrain = crate::TerrainGenerator::new(crate::TerrainConfig::default());
+    let registry = Arc::new(BlockRegistry::with_lights());
+    let full = terrain
+        .generate_world(
+            registry.clone(),
+            ChunkPos::new(0, -1, 0),
+            ChunkPos::new(2, 2, 1),
+        )
+        .unwrap();
+    let mut w = World::new(registry.clone());
+    let mut f = LightField::empty(registry);
+    let mut all: Vec<ChunkPos> = full.iter().map(|(p, _)| p).collect();
+    all.sort_by_key(|p| (p.x * 7 + p.y * 3 + p.z * 5) % 4);
+    let batches: Vec<Vec<ChunkPos>> = all.chunks(all.len() / 3 + 1).map(<[_]>::to_vec).collect();
+    for (i, batch) in batches.iter().enumerate() {
+        for &p in batch {
+            let mut c = full.chunk(p).unwrap().clone();
+            c.set(7, 30, 9, TORCH).unwrap();
+            c.set(20, 3, 20, blocks::RED_GLASS).unwrap();
+            w.insert_chunk(p, c).unwrap();
+        }
+        // One lit already comes again, its blocks changed.
+        let mut positions = batch.clone();
+        if i > 0 {
+            let again = batches[0][0];
+            let mut c = w.chunk(again).unwrap().clone();
+            c.fill_box([0, 10, 0], [31, 12, 31], BlockId::AIR).unwrap();
+            w.insert_chunk(again, c).unwrap();
+            positions.push(again);
+        }
+        f.add_chunks(&w, &positions).unwrap();
+        assert_same(
+            &all_levels(&f, &w),
+            &all_levels(&LightField::new(&w), &w),
+            &format!("batch {i} of {}", batch.len()),
+        );
+    }
+    assert_eq!(f.len(), full.len());
+}

@@ -158,11 +158,7 @@ impl World {
     /// Unloads a chunk; it and its loaded neighbours become dirty (the mesher then returns
     /// empty meshes for it).
     pub fn remove_chunk(&mut self, pos: ChunkPos) -> Option<Chunk> {
-        let old = self.chunks.remove(&pos).map(Arc::unwrap_or_clone);
-        if old.is_some() {
-            self.mark_with_neighbours(pos);
-        }
-        old
+        self.remove_shared(pos).map(Arc::unwrap_or_clone)
     }
 
     /// Marks `pos` and its loaded neighbours (all 26: ambient occlusion reads diagonal
@@ -184,6 +180,34 @@ impl World {
     /// The chunk at `pos` as a shared handle (for a job on another thread), if loaded.
     pub fn shared(&self, pos: ChunkPos) -> Option<Arc<Chunk>> {
         self.chunks.get(&pos).cloned()
+    }
+
+    /// Puts the shared `chunk` at `pos` (one another world holds too: no copy), as
+    /// [`World::insert_chunk`] does, and returns the chunk it replaced, shared. Fails the
+    /// same way.
+    pub fn insert_shared(
+        &mut self,
+        pos: ChunkPos,
+        chunk: Arc<Chunk>,
+    ) -> Result<Option<Arc<Chunk>>> {
+        if !pos.is_valid() {
+            return Err(Error::ChunkOutOfRange(pos));
+        }
+        if let Some((id, _)) = chunk.palette().find(|(id, _)| !self.registry.contains(*id)) {
+            return Err(Error::UnknownBlock(id, self.registry.len()));
+        }
+        self.mark_with_neighbours(pos);
+        Ok(self.chunks.insert(pos, chunk))
+    }
+
+    /// Unloads a chunk as [`World::remove_chunk`] does, returning it shared (no copy where
+    /// another world or a job holds it too).
+    pub fn remove_shared(&mut self, pos: ChunkPos) -> Option<Arc<Chunk>> {
+        let old = self.chunks.remove(&pos);
+        if old.is_some() {
+            self.mark_with_neighbours(pos);
+        }
+        old
     }
 
     /// Puts `chunk` at `pos` in place of `expected` (the same blocks in another form, say

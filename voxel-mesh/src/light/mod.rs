@@ -315,10 +315,13 @@ pub(crate) struct LitCells<'a> {
 
 impl<'a> LitCells<'a> {
     pub(crate) fn new(field: &'a LightField, pos: ChunkPos) -> Self {
-        let chunks: [Option<&'a LightChunk>; 27] = std::array::from_fn(|i| {
-            let d = [i / 9, i / 3 % 3, i % 3].map(|v| v as i32 - 1);
-            pos.offset(d).and_then(|p| field.chunk(p))
-        });
+        Self::from_fn(|d| pos.offset(d).and_then(|p| field.chunk(p)))
+    }
+
+    /// The light of the chunk at offset `d` (each coordinate −1 to 1) from `light`.
+    pub(crate) fn from_fn(light: impl Fn([i32; 3]) -> Option<&'a LightChunk>) -> Self {
+        let chunks: [Option<&'a LightChunk>; 27] =
+            std::array::from_fn(|i| light([i / 9, i / 3 % 3, i % 3].map(|v| v as i32 - 1)));
         Self {
             layers: std::array::from_fn(|py| {
                 let (yr, y) = region(py);

@@ -53,7 +53,7 @@
 
 use voxel_core::{
     BlockId, BlockRegistry, CHUNK_AREA, CHUNK_SIZE, Chunk, ChunkPos, ColumnMask, Face, LayerMask,
-    LightField, MaskBuffer, Neighbourhood, Occupancy, RenderClass, row_index,
+    LightChunk, LightField, MaskBuffer, Neighbourhood, Occupancy, RenderClass, row_index,
 };
 
 use crate::ao::{AO_NONE, Pad, cover_occluded};
@@ -512,6 +512,21 @@ impl Mesher {
         out: &mut ChunkMeshes,
     ) -> Result<()> {
         let cells = LitCells::new(light, pos);
+        self.mesh_impl(chunk, neighbours.into(), Some(&cells), out)
+    }
+
+    /// [`Mesher::mesh_lit_into`] from the light of the chunk and its 26 neighbours as
+    /// `light` gives it for each offset (each coordinate −1 to 1; `None` where not lit):
+    /// what a mesher on a worker thread reads, from snapshots of the field
+    /// ([`LightField::shared`]) taken when the job was made.
+    pub fn mesh_lit_from<'n, 'l>(
+        &mut self,
+        chunk: &Chunk,
+        neighbours: impl Into<Neighbourhood<'n>>,
+        light: impl Fn([i32; 3]) -> Option<&'l LightChunk>,
+        out: &mut ChunkMeshes,
+    ) -> Result<()> {
+        let cells = LitCells::from_fn(light);
         self.mesh_impl(chunk, neighbours.into(), Some(&cells), out)
     }
 

@@ -8,6 +8,7 @@ use std::sync::Arc;
 use voxel_core::{BlockId, Chunk, ChunkPos, WorldPos};
 
 use super::ChunkStreamer;
+use super::light::LightOp;
 use super::local::{local_index, local_of};
 use super::slot::State;
 use super::source::generate_checked;
@@ -147,22 +148,20 @@ impl ChunkStreamer {
                 if chunk.as_uniform() != Some(BlockId::AIR) {
                     self.world.insert_chunk(c, chunk)?;
                 }
+                if let Some(light) = &mut self.light {
+                    light.insert(c, self.world.shared(c));
+                }
             }
             Some(_) => {}
         }
         self.world.take_dirty();
         let old = self.world.set_block(pos, id)?;
         self.record_edit(pos, id);
+        if let Some(light) = &mut self.light {
+            light.push(LightOp::Set(pos, id));
+        }
         for d in self.world.take_dirty() {
-            let version = self.next_version();
-            if let Some(slot) = self.slots.get_mut(&d)
-                && matches!(slot.state, State::Meshing | State::Ready | State::Meshed)
-                && !slot.failed
-            {
-                slot.version = version;
-                slot.state = State::Generated;
-                self.queue_remesh(d);
-            }
+            self.stale(d);
         }
         Ok(old)
     }

@@ -5,10 +5,11 @@ use std::panic::AssertUnwindSafe;
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
 
-use voxel_core::{BlockRegistry, Chunk, ChunkPos, Neighbourhood};
+use voxel_core::{BlockRegistry, Chunk, ChunkPos, LightChunk, Neighbourhood};
 use voxel_mesh::{ChunkMeshes, Mesher};
 
 use super::ChunkStreamer;
+use super::light::{LitWorld, Snapshots, StreamLight, light_job};
 use super::slot::{Ready, Slot, State};
 use super::source::generate_checked;
 
@@ -31,7 +32,18 @@ pub(super) enum Done {
         version: u64,
         why: String,
     },
+    /// A light job's result (see `light`): its world and field back (`None`: it
+    /// panicked), the snapshots of the chunks whose light changed, what failed.
+    Lit {
+        epoch: u64,
+        lit: Option<Box<LitWorld>>,
+        changed: Snapshots,
+        failed: Vec<(ChunkPos, String)>,
+    },
 }
+
+/// The light of a chunk's neighbourhood, by `(dx + 1) * 9 + (dy + 1) * 3 + (dz + 1)`.
+type Lights = [Option<Arc<LightChunk>>; 27];
 
 thread_local! {
     /// Each worker's mesher (its scratch reused), for the registry it was made for.
@@ -42,6 +54,7 @@ fn mesh_on_worker(
     registry: &Arc<BlockRegistry>,
     centre: &Chunk,
     neighbours: &[Option<Arc<Chunk>>; 26],
+    lights: Option<&Lights>,
 ) -> std::result::Result<ChunkMeshes, String> {
     let key = Arc::as_ptr(registry) as usize;
     MESHER.with_borrow_mut(|m| {
@@ -53,7 +66,20 @@ fn mesh_on_worker(
             let i = Neighbourhood::OFFSETS.iter().position(|&o| o == d)?;
             neighbours[i].as_deref()
         });
-        mesher.mesh(centre, nb).map_err(|e| e.to_string())
+        match lights {
+            Some(lights) => {
+                let mut out = ChunkMeshes::default();
+                let light = |d: [i32; 3]| {
+                    let i = (d[0] + 1) * 9 + (d[1] + 1) * 3 + (d[2] + 1);
+                    lights[i as usize].as_deref()
+                };
+                mesher
+                    .mesh_lit_from(centre, nb, light, &mut out)
+                    .map(|()| out)
+            }
+            None => mesher.mesh(centre, nb),
+        }
+        .map_err(|e| e.to_string())
     })
 }
 
@@ -100,6 +126,17 @@ impl ChunkStreamer {
             });
             return;
         };
+        let lights = match &self.light {
+            Some(light) => match light.neighbourhood(pos) {
+                Some(l) => Some(l),
+                // Not lit yet (`meshable` waits for it): meshed when it is.
+                None => return,
+            },
+            None => None,
+        };
+        let Some(slot) = self.slots.get_mut(&pos) else {
+            return;
+        };
         slot.state = State::Meshing;
         let version = slot.version;
         let neighbours =
@@ -107,7 +144,7 @@ impl ChunkStreamer {
         let registry = self.registry.clone();
         self.spawn(move || {
             std::panic::catch_unwind(AssertUnwindSafe(|| {
-                let meshes = mesh_on_worker(&registry, &centre, &neighbours);
+                let meshes = mesh_on_worker(&registry, &centre, &neighbours, lights.as_ref());
                 let packed = (!centre.is_packed()).then(|| {
                     let mut c = (*centre).clone();
                     c.pack();
@@ -128,9 +165,37 @@ impl ChunkStreamer {
         });
     }
 
+    /// Sends what happened to the blocks to a light job (see `light`), if none is in
+    /// flight.
+    pub(super) fn dispatch_light(&mut self) {
+        if self.jobs >= self.config.max_jobs {
+            return;
+        }
+        let Some((mut lit, ops, epoch)) = self.light.as_mut().and_then(StreamLight::take_job)
+        else {
+            return;
+        };
+        self.spawn(move || {
+            match std::panic::catch_unwind(AssertUnwindSafe(|| light_job(&mut lit, ops))) {
+                Ok((changed, failed)) => Done::Lit {
+                    epoch,
+                    lit: Some(lit),
+                    changed,
+                    failed,
+                },
+                Err(_) => Done::Lit {
+                    epoch,
+                    lit: None,
+                    changed: Vec::new(),
+                    failed: Vec::new(),
+                },
+            }
+        });
+    }
+
     /// Runs `job` on the pool and sends what it made back, unless the streamer was dropped
     /// before the job started.
-    fn spawn(&mut self, job: impl FnOnce() -> Done + Send + 'static) {
+    pub(super) fn spawn(&mut self, job: impl FnOnce() -> Done + Send + 'static) {
         let tx = self.tx.clone();
         let cancelled = self.cancelled.clone();
         self.jobs += 1;

@@ -45,6 +45,12 @@
 //!   ([`ChunkStreamer::memory_bytes`] counts them): an edited chunk that unloads keeps only
 //!   its edits, and comes back as the source's blocks with its edits applied.
 //!   [`ChunkStreamer::edits`] lists them for a game to save.
+//! - **With light on** ([`ChunkStreamer::set_light`]), once idle every drawn chunk holds
+//!   the meshes [`voxel_mesh::Mesher::mesh_lit`] makes of it with the light
+//!   [`voxel_core::LightField::new`] gives the resident chunks (air ones included): light
+//!   crosses chunk borders, and comes in and goes with the chunks. No update lights a
+//!   chunk: the light job does, on the pool, and a chunk is meshed once it and its 26
+//!   neighbours are lit.
 //! - **Dropping the streamer stops its jobs**: queued jobs return at once, without
 //!   calling the source or the mesher.
 //!
@@ -77,6 +83,9 @@
 //! - `jobs`: the generation and meshing jobs the streamer's pool runs.
 //! - `pool`: where they run (worker threads, or the updating thread within a budget).
 //! - `edits`: edits of the blocks ([`ChunkStreamer::set_block`]), kept per chunk.
+//! - `light`: light as chunks stream ([`ChunkStreamer::set_light`]): a light field over
+//!   the resident chunks, updated by one job at a time on the pool, its snapshots read
+//!   by the meshing jobs.
 //!
 //! [`Mesher::mesh`]: voxel_mesh::Mesher::mesh
 //! [`Renderer`]: crate::Renderer
@@ -84,6 +93,7 @@
 pub(crate) mod config;
 pub(crate) mod edits;
 mod jobs;
+mod light;
 mod local;
 mod pool;
 pub(crate) mod schedule;
@@ -142,6 +152,8 @@ pub struct ChunkStreamer {
     /// The next version number: versions are never reused, so that a job of a chunk that
     /// unloaded and loaded again cannot pass for the new one's (it may carry older edits).
     next_version: u64,
+    /// Light, when on ([`ChunkStreamer::set_light`]).
+    light: Option<light::StreamLight>,
 }
 
 impl std::fmt::Debug for ChunkStreamer {
@@ -155,6 +167,7 @@ impl std::fmt::Debug for ChunkStreamer {
             .field("unload", &self.unload.len())
             .field("remesh", &self.remesh.len())
             .field("ready", &self.ready.len())
+            .field("light", &self.light.is_some())
             .field("cursor", &(self.cursor, self.offsets.len()))
             .finish_non_exhaustive()
     }
@@ -227,6 +240,7 @@ impl ChunkStreamer {
             rx,
             jobs: 0,
             next_version: 0,
+            light: None,
         }
     }
 
@@ -336,5 +350,14 @@ impl ChunkStreamer {
             && self.unload.is_empty()
             && self.remesh.is_empty()
             && self.cursor >= self.offsets.len()
+            && self.light.as_ref().is_none_or(light::StreamLight::is_idle)
+    }
+
+    /// The positions whose blocks are resident ([`ChunkStreamer::is_resident`]).
+    pub fn resident(&self) -> impl Iterator<Item = ChunkPos> + '_ {
+        self.slots
+            .iter()
+            .filter(|(_, s)| s.has_blocks())
+            .map(|(p, _)| *p)
     }
 }

@@ -10,6 +10,7 @@ use voxel_core::{BlockId, CHUNK_SIZE, ChunkPos, Neighbourhood};
 use web_time::Instant;
 
 use super::jobs::Done;
+use super::light::LightOp;
 use super::slot::{Ready, Slot, State};
 use super::{ChunkSink, ChunkStreamer};
 use crate::{Error, Result};
@@ -202,6 +203,9 @@ impl ChunkStreamer {
                         // The source's ids were checked by the job.
                         let _ = self.world.insert_chunk(pos, chunk);
                     }
+                    if let Some(light) = &mut self.light {
+                        light.insert(pos, self.world.shared(pos));
+                    }
                 }
                 Done::Meshed {
                     pos,
@@ -217,8 +221,11 @@ impl ChunkStreamer {
                         continue;
                     };
                     frame.meshed += 1;
-                    if let Some((sent, chunk)) = packed {
-                        self.world.replace_shared(pos, &sent, chunk);
+                    if let Some((sent, chunk)) = packed
+                        && self.world.replace_shared(pos, &sent, chunk)
+                        && let (Some(light), Some(now)) = (&mut self.light, self.world.shared(pos))
+                    {
+                        light.push(LightOp::Replace(pos, now));
                     }
                     match meshes {
                         Ok(meshes) => {
@@ -245,7 +252,19 @@ impl ChunkStreamer {
                         slot.state = State::Meshed;
                         slot.failed = true;
                         frame.failed.push((pos, why));
+                        if let Some(light) = &mut self.light {
+                            light.insert(pos, None);
+                        }
                     }
+                }
+                Done::Lit {
+                    epoch,
+                    lit,
+                    changed,
+                    failed,
+                } => {
+                    frame.failed.extend(failed);
+                    self.receive_light(epoch, lit, changed, &mut frame.failed);
                 }
             }
         }
@@ -308,7 +327,10 @@ impl ChunkStreamer {
             if self.may_leave(pos, centre) {
                 self.slots.remove(&pos);
                 // Its edits stay in `edits`: it comes back as the source plus them.
-                self.world.remove_chunk(pos);
+                self.world.remove_shared(pos);
+                if let Some(light) = &mut self.light {
+                    light.push(LightOp::Remove(pos));
+                }
                 worked = true;
                 // A neighbour meshed to nothing from its blocks (none of them needs
                 // neighbours, see `may_leave`) is not done any more: the blocks it was
@@ -335,6 +357,7 @@ impl ChunkStreamer {
 
     /// Whether the chunk at `pos` and its 26 neighbours have their blocks (faces are culled
     /// against the face neighbours; ambient occlusion reads the edge and corner ones).
+    /// With light on, they are all lit too.
     fn meshable(&self, pos: ChunkPos) -> bool {
         self.slots
             .get(&pos)
@@ -343,9 +366,11 @@ impl ChunkStreamer {
                 pos.offset(d)
                     .is_none_or(|n| self.slots.get(&n).is_some_and(Slot::has_blocks))
             })
+            && self.light.as_ref().is_none_or(|l| l.lit_around(pos))
     }
 
     fn dispatch(&mut self, centre: ChunkPos) {
+        self.dispatch_light();
         // Edited chunks first. One that waits for neighbours asks for them itself, like a
         // wanted one; one past the margin is left to its unload.
         let mut waiting = VecDeque::new();

@@ -985,3 +985,212 @@ fn a_local_update_stays_within_its_budget() {
         assert!(updates >= made / most, "{made} chunks in {updates} updates");
     }
 }
+
+/// The light tests' registry: the default blocks (the test source's ids) and the light
+/// sources.
+fn lit_registry() -> Arc<BlockRegistry> {
+    Arc::new(BlockRegistry::with_lights())
+}
+
+/// The contract with light on (or off), once idle: every drawn chunk holds the meshes
+/// [`Mesher::mesh_lit`] makes of the true world with the light [`LightField::new`] gives
+/// the resident chunks (their true blocks, air ones included), with its corner light
+/// (without light, those of [`Mesher::mesh`]);
+/// every chunk within the view distance whose lit mesh has faces is drawn. Returns how
+/// many corner lights of the drawn chunks are neither the open sky's full light nor dark
+/// (block light, or sky light filtered or fallen off): what shows the light is not
+/// trivial.
+fn check_lit_against_truth(
+    s: &ChunkStreamer,
+    sink: &Holder,
+    truth: &Truth,
+    eye: DVec3,
+    what: &str,
+) -> usize {
+    use voxel_core::{LightField, World};
+    let mut world = World::new(lit_registry());
+    for p in s.resident() {
+        world.insert_chunk(p, truth.cached(p)).unwrap();
+    }
+    let field = LightField::new(&world);
+    let mut mesher = Mesher::new(world.registry());
+    let lit = s.has_light();
+    let mut fresh = |pos: ChunkPos| match world.chunk(pos) {
+        Some(c) if lit => mesher
+            .mesh_lit(c, world.neighbourhood(pos), &field, pos)
+            .unwrap(),
+        Some(c) => mesher.mesh(c, world.neighbourhood(pos)).unwrap(),
+        None => ChunkMeshes::default(),
+    };
+    let mut shaded = 0;
+    for (&pos, meshes) in &sink.held {
+        let want = fresh(pos);
+        if !same_lit_meshes(meshes, &want) {
+            // Which of the 27 chunks' light differs from the fresh field's.
+            let differ: Vec<ChunkPos> = Neighbourhood::OFFSETS
+                .iter()
+                .chain([&[0, 0, 0]])
+                .filter_map(|&d| pos.offset(d))
+                .filter(|&p| {
+                    let (a, b) = (s.light_chunk(p), field.chunk(p));
+                    let cells = |c: Option<&voxel_core::LightChunk>| {
+                        c.map(|c| {
+                            (0..CHUNK_SIZE.pow(3))
+                                .map(|i| c.get(i / 1024, i / 32 % 32, i % 32))
+                                .collect::<Vec<_>>()
+                        })
+                    };
+                    cells(a.as_deref()) != cells(b)
+                })
+                .collect();
+            panic!(
+                "{what}: {pos:?} drawn with {} quads and {} light bytes, a fresh lit mesh of \
+                 the resident world has {} and {}; the light of {differ:?} differs from the \
+                 fresh field's",
+                meshes.len(),
+                meshes.light.bytes(),
+                want.len(),
+                want.light.bytes(),
+            );
+        }
+        assert_eq!(meshes.light.is_empty(), !lit, "{what}: {pos:?} lit: {lit}");
+        shaded += meshes
+            .light
+            .palette
+            .iter()
+            .map(|p| p.unpack())
+            .filter(|l| l.block != [0; 3] || (l.sky != [255; 3] && l.sky != [0; 3]))
+            .count();
+    }
+    let centre = ChunkStreamer::centre_of(eye).unwrap();
+    for o in &s.offsets {
+        let pos = ChunkPos::new(centre.x + o[0], centre.y + o[1], centre.z + o[2]);
+        if !sink.held.contains_key(&pos) {
+            assert!(
+                fresh(pos).is_empty(),
+                "{what}: {pos:?} within the view distance not drawn"
+            );
+        }
+    }
+    shaded
+}
+
+/// Whether `a` and `b` hold the same quads, each with the same corner lights, in any
+/// order: the mesher lists the quads of each block type, and the lights of its palette,
+/// in the order it meets them, which follows the order of the chunk's palette (a chunk
+/// generated again with its edits lists its types in another order than one edited in
+/// place).
+fn same_lit_meshes(a: &ChunkMeshes, b: &ChunkMeshes) -> bool {
+    type Lit = (u32, u32, Option<[([u8; 3], [u8; 3]); 4]>);
+    let kinds = |m: &ChunkMeshes| -> [Vec<Lit>; 3] {
+        let l = &m.light;
+        let kind = |quads: &[voxel_mesh::PackedQuad], lights: &[voxel_mesh::QuadLight]| {
+            let mut v: Vec<Lit> = quads
+                .iter()
+                .enumerate()
+                .map(|(i, q)| {
+                    let c = lights.get(i).and_then(|ql| l.corners(*ql));
+                    (q.geometry, q.block, c.map(|c| c.map(|c| (c.sky, c.block))))
+                })
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        [
+            kind(&m.opaque, &l.opaque),
+            kind(&m.cutout, &l.cutout),
+            kind(&m.translucent, &l.translucent),
+        ]
+    };
+    let counts = |m: &ChunkMeshes| {
+        [
+            m.light.opaque.len(),
+            m.light.cutout.len(),
+            m.light.translucent.len(),
+        ]
+    };
+    counts(a) == counts(b) && kinds(a) == kinds(b)
+}
+
+/// A streamer with light over the deterministic test source with the light registry.
+fn lit_streamer(view_distance: u32, local: bool) -> ChunkStreamer {
+    let config = StreamConfig {
+        view_distance,
+        vertical_distance: 1,
+        hysteresis: 1,
+        threads: 2,
+        local_budget: std::time::Duration::from_millis(2),
+        ..StreamConfig::default()
+    };
+    let source = TestSource {
+        failing: true,
+        changing: None,
+    };
+    let s = if local {
+        ChunkStreamer::new_local(lit_registry(), source, config)
+    } else {
+        ChunkStreamer::new(lit_registry(), source, config)
+    };
+    s.unwrap().with_light()
+}
+
+/// Light as chunks stream: a route of stops, moves two chunks and a teleport, with edits
+/// that light (a torch, lava), filter (red glass) and stop light (stone over a shaft),
+/// in the eye's chunk, on chunk borders and at the view-distance edge; each stop checked
+/// once idle against the resident world's light. Then light off (the unlit contract) and
+/// on again (the lit one), on worker threads and on the updating thread.
+#[test]
+fn a_lit_streamer_holds_the_lit_truth_once_idle() {
+    use voxel_core::light_blocks::{LAVA, TORCH};
+    for local in [false, true] {
+        let mut s = lit_streamer(2, local);
+        let mut truth = Truth::new(true);
+        let mut sink = Holder::default();
+        let mut failed = HashSet::new();
+        let mut shaded = 0;
+        let route = [
+            ChunkPos::new(0, 0, 0),
+            ChunkPos::new(-2, 0, 0),
+            ChunkPos::new(7, 1, -3),
+            ChunkPos::new(0, 0, 0),
+        ];
+        for (i, &c) in route.iter().enumerate() {
+            let eye = eye_in(c);
+            let what = format!("local {local}, stop {i}");
+            let idle = run_to_idle(&mut s, eye, &mut sink, &mut failed, 20_000);
+            assert!(idle.is_some(), "{what}: not idle: {s:?}");
+            shaded += check_lit_against_truth(&s, &sink, &truth, eye, &what);
+            let (x, y, z) = (c.x * 32, c.y * 32, c.z * 32);
+            for (at, id) in [
+                (WorldPos::new(x + 5, y + 6, z + 7), TORCH),
+                (WorldPos::new(x + 31, y + 2, z + 16), LAVA),
+                (WorldPos::new(x + 32, y + 2, z + 16), blocks::RED_GLASS),
+                (WorldPos::new(x + 16, y + 31, z + 16), blocks::STONE),
+                (WorldPos::new(x + 64, y + 5, z), TORCH),
+                (WorldPos::new(x + 5, y + 6, z + 7), blocks::GLASS),
+            ] {
+                if s.set_block(at, id).is_ok() {
+                    truth.edit(at, id);
+                }
+            }
+            let idle = run_to_idle(&mut s, eye, &mut sink, &mut failed, 20_000);
+            assert!(idle.is_some(), "{what} edited: not idle: {s:?}");
+            shaded += check_lit_against_truth(&s, &sink, &truth, eye, &format!("{what} edited"));
+        }
+        assert!(
+            shaded > 100,
+            "local {local}: {shaded} corner lights other than the open sky's"
+        );
+        let eye = eye_in(route[3]);
+        s.set_light(false);
+        let idle = run_to_idle(&mut s, eye, &mut sink, &mut failed, 20_000);
+        assert!(idle.is_some(), "light off: not idle");
+        check_lit_against_truth(&s, &sink, &truth, eye, "light off");
+        s.set_light(true);
+        let idle = run_to_idle(&mut s, eye, &mut sink, &mut failed, 20_000);
+        assert!(idle.is_some(), "light on again: not idle");
+        check_lit_against_truth(&s, &sink, &truth, eye, "light on again");
+        assert!(s.light_bytes() > 0);
+        assert!(sink.held.len() > 10, "{} chunks drawn", sink.held.len());
+    }
+}
