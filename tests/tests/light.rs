@@ -14,8 +14,8 @@ use voxel_core::light_blocks::TORCH;
 use voxel_core::{BlockId, BlockRegistry, LightField, SunFilters, SunMarch, World, WorldPos};
 use voxel_mesh::{mesh_dirty_lit, mesh_world};
 use voxel_render::{
-    Camera, GpuContext, Image, Lighting, MAX_SUN_CHUNKS, QuadFetch, Renderer, RendererConfig,
-    SunRegion, Technique,
+    Camera, ChunkStreamer, GpuContext, Image, Lighting, MAX_SUN_CHUNKS, QuadFetch, Renderer,
+    RendererConfig, StreamConfig, SunFeed, SunRegion, Technique,
 };
 
 use tests::*;
@@ -755,5 +755,67 @@ fn sun_shadows_follow_the_eye_reading_only_the_chunks_that_come_in() {
     assert!(
         diff(&walked, &unshaded).differing > 300,
         "the pillars cast shadows there"
+    );
+}
+
+/// Sun shadows over a lit streamer's chunks (`SunFeed`): the pillars' floor streamed with
+/// light around an eye that walks along the row (each step streamed to idle), the feed
+/// reading each chunk as its blocks come in and following the eye. At the end the picture
+/// is, bit for bit, the one drawn with the volume read whole from the streamer's world
+/// there, and the pillars cast their shadows.
+#[test]
+fn sun_shadows_follow_a_lit_streamer() {
+    let Some(ctx) = gpu() else { return };
+    let mut world = World::new(Arc::new(BlockRegistry::with_lights()));
+    voxel_lab::scene::fill_box(&mut world, [-256, 0, -16], [255, 0, 15], STONE).unwrap();
+    for x in (-250..250).step_by(12) {
+        voxel_lab::scene::fill_box(&mut world, [x, 1, -1], [x, 6, 1], STONE).unwrap();
+    }
+    let config = StreamConfig {
+        view_distance: 3,
+        vertical_distance: 1,
+        ..StreamConfig::default()
+    };
+    let mut streamer = ChunkStreamer::new(world.registry().clone(), world.clone(), config)
+        .unwrap()
+        .with_light();
+    let c = slanted_sun(Technique::SortedQuads);
+    let mut r = Renderer::new(&ctx, world.registry(), c).unwrap();
+    let mut feed = SunFeed::new();
+    let mut eye = DVec3::new(0.5, 14.0, 12.0);
+    for step in 0..=10 {
+        eye.x = 0.5 + f64::from(step) * 8.0;
+        let mut idle = false;
+        for _ in 0..20_000 {
+            let f = streamer.update(eye, &mut r).unwrap();
+            assert!(f.failed.is_empty(), "{:?}", f.failed);
+            feed.update(&mut r, &streamer, eye, &f).unwrap();
+            if streamer.is_idle() {
+                idle = true;
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
+        assert!(idle, "step {step}: not idle");
+    }
+    let region = r.sun_region().unwrap();
+    assert_eq!(region.chunks, [MAX_SUN_CHUNKS; 3]);
+    let camera = Camera::look_at(eye, DVec3::new(eye.x, 0.0, 0.5), 60.0, 0.1, 300.0).unwrap();
+    let fed = frame(&ctx, &mut r, &camera);
+    fed.save_png(&out_dir("light").join("sun_streamed.png"))
+        .unwrap();
+    r.clear_sun_shadows();
+    let unshaded = frame(&ctx, &mut r, &camera);
+    r.set_sun_shadows(streamer.world(), region).unwrap();
+    let whole = frame(&ctx, &mut r, &camera);
+    assert_eq!(
+        diff(&fed, &whole).max,
+        0,
+        "the fed volume is the one read whole"
+    );
+    assert!(
+        diff(&fed, &unshaded).differing > 300,
+        "the pillars cast shadows: {} pixels differ",
+        diff(&fed, &unshaded).differing
     );
 }

@@ -288,18 +288,20 @@ impl VoxelWorld {
     /// from a `LightField` lit now, meshed into every chunk, and the sun's shadows through
     /// them over the chunks nearest the first [`VoxelCamera`] (`Renderer::set_sun_shadows`,
     /// following the camera); edits ([`VoxelWorld::set_block`]) relight what they change.
-    /// A fixed world only: a streamed world is drawn unlit (lighting chunks as they
-    /// stream is not done yet), with a warning.
+    /// A streamed world is lit as it streams (`ChunkStreamer::set_light`: on the
+    /// streamer's workers), without sun shadows.
     pub fn with_light(mut self) -> Self {
-        match &self.source {
+        match &mut self.source {
             Source::Fixed(w) => {
                 self.light = Some(LitWorld {
                     field: voxel_core::LightField::new(w),
                     sun_shadows: true,
                 });
             }
-            Source::Streamed(_) => {
-                log::warn!("voxel-bevy: a streamed world is drawn unlit");
+            Source::Streamed(s) => {
+                s.get_mut()
+                    .unwrap_or_else(PoisonError::into_inner)
+                    .set_light(true);
             }
         }
         self

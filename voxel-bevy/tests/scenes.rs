@@ -138,3 +138,79 @@ fn a_technique_that_stalls_is_reported_and_the_previous_one_draws_on() {
     );
     assert_eq!(tests::diff(&before, &after).max, 0);
 }
+
+/// A streamed world with light (`VoxelWorld::streamed(..).with_light()`): the cathedral's
+/// blocks streamed around the camera and lit as they stream, drawn through Bevy as the
+/// crate draws the same lit streamer on its own (same device, same camera, once both are
+/// idle).
+#[test]
+fn a_lit_streamed_world_matches_the_crate() {
+    if !have_gpu() {
+        return;
+    }
+    use std::sync::Arc;
+    use voxel_render::{ChunkStreamer, Renderer, StreamConfig};
+    let s = scene("light/cathedral");
+    let cam = s.cameras[0];
+    let size = (160, 120);
+    let config = StreamConfig {
+        view_distance: 4,
+        vertical_distance: 2,
+        ..StreamConfig::default()
+    };
+    let registry = s.world.registry().clone();
+    let world = VoxelWorld::streamed(registry.clone(), s.world.clone(), config)
+        .unwrap()
+        .with_light();
+    let mut h = Harness::new(
+        world,
+        cam.eye,
+        cam.forward,
+        cam.fov_y_deg,
+        cam.near,
+        cam.far,
+        size,
+        false,
+    );
+    h.app
+        .insert_resource(VoxelTechnique::Use(Technique::SortedQuads));
+    let idle = |h: &mut Harness| {
+        let mut w = h.app.world_mut().resource_mut::<VoxelWorld>();
+        let s = w.streamer().unwrap();
+        assert!(s.has_light());
+        s.is_idle()
+    };
+    let mut frames = 0;
+    while !idle(&mut h) {
+        h.frames(1);
+        std::thread::sleep(std::time::Duration::from_millis(2));
+        frames += 1;
+        assert!(frames < 5_000, "the streamed world never idle");
+    }
+    let bevy = h.frames(2);
+    let ctx = h.ctx();
+    let camera = h.camera();
+    let mut r = Renderer::new(
+        &ctx,
+        &registry,
+        tests::technique_config(Technique::SortedQuads, size.0, size.1),
+    )
+    .unwrap();
+    let mut streamer = ChunkStreamer::new(Arc::clone(&registry), s.world.clone(), config)
+        .unwrap()
+        .with_light();
+    while !streamer.is_idle() {
+        streamer.update(cam.eye, &mut r).unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    let reference = tests::frame(&ctx, &mut r, &camera);
+    save("cathedral-streamed-lit", &bevy, &reference);
+    let share = share_over_one(&bevy, &reference);
+    assert!(
+        share <= 0.001,
+        "{:.3} % of the pixels differ by more than 1/255 ({:?})",
+        share * 100.0,
+        tests::diff(&bevy, &reference)
+    );
+    assert!(tests::distinct_colours(&bevy) > 20, "a flat picture");
+}

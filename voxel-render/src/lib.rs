@@ -90,7 +90,7 @@ pub use stages::{
 };
 pub use stream::{
     ChunkStreamer, config::StreamConfig, schedule::StreamFrame, source::ChunkSink,
-    source::ChunkSource,
+    source::ChunkSource, sun_feed::SunFeed,
 };
 pub use sun::{MAX_SUN_CHUNKS, SunRegion};
 pub use timing::{GpuPass, GpuTimes};

@@ -104,7 +104,7 @@ impl SunRegion {
     }
 
     /// Every chunk of the region.
-    fn positions(self) -> impl Iterator<Item = ChunkPos> {
+    pub fn positions(self) -> impl Iterator<Item = ChunkPos> {
         let [cx, cy, cz] = self.chunks.map(|c| c as i32);
         (0..cz).flat_map(move |z| {
             (0..cy).flat_map(move |y| {

@@ -28,7 +28,7 @@ use voxel_mesh::levels::LevelRings;
 use voxel_render::far::{FarConfig, FarField, FarStatus};
 use voxel_render::{
     Camera, ChunkSink, ChunkStreamer, FrameStats, GpuContext, GpuTimes, Image, Lighting, OitConfig,
-    Renderer, RendererConfig, StreamConfig, StreamFrame, Technique, readback,
+    Renderer, RendererConfig, StreamConfig, StreamFrame, SunFeed, Technique, readback,
 };
 use winit::application::ApplicationHandler;
 use winit::event::{DeviceEvent, ElementState, MouseButton, WindowEvent};
@@ -298,6 +298,8 @@ struct Streaming {
     /// Past [`STREAMED_VIEW_DISTANCE`]: the far view that draws the terrain, and what its
     /// last update did; the streamer then keeps only the world near the eye, undrawn.
     far: Option<(FarField, FarStatus)>,
+    /// Sun shadows over lit terrain, for the renderer and the reference.
+    sun: [SunFeed; 2],
 }
 
 impl Streaming {
@@ -316,6 +318,7 @@ impl Streaming {
                 streamer,
                 last: StreamFrame::default(),
                 far: None,
+                sun: Default::default(),
             });
         }
         let field = FarField::new(
@@ -330,6 +333,7 @@ impl Streaming {
             streamer: streamer(seed, NEAR_WORLD, None)?,
             last: StreamFrame::default(),
             far: Some((field, FarStatus::default())),
+            sun: Default::default(),
         })
     }
 
@@ -572,9 +576,14 @@ impl Gfx {
             fade_in_frames: settings.fade_in_frames,
             ..RendererConfig::default()
         };
+        // Lit terrain streams over the light sources' registry (the sun shadows check it).
+        let terrain_registry = || match opts.light {
+            true => BlockRegistry::with_lights(),
+            false => BlockRegistry::default(),
+        };
         let registry = open
             .as_ref()
-            .map_or_else(BlockRegistry::default, |s| (**s.world.registry()).clone());
+            .map_or_else(terrain_registry, |s| (**s.world.registry()).clone());
         let mut renderer = Renderer::new(&ctx, &registry, config)?;
         renderer.set_level_bands(settings.level_bands);
         let lit = open.as_ref().and_then(SceneLight::new);
@@ -675,6 +684,14 @@ impl Gfx {
         };
         if let Some((pos, why)) = frame.failed.first() {
             self.status.message = format!("chunk {pos:?}: {why}");
+        }
+        // Lit terrain: sun shadows over its chunks as they stream.
+        let s = &mut self.streaming;
+        if self.lit.is_none() && s.far.is_none() && s.streamer.has_light() {
+            s.sun[0].update(&mut self.renderer, &s.streamer, eye, &frame)?;
+            if let Some(r) = &mut self.reference {
+                s.sun[1].update(r, &s.streamer, eye, &frame)?;
+            }
         }
         // A lit scene's sun shadows follow the eye (a scene wider than the volume).
         if let Some(l) = &self.lit {
@@ -918,6 +935,13 @@ impl Gfx {
         self.renderer.clear_chunks();
         if let Some(r) = &mut self.reference {
             r.clear_chunks();
+        }
+        if self.lit.is_none() {
+            // Lit terrain's shadows: the new world's are read as it streams.
+            self.renderer.clear_sun_shadows();
+            if let Some(r) = &mut self.reference {
+                r.clear_sun_shadows();
+            }
         }
         self.streaming = Streaming::new(seed, view_distance, self.scene.as_ref(), self.light)?;
         Ok(())

@@ -86,6 +86,9 @@
 //! - `light`: light as chunks stream ([`ChunkStreamer::set_light`]): a light field over
 //!   the resident chunks, updated by one job at a time on the pool, its snapshots read
 //!   by the meshing jobs.
+//! - `sun_feed`: sun shadows over the streamed chunks ([`SunFeed`]).
+//!
+//! [`SunFeed`]: crate::SunFeed
 //!
 //! [`Mesher::mesh`]: voxel_mesh::Mesher::mesh
 //! [`Renderer`]: crate::Renderer
@@ -99,6 +102,7 @@ mod pool;
 pub(crate) mod schedule;
 mod slot;
 pub(crate) mod source;
+pub(crate) mod sun_feed;
 
 #[cfg(test)]
 mod tests;
