@@ -235,7 +235,15 @@ impl LightField {
             return Ok(false);
         };
         let below = self.below(pos);
-        let before = self.column_levels(world, &below);
+        // A chunk of air passes the beam down as a gap does: nothing below changes.
+        let air = world
+            .chunk(pos)
+            .is_some_and(|c| c.as_uniform() == Some(BlockId::AIR));
+        let before = if air {
+            Vec::new()
+        } else {
+            self.column_levels(world, &below)
+        };
         // Nothing leads into it any more; it still leads out, for the removal.
         for d in 0..6 {
             let n = self.entries[ci as usize].neigh[d];
@@ -247,7 +255,7 @@ impl LightField {
             set.remove(&pos.y);
         }
         let mut sky = Vec::new();
-        if let Some(&top) = below.first() {
+        if let Some(&top) = below.first().filter(|_| !air) {
             let beam = self.beam_from_above(world, pos);
             self.entries[top as usize].beam_in = beam;
             sky = self.changed_below(world, NONE, &below, &before);

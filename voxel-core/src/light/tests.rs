@@ -633,3 +633,43 @@ fn chunks_lit_in_batches_equal_a_full_light() {
     }
     assert_eq!(f.len(), full.len());
 }
+
+/// Chunks of air unlit at the top of a column and between lit chunks (the beam passes
+/// down as through a gap) give what lighting the rest gives.
+#[test]
+fn air_chunks_unlit_equal_a_full_light() {
+    let registry = Arc::new(BlockRegistry::with_lights());
+    let mut w = World::new(registry);
+    for y in -1..=3 {
+        for x in 0..2 {
+            w.insert_chunk(ChunkPos::new(x, y, 0), crate::Chunk::default())
+                .unwrap();
+        }
+    }
+    // Ground with a pool and red glass in chunk row 0, stone at row 2 over half of it.
+    fill(&mut w, [0, -32, 0], [63, 4, 31], blocks::STONE);
+    fill(&mut w, [5, 2, 5], [20, 4, 20], blocks::WATER);
+    fill(&mut w, [30, 5, 3], [40, 5, 12], blocks::RED_GLASS);
+    fill(&mut w, [0, 70, 0], [31, 72, 31], blocks::STONE);
+    w.set_block(WorldPos::new(40, 8, 20), TORCH).unwrap();
+    let mut f = LightField::new(&w);
+    for p in [
+        ChunkPos::new(0, 3, 0),
+        ChunkPos::new(1, 1, 0),
+        ChunkPos::new(0, 1, 0),
+        ChunkPos::new(1, 3, 0),
+    ] {
+        assert_eq!(
+            w.chunk(p).unwrap().as_uniform(),
+            Some(BlockId::AIR),
+            "{p:?}"
+        );
+        assert!(f.remove_chunk(&w, p).unwrap());
+        w.remove_chunk(p);
+        assert_same(
+            &all_levels(&f, &w),
+            &all_levels(&LightField::new(&w), &w),
+            &format!("remove {p:?}"),
+        );
+    }
+}
