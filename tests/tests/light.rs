@@ -785,18 +785,18 @@ fn sun_shadows_follow_a_lit_streamer() {
     let mut eye = DVec3::new(0.5, 14.0, 12.0);
     for step in 0..=10 {
         eye.x = 0.5 + f64::from(step) * 8.0;
-        let mut idle = false;
-        for _ in 0..20_000 {
+        // Not idle within two minutes: a streamer that never settles.
+        let start = std::time::Instant::now();
+        loop {
             let f = streamer.update(eye, &mut r).unwrap();
             assert!(f.failed.is_empty(), "{:?}", f.failed);
             feed.update(&mut r, &streamer, eye, &f).unwrap();
             if streamer.is_idle() {
-                idle = true;
                 break;
             }
-            std::thread::sleep(std::time::Duration::from_micros(200));
+            assert!(start.elapsed().as_secs() < 120, "step {step}: not idle");
+            std::thread::sleep(std::time::Duration::from_micros(300));
         }
-        assert!(idle, "step {step}: not idle");
     }
     let region = r.sun_region().unwrap();
     assert_eq!(region.chunks, [MAX_SUN_CHUNKS; 3]);
