@@ -360,9 +360,6 @@ pub fn run(ctx: &GpuContext, opts: &StreamOptions) -> Result<StreamReport> {
             draw_calls: stats.draw_calls,
         });
         progress.step(&format!("frame {i}"));
-        if i % 30 == 0 {
-            eprintln!("{streamer:?}");
-        }
     }
     progress.finish();
 
