@@ -5,7 +5,7 @@ use std::collections::HashSet;
 use std::sync::Arc;
 
 use super::LightField;
-use super::engine::{Cell, Engine, NONE, Scratch, level};
+use super::engine::{Cell, Engine, NONE, Scratch, block_above, level};
 use super::store::{Beam, LightChunk, Local, local};
 use crate::{
     BlockId, CHUNK_AREA, CHUNK_SIZE, CHUNK_VOLUME, ChunkPos, Error, Result, World, WorldPos,
@@ -81,23 +81,7 @@ impl LightField {
             return Ok(false);
         }
         if !self.index.contains_key(&pos) {
-            let mut sky = Vec::new();
-            let ci = self.insert_new(world, pos, &mut sky);
-            let mut flood: [Vec<Cell>; 6] = Default::default();
-            self.seeds_of(ci, &mut flood);
-            let around = self.around(ci);
-            for f in &mut flood {
-                f.extend_from_slice(&around);
-            }
-            let mut engine = Engine::new(&mut self.entries, &self.props, world);
-            run(
-                &mut engine,
-                &[],
-                &sky,
-                &flood,
-                &mut self.scratch,
-                &mut self.changed,
-            );
+            self.add_chunks(world, &[pos])?;
             return Ok(true);
         }
         // Replaced.
@@ -183,17 +167,12 @@ impl LightField {
         let lit_above = self
             .index
             .contains_key(&ChunkPos::new(pos.x, pos.y + 1, pos.z));
-        let o = pos.origin();
         let mut kinds = [air; CHUNK_AREA];
         let mut beam = [[0.0; 3]; CHUNK_AREA];
         for (col, (k, b)) in kinds.iter_mut().zip(&mut beam).enumerate() {
             *b = beam_in.get(col);
             if lit_above {
-                let id = world.get_block(WorldPos::new(
-                    (o[0] + (col >> 5) as i64) as i32,
-                    (o[1] + CHUNK_SIZE as i64) as i32,
-                    (o[2] + (col & 31) as i64) as i32,
-                ));
+                let id = block_above(world, pos, col);
                 *k = self.props.get(id.index()).unwrap_or(&self.props[0]).kind;
             }
         }

@@ -23,6 +23,28 @@ pub(super) struct Entry {
     pub neigh: [u32; 6],
 }
 
+impl Entry {
+    /// Turns its layers whose cells all agree back into uniform ones; a snapshot handed
+    /// out is copied only where there is something to compact.
+    pub fn compact(&mut self) {
+        if self.light.compactable() {
+            Arc::make_mut(&mut self.light).compact();
+        }
+    }
+}
+
+/// The block of `world` just above the top of column `col` (`x << 5 | z`) of the chunk at
+/// `pos`.
+pub(super) fn block_above(world: &World, pos: ChunkPos, col: usize) -> BlockId {
+    let o = pos.origin();
+    let (x, z) = ((col >> 5) as i64, (col & 31) as i64);
+    world.get_block(WorldPos::new(
+        (o[0] + x) as i32,
+        (o[1] + CHUNK_SIZE as i64) as i32,
+        (o[2] + z) as i32,
+    ))
+}
+
 /// A cell of the lit world: entry index and local index.
 pub(super) type Cell = (u32, Local);
 
@@ -121,13 +143,7 @@ impl<'a> Engine<'a> {
         if e.neigh[2] == NONE {
             return BlockId::AIR;
         }
-        let o = e.pos.origin();
-        let (x, z) = ((col >> 5) as i64, (col & 31) as i64);
-        self.world.get_block(WorldPos::new(
-            (o[0] + x) as i32,
-            (o[1] + CHUNK_SIZE as i64) as i32,
-            (o[2] + z) as i32,
-        ))
+        block_above(self.world, e.pos, col)
     }
 
     /// The beam (exact) in each cell of column `col` of chunk `c`, by y, from the beam

@@ -203,20 +203,14 @@ impl LightField {
     /// the layers they touch in the 6 KiB form, as cheap to edit again).
     pub fn compact(&mut self) {
         for e in &mut self.entries {
-            // A snapshot handed out is copied only where there is something to compact.
-            if e.light.compactable() {
-                Arc::make_mut(&mut e.light).compact();
-            }
+            e.compact();
         }
     }
 
     /// [`LightField::compact`] for the chunk at `pos` only.
     pub fn compact_chunk(&mut self, pos: ChunkPos) {
         if let Some(&i) = self.index.get(&pos) {
-            let e = &mut self.entries[i as usize];
-            if e.light.compactable() {
-                Arc::make_mut(&mut e.light).compact();
-            }
+            self.entries[i as usize].compact();
         }
     }
 
