@@ -89,24 +89,26 @@ impl StreamLight {
 
     /// Whether `pos`'s chunk and its 26 neighbours (those that exist) are lit.
     pub(super) fn lit_around(&self, pos: ChunkPos) -> bool {
-        (0..27).all(|i| {
-            let d = [i / 9, i / 3 % 3, i % 3].map(|v| v - 1);
-            pos.offset(d).is_none_or(|p| self.lights.contains_key(&p))
-        })
+        around(pos).all(|p| p.is_none_or(|p| self.lights.contains_key(&p)))
     }
 
     /// The light of `pos`'s chunk and its 26 neighbours, by `(dx + 1) * 9 + (dy + 1) * 3 +
     /// (dz + 1)`; `None` unless all of them that exist are lit.
     pub(super) fn neighbourhood(&self, pos: ChunkPos) -> Option<[Option<Arc<LightChunk>>; 27]> {
         let mut out: [Option<Arc<LightChunk>>; 27] = Default::default();
-        for (i, o) in out.iter_mut().enumerate() {
-            let d = [i / 9, i / 3 % 3, i % 3].map(|v| v as i32 - 1);
-            if let Some(p) = pos.offset(d) {
+        for (o, p) in out.iter_mut().zip(around(pos)) {
+            if let Some(p) = p {
                 *o = Some(self.lights.get(&p)?.clone());
             }
         }
         Some(out)
     }
+}
+
+/// `pos` and its 26 neighbours, by `(dx + 1) * 9 + (dy + 1) * 3 + (dz + 1)` (`None` past
+/// the world's edge).
+fn around(pos: ChunkPos) -> impl Iterator<Item = Option<ChunkPos>> {
+    (0..27).map(move |i| pos.offset([i / 9, i / 3 % 3, i % 3].map(|v| v - 1)))
 }
 
 /// A light snapshot per chunk whose light changed (`None`: no longer lit).
@@ -123,42 +125,34 @@ pub(super) fn light_job(
     let mut removed = Vec::new();
     // Chunks come in many at a time: lit together, with one flood.
     let mut batch: Vec<ChunkPos> = Vec::new();
-    let mut flush = |batch: &mut Vec<ChunkPos>, world: &World, field: &mut LightField| {
-        if let Err(e) = field.add_chunks(world, batch) {
-            failed.extend(batch.iter().map(|p| (*p, format!("light: {e}"))));
-        }
-        batch.clear();
-    };
-    let mut op_failed = Vec::new();
     for op in ops {
         let (pos, done) = match op {
             LightOp::Insert(pos, chunk) => {
-                match world.insert_shared(pos, chunk) {
-                    Ok(_) => batch.push(pos),
-                    Err(e) => op_failed.push((pos, format!("light: {e}"))),
+                let done = world.insert_shared(pos, chunk).map(drop);
+                if done.is_ok() {
+                    batch.push(pos);
                 }
-                continue;
+                (pos, done)
             }
             // The same blocks: nothing to light.
             LightOp::Replace(pos, chunk) => (pos, world.insert_shared(pos, chunk).map(drop)),
             LightOp::Remove(pos) => {
-                flush(&mut batch, world, field);
+                light_batch(&mut batch, world, field, &mut failed);
                 let done = field.remove_chunk(world, pos).map(drop);
                 world.remove_shared(pos);
                 removed.push(pos);
                 (pos, done)
             }
             LightOp::Set(at, id) => {
-                flush(&mut batch, world, field);
+                light_batch(&mut batch, world, field, &mut failed);
                 (at.split().0, field.set_block(world, at, id).map(drop))
             }
         };
         if let Err(e) = done {
-            op_failed.push((pos, format!("light: {e}")));
+            failed.push((pos, format!("light: {e}")));
         }
     }
-    flush(&mut batch, world, field);
-    failed.extend(op_failed);
+    light_batch(&mut batch, world, field, &mut failed);
     // Blocks set are not edits the job's world keeps track of.
     world.take_dirty();
     let mut changed: Vec<_> = field
@@ -176,6 +170,19 @@ pub(super) fn light_job(
             .map(|p| (p, None)),
     );
     (changed, failed)
+}
+
+/// Lights the chunks of `batch` (in `world`, not lit yet) with one flood, and empties it.
+fn light_batch(
+    batch: &mut Vec<ChunkPos>,
+    world: &World,
+    field: &mut LightField,
+    failed: &mut Vec<(ChunkPos, String)>,
+) {
+    if let Err(e) = field.add_chunks(world, batch) {
+        failed.extend(batch.iter().map(|p| (*p, format!("light: {e}"))));
+    }
+    batch.clear();
 }
 
 impl ChunkStreamer {
