@@ -49,6 +49,24 @@ fn demo(x: &Xvfb, args: &[&str]) {
     );
 }
 
+/// A 640 × 360 screenshot of the terrain at `view_distance` after 3 frames, saved at
+/// `path`, with `extra` arguments.
+fn terrain_shot(x: &Xvfb, path: &Path, view_distance: &str, extra: &[&str]) -> Image {
+    let mut args = vec![
+        "--size",
+        "640x360",
+        "--frames",
+        "3",
+        "--view-distance",
+        view_distance,
+        "--screenshot",
+        path.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    demo(x, &args);
+    Image::load_png(path).unwrap()
+}
+
 /// Where the panel ends: the first column whose mean brightness is that of the scene (sky,
 /// grass, water), not of the dark panel with its text.
 fn panel_edge(img: &Image) -> u32 {
@@ -312,20 +330,7 @@ fn the_window_draws_a_far_view_past_the_streamed_distance() {
     let dir = out_dir("window-far");
     let shot = |vd: &str, extra: &[&str]| {
         let path = dir.join(format!("view-distance-{vd}.png"));
-        let vd = vd.trim_end_matches("-bands");
-        let mut args = vec![
-            "--size",
-            "640x360",
-            "--frames",
-            "3",
-            "--view-distance",
-            vd,
-            "--screenshot",
-            path.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        demo(&x, &args);
-        Image::load_png(&path).unwrap()
+        terrain_shot(&x, &path, vd.trim_end_matches("-bands"), extra)
     };
     let near = shot("4", &[]);
     let far = shot("64", &["--edit"]);
@@ -433,22 +438,7 @@ fn the_window_draws_a_lit_scene_with_its_light_and_sun_shadows() {
 fn the_window_lights_the_terrain_as_it_streams() {
     let Some(x) = vulkan_and_xvfb() else { return };
     let dir = out_dir("window-lit-terrain");
-    let shot = |name: &str, extra: &[&str]| {
-        let path = dir.join(name);
-        let mut args = vec![
-            "--size",
-            "640x360",
-            "--frames",
-            "3",
-            "--view-distance",
-            "4",
-            "--screenshot",
-            path.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        demo(&x, &args);
-        view(&Image::load_png(&path).unwrap())
-    };
+    let shot = |name: &str, extra: &[&str]| view(&terrain_shot(&x, &dir.join(name), "4", extra));
     let unlit = shot("unlit.png", &[]);
     let lit = shot("lit.png", &["--light"]);
     assert!(distinct(&lit) > 100, "{} colours", distinct(&lit));

@@ -309,13 +309,8 @@ impl Streaming {
     fn new(seed: u32, view_distance: u32, scene: Option<&OpenScene>, light: bool) -> Result<Self> {
         if view_distance <= STREAMED_VIEW_DISTANCE || scene.is_some() {
             let view_distance = view_distance.min(STREAMED_VIEW_DISTANCE);
-            let streamer = if light && scene.is_none() {
-                lit_terrain(seed, view_distance)?
-            } else {
-                streamer(seed, view_distance, scene)?
-            };
             return Ok(Self {
-                streamer,
+                streamer: streamer(seed, view_distance, scene, light)?,
                 last: StreamFrame::default(),
                 far: None,
                 sun: Default::default(),
@@ -330,7 +325,7 @@ impl Streaming {
             },
         )?;
         Ok(Self {
-            streamer: streamer(seed, NEAR_WORLD, None)?,
+            streamer: streamer(seed, NEAR_WORLD, None, false)?,
             last: StreamFrame::default(),
             far: Some((field, FarStatus::default())),
             sun: Default::default(),
@@ -387,29 +382,38 @@ impl ChunkSink for Sinks<'_> {
 }
 
 /// A streamer of `seed`'s terrain (or of the opened scene's world) with `view_distance`
-/// chunks each way (4 up and down).
-fn streamer(seed: u32, view_distance: u32, scene: Option<&OpenScene>) -> Result<ChunkStreamer> {
+/// chunks each way (4 up and down); the terrain lit as it streams with `light` (a scene
+/// has its own light).
+fn streamer(
+    seed: u32,
+    view_distance: u32,
+    scene: Option<&OpenScene>,
+    light: bool,
+) -> Result<ChunkStreamer> {
     let config = StreamConfig {
         view_distance,
         vertical_distance: 4,
         ..StreamConfig::default()
     };
-    match scene {
-        Some(s) => ChunkStreamer::new(s.world.registry().clone(), s.world.clone(), config),
-        None => ChunkStreamer::new(Arc::new(BlockRegistry::default()), terrain(seed), config),
-    }
-    .map_err(Error::from)
+    Ok(match scene {
+        Some(s) => ChunkStreamer::new(s.world.registry().clone(), s.world.clone(), config)?,
+        None => {
+            let registry = Arc::new(terrain_registry(light));
+            let mut streamer = ChunkStreamer::new(registry, terrain(seed), config)?;
+            streamer.set_light(light);
+            streamer
+        }
+    })
 }
 
-/// [`streamer`] of `seed`'s terrain with the light sources' registry, lit as it streams.
-fn lit_terrain(seed: u32, view_distance: u32) -> Result<ChunkStreamer> {
-    let config = StreamConfig {
-        view_distance,
-        vertical_distance: 4,
-        ..StreamConfig::default()
-    };
-    let registry = Arc::new(BlockRegistry::with_lights());
-    Ok(ChunkStreamer::new(registry, terrain(seed), config)?.with_light())
+/// The blocks of the generated terrain: with the light sources where it is lit (the sun
+/// shadows check that the renderer's registry is the streamer's).
+fn terrain_registry(light: bool) -> BlockRegistry {
+    if light {
+        BlockRegistry::with_lights()
+    } else {
+        BlockRegistry::default()
+    }
 }
 
 /// The default terrain of `seed`.
@@ -576,14 +580,10 @@ impl Gfx {
             fade_in_frames: settings.fade_in_frames,
             ..RendererConfig::default()
         };
-        // Lit terrain streams over the light sources' registry (the sun shadows check it).
-        let terrain_registry = || match opts.light {
-            true => BlockRegistry::with_lights(),
-            false => BlockRegistry::default(),
-        };
-        let registry = open
-            .as_ref()
-            .map_or_else(terrain_registry, |s| (**s.world.registry()).clone());
+        let registry = open.as_ref().map_or_else(
+            || terrain_registry(opts.light),
+            |s| (**s.world.registry()).clone(),
+        );
         let mut renderer = Renderer::new(&ctx, &registry, config)?;
         renderer.set_level_bands(settings.level_bands);
         let lit = open.as_ref().and_then(SceneLight::new);
