@@ -698,6 +698,17 @@ fn sun_shadows_draw_the_same_on_every_fetch_and_backend() {
     }
 }
 
+/// A stone floor 16 chunks across (x −256 to 255, z −16 to 15) with stone pillars in a
+/// row along x, every 12 blocks, 6 high.
+fn pillars() -> World {
+    let mut world = World::new(Arc::new(BlockRegistry::with_lights()));
+    voxel_lab::scene::fill_box(&mut world, [-256, 0, -16], [255, 0, 15], STONE).unwrap();
+    for x in (-250..250).step_by(12) {
+        voxel_lab::scene::fill_box(&mut world, [x, 1, -1], [x, 6, 1], STONE).unwrap();
+    }
+    world
+}
+
 /// Sun shadows that follow a moving player: a floor 16 chunks across with stone pillars in a
 /// row, the volume 4 × 1 × 4 chunks. As the eye walks along the row, `follow_sun_shadows`
 /// reads only the chunks that come into the volume (4 a chunk crossed, none while the eye
@@ -706,11 +717,7 @@ fn sun_shadows_draw_the_same_on_every_fetch_and_backend() {
 #[test]
 fn sun_shadows_follow_the_eye_reading_only_the_chunks_that_come_in() {
     let Some(ctx) = gpu() else { return };
-    let mut world = World::new(Arc::new(BlockRegistry::with_lights()));
-    voxel_lab::scene::fill_box(&mut world, [-256, 0, -16], [255, 0, 15], STONE).unwrap();
-    for x in (-250..250).step_by(12) {
-        voxel_lab::scene::fill_box(&mut world, [x, 1, -1], [x, 6, 1], STONE).unwrap();
-    }
+    let world = pillars();
     let camera_at = |x: f64| {
         Camera::look_at(
             DVec3::new(x, 14.0, 12.0),
@@ -766,11 +773,7 @@ fn sun_shadows_follow_the_eye_reading_only_the_chunks_that_come_in() {
 #[test]
 fn sun_shadows_follow_a_lit_streamer() {
     let Some(ctx) = gpu() else { return };
-    let mut world = World::new(Arc::new(BlockRegistry::with_lights()));
-    voxel_lab::scene::fill_box(&mut world, [-256, 0, -16], [255, 0, 15], STONE).unwrap();
-    for x in (-250..250).step_by(12) {
-        voxel_lab::scene::fill_box(&mut world, [x, 1, -1], [x, 6, 1], STONE).unwrap();
-    }
+    let world = pillars();
     let config = StreamConfig {
         view_distance: 3,
         vertical_distance: 1,
