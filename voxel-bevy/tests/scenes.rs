@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use common::{Harness, have_gpu, save, share_over_one};
 use voxel_bevy::{VoxelContent, VoxelMessage, VoxelStatus, VoxelTechnique, VoxelWorld};
 use voxel_lab::scene::Scene;
-use voxel_render::Technique;
+use voxel_render::{Image, Technique};
 
 fn scene(name: &str) -> Scene {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -51,17 +51,23 @@ fn matches_the_crate(name: &str, hdr: bool) {
         let drawing = h.app.world().resource::<VoxelStatus>().drawing.unwrap();
         let reference = tests::render(&ctx, &reference_scene, drawing, size.0, size.1);
         let tag = format!("{name}-{}{}", t.name(), if hdr { "-hdr" } else { "" });
-        save(&tag, &bevy, &reference);
-        let share = share_over_one(&bevy, &reference);
-        eprintln!("{tag}: {:.4} % of pixels over 1/255", share * 100.0);
-        assert!(
-            share <= 0.001,
-            "{tag}: {:.3} % of the pixels differ by more than 1/255 ({:?})",
-            share * 100.0,
-            tests::diff(&bevy, &reference)
-        );
-        assert!(tests::distinct_colours(&bevy) > 20, "{tag}: a flat picture");
+        assert_same_picture(&tag, &bevy, &reference);
     }
+}
+
+/// Saves Bevy's picture and the crate's under `tag` and checks that at most 0.1 % of the
+/// pixels differ by more than 1/255, and that Bevy's is not flat.
+fn assert_same_picture(tag: &str, bevy: &Image, reference: &Image) {
+    save(tag, bevy, reference);
+    let share = share_over_one(bevy, reference);
+    eprintln!("{tag}: {:.4} % of pixels over 1/255", share * 100.0);
+    assert!(
+        share <= 0.001,
+        "{tag}: {:.3} % of the pixels differ by more than 1/255 ({:?})",
+        share * 100.0,
+        tests::diff(bevy, reference)
+    );
+    assert!(tests::distinct_colours(bevy) > 20, "{tag}: a flat picture");
 }
 
 /// The cathedral window (`light = true`): light through stained glass, a torch behind blue
@@ -204,13 +210,5 @@ fn a_lit_streamed_world_matches_the_crate() {
         std::thread::sleep(std::time::Duration::from_millis(1));
     }
     let reference = tests::frame(&ctx, &mut r, &camera);
-    save("cathedral-streamed-lit", &bevy, &reference);
-    let share = share_over_one(&bevy, &reference);
-    assert!(
-        share <= 0.001,
-        "{:.3} % of the pixels differ by more than 1/255 ({:?})",
-        share * 100.0,
-        tests::diff(&bevy, &reference)
-    );
-    assert!(tests::distinct_colours(&bevy) > 20, "a flat picture");
+    assert_same_picture("cathedral-streamed-lit", &bevy, &reference);
 }
