@@ -20,6 +20,7 @@ const RENDER: &[&str] = &[
     "fetch",
     "sun",
     "gpu",
+    "light_volume",
     "bindings",
     "textures",
     "arena",

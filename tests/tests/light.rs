@@ -8,14 +8,16 @@
 
 use std::sync::Arc;
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use voxel_core::blocks::{GLASS, RED_GLASS, STONE};
 use voxel_core::light_blocks::TORCH;
 use voxel_core::{BlockId, BlockRegistry, LightField, SunFilters, SunMarch, World, WorldPos};
 use voxel_mesh::{mesh_dirty_lit, mesh_world};
+use voxel_render::content::{Content, ContentStages, Entity};
 use voxel_render::{
-    Camera, ChunkStreamer, GpuContext, Image, Lighting, MAX_SUN_CHUNKS, QuadFetch, Renderer,
-    RendererConfig, StreamConfig, SunFeed, SunRegion, Technique,
+    Camera, ChunkStreamer, Error, GameStages, GpuContext, Image, Lighting, MAX_LIGHT_CHUNKS,
+    MAX_SUN_CHUNKS, QuadFetch, Renderer, RendererConfig, StreamConfig, SunFeed, SunRegion,
+    Technique,
 };
 
 use tests::*;
@@ -769,11 +771,14 @@ fn sun_shadows_follow_the_eye_reading_only_the_chunks_that_come_in() {
 /// light around an eye that walks along the row (each step streamed to idle), the feed
 /// reading each chunk as its blocks come in and following the eye. At the end the picture
 /// is, bit for bit, the one drawn with the volume read whole from the streamer's world
-/// there, and the pillars cast their shadows.
+/// there, and the pillars cast their shadows; the light volume the feed keeps (crates under
+/// a red glass roof lit by it) is likewise the one read whole.
 #[test]
 fn sun_shadows_follow_a_lit_streamer() {
     let Some(ctx) = gpu() else { return };
-    let world = pillars();
+    // Red glass over the row where the walk ends: the sky light under it is tinted.
+    let mut world = pillars();
+    voxel_lab::scene::fill_box(&mut world, [60, 8, -3], [100, 8, 3], RED_GLASS).unwrap();
     let config = StreamConfig {
         view_distance: 3,
         vertical_distance: 1,
@@ -804,6 +809,36 @@ fn sun_shadows_follow_a_lit_streamer() {
     let region = r.sun_region().unwrap();
     assert_eq!(region.chunks, [MAX_SUN_CHUNKS; 3]);
     let camera = Camera::look_at(eye, DVec3::new(eye.x, 0.0, 0.5), 60.0, 0.1, 300.0).unwrap();
+    // The light volume followed too: crates among the pillars, under the glass, are lit
+    // by it as by one read whole from the streamer's light there.
+    let light_region = r.light_region().unwrap();
+    assert_eq!(light_region.chunks, [MAX_LIGHT_CHUNKS; 3]);
+    assert!(light_region.contains(WorldPos::containing(eye.to_array()).split().0));
+    let crates = Content {
+        particles: Vec::new(),
+        entities: (0..6)
+            .map(|i| crate_box(DVec3::new(eye.x - 9.0 + 4.0 * f64::from(i), 1.5, 0.5), 1.0))
+            .collect(),
+    };
+    let lit_things = |r: &mut Renderer| {
+        let mut game = ContentStages::new(r, crates.clone()).unwrap();
+        frame_with(&ctx, r, &camera, &mut game)
+    };
+    let fed_things = lit_things(&mut r);
+    let light = |p: voxel_core::ChunkPos| streamer.light_chunk(p);
+    r.set_light_volume(streamer.world(), &light, light_region)
+        .unwrap();
+    let whole_things = lit_things(&mut r);
+    assert_eq!(
+        diff(&fed_things, &whole_things).max,
+        0,
+        "the fed light volume is the one read whole"
+    );
+    r.clear_light_volume();
+    assert!(
+        diff(&fed_things, &lit_things(&mut r)).differing > 50,
+        "the crates are lit by the volume"
+    );
     let fed = frame(&ctx, &mut r, &camera);
     fed.save_png(&out_dir("light").join("sun_streamed.png"))
         .unwrap();
@@ -821,4 +856,165 @@ fn sun_shadows_follow_a_lit_streamer() {
         "the pillars cast shadows: {} pixels differ",
         diff(&fed, &unshaded).differing
     );
+}
+
+/// A grey crate of 1 block centred on `center`, of `opacity`.
+fn crate_box(center: DVec3, opacity: f32) -> Entity {
+    Entity {
+        center,
+        half_extents: [0.5; 3],
+        rotation: DQuat::IDENTITY,
+        color: [200, 200, 200],
+        opacity,
+        emissive: 0.0,
+    }
+}
+
+/// One frame of `renderer` with `game`.
+fn frame_with(
+    ctx: &GpuContext,
+    renderer: &mut Renderer,
+    camera: &Camera,
+    game: &mut impl GameStages,
+) -> Image {
+    let (w, h) = renderer.size();
+    let target = Offscreen::new(ctx, w, h);
+    renderer
+        .render_and_submit(&target.view, camera, game)
+        .unwrap();
+    target.read(ctx).unwrap()
+}
+
+/// `world` lit and drawn with `config` and a crate of `opacity` on the floor at (5, 1, 5),
+/// the light volume over the world where `volume`.
+fn crate_in(
+    ctx: &GpuContext,
+    world: &World,
+    config: RendererConfig,
+    opacity: f32,
+    volume: bool,
+) -> Image {
+    let mut r = renderer(ctx, world, config, true);
+    if volume {
+        let field = LightField::new(world);
+        let region = SunRegion::around(world, WorldPos::new(5, 1, 5)).unwrap();
+        r.set_light_volume(world, &|p| field.shared(p), region)
+            .unwrap();
+    }
+    let crates = Content {
+        particles: Vec::new(),
+        entities: vec![crate_box(DVec3::new(5.5, 1.5, 5.5), opacity)],
+    };
+    let mut game = ContentStages::new(&r, crates).unwrap();
+    frame_with(ctx, &mut r, &floor_camera(), &mut game)
+}
+
+/// A game's things are lit by the light field where the renderer has a light volume
+/// (`Renderer::set_light_volume`), as the world's faces are: a crate under the red pane
+/// takes the pane's filter on its top as the floor does; in a closed dark room it is
+/// black, by a torch warm; a translucent one is tinted in every technique; the instanced
+/// fetch, WebGL2's limits and GL draw the same. Without a volume it is lit as before, by
+/// the sun and the ambient light alone. A region the volume cannot hold is refused.
+#[test]
+fn a_games_things_are_lit_by_the_light_volume() {
+    let Some(ctx) = gpu() else { return };
+    let camera = floor_camera();
+    let top = |img: &Image| {
+        let (x, y) = pixel(&camera, DVec3::new(5.5, 2.0, 5.5));
+        img.pixel(x, y)
+    };
+    let pane = room(RED_GLASS);
+    let field = LightField::new(&pane);
+    // The cells the top face's corners sample (half a block above it) lie in the pane's
+    // beam: one level.
+    let level = field.get(WorldPos::new(5, 2, 5)).unwrap();
+    for x in 4..=6 {
+        for z in 4..=6 {
+            assert_eq!(field.get(WorldPos::new(x, 2, z)).unwrap(), level);
+        }
+    }
+    let sq = config(Technique::SortedQuads);
+    let unlit = crate_in(&ctx, &pane, sq.clone(), 1.0, false);
+    let lit = crate_in(&ctx, &pane, sq.clone(), 1.0, true);
+    let dir = out_dir("light");
+    unlit.save_png(&dir.join("crate_unlit.png")).unwrap();
+    lit.save_png(&dir.join("crate_under_the_pane.png")).unwrap();
+    let (u, l) = (top(&unlit), top(&lit));
+    assert!(
+        u[0] > 100,
+        "without a volume the crate is lit by the sky: {u:?}"
+    );
+    for ch in 0..3 {
+        let want = to_srgb(to_linear(u[ch]) * f32::from(level.sky[ch]) / 255.0);
+        assert!(
+            (f32::from(l[ch]) - want).abs() <= 2.0,
+            "channel {ch} of the crate's top under the pane is {} (unlit {}), want {want:.1}",
+            l[ch],
+            u[ch]
+        );
+    }
+    // The same on the instanced fetch, under WebGL2's limits and on GL.
+    let mut instanced = sq.clone();
+    instanced.quad_fetch = Some(QuadFetch::Instanced);
+    let mut others = vec![("instanced", crate_in(&ctx, &pane, instanced, 1.0, true))];
+    for (name, other) in [
+        ("webgl2", webgl2()),
+        ("gl", gl()),
+        ("gl webgl2", gl_webgl2()),
+    ] {
+        if let Some(other) = other {
+            others.push((name, crate_in(&other, &pane, sq.clone(), 1.0, true)));
+        }
+    }
+    for (name, img) in &others {
+        let t = top(img);
+        assert!(
+            (0..3).all(|ch| t[ch].abs_diff(l[ch]) <= 2),
+            "{name}: the crate's top is {t:?}, with the storage fetch on Vulkan {l:?}"
+        );
+    }
+    // A closed room: black without a torch, warm by one.
+    let dark = room(STONE);
+    let d = top(&crate_in(&ctx, &dark, sq.clone(), 1.0, true));
+    assert_eq!(
+        &d[..3],
+        &[0, 0, 0],
+        "a crate in a dark room is black: {d:?}"
+    );
+    let mut torch = room(STONE);
+    voxel_lab::scene::fill_box(&mut torch, [5, 1, 7], [5, 1, 7], TORCH).unwrap();
+    let by_torch = crate_in(&ctx, &torch, sq.clone(), 1.0, true);
+    by_torch
+        .save_png(&dir.join("crate_by_a_torch.png"))
+        .unwrap();
+    let t = top(&by_torch);
+    assert!(
+        t[0] > 40 && t[0] > t[1] && t[1] > t[2],
+        "a crate by a torch is lit warm: {t:?}"
+    );
+    // A translucent crate under the pane: redder lit than unlit, in every technique.
+    for technique in Technique::ALL.into_iter().filter(|t| t.draws()) {
+        let c = config(technique);
+        let u = top(&crate_in(&ctx, &pane, c.clone(), 0.6, false));
+        let l = top(&crate_in(&ctx, &pane, c, 0.6, true));
+        let red = |p: [u8; 4]| f32::from(p[0]) / f32::from(p[1].max(1));
+        assert!(
+            red(l) > red(u) + 0.1,
+            "{}: a glass crate under the pane is tinted: {l:?} lit, {u:?} unlit",
+            technique.name()
+        );
+    }
+    // Bad regions change nothing.
+    let mut r = renderer(&ctx, &pane, sq, true);
+    for chunks in [[MAX_LIGHT_CHUNKS + 1, 1, 1], [0, 1, 1]] {
+        let region = SunRegion {
+            min: voxel_core::ChunkPos::new(0, 0, 0),
+            chunks,
+        };
+        match r.set_light_volume(&pane, &|p| field.shared(p), region) {
+            Err(Error::InvalidSetting(why)) => assert!(why.contains("light volume"), "{why}"),
+            other => panic!("{chunks:?}: {other:?}"),
+        }
+        assert_eq!(r.light_region(), None);
+    }
 }

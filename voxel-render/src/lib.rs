@@ -18,7 +18,9 @@
 //!   technique, and the helpers its pipelines and overlays are built with; [`Both`] draws
 //!   two games' stages (the ready-made content and the game's own) as one.
 //! - [`content`]: a game's particles and boxes, opaque or translucent, drawn through the
-//!   frame's stages by every technique without WGSL of its own.
+//!   frame's stages by every technique without WGSL of its own, lit by the light field
+//!   where the renderer has a light volume ([`Renderer::set_light_volume`]; a game's own
+//!   shaders read it through [`light_wgsl`]).
 //! - [`Image`] and [`readback`]: pictures back to the CPU, PNG files; [`textures`]: a
 //!   game's block textures.
 //!
@@ -29,8 +31,8 @@
 //! Modules depend on each other one way, from the bottom: `error`, `context`, `ladder`
 //! (what each pass needs of a device), `camera`, `readback`, `submission`, `timing`,
 //! `cost` (what a frame asks of the GPU, counted), `fetch` (how quads reach the vertex shader),
-//! `sun` (the sun shadows' volume) → `gpu` (pass and pipeline plumbing) →
-//! `bindings` (what every chunk pipeline binds), `textures`, `arena` (the quad arena),
+//! `sun` (the sun shadows' volume) → `gpu` (pass and pipeline plumbing) → `light_volume`
+//! (the light field around the eye for a game's shaders) → `bindings` (what every chunk pipeline binds), `textures`, `arena` (the quad arena),
 //! `layers` (translucent planes) → `chunks` → `medium` (translucent volumes seen from
 //! inside) → `stages` (what a game draws in a frame) → `oit` (techniques) → `renderer` →
 //! `content` (ready-made game content) → `stream` (chunks loaded around a moving eye) →
@@ -53,6 +55,7 @@ mod fetch;
 mod gpu;
 mod ladder;
 mod layers;
+mod light_volume;
 pub mod low_level;
 mod medium;
 mod oit;
@@ -75,6 +78,7 @@ pub use context::{
 };
 pub use error::{Error, Result};
 pub use fetch::QuadFetch;
+pub use light_volume::{ChunkLight, MAX_LIGHT_CHUNKS, light_wgsl};
 pub use oit::{
     OitConfig, Technique, moments::MboitSettings, peeling::PeelingSettings,
     stipple::StippleSettings, stipple::bayer::BayerSize, wboit::WboitSettings,

@@ -174,6 +174,10 @@ pub struct GameFrame<'a> {
     /// `sorted-quads` cuts into parts is at its first part's position, and
     /// [`GameStages::translucent`] draws that position once per part.
     pub order: Option<&'a [u32]>,
+    /// The light volume's group (`Renderer::light_layout`), for the game's shaders to read
+    /// the light field around the eye with [`light_wgsl`](crate::light_volume::light_wgsl)'s functions; always there
+    /// to bind (without a volume they give the light of a world drawn unlit).
+    pub light: &'a wgpu::BindGroup,
     /// The writes [`GameFrame::write_buffer`] gathers in `prepare`.
     pub(crate) writes: &'a GameWrites,
 }

@@ -31,7 +31,8 @@ const MAX_TILES: usize = MAX_SUN_CHUNKS as usize * TILES;
 /// front of the face.
 pub const SUN_NUDGE: f32 = 1e-3;
 
-/// The chunks a renderer's sun shadows cover: `chunks` along x, y and z from `min`.
+/// The chunks a renderer's sun shadows, or its light volume, cover: `chunks` along x, y
+/// and z from `min`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SunRegion {
     /// The first chunk.
@@ -44,11 +45,18 @@ impl SunRegion {
     /// The loaded chunks of `world`, or the [`MAX_SUN_CHUNKS`] along each axis nearest
     /// `around` where they span more; `None` for a world with no chunk.
     pub fn around(world: &World, around: WorldPos) -> Option<Self> {
+        Self::around_at_most(world, around, MAX_SUN_CHUNKS)
+    }
+
+    /// The loaded chunks of `world`, or the `max` along each axis nearest `around` where
+    /// they span more (a light volume's: `MAX_LIGHT_CHUNKS`); `None` for a world with no
+    /// chunk.
+    pub fn around_at_most(world: &World, around: WorldPos, max: u32) -> Option<Self> {
         let (lo, hi) = world.chunk_bounds()?;
         let (lo, hi) = ([lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]);
         let (centre, _) = around.split();
         let centre = [centre.x, centre.y, centre.z];
-        let max = MAX_SUN_CHUNKS as i32;
+        let max = max.clamp(1, 1 << 16) as i32;
         let mut min = [0; 3];
         let mut chunks = [0; 3];
         for a in 0..3 {
@@ -58,7 +66,7 @@ impl SunRegion {
                 chunks[a] = span as u32;
             } else {
                 min[a] = (centre[a] - max / 2).clamp(lo[a], hi[a] - max + 1);
-                chunks[a] = MAX_SUN_CHUNKS;
+                chunks[a] = max as u32;
             }
         }
         Some(Self {
@@ -113,8 +121,26 @@ impl SunRegion {
         })
     }
 
+    /// Whether its first and last chunks lie in the `i32` world.
+    pub(crate) fn is_valid(&self) -> bool {
+        self.min.is_valid() && self.max().is_valid()
+    }
+
+    /// The region moved so that its x and z centre on chunk `centre`, its size and heights
+    /// kept; `None` where it does not move, or would leave the `i32` world.
+    pub(crate) fn centred_on(&self, centre: ChunkPos) -> Option<Self> {
+        let half = |n: u32| (n / 2) as i32;
+        let min = ChunkPos::new(
+            centre.x.saturating_sub(half(self.chunks[0])),
+            self.min.y,
+            centre.z.saturating_sub(half(self.chunks[2])),
+        );
+        let new = Self { min, ..*self };
+        (new != *self && new.is_valid()).then_some(new)
+    }
+
     /// Where chunk `pos`'s cells lie in the torus, in chunks.
-    fn slot(&self, pos: ChunkPos) -> [u32; 3] {
+    pub(crate) fn slot(&self, pos: ChunkPos) -> [u32; 3] {
         let p = [pos.x, pos.y, pos.z];
         std::array::from_fn(|a| p[a].rem_euclid(self.chunks[a] as i32) as u32)
     }
@@ -202,8 +228,7 @@ impl SunVolume {
         let largest = device.limits().max_texture_dimension_3d;
         if region.chunks.iter().any(|&c| c == 0 || c > MAX_SUN_CHUNKS)
             || region.blocks().iter().any(|&b| b > largest)
-            || !region.min.is_valid()
-            || !region.max().is_valid()
+            || !region.is_valid()
         {
             return Err(Error::InvalidSetting(format!(
                 "sun shadows over {region:?}: 1 to {MAX_SUN_CHUNKS} chunks an axis, at most \
@@ -231,16 +256,9 @@ impl SunVolume {
     /// chunks that stay are not touched. Returns how many chunks were read.
     pub(crate) fn follow(&mut self, queue: &wgpu::Queue, world: &World, centre: ChunkPos) -> usize {
         let Some(old) = self.region else { return 0 };
-        let half = |n: u32| (n / 2) as i32;
-        let min = ChunkPos::new(
-            centre.x.saturating_sub(half(old.chunks[0])),
-            old.min.y,
-            centre.z.saturating_sub(half(old.chunks[2])),
-        );
-        let new = SunRegion { min, ..old };
-        if new == old || !new.min.is_valid() || !new.max().is_valid() {
+        let Some(new) = old.centred_on(centre) else {
             return 0;
-        }
+        };
         self.region = Some(new);
         self.tops.retain(|&pos, _| new.contains(pos));
         let entering: Vec<ChunkPos> = new.positions().filter(|&p| !old.contains(p)).collect();

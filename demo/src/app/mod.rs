@@ -464,14 +464,16 @@ impl SceneLight {
             .map_or_else(ChunkMeshes::default, |(_, m)| m))
     }
 
-    /// Sun shadows over the chunks nearest `eye` in `renderer`, when the scene has them.
+    /// Sun shadows over the chunks nearest `eye` in `renderer`, when the scene has them,
+    /// and the light volume there (the game's things lit by the field).
     fn shadow(&self, renderer: &mut Renderer, eye: DVec3) -> Result<()> {
+        use voxel_render::{MAX_LIGHT_CHUNKS, SunRegion};
         let around = voxel_core::WorldPos::containing(eye.to_array());
-        if let (true, Some(region)) = (
-            self.sun_shadows,
-            voxel_render::SunRegion::around(&self.world, around),
-        ) {
+        if let (true, Some(region)) = (self.sun_shadows, SunRegion::around(&self.world, around)) {
             renderer.set_sun_shadows(&self.world, region)?;
+        }
+        if let Some(region) = SunRegion::around_at_most(&self.world, around, MAX_LIGHT_CHUNKS) {
+            renderer.set_light_volume(&self.world, &|p| self.field.shared(p), region)?;
         }
         Ok(())
     }
@@ -885,9 +887,13 @@ impl Gfx {
                 }
             }
         }
+        let light = |p| lit.field.shared(p);
         self.renderer.update_sun_shadows(&lit.world, &changed);
+        self.renderer
+            .update_light_volume(&lit.world, &light, &changed);
         if let Some(r) = &mut self.reference {
             r.update_sun_shadows(&lit.world, &changed);
+            r.update_light_volume(&lit.world, &light, &changed);
         }
         Ok(())
     }
@@ -1038,6 +1044,9 @@ impl Gfx {
         }
         if let (Some(l), Some(region)) = (&self.lit, self.renderer.sun_region()) {
             r.set_sun_shadows(&l.world, region)?;
+        }
+        if let (Some(l), Some(region)) = (&self.lit, self.renderer.light_region()) {
+            r.set_light_volume(&l.world, &|p| l.field.shared(p), region)?;
         }
         Ok(r)
     }

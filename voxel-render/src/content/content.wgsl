@@ -1,17 +1,17 @@
 // A game's content drawn through the renderer's stages (draw.rs): boxes turned any way
 // and camera-facing particles, 36 vertices a box and 6 a particle, each instance a `Prim`
 // (from a storage buffer, `content_storage.wgsl`, or per-instance vertex attributes,
-// `content_instanced.wgsl`, appended after this). Lit like the world's faces: Lambert with
-// the sun plus ambient at the light's brightness, a particle as a face turned to the sky;
-// plus the light it gives off, in multiples of its linear colour.
+// `content_instanced.wgsl`, appended after this). Lit like the world's faces, by the light
+// field around it where the renderer has a light volume (`voxel_shade` of
+// `light_volume.wgsl`, appended before the instances' entry: Lambert with the sun plus
+// ambient at the light's brightness, times the sky light there, or the block light where
+// brighter), each box vertex half a block in front of its face, a particle at its centre as
+// a face turned to the sky; plus the light it gives off, in multiples of its linear colour.
 
 struct View {
     view_proj: mat4x4<f32>,
     right: vec4<f32>,
     up: vec4<f32>,
-    sun: vec3<f32>,
-    ambient: f32,
-    brightness: f32,
 };
 
 struct Prim {
@@ -44,7 +44,7 @@ const SQUARE = array<vec2<f32>, 6>(
 );
 
 // The colour of `p` lit by `light`, plus its own light.
-fn content_color(p: Prim, light: f32) -> vec4<f32> {
+fn content_color(p: Prim, light: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(p.color.rgb * (light + p.emissive), p.color.a);
 }
 
@@ -61,8 +61,7 @@ fn content_vertex(vi: u32, p: Prim) -> ContentOut {
         }
         let world = p.center + (view.right.xyz * c.x + view.up.xyz * c.y) * p.axis_x.x;
         out.position = view.view_proj * vec4<f32>(world, 1.0);
-        let light = view.brightness * (view.ambient + (1.0 - view.ambient) * max(view.sun.y, 0.0));
-        out.color = content_color(p, light);
+        out.color = content_color(p, voxel_shade(p.center, vec3<f32>(0.0)));
         return out;
     }
     // Face f of a box: axis f / 2, on its + side for even f.
@@ -77,8 +76,8 @@ fn content_vertex(vi: u32, p: Prim) -> ContentOut {
     let k = select(vec2<f32>(c.y, c.x), c, sign > 0.0);
     let world = p.center + n + u * k.x + v * k.y;
     out.position = view.view_proj * vec4<f32>(world, 1.0);
-    let light = view.brightness * (view.ambient + (1.0 - view.ambient) * max(dot(normalize(n), view.sun), 0.0));
-    out.color = content_color(p, light);
+    let normal = normalize(n);
+    out.color = content_color(p, voxel_shade(world + normal * 0.5, normal));
     return out;
 }
 

@@ -8,6 +8,7 @@ use glam::DVec3;
 use super::{Content, Entity, Particle};
 use crate::error::scoped;
 use crate::ladder::{self, Limit, Need};
+use crate::light_volume::light_wgsl;
 use crate::stages::{
     DEPTH_COMPARE, GameFrame, GameStages, OIT_GROUP, Stages, TranslucentContract, TranslucentObject,
 };
@@ -42,10 +43,6 @@ struct View {
     view_proj: [[f32; 4]; 4],
     right: [f32; 4],
     up: [f32; 4],
-    sun: [f32; 3],
-    ambient: f32,
-    brightness: f32,
-    _pad: [f32; 3],
 }
 
 /// The fields of [`Prim`] as per-instance vertex attributes (`content_instanced.wgsl`).
@@ -139,6 +136,8 @@ pub struct ContentStages {
     view_layout: wgpu::BindGroupLayout,
     /// The instances' group (storage fetch).
     prims_layout: wgpu::BindGroupLayout,
+    /// The renderer's light volume group (`Renderer::light_layout`), after the instances'.
+    light_layout: wgpu::BindGroupLayout,
     view_group: wgpu::BindGroup,
     /// Instances a buffer holds at most: a storage binding's or a buffer's size.
     per_page: usize,
@@ -372,6 +371,7 @@ impl ContentStages {
             .unwrap_or(usize::MAX)
             .max(1);
         let module_src = CONTENT_WGSL.to_owned()
+            + &light_wgsl(light_group(fetch))
             + match fetch {
                 QuadFetch::Storage => STORAGE_WGSL,
                 QuadFetch::Instanced => INSTANCED_WGSL,
@@ -384,6 +384,7 @@ impl ContentStages {
             view,
             view_layout,
             prims_layout,
+            light_layout: renderer.light_layout().clone(),
             view_group,
             per_page,
             opaque: Instances::default(),
@@ -511,12 +512,16 @@ impl ContentStages {
         }
     }
 
-    /// The groups of its pipelines before [`OIT_GROUP`]: the view, and the instances'
-    /// group where they come from storage buffers.
+    /// The groups of its pipelines before [`OIT_GROUP`]: the view, the instances' group
+    /// where they come from storage buffers, the light volume's.
     fn groups(&self) -> Vec<Option<&wgpu::BindGroupLayout>> {
         match self.fetch {
-            QuadFetch::Storage => vec![Some(&self.view_layout), Some(&self.prims_layout)],
-            QuadFetch::Instanced => vec![Some(&self.view_layout)],
+            QuadFetch::Storage => vec![
+                Some(&self.view_layout),
+                Some(&self.prims_layout),
+                Some(&self.light_layout),
+            ],
+            QuadFetch::Instanced => vec![Some(&self.view_layout), Some(&self.light_layout)],
         }
     }
 
@@ -695,10 +700,22 @@ impl ContentStages {
         }
     }
 
-    /// Binds what every draw of its pipelines reads besides the instances.
-    fn bind_view(&self, pass: &mut wgpu::RenderPass<'_>) {
+    /// Binds what every draw of its pipelines reads besides the instances: the view and
+    /// the frame's light volume.
+    fn bind_view(&self, pass: &mut wgpu::RenderPass<'_>, frame: &GameFrame<'_>) {
         crate::cost::set_bind_group(0, Some(&self.view_group), &[]);
         pass.set_bind_group(0, &self.view_group, &[]);
+        let light = light_group(self.fetch);
+        crate::cost::set_bind_group(light, Some(frame.light), &[]);
+        pass.set_bind_group(light, frame.light, &[]);
+    }
+}
+
+/// The group the light volume is bound at: after the instances' where they have one.
+fn light_group(fetch: QuadFetch) -> u32 {
+    match fetch {
+        QuadFetch::Storage => 2,
+        QuadFetch::Instanced => 1,
     }
 }
 
@@ -765,10 +782,6 @@ impl GameStages for ContentStages {
             view_proj: frame.view_proj.to_cols_array_2d(),
             right: v(right),
             up: v(true_up),
-            sun: frame.sun_dir.to_array(),
-            ambient: frame.ambient,
-            brightness: frame.brightness,
-            _pad: [0.0; 3],
         };
         // In the frame's encoder: a frame recorded before this one keeps its own view.
         let mut written = frame.write_buffer(&self.view, 0, bytemuck::bytes_of(&view));
@@ -823,13 +836,13 @@ impl GameStages for ContentStages {
         }
     }
 
-    fn opaque(&self, pass: &mut wgpu::RenderPass<'_>, _frame: &GameFrame<'_>) {
+    fn opaque(&self, pass: &mut wgpu::RenderPass<'_>, frame: &GameFrame<'_>) {
         let Some((_, pipeline)) = &self.opaque_pipeline else {
             return;
         };
         crate::cost::set_pipeline(pipeline);
         pass.set_pipeline(pipeline);
-        self.bind_view(pass);
+        self.bind_view(pass, frame);
         self.opaque
             .draw(pass, self.fetch, 0..self.opaque.count, self.per_page);
     }
@@ -837,7 +850,7 @@ impl GameStages for ContentStages {
     fn translucent(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
-        _frame: &GameFrame<'_>,
+        frame: &GameFrame<'_>,
         variant: usize,
         objects: Range<usize>,
     ) {
@@ -853,7 +866,7 @@ impl GameStages for ContentStages {
         }
         crate::cost::set_pipeline(pipeline);
         pass.set_pipeline(pipeline);
-        self.bind_view(pass);
+        self.bind_view(pass, frame);
         self.translucent
             .draw(pass, self.fetch, objects, self.per_page);
     }
@@ -866,7 +879,7 @@ mod tests {
 
     #[test]
     fn prim_and_view_match_the_wgsl() {
-        let module = parse(&(CONTENT_WGSL.to_owned() + STORAGE_WGSL));
+        let module = parse(&(CONTENT_WGSL.to_owned() + &light_wgsl(2) + STORAGE_WGSL));
         assert_layout::<Prim>(
             &module,
             "Prim",
@@ -887,13 +900,10 @@ mod tests {
                 field!(View, view_proj),
                 field!(View, right),
                 field!(View, up),
-                field!(View, sun),
-                field!(View, ambient),
-                field!(View, brightness),
             ],
         );
         // The instanced entry point parses too, its attributes at the fields' offsets.
-        let _ = parse(&(CONTENT_WGSL.to_owned() + INSTANCED_WGSL));
+        let _ = parse(&(CONTENT_WGSL.to_owned() + &light_wgsl(1) + INSTANCED_WGSL));
         assert_eq!(PRIM_ATTRIBUTES[3].offset, 28);
         assert_eq!(PRIM_BYTES, 80);
     }

@@ -21,6 +21,7 @@ use crate::bindings::{FrameUniforms, MEDIA_EYE, MEDIA_NONE, MEDIA_VOLUMES, MEDIA
 use crate::chunks::{DrawList, DrawMode, FrameDraws, Frustum, GpuChunk, MeshKind};
 use crate::error::scoped;
 use crate::gpu::{self, Depth, Pass};
+use crate::light_volume::Lighting;
 use crate::medium::{self, MediumLook};
 use crate::oit::sorted::interleave::ChunkSequence;
 use crate::oit::{FrameView, Technique, TechniqueReport, TranslucentFrame};
@@ -287,6 +288,16 @@ impl Renderer {
         let mut writes = writes.into_inner().unwrap_or_else(PoisonError::into_inner);
         writes.write(&self.scene.frame_buffer, 0, bytemuck::bytes_of(&uniforms));
         let (eye_int, eye_frac) = camera.eye_split();
+        let light = self.scene.light.uniforms(
+            eye_int,
+            eye_frac.to_array(),
+            Lighting {
+                sun_dir: sun_unit(self.config.sun_dir).to_array(),
+                ambient: self.config.ambient,
+                brightness: self.config.brightness,
+            },
+        );
+        writes.write(self.scene.light.uniform(), 0, bytemuck::bytes_of(&light));
         let game_writes = GameWrites::open();
         let game_frame = GameFrame {
             camera,
@@ -300,6 +311,7 @@ impl Renderer {
             ambient: self.config.ambient,
             brightness: self.config.brightness,
             order: sorts.then_some(order),
+            light: &self.scene.light.group,
             writes: &game_writes,
         };
         if stages != crate::stages::Stages::default() {

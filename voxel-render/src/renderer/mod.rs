@@ -22,6 +22,7 @@ use crate::error::scoped;
 use crate::fetch::{QuadFetch, TableTexture};
 use crate::gpu::{self, ChunkPipeline, DepthMode};
 use crate::ladder;
+use crate::light_volume::{ChunkLight, LightVolume};
 use crate::medium::{self, MediumLook, MediumPass};
 use crate::oit::sorted::interleave::Interleaver;
 use crate::oit::{OitConfig, OitManager, Setup, Technique, TechniqueReport};
@@ -229,6 +230,7 @@ impl Renderer {
             media,
             sun_table: looks.len() as u32,
             sun,
+            light: LightVolume::new(device, registry),
             depth_sampler: gpu::depth_sampler(device),
         };
         let (opaque, cutout) = Self::opaque_pipelines(ctx, &layouts, config.msaa);
@@ -383,6 +385,76 @@ impl Renderer {
     /// The region the sun shadows cover, if on.
     pub fn sun_region(&self) -> Option<SunRegion> {
         self.scene.sun.region()
+    }
+
+    /// Turns the light volume on over `region` (see [`SunRegion::around`]; at most
+    /// [`MAX_LIGHT_CHUNKS`](crate::MAX_LIGHT_CHUNKS) chunks an axis), the light of its chunks read now through
+    /// `light` ([`voxel_core::LightField::shared`], or a lit streamer's
+    /// `ChunkStreamer::light_chunk`) with `world`'s blocks: a game's content and its own
+    /// shaders are lit by the light field there ([`light_wgsl`](crate::light_volume::light_wgsl),
+    /// `docs/light.md`, "Light for a game's things"). A region the adapter cannot hold or
+    /// a world over another registry is an [`Error::InvalidSetting`] that changes nothing.
+    /// Edits reach it through [`Renderer::update_light_volume`].
+    pub fn set_light_volume(
+        &mut self,
+        world: &World,
+        light: ChunkLight<'_>,
+        region: SunRegion,
+    ) -> Result<()> {
+        self.ctx.check_device()?;
+        let ctx = &self.ctx;
+        let volume = &mut self.scene.light;
+        scoped(&ctx.device, "light volume", || {
+            volume.set(&ctx.device, &ctx.queue, world, light, region)
+        })?
+    }
+
+    /// Reads chunks `chunks` again into the light volume (those whose light an edit
+    /// changed: [`voxel_core::LightField::take_changed`]'s); chunks outside the region, or
+    /// without a volume, are skipped. A chunk without blocks or light reads as unlit.
+    pub fn update_light_volume(
+        &mut self,
+        world: &World,
+        light: ChunkLight<'_>,
+        chunks: &[ChunkPos],
+    ) {
+        self.scene
+            .light
+            .update(&self.ctx.queue, world, light, chunks);
+    }
+
+    /// Moves the light volume's region so that its x and z centre on the chunk of `eye`,
+    /// as [`Renderer::follow_sun_shadows`] does the sun's; returns how many chunks were
+    /// read (256 KiB each).
+    pub fn follow_light_volume(
+        &mut self,
+        world: &World,
+        light: ChunkLight<'_>,
+        eye: WorldPos,
+    ) -> usize {
+        let (centre, _) = eye.split();
+        self.scene
+            .light
+            .follow(&self.ctx.queue, world, light, centre)
+    }
+
+    /// Turns the light volume off (frees it): a game's things are lit as before light
+    /// existed.
+    pub fn clear_light_volume(&mut self) {
+        self.scene.light.clear(&self.ctx.device);
+    }
+
+    /// The region the light volume covers, if on.
+    pub fn light_region(&self) -> Option<SunRegion> {
+        self.scene.light.region()
+    }
+
+    /// The layout of the group a game binds the light volume with (the frame's
+    /// [`crate::stages::GameFrame::light`]), for its pipelines: a uniform and two 3D
+    /// textures and a sampler, visible to the vertex and fragment stages, as
+    /// [`light_wgsl`](crate::light_volume::light_wgsl) declares them.
+    pub fn light_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.scene.light.layout
     }
 
     /// Uploads or replaces a chunk's meshes; empty meshes remove it. A chunk that was not

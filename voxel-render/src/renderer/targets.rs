@@ -9,6 +9,7 @@ use crate::QuadFetch;
 use crate::bindings::SharedLayouts;
 use crate::fetch::TableTexture;
 use crate::gpu::{self, FullscreenPipeline, Target};
+use crate::light_volume::LightVolume;
 use crate::medium;
 use crate::sun::SunVolume;
 use crate::textures::BlockTextures;
@@ -28,6 +29,8 @@ pub(super) struct SceneResources {
     pub(super) sun_table: u32,
     /// The sun shadows' volume (`sun_cells` in `common.wgsl`).
     pub(super) sun: SunVolume,
+    /// The light field around the eye for a game's shaders (`light_volume.rs`).
+    pub(super) light: LightVolume,
     /// The nearest sampler every depth texture is read with (`gpu::DEPTH_READ`).
     pub(super) depth_sampler: wgpu::Sampler,
 }

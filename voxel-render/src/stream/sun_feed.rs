@@ -1,15 +1,17 @@
-//! Sun shadows over a lit streamer's chunks ([`SunFeed`]).
+//! Sun shadows and the light volume over a lit streamer's chunks ([`SunFeed`]).
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
 
 use glam::DVec3;
-use voxel_core::{ChunkPos, WorldPos};
+use voxel_core::{ChunkPos, LightChunk, WorldPos};
 
 use super::ChunkStreamer;
 use super::schedule::StreamFrame;
-use crate::{MAX_SUN_CHUNKS, Renderer, Result, SunRegion};
+use crate::{MAX_LIGHT_CHUNKS, MAX_SUN_CHUNKS, Renderer, Result, SunRegion};
 
-/// Keeps a renderer's sun shadows (`docs/light.md`, "Sun shadows") over the chunks a
+/// Keeps a renderer's sun shadows (`docs/light.md`, "Sun shadows") and, on a lit
+/// streamer, its light volume ("Light for a game's things") over the chunks a
 /// [`ChunkStreamer`] holds around the eye, as they stream: one per renderer, called after
 /// each [`ChunkStreamer::update`]. The sun's light dims and tints only on lit chunks
 /// ([`ChunkStreamer::set_light`]).
@@ -18,6 +20,23 @@ pub struct SunFeed {
     /// The region's chunks read into the volume with their blocks. One read before its
     /// blocks came in read as air; it is read again when they are resident.
     read: HashSet<ChunkPos>,
+    /// The light volume's chunks, with the light snapshot each was read with: a chunk is
+    /// read again when the streamer's snapshot is another.
+    lights: HashMap<ChunkPos, Arc<LightChunk>>,
+}
+
+/// A region of `chunks` an axis centred on `at`'s chunk.
+fn centred(at: WorldPos, chunks: u32) -> SunRegion {
+    let (c, _) = at.split();
+    let half = (chunks / 2) as i32;
+    SunRegion {
+        min: ChunkPos::new(
+            c.x.saturating_sub(half),
+            c.y.saturating_sub(half),
+            c.z.saturating_sub(half),
+        ),
+        chunks: [chunks; 3],
+    }
 }
 
 impl SunFeed {
@@ -53,16 +72,7 @@ impl SunFeed {
                 new
             }
             None => {
-                let (c, _) = at.split();
-                let half = (MAX_SUN_CHUNKS / 2) as i32;
-                let region = SunRegion {
-                    min: ChunkPos::new(
-                        c.x.saturating_sub(half),
-                        c.y.saturating_sub(half),
-                        c.z.saturating_sub(half),
-                    ),
-                    chunks: [MAX_SUN_CHUNKS; 3],
-                };
+                let region = centred(at, MAX_SUN_CHUNKS);
                 renderer.set_sun_shadows(world, region)?;
                 self.read = region
                     .positions()
@@ -79,6 +89,63 @@ impl SunFeed {
         fresh.extend(frame.uploaded.iter().filter(|p| region.contains(**p)));
         if !fresh.is_empty() {
             renderer.update_sun_shadows(world, &fresh);
+        }
+        if streamer.has_light() {
+            self.update_light(renderer, streamer, at, frame)?;
+        }
+        Ok(())
+    }
+
+    /// The light volume: made over [`MAX_LIGHT_CHUNKS`] chunks an axis centred on `at`'s
+    /// chunk on the first call, then moved with it; each chunk read again when its light
+    /// snapshot changes, or `frame` uploaded it (its blocks changed).
+    fn update_light(
+        &mut self,
+        renderer: &mut Renderer,
+        streamer: &ChunkStreamer,
+        at: WorldPos,
+        frame: &StreamFrame,
+    ) -> Result<()> {
+        let world = streamer.world();
+        let light = |p: ChunkPos| streamer.light_chunk(p);
+        // The chunks read now with the light they were read with.
+        let (region, came) = match renderer.light_region() {
+            Some(old) => {
+                renderer.follow_light_volume(world, &light, at);
+                let new = renderer.light_region().unwrap_or(old);
+                self.lights.retain(|p, _| new.contains(*p));
+                (new, new.positions().filter(|p| !old.contains(*p)).collect())
+            }
+            None => {
+                let region = centred(at, MAX_LIGHT_CHUNKS);
+                renderer.set_light_volume(world, &light, region)?;
+                self.lights.clear();
+                (region, region.positions().collect::<Vec<_>>())
+            }
+        };
+        for pos in came {
+            if let Some(l) = light(pos) {
+                self.lights.insert(pos, l);
+            }
+        }
+        let mut changed = Vec::new();
+        for pos in region.positions() {
+            let now = light(pos);
+            let same = match (self.lights.get(&pos), &now) {
+                (Some(old), Some(now)) => Arc::ptr_eq(old, now),
+                (None, None) => true,
+                _ => false,
+            };
+            if !same || frame.uploaded.contains(&pos) {
+                changed.push(pos);
+            }
+            match now {
+                Some(now) => self.lights.insert(pos, now),
+                None => self.lights.remove(&pos),
+            };
+        }
+        if !changed.is_empty() {
+            renderer.update_light_volume(world, &light, &changed);
         }
         Ok(())
     }
